@@ -1,0 +1,99 @@
+"""Image files through OpenImageIO, colour-managed with explicitly named OCIO colour spaces.
+
+Mitsuba's rgb variants render scene-linear Rec.709, which OCIO's built-in config calls
+``lin_rec709_scene``; display PNGs are ``srgb_rec709_scene``. Names are always given explicitly: the
+default config's ``scene_linear`` role is ACEScg, not what we render. Id maps are never colour-converted.
+Every write goes to a temporary file in the target folder and is renamed into place.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import OpenImageIO as oiio
+
+LINEAR_SPACE = "lin_rec709_scene"
+DISPLAY_SPACE = "srgb_rec709_scene"
+
+
+def _write(path: Path, pixels: np.ndarray, fmt: str, attributes: dict[str, str] | None = None,
+           channel_names: list[str] | None = None) -> Path:
+    """Write (H, W) or (H, W, C) ``pixels`` as ``fmt`` ('uint8', 'uint16', 'float', 'half') atomically."""
+    if pixels.ndim == 2:
+        pixels = pixels[:, :, None]
+    h, w, c = pixels.shape
+    spec = oiio.ImageSpec(w, h, c, fmt)
+    if channel_names:
+        spec.channelnames = tuple(channel_names)
+    for key, value in (attributes or {}).items():
+        spec.attribute(key, value)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        out = oiio.ImageOutput.create(tmp)
+        if out is None or not out.open(tmp, spec):
+            raise OSError(f"{path}: OpenImageIO cannot open it for writing: {oiio.geterror()}")
+        # ImageBuf/ImageOutput want (H, W, C); a 2-D array would be read as the wrong shape.
+        ok = out.write_image(np.ascontiguousarray(pixels))
+        out.close()
+        if not ok:
+            raise OSError(f"{path}: OpenImageIO failed to write: {out.geterror()}")
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def write_linear_exr(path: Path, rgb: np.ndarray) -> Path:
+    """(H, W, 3) float32 scene-linear Rec.709 → float EXR tagged ``lin_rec709_scene``."""
+    return _write(path, rgb.astype(np.float32), "float", {"oiio:ColorSpace": LINEAR_SPACE, "compression": "zip"})
+
+
+def linear_to_display(rgb: np.ndarray) -> np.ndarray:
+    """(H, W, 3) float32 scene-linear Rec.709 → (H, W, 3) uint8 sRGB through OCIO (values clipped to 0..1)."""
+    buf = oiio.ImageBuf(np.ascontiguousarray(rgb.astype(np.float32)))
+    converted = oiio.ImageBufAlgo.colorconvert(buf, LINEAR_SPACE, DISPLAY_SPACE)
+    if converted.has_error:
+        raise RuntimeError(f"colour conversion {LINEAR_SPACE} -> {DISPLAY_SPACE} failed: {converted.geterror()}")
+    display = np.clip(converted.get_pixels(oiio.FLOAT), 0.0, 1.0)
+    return np.round(display * 255.0).astype(np.uint8)
+
+
+def write_display_png(path: Path, rgb: np.ndarray) -> Path:
+    """Scene-linear (H, W, 3) float32 → 8-bit sRGB PNG tagged ``srgb_rec709_scene``."""
+    return _write(path, linear_to_display(rgb), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE})
+
+
+def write_color_png(path: Path, rgb8: np.ndarray) -> Path:
+    """(H, W, 3) uint8 sRGB values written as they are (class colours)."""
+    return _write(path, rgb8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE})
+
+
+def write_id_png(path: Path, ids: np.ndarray) -> Path:
+    """(H, W) uint8 or uint16 ids written raw: no colour conversion, one channel."""
+    fmt = "uint8" if ids.dtype == np.uint8 else "uint16"
+    return _write(path, ids, fmt, {"oiio:ColorSpace": "Raw"}, channel_names=["Y"])
+
+
+def write_depth_exr(path: Path, depth: np.ndarray, description: str) -> Path:
+    """(H, W) float32 depth in metres → single-channel float EXR (channel ``Z``) with its definition."""
+    return _write(path, depth.astype(np.float32), "float",
+                  {"synthua:depth": description, "compression": "zip"}, channel_names=["Z"])
+
+
+def read_image(path: str | Path) -> tuple[np.ndarray, oiio.ImageSpec]:
+    """Pixels in their file format as (H, W, C), and the spec (for tests and inspection)."""
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise OSError(f"{path}: OpenImageIO cannot read it: {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        pixels = inp.read_image(spec.format)
+    finally:
+        inp.close()
+    return np.asarray(pixels), spec

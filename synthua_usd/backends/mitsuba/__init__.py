@@ -1,0 +1,1 @@
+"""Mitsuba 3 backend: variant selection, scene translation, RGB and label rendering."""

@@ -1,0 +1,108 @@
+"""SceneSnapshot + camera → Mitsuba scene description (a ``mi.load_dict`` dict), with its shape table.
+
+A pure function of its inputs: nothing is rendered and no global state is touched; the caller passes the
+``mitsuba`` module with its variant already active (:func:`synthua_usd.backends.mitsuba.variants.activate`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from synthua_usd.cameras import PinholeCamera
+from synthua_usd.render_config import RenderConfig
+from synthua_usd.scene import Light, Material, SceneSnapshot
+
+
+@dataclass(frozen=True)
+class ShapeRecord:
+    """One row of the instance table: Mitsuba shape id ↔ prim path ↔ class id ↔ instance id."""
+
+    shape_id: str
+    prim_path: str
+    class_id: int
+    instance_id: int
+
+
+@dataclass(frozen=True, eq=False)
+class Translation:
+    """``scene`` is the dict for ``mi.load_dict(scene, optimize=False)``; ``shapes`` is aligned with the
+    snapshot's meshes. Loading must keep ``optimize=False``: merging meshes would lose instance identity."""
+
+    scene: dict
+    shapes: tuple[ShapeRecord, ...]
+
+
+def shape_id(index: int) -> str:
+    return f"mesh_{index:06d}"
+
+
+def bsdf_dict(material: Material) -> dict:
+    """UsdPreviewSurface constants → Mitsuba ``principled`` BSDF (linear Rec.709 base colour)."""
+    return {"type": "principled",
+            "base_color": {"type": "rgb", "value": list(material.base_color)},
+            "roughness": float(np.clip(material.roughness, 0.0, 1.0)),
+            "metallic": float(np.clip(material.metallic, 0.0, 1.0))}
+
+
+def emitter_dict(light: Light) -> dict:
+    if light.kind == "distant":
+        value = [c * light.irradiance for c in light.color]
+        return {"type": "directional", "direction": list(light.direction), "irradiance": {"type": "rgb", "value": value}}
+    if light.kind == "dome":
+        value = [c * light.radiance for c in light.color]
+        return {"type": "constant", "radiance": {"type": "rgb", "value": value}}
+    raise ValueError(f"{light.prim_path}: light kind '{light.kind}' has no Mitsuba emitter; expected distant or dome")
+
+
+def sensor_dict(mi, camera: PinholeCamera, config: RenderConfig, spp: int | None = None) -> dict:
+    """A perspective sensor with the camera's conformed horizontal field of view."""
+    right, up, forward = camera.axes()
+    origin = camera.origin
+    fov_x, _ = camera.fov_deg(config.width, config.height)
+    return {
+        "type": "perspective",
+        "fov": fov_x,
+        "fov_axis": "x",
+        "near_clip": camera.clip_near_m,
+        "far_clip": camera.clip_far_m,
+        "to_world": mi.ScalarTransform4f().look_at(origin=origin.tolist(), target=(origin + forward).tolist(),
+                                                    up=up.tolist()),
+        "film": {"type": "hdrfilm", "width": config.width, "height": config.height, "pixel_format": "rgb",
+                 "rfilter": {"type": config.pixel_filter}},
+        "sampler": {"type": "independent", "sample_count": spp or config.spp, "seed": config.seed},
+    }
+
+
+def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter=None):
+    props = mi.Properties()
+    props["bsdf"] = bsdf
+    if emitter is not None:
+        props["emitter"] = emitter
+    mesh = mi.Mesh(key, len(points), len(triangles), props=props, has_vertex_normals=False, has_vertex_texcoords=False)
+    params = mi.traverse(mesh)
+    params["vertex_positions"] = type(params["vertex_positions"])(np.ascontiguousarray(points, np.float32).ravel())
+    params["faces"] = type(params["faces"])(np.ascontiguousarray(triangles, np.uint32).ravel())
+    params.update()
+    return mesh
+
+
+def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: RenderConfig) -> Translation:
+    """The Mitsuba scene for ``snapshot`` seen by ``camera`` (one shape per gprim, flat shading)."""
+    bsdfs = {key: mi.load_dict(bsdf_dict(m)) for key, m in sorted(snapshot.materials.items())}
+    scene: dict = {"type": "scene",
+                   "integrator": {"type": "path", "max_depth": config.max_depth},
+                   "sensor": sensor_dict(mi, camera, config)}
+    shapes = []
+    for i, item in enumerate(snapshot.meshes):
+        key = shape_id(i)
+        material = snapshot.materials[item.material_key]
+        emitter = None
+        if any(material.emissive_color):
+            emitter = mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": list(material.emissive_color)}})
+        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[item.material_key], emitter)
+        shapes.append(ShapeRecord(key, item.prim_path, item.class_id, item.instance_id))
+    for k, light in enumerate(snapshot.lights):
+        scene[f"light_{k:03d}"] = emitter_dict(light)
+    return Translation(scene=scene, shapes=tuple(shapes))

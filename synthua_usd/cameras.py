@@ -1,0 +1,126 @@
+"""Pinhole cameras: physical lens values, the image they form, intrinsics and pixel-centre rays.
+
+Frames and conventions
+----------------------
+* ``camera_to_world`` is a (4, 4) float64 matrix in the column-vector convention (``p_world = M @ p_cam``),
+  world units metres. The camera looks down its local -Z axis with +Y up and +X right (USD/OpenGL).
+* Pixel (0, 0) is the top-left pixel; pixel centres are at integer + 0.5; image y grows downward.
+* Intrinsics ``K`` follow OpenCV: x right, y down, z forward; ``cx = W/2``, ``cy = H/2`` (no lens shift).
+* Lens values are in millimetres here. USD authors them in tenths of a scene unit; the USD reader converts.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from synthua_usd.errors import InputError
+
+#: USD's default ``aspectRatioConformPolicy``: when the image and aperture aspects differ, the aperture
+#: grows along one axis so that the whole authored aperture stays visible.
+CONFORM_EXPAND = "expandAperture"
+
+
+@dataclass(frozen=True, eq=False)
+class PinholeCamera:
+    """A perspective camera at one time code.
+
+    Attributes
+    ----------
+    path : str
+        Prim path of the camera in its stage.
+    focal_length_mm, horizontal_aperture_mm, vertical_aperture_mm : float
+        Physical lens and filmback, millimetres.
+    clip_near_m, clip_far_m : float
+        Clipping range, metres.
+    camera_to_world : (4, 4) float64
+        Rigid transform, column-vector convention, metres.
+    """
+
+    path: str
+    focal_length_mm: float
+    horizontal_aperture_mm: float
+    vertical_aperture_mm: float
+    clip_near_m: float
+    clip_far_m: float
+    camera_to_world: np.ndarray = field(repr=False)
+
+    def __post_init__(self) -> None:
+        for name in ("focal_length_mm", "horizontal_aperture_mm", "vertical_aperture_mm"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise InputError(f"camera {self.path}: {name} should be > 0, but was {value}")
+        if not (0 < self.clip_near_m < self.clip_far_m):
+            raise InputError(f"camera {self.path}: clipping range should satisfy 0 < near < far, "
+                             f"but was ({self.clip_near_m}, {self.clip_far_m})")
+        m = np.asarray(self.camera_to_world, np.float64)
+        if m.shape != (4, 4) or not np.all(np.isfinite(m)):
+            raise InputError(f"camera {self.path}: camera_to_world should be a finite 4x4 matrix")
+        object.__setattr__(self, "camera_to_world", m)
+
+    # --- image formation -------------------------------------------------------------------------
+
+    def conformed_aperture_mm(self, width: int, height: int) -> tuple[float, float]:
+        """(horizontal, vertical) aperture in mm after USD's ``expandAperture`` conform to a W×H image."""
+        _check_size(width, height)
+        h, v = self.horizontal_aperture_mm, self.vertical_aperture_mm
+        image_aspect = width / height
+        if image_aspect > h / v:
+            return v * image_aspect, v
+        return h, h / image_aspect
+
+    def fov_deg(self, width: int, height: int) -> tuple[float, float]:
+        """(horizontal, vertical) full field of view in degrees for a W×H image."""
+        h, v = self.conformed_aperture_mm(width, height)
+        return (math.degrees(2 * math.atan(h / (2 * self.focal_length_mm))),
+                math.degrees(2 * math.atan(v / (2 * self.focal_length_mm))))
+
+    def intrinsics(self, width: int, height: int) -> np.ndarray:
+        """(3, 3) float64 OpenCV intrinsic matrix K in pixels for a W×H image (square pixels)."""
+        h, _ = self.conformed_aperture_mm(width, height)
+        f_px = self.focal_length_mm * width / h
+        return np.array([[f_px, 0.0, width / 2.0], [0.0, f_px, height / 2.0], [0.0, 0.0, 1.0]])
+
+    # --- pose --------------------------------------------------------------------------------------
+
+    @property
+    def origin(self) -> np.ndarray:
+        """(3,) float64 camera centre, world metres."""
+        return self.camera_to_world[:3, 3].copy()
+
+    def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Unit (right, up, forward) vectors in world space; forward is the local -Z axis."""
+        r = self.camera_to_world[:3, :3]
+        right, up, back = (r[:, i] / np.linalg.norm(r[:, i]) for i in range(3))
+        return right, up, -back
+
+    def world_to_camera_opencv(self) -> np.ndarray:
+        """(4, 4) float64 extrinsic matrix [R|t] mapping world points to OpenCV camera coordinates."""
+        right, up, forward = self.axes()
+        rot = np.stack([right, -up, forward])  # rows: x right, y down, z forward
+        out = np.eye(4)
+        out[:3, :3] = rot
+        out[:3, 3] = -rot @ self.origin
+        return out
+
+    def pixel_center_rays(self, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """Rays through every pixel centre, row-major from the top-left pixel.
+
+        Returns ``origins`` (H*W, 3) float64 and unit ``directions`` (H*W, 3) float64, world space.
+        Computed from the lens values alone, independently of any renderer.
+        """
+        k = self.intrinsics(width, height)
+        xs = (np.arange(width) + 0.5 - k[0, 2]) / k[0, 0]
+        ys = (np.arange(height) + 0.5 - k[1, 2]) / k[1, 1]
+        gx, gy = np.meshgrid(xs, ys)
+        right, up, forward = self.axes()
+        d = gx.reshape(-1, 1) * right - gy.reshape(-1, 1) * up + forward
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        return np.broadcast_to(self.origin, d.shape).copy(), d
+
+
+def _check_size(width: int, height: int) -> None:
+    if not (isinstance(width, int) and isinstance(height, int) and width > 0 and height > 0):
+        raise InputError(f"image size should be positive integers, but was {width}x{height}")

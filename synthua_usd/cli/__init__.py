@@ -1,0 +1,1 @@
+"""The ``synthua`` command line."""

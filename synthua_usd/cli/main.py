@@ -1,0 +1,218 @@
+"""``synthua``: one command, a subcommand per step. Thin: parse, call the library, print, return a status.
+
+Exit status: 0 success (or a clean validation), 1 validation findings or an unexpected failure,
+2 unusable input (missing or malformed file, unknown camera, frame out of range, bad option).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import sys
+import time
+from pathlib import Path
+
+import click
+
+from synthua_usd import __version__
+from synthua_usd.errors import SynthuaError
+from synthua_usd.findings import Finding, Severity
+
+log = logging.getLogger("synthua")
+
+EXIT_OK, EXIT_FINDINGS, EXIT_INPUT = 0, 1, 2
+
+
+def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
+    """Print findings; 1 when any is a warning or error (or any at all with --strict), else 0."""
+    if as_json:
+        click.echo(json.dumps([f.to_dict() for f in findings], indent=2))
+    else:
+        for f in findings:
+            click.echo(f.format())
+        counts = {s: sum(1 for f in findings if f.severity is s) for s in Severity}
+        click.echo(f"{counts[Severity.ERROR]} errors, {counts[Severity.WARNING]} warnings, {counts[Severity.INFO]} notes",
+                   err=True)
+    threshold = Severity.INFO if strict else Severity.WARNING
+    return EXIT_FINDINGS if any(f.severity >= threshold for f in findings) else EXIT_OK
+
+
+def _class_map(path: Path | None):
+    from synthua_usd.taxonomy import ClassMap
+
+    return ClassMap.load(path) if path else ClassMap.default()
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.version_option(__version__, prog_name="synthua")
+@click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
+def cli(verbose: int) -> None:
+    """Turn layered OpenUSD street scenes into exactly labelled images.
+
+    \b
+    Typical session:
+      synthua create street stages/            # write the demo layers and scenario.usda
+      synthua validate stage stages/scenario.usda
+      synthua inspect stages/scenario.usda
+      synthua render stages/scenario.usda --camera /World/Cameras/CCTV --out out/cctv
+    """
+    level = logging.WARNING - 10 * verbose
+    logging.basicConfig(level=max(level, logging.DEBUG), format="synthua: %(levelname)s: %(message)s", force=True)
+
+
+# --- validate ---------------------------------------------------------------------------------------------
+
+@cli.group()
+def validate() -> None:
+    """Check class maps and stages; print findings (exit 0 clean, 1 findings, 2 unusable input)."""
+
+
+@validate.command("classes")
+@click.argument("file", type=click.Path(path_type=Path), required=False)
+@click.option("--json", "as_json", is_flag=True, help="Print findings as JSON.")
+@click.option("--strict", is_flag=True, help="Exit 1 on notes too.")
+def validate_classes(file: Path | None, as_json: bool, strict: bool) -> int:
+    """Validate a class map FILE (default: the bundled schemas/classmap.json).
+
+    Runs the JSON Schema first, then rules it cannot express: unique ids, names, aliases and colours,
+    id 0 = black 'unlabelled', and a minimum CIEDE2000 distance between class colours.
+    """
+    from synthua_usd.classmap_rules import check_classmap
+    from synthua_usd.schemas import bundled_path, read_json
+
+    path = file or bundled_path("classmap.json")
+    return _report(check_classmap(read_json(path)), as_json, strict)
+
+
+@validate.command("stage")
+@click.argument("stage", type=click.Path(path_type=Path))
+@click.option("--class-map", type=click.Path(path_type=Path), help="Class map to check labels against.")
+@click.option("--json", "as_json", is_flag=True, help="Print findings as JSON.")
+@click.option("--strict", is_flag=True, help="Exit 1 on notes too.")
+def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: bool) -> int:
+    """Validate a USD STAGE: OpenUSD's UsdValidation validators plus synthua's rules.
+
+    synthua's rules: every renderable gprim has exactly one class (directly or from one ancestor), every
+    label is in the class map, cameras have valid physical lens values, stage metadata is stated, and
+    render settings name a real camera.
+    """
+    from synthua_usd.usd.rules import validate_stage as run_rules
+    from synthua_usd.usd.stage_io import open_stage
+
+    cmap = _class_map(class_map)
+    return _report(run_rules(open_stage(stage), cmap), as_json, strict)
+
+
+# --- compose / inspect / create ----------------------------------------------------------------------------
+
+@cli.command()
+@click.argument("out", type=click.Path(path_type=Path))
+@click.argument("layers", nargs=-1, required=True, type=click.Path(path_type=Path))
+def compose(out: Path, layers: tuple[Path, ...]) -> int:
+    """Write scenario root OUT that sublayers LAYERS (strongest first).
+
+    The root states upAxis, metersPerUnit and timeCodesPerSecond (the layers must agree), the union of
+    their time ranges and the first defaultPrim. Paths are stored relative to OUT.
+
+    \b
+    Example:
+      synthua compose my.usda stages/render.usda stages/environment.usda stages/cameras.usda \\
+          stages/agents.usda stages/semantics.usda stages/twin.usda
+    """
+    from synthua_usd.usd.compose import compose_layers
+
+    path = compose_layers(out, list(layers))
+    click.echo(f"wrote {path} ({len(layers)} sublayers)")
+    return EXIT_OK
+
+
+@cli.command()
+@click.argument("stage", type=click.Path(path_type=Path))
+@click.option("--class-map", type=click.Path(path_type=Path), help="Class map used to read labels.")
+def inspect(stage: Path, class_map: Path | None) -> int:
+    """Print what STAGE holds: layer stack, prims per class, cameras, lights and time range."""
+    from synthua_usd.usd.inspect import summarize
+    from synthua_usd.usd.stage_io import open_stage
+
+    click.echo(summarize(open_stage(stage), _class_map(class_map)).format())
+    return EXIT_OK
+
+
+@cli.group()
+def create() -> None:
+    """Generate shipped scenes as USD layers."""
+
+
+@create.command("street")
+@click.argument("out_dir", type=click.Path(path_type=Path))
+def create_street(out_dir: Path) -> int:
+    """Write the demo street (twin, semantics, agents, cameras, environment, render layers and
+    scenario.usda) into OUT_DIR. Deterministic: the same version writes the same bytes."""
+    from synthua_usd.usd.street_demo import write_street_demo
+
+    for path in write_street_demo(out_dir):
+        click.echo(f"wrote {path}")
+    return EXIT_OK
+
+
+# --- render --------------------------------------------------------------------------------------------------
+
+@cli.command()
+@click.argument("scenario", type=click.Path(path_type=Path))
+@click.option("--camera", help="Camera prim path, e.g. /World/Cameras/CCTV [default: the render settings' camera].")
+@click.option("--frame", type=float, help="Time code to render [default: the stage's start time code].")
+@click.option("--width", type=click.IntRange(1, 16384), help="Image width in pixels [default: render settings, else 1280].")
+@click.option("--height", type=click.IntRange(1, 16384), help="Image height in pixels [default: render settings, else 960].")
+@click.option("--spp", type=click.IntRange(1, 65536), help="RGB samples per pixel [default: render settings, else 64]. "
+                                                          "Labels always use one ray per pixel centre.")
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Sampler seed of the RGB pass.")
+@click.option("--variant", help="Mitsuba variant (cuda_ad_rgb, llvm_ad_rgb, scalar_rgb) [default: best available].")
+@click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
+@click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder (created).")
+def render(scenario: Path, camera: str | None, frame: float | None, width: int | None, height: int | None,
+           spp: int | None, seed: int, variant: str | None, class_map: Path | None, out_dir: Path) -> int:
+    """Render one frame of SCENARIO into --out.
+
+    \b
+    Writes rgb.exr (scene-linear Rec.709), rgb.png (display sRGB), class.png (8-bit class ids),
+    semantic.png (class colours), instance.png (16-bit instance ids, 0 = none), depth.exr (z-depth in
+    metres, 0 = no hit) and frame.json (camera intrinsics/extrinsics, class map, instances with pixel
+    counts). Nothing is written unless every input checks out.
+    """
+    from synthua_usd.pipeline.frame import FrameRequest, run_frame
+
+    t0 = time.perf_counter()
+    result = run_frame(FrameRequest(stage_path=scenario, out_dir=out_dir, camera_path=camera, frame=frame,
+                                    width=width, height=height, spp=spp, seed=seed, variant=variant,
+                                    class_map_path=class_map), show_progress=sys.stderr.isatty())
+    doc = result.document
+    visible = sum(1 for i in doc["instances"] if i["pixel_count"])
+    click.echo(f"rendered {doc['camera']['prim_path']} at frame {doc['time_code']:g}: "
+               f"{doc['image']['width']}x{doc['image']['height']}, {doc['render']['spp']} spp, "
+               f"{doc['render']['variant']}, {visible} visible instances, {time.perf_counter() - t0:.1f} s")
+    click.echo(f"wrote {len(result.files)} files to {out_dir}")
+    return EXIT_OK
+
+
+# --- entry point ---------------------------------------------------------------------------------------------
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI and return the exit status (the console script passes it to ``sys.exit``)."""
+    try:
+        result = cli.main(args=argv, prog_name="synthua", standalone_mode=False)
+    except click.exceptions.Exit as exc:
+        return exc.exit_code
+    except click.ClickException as exc:
+        exc.show()
+        return EXIT_INPUT
+    except click.Abort:
+        click.echo("synthua: aborted", err=True)
+        return EXIT_FINDINGS
+    except SynthuaError as exc:
+        click.echo(f"synthua: error: {exc}", err=True)
+        return EXIT_INPUT
+    return result if isinstance(result, int) else EXIT_OK
+
+
+def run() -> None:
+    sys.exit(main())

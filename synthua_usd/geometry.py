@@ -1,0 +1,107 @@
+"""Low-poly geometry builders for procedural assets: arrays in, arrays out, no USD.
+
+Every builder returns ``(points, triangles)``: points (n, 3) float64 in metres, triangles (m, 3) int64 with
+counter-clockwise winding seen from outside. Z is up.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+Mesh = tuple[np.ndarray, np.ndarray]
+
+
+def _arrays(mesh: trimesh.Trimesh) -> Mesh:
+    return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
+
+
+def box(min_corner, max_corner) -> Mesh:
+    """Axis-aligned box between two corners (3,) metres."""
+    lo, hi = np.asarray(min_corner, float), np.asarray(max_corner, float)
+    if np.any(hi <= lo):
+        raise ValueError(f"box corners should satisfy min < max on every axis, but were {lo} and {hi}")
+    return _arrays(trimesh.creation.box(bounds=np.stack([lo, hi])))
+
+
+def cylinder(center, radius: float, height: float, axis: str = "z", sections: int = 16) -> Mesh:
+    """Closed cylinder of ``radius`` and ``height`` (metres) centred at ``center`` along ``axis``."""
+    points, tris = _along(trimesh.creation.cylinder(radius=radius, height=height, sections=sections), axis)
+    return points + np.asarray(center, float), tris
+
+
+def sphere(center, radius: float, subdivisions: int = 2) -> Mesh:
+    mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    mesh.apply_translation(center)
+    return _arrays(mesh)
+
+
+def ellipsoid(center, radii, subdivisions: int = 2) -> Mesh:
+    points, tris = sphere((0, 0, 0), 1.0, subdivisions)
+    return points * np.asarray(radii, float) + np.asarray(center, float), tris
+
+
+def ramp(x0: float, x1: float, y_low: float, y_high: float, z_low: float, z_high: float, z_base: float) -> Mesh:
+    """A wedge rising along y from ``z_low`` at ``y_low`` to ``z_high`` at ``y_high``, between x0 and x1.
+
+    The base is at ``z_base``. Used for curb ramps. ``y_low`` may be greater than ``y_high``.
+    """
+    pts = np.array([
+        [x0, y_low, z_base], [x1, y_low, z_base], [x1, y_high, z_base], [x0, y_high, z_base],
+        [x0, y_low, z_low], [x1, y_low, z_low], [x1, y_high, z_high], [x0, y_high, z_high],
+    ], float)
+    hull = trimesh.Trimesh(pts, process=True).convex_hull
+    return _arrays(hull)
+
+
+def merge(*parts: Mesh) -> Mesh:
+    """Concatenate meshes into one (no welding)."""
+    points, tris, offset = [], [], 0
+    for p, t in parts:
+        points.append(np.asarray(p, float))
+        tris.append(np.asarray(t, np.int64) + offset)
+        offset += len(p)
+    return np.concatenate(points), np.concatenate(tris)
+
+
+def translate(mesh: Mesh, offset) -> Mesh:
+    return mesh[0] + np.asarray(offset, float), mesh[1]
+
+
+def look_at(eye, target, up=(0.0, 0.0, 1.0)) -> np.ndarray:
+    """(4, 4) camera-to-world matrix, column-vector convention, for a camera at ``eye`` looking at
+    ``target`` down its local -Z axis with local +Y towards ``up``."""
+    eye, target, up = (np.asarray(v, float) for v in (eye, target, up))
+    forward = target - eye
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, up)
+    if np.linalg.norm(right) < 1e-9:
+        raise ValueError("look_at: view direction is parallel to the up vector")
+    right /= np.linalg.norm(right)
+    true_up = np.cross(right, forward)
+    m = np.eye(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = right, true_up, -forward, eye
+    return m
+
+
+def cone(radius: float, height: float, axis: str = "z", sections: int = 16) -> Mesh:
+    """Closed cone centred at the origin along ``axis``, apex towards +axis (USD's UsdGeom.Cone)."""
+    mesh = trimesh.creation.cone(radius=radius, height=height, sections=sections)
+    mesh.apply_translation((0.0, 0.0, -height / 2.0))
+    return _along(mesh, axis)
+
+
+def capsule(radius: float, height: float, axis: str = "z", sections: int = 16) -> Mesh:
+    """Capsule centred at the origin: a cylinder of ``height`` capped by hemispheres (USD's UsdGeom.Capsule)."""
+    mesh = trimesh.creation.capsule(height=height, radius=radius, count=[sections, sections])
+    return _along(mesh, axis)
+
+
+def _along(mesh: trimesh.Trimesh, axis: str) -> Mesh:
+    if axis == "x":
+        mesh.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
+    elif axis == "y":
+        mesh.apply_transform(trimesh.transformations.rotation_matrix(-np.pi / 2, [1, 0, 0]))
+    elif axis != "z":
+        raise ValueError(f"axis should be 'X', 'Y' or 'Z', but was {axis!r}")
+    return _arrays(mesh)

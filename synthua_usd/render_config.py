@@ -1,0 +1,64 @@
+"""Render settings as a checked, frozen dataclass (plain data; backends read it)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+from synthua_usd.errors import InputError
+
+PIXEL_FILTERS = ("gaussian", "box")
+MAX_SIDE = 16384
+
+
+@dataclass(frozen=True)
+class RenderConfig:
+    """How to render one frame.
+
+    Attributes
+    ----------
+    width, height : int
+        Image size in pixels.
+    spp : int
+        Path-tracing samples per pixel for RGB. Labels always use one ray through each pixel centre.
+    max_depth : int
+        Mitsuba path length (``max_depth = 4`` matches Cycles ``max_bounces = 2``).
+    pixel_filter : str
+        RGB reconstruction filter, ``gaussian`` (Mitsuba's default) or ``box`` (what a denoiser wants).
+    seed : int
+        Seed of the RGB sampler; the same seed gives the same image on the same variant.
+    variant : str | None
+        Mitsuba variant; None picks cuda → llvm → scalar at run time.
+    """
+
+    width: int = 1280
+    height: int = 960
+    spp: int = 64
+    max_depth: int = 8
+    pixel_filter: str = "gaussian"
+    seed: int = 0
+    variant: str | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("width", "height"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or not 0 < value <= MAX_SIDE:
+                raise InputError(f"{name} should be an integer in 1..{MAX_SIDE}, but was {value!r}")
+        if not isinstance(self.spp, int) or self.spp < 1:
+            raise InputError(f"spp should be an integer >= 1, but was {self.spp!r}")
+        if not isinstance(self.max_depth, int) or self.max_depth < 1:
+            raise InputError(f"max_depth should be an integer >= 1, but was {self.max_depth!r}")
+        if self.pixel_filter not in PIXEL_FILTERS:
+            raise InputError(f"pixel_filter should be one of {', '.join(PIXEL_FILTERS)}, but was {self.pixel_filter!r}")
+        if not isinstance(self.seed, int) or self.seed < 0:
+            raise InputError(f"seed should be an integer >= 0, but was {self.seed!r}")
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "RenderConfig":
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise InputError(f"render config: unknown keys {unknown}; known keys: {sorted(known)}")
+        return cls(**data)
+
+    def to_dict(self) -> dict:
+        return asdict(self)

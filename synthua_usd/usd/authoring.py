@@ -1,0 +1,121 @@
+"""Small helpers that author layers the way every synthua layer is authored.
+
+Every layer states ``upAxis``, ``metersPerUnit``, ``defaultPrim`` and ``timeCodesPerSecond``; meshes carry
+extents; materials are UsdPreviewSurface; labels use UsdSemantics.LabelsAPI with the taxonomy as
+instance name.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdSemantics, UsdShade, Vt
+
+from synthua_usd.scene import Material
+
+
+@dataclass(frozen=True)
+class StageMetadata:
+    """Metadata every synthua layer states explicitly."""
+
+    up_axis: str = "Z"
+    meters_per_unit: float = 1.0
+    time_codes_per_second: float = 24.0
+    start_time_code: float = 1.0
+    end_time_code: float = 48.0
+    default_prim: str = "World"
+
+
+def new_layer(meta: StageMetadata, doc: str) -> Usd.Stage:
+    """An in-memory stage whose root layer will be saved as a synthua layer."""
+    stage = Usd.Stage.CreateInMemory()
+    apply_metadata(stage, meta)
+    stage.GetRootLayer().documentation = doc
+    return stage
+
+
+def apply_metadata(stage: Usd.Stage, meta: StageMetadata) -> None:
+    UsdGeom.SetStageUpAxis(stage, meta.up_axis)
+    UsdGeom.SetStageMetersPerUnit(stage, meta.meters_per_unit)
+    stage.SetTimeCodesPerSecond(meta.time_codes_per_second)
+    stage.SetFramesPerSecond(meta.time_codes_per_second)
+    stage.SetStartTimeCode(meta.start_time_code)
+    stage.SetEndTimeCode(meta.end_time_code)
+    stage.GetRootLayer().defaultPrim = meta.default_prim
+
+
+def save_layer_atomic(layer: Sdf.Layer, path: str | Path) -> Path:
+    """Export ``layer`` as ``.usda`` text to ``path`` through a temporary file and a rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        if not layer.Export(tmp):
+            raise OSError(f"{path}: USD could not write the layer")
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; layers are meant to be shared.
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def define_xform(stage: Usd.Stage, path: str, kind: str | None = None,
+                 translate: tuple[float, float, float] | None = None,
+                 rotate_z_deg: float | None = None) -> UsdGeom.Xform:
+    xf = UsdGeom.Xform.Define(stage, path)
+    if kind:
+        Usd.ModelAPI(xf.GetPrim()).SetKind(kind)
+    if translate is not None:
+        xf.AddTranslateOp().Set(Gf.Vec3d(*translate))
+    if rotate_z_deg is not None:
+        xf.AddRotateZOp().Set(float(rotate_z_deg))
+    return xf
+
+
+def define_mesh(stage: Usd.Stage, path: str, points: np.ndarray, triangles: np.ndarray,
+                material: UsdShade.Material | None = None) -> UsdGeom.Mesh:
+    """A triangle mesh. ``points`` (n, 3) float, local metres; ``triangles`` (m, 3) int, CCW front faces."""
+    mesh = UsdGeom.Mesh.Define(stage, path)
+    pts = np.asarray(points, np.float32)
+    tris = np.asarray(triangles, np.int32)
+    mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(pts))
+    mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(tris), 3, np.int32)))
+    mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(tris.reshape(-1)))
+    mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+    mesh.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*map(float, pts.min(0))), Gf.Vec3f(*map(float, pts.max(0)))]))
+    if material is not None:
+        bind_material(mesh.GetPrim(), material)
+    return mesh
+
+
+def bind_material(prim: Usd.Prim, material: UsdShade.Material) -> None:
+    UsdShade.MaterialBindingAPI.Apply(prim).Bind(material)
+
+
+def define_preview_material(stage: Usd.Stage, path: str, spec: Material) -> UsdShade.Material:
+    """A UsdPreviewSurface material with constant inputs."""
+    material = UsdShade.Material.Define(stage, path)
+    shader = UsdShade.Shader.Define(stage, f"{path}/PreviewSurface")
+    shader.CreateIdAttr("UsdPreviewSurface")
+    shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*spec.base_color))
+    shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(float(spec.roughness))
+    shader.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(float(spec.metallic))
+    if any(spec.emissive_color):
+        shader.CreateInput("emissiveColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*spec.emissive_color))
+    material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+    return material
+
+
+def apply_label(prim: Usd.Prim, taxonomy: str, label: str) -> None:
+    """Give ``prim`` (and, by inheritance, everything below it) one class of ``taxonomy``."""
+    UsdSemantics.LabelsAPI.Apply(prim, taxonomy).CreateLabelsAttr([label])
+
+
+def set_kind(prim: Usd.Prim, kind: str = Kind.Tokens.component) -> None:
+    Usd.ModelAPI(prim).SetKind(kind)

@@ -1,0 +1,252 @@
+"""Stage → :class:`SceneSnapshot`: the composed stage at one time code as plain world-space data.
+
+Gprims are triangulated in world space (metres) by a handler registered per prim type; materials are
+UsdPreviewSurface constants; lights are UsdLux distant and dome lights. Each gprim gets the class and
+instance of the labelled prim above it (see :mod:`synthua_usd.usd.semantics`).
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Callable
+
+import numpy as np
+from pxr import Gf, Usd, UsdGeom, UsdLux, UsdShade
+
+from synthua_usd import geometry as geo
+from synthua_usd.errors import StageError, UnsupportedPrimError
+from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
+from synthua_usd.taxonomy import ClassMap
+from synthua_usd.usd.semantics import label_sites, renderable_gprims
+from synthua_usd.usd.stage_io import check_time_code, meters_per_unit
+
+log = logging.getLogger(__name__)
+
+Triangulator = Callable[[Usd.Prim, Usd.TimeCode], geo.Mesh]
+GPRIM_HANDLERS: dict[str, Triangulator] = {}
+
+
+def gprim_handler(type_name: str):
+    """Register a function returning local-space ``(points, triangles)`` for one gprim type."""
+    def register(fn: Triangulator) -> Triangulator:
+        GPRIM_HANDLERS[type_name] = fn
+        return fn
+    return register
+
+
+@gprim_handler("Mesh")
+def _mesh(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
+    mesh = UsdGeom.Mesh(prim)
+    points = np.asarray(mesh.GetPointsAttr().Get(t) or [], np.float64).reshape(-1, 3)
+    counts = np.asarray(mesh.GetFaceVertexCountsAttr().Get(t) or [], np.int64)
+    indices = np.asarray(mesh.GetFaceVertexIndicesAttr().Get(t) or [], np.int64)
+    if counts.sum() != len(indices):
+        raise StageError(f"{prim.GetPath()}: faceVertexCounts sum to {counts.sum()} but there are "
+                         f"{len(indices)} faceVertexIndices")
+    if len(indices) and (indices.min() < 0 or indices.max() >= len(points)):
+        raise StageError(f"{prim.GetPath()}: faceVertexIndices reach {indices.max()} but there are {len(points)} points")
+    holes = set(np.asarray(mesh.GetHoleIndicesAttr().Get(t) or [], np.int64).tolist())
+    tris = _fan_triangulate(counts, indices, holes)
+    if mesh.GetOrientationAttr().Get(t) == UsdGeom.Tokens.leftHanded:
+        tris = tris[:, ::-1]
+    return points, tris
+
+
+def _fan_triangulate(counts: np.ndarray, indices: np.ndarray, holes: set[int]) -> np.ndarray:
+    """(m, 3) int64 triangles from polygon faces; faces with fewer than 3 vertices are skipped."""
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]) if len(counts) else np.zeros(0, np.int64)
+    if np.all(counts == 3) and not holes:
+        return indices.reshape(-1, 3)
+    out = []
+    for face, (start, n) in enumerate(zip(starts, counts)):
+        if n < 3 or face in holes:
+            continue
+        for k in range(1, n - 1):
+            out.append((indices[start], indices[start + k], indices[start + k + 1]))
+    return np.asarray(out, np.int64).reshape(-1, 3)
+
+
+@gprim_handler("Cube")
+def _cube(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
+    half = 0.5 * float(UsdGeom.Cube(prim).GetSizeAttr().Get(t))
+    return geo.box((-half,) * 3, (half,) * 3)
+
+
+@gprim_handler("Sphere")
+def _sphere(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
+    return geo.sphere((0, 0, 0), float(UsdGeom.Sphere(prim).GetRadiusAttr().Get(t)), subdivisions=3)
+
+
+@gprim_handler("Cylinder")
+def _cylinder(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
+    cyl = UsdGeom.Cylinder(prim)
+    return geo.cylinder((0, 0, 0), float(cyl.GetRadiusAttr().Get(t)), float(cyl.GetHeightAttr().Get(t)),
+                        axis=str(cyl.GetAxisAttr().Get(t)).lower(), sections=32)
+
+
+@gprim_handler("Cone")
+def _cone(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
+    cone = UsdGeom.Cone(prim)
+    return geo.cone(float(cone.GetRadiusAttr().Get(t)), float(cone.GetHeightAttr().Get(t)),
+                    axis=str(cone.GetAxisAttr().Get(t)).lower(), sections=32)
+
+
+@gprim_handler("Capsule")
+def _capsule(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
+    cap = UsdGeom.Capsule(prim)
+    return geo.capsule(float(cap.GetRadiusAttr().Get(t)), float(cap.GetHeightAttr().Get(t)),
+                       axis=str(cap.GetAxisAttr().Get(t)).lower())
+
+
+# --- materials ------------------------------------------------------------------------------------------
+
+_DEFAULT_MATERIAL = Material("default", (0.18, 0.18, 0.18), 0.5)
+
+
+def _input_value(shader: UsdShade.Shader, name: str, fallback):
+    inp = shader.GetInput(name)
+    if not inp:
+        return fallback
+    if inp.HasConnectedSource():
+        log.warning("%s: input '%s' is connected to a texture or node graph; textures are not supported yet, "
+                    "using the constant %s", shader.GetPath(), name, fallback)
+        return fallback
+    value = inp.Get()
+    return fallback if value is None else value
+
+
+def _material_for(prim: Usd.Prim, t: Usd.TimeCode, cache: dict[str, Material]) -> Material:
+    bound, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
+    if bound:
+        key = str(bound.GetPath())
+        if key not in cache:
+            cache[key] = _preview_surface(bound, key)
+        return cache[key]
+    color = UsdGeom.Gprim(prim).GetDisplayColorAttr().Get(t)
+    if color is not None and len(color) >= 1:
+        rgb = tuple(float(c) for c in color[0])
+        key = "displayColor(%.4f,%.4f,%.4f)" % rgb
+        cache.setdefault(key, Material(key, rgb, 0.6))
+        return cache[key]
+    cache.setdefault(_DEFAULT_MATERIAL.key, _DEFAULT_MATERIAL)
+    return _DEFAULT_MATERIAL
+
+
+def _preview_surface(material: UsdShade.Material, key: str) -> Material:
+    shader = material.ComputeSurfaceSource()[0]
+    if not shader or shader.GetIdAttr().Get() != "UsdPreviewSurface":
+        found = shader.GetIdAttr().Get() if shader else "no surface shader"
+        log.warning("%s: surface is %s, not UsdPreviewSurface; rendering it grey", key, found)
+        return Material(key, _DEFAULT_MATERIAL.base_color, _DEFAULT_MATERIAL.roughness)
+    return Material(key,
+                    base_color=tuple(float(c) for c in _input_value(shader, "diffuseColor", Gf.Vec3f(0.18))),
+                    roughness=float(_input_value(shader, "roughness", 0.5)),
+                    metallic=float(_input_value(shader, "metallic", 0.0)),
+                    emissive_color=tuple(float(c) for c in _input_value(shader, "emissiveColor", Gf.Vec3f(0.0))))
+
+
+# --- lights -----------------------------------------------------------------------------------------------
+
+def _light_power(light: UsdLux.LightAPI, t: Usd.TimeCode) -> tuple[float, tuple[float, float, float]]:
+    intensity = float(light.GetIntensityAttr().Get(t)) * 2.0 ** float(light.GetExposureAttr().Get(t))
+    return intensity, tuple(float(c) for c in light.GetColorAttr().Get(t))
+
+
+def _read_light(prim: Usd.Prim, t: Usd.TimeCode) -> Light:
+    path = str(prim.GetPath())
+    power, color = _light_power(UsdLux.LightAPI(prim), t)
+    if prim.IsA(UsdLux.DistantLight):
+        m = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(t), float).T
+        d = m[:3, :3] @ np.array([0.0, 0.0, -1.0])
+        d /= np.linalg.norm(d)
+        angle = float(UsdLux.DistantLight(prim).GetAngleAttr().Get(t))
+        return Light(path, "distant", color, direction=tuple(d), angle_deg=angle, irradiance=power)
+    if prim.IsA(UsdLux.DomeLight):
+        if UsdLux.DomeLight(prim).GetTextureFileAttr().Get(t):
+            log.warning("%s: dome textures are not supported yet; using its colour and intensity", path)
+        return Light(path, "dome", color, radiance=power)
+    raise UnsupportedPrimError(f"{path}: light type '{prim.GetTypeName()}' is not supported; "
+                               f"supported lights: DistantLight, DomeLight")
+
+
+# --- the snapshot -------------------------------------------------------------------------------------------
+
+def collect_instances(stage: Usd.Stage, class_map: ClassMap) -> dict[str, Instance]:
+    """Every labelled prim above a gprim (visible or not, so ids stay stable over time), by prim path.
+
+    Ids are 1-based in prim-path order. Raises :class:`StageError` for labels missing from the class map
+    and for label sites that hold more than one label.
+    """
+    sites: dict[str, tuple[str, ...]] = {}
+    for prim in Usd.PrimRange.Stage(stage, Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)):
+        if prim.IsA(UsdGeom.Gprim):
+            found = label_sites(prim, class_map.taxonomy)
+            if found:
+                sites.setdefault(found[0].prim_path, found[0].labels)
+    out = {}
+    for k, path in enumerate(sorted(sites), start=1):
+        labels = sites[path]
+        if len(labels) != 1:
+            raise StageError(f"{path}: has {len(labels)} labels {list(labels)} in taxonomy '{class_map.taxonomy}'; "
+                             f"expected exactly one")
+        cls = class_map.resolve(labels[0])
+        if cls is None:
+            raise StageError(f"{path}: label '{labels[0]}' is not a class of {class_map.source}; "
+                             f"use one of its class names or aliases")
+        out[path] = Instance(id=k, prim_path=path, class_id=cls.id, class_name=cls.name, isthing=cls.isthing,
+                             relations=_relations(stage.GetPrimAtPath(path)))
+    if len(out) > 65535:
+        raise StageError(f"{stage.GetRootLayer().identifier}: {len(out)} labelled instances do not fit 16-bit "
+                         f"instance maps (at most 65535)")
+    return out
+
+
+def _relations(prim: Usd.Prim) -> tuple[tuple[str, str], ...]:
+    """``synthua:*`` relationships of an instance prim, as (name, first target path)."""
+    out = []
+    for rel in prim.GetRelationships():
+        if rel.GetNamespace() == "synthua" and rel.GetTargets():
+            out.append((rel.GetBaseName(), str(rel.GetTargets()[0])))
+    return tuple(sorted(out))
+
+
+def read_snapshot(stage: Usd.Stage, time_code: float, class_map: ClassMap) -> SceneSnapshot:
+    """Everything renderable in ``stage`` at ``time_code`` (checked against the stage's time range)."""
+    check_time_code(stage, time_code)
+    t = Usd.TimeCode(time_code)
+    mpu = meters_per_unit(stage)
+    instances = collect_instances(stage, class_map)
+    xcache = UsdGeom.XformCache(t)
+    materials: dict[str, Material] = {}
+    meshes = []
+    unlabelled = []
+    for prim in renderable_gprims(stage, t):
+        type_name = prim.GetTypeName()
+        handler = GPRIM_HANDLERS.get(type_name)
+        if handler is None:
+            raise UnsupportedPrimError(f"{prim.GetPath()}: gprim type '{type_name}' is not supported; supported "
+                                       f"types: {', '.join(sorted(GPRIM_HANDLERS))}")
+        points, tris = handler(prim, t)
+        if len(tris) == 0:
+            continue
+        m = np.array(xcache.GetLocalToWorldTransform(prim), float)  # row-vector convention
+        world = (points @ m[:3, :3] + m[3, :3]) * mpu
+        if np.linalg.det(m[:3, :3]) < 0:  # a mirroring transform flips the winding
+            tris = tris[:, ::-1]
+        if not np.all(np.isfinite(world)):
+            raise StageError(f"{prim.GetPath()}: has non-finite point coordinates at time {time_code:g}")
+        sites = label_sites(prim, class_map.taxonomy)
+        inst = instances.get(sites[0].prim_path) if sites else None
+        if inst is None:
+            unlabelled.append(str(prim.GetPath()))
+        meshes.append(MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
+                               material_key=_material_for(prim, t, materials).key,
+                               instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0))
+    if unlabelled:
+        log.warning("%d gprims have no '%s' label and render as class 0 (unlabelled), e.g. %s",
+                    len(unlabelled), class_map.taxonomy, unlabelled[0])
+    lights = tuple(_read_light(p, t) for p in stage.Traverse() if p.HasAPI(UsdLux.LightAPI))
+    if not lights:
+        log.warning("%s: no UsdLux lights; RGB will be black", stage.GetRootLayer().identifier)
+    return SceneSnapshot(time_code=time_code, up_axis=str(UsdGeom.GetStageUpAxis(stage)), meshes=tuple(meshes),
+                         materials=materials, lights=lights, instances=tuple(sorted(instances.values(), key=lambda i: i.id)))

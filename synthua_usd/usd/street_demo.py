@@ -1,0 +1,376 @@
+"""The walking-skeleton demo: a 40 m street segment authored as separate USD layers.
+
+Layout (Z up, metres): the road runs along X between y = -3.5 and 3.5 at z = 0; sidewalks (top at
+z = 0.15, kerb 15 cm) run beside it; the north sidewalk has one curb ramp where a zebra crosswalk meets it.
+Building A stands north, building B south. One pedestrian walks along the south sidewalk; one manual
+wheelchair user rolls along the north sidewalk towards the ramp.
+
+``write_street_demo`` writes twin, semantics, agents, cameras, environment and render layers and a
+``scenario.usda`` that composes them by sublayers. Output is deterministic: no randomness, fixed order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdLux, UsdRender
+
+from synthua_usd import geometry as geo
+from synthua_usd.scene import Material
+from synthua_usd.usd.authoring import (StageMetadata, apply_label, define_mesh, define_preview_material,
+                                       define_xform, new_layer, save_layer_atomic, set_kind)
+from synthua_usd.usd.cameras import author_camera
+from synthua_usd.usd.compose import compose_layers
+
+TAXONOMY = "synthua"
+META = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=24.0,
+                     start_time_code=1.0, end_time_code=48.0, default_prim="World")
+
+ROAD_HALF_WIDTH = 3.5
+SIDEWALK_WIDTH = 3.0
+KERB_HEIGHT = 0.15
+STREET_HALF_LENGTH = 20.0
+CROSSWALK_X = 2.0
+RAMP_HALF_WIDTH = 0.75
+RAMP_LENGTH = 1.8  # 15 cm over 1.8 m: 1:12, the usual maximum running slope for curb ramps.
+
+LAYER_FILES = ("render.usda", "environment.usda", "cameras.usda", "agents.usda", "semantics.usda", "twin.usda")
+
+MATERIALS = {
+    "Asphalt": Material("Asphalt", (0.045, 0.045, 0.05), 0.9),
+    "Concrete": Material("Concrete", (0.36, 0.35, 0.33), 0.85),
+    "Granite": Material("Granite", (0.48, 0.47, 0.46), 0.7),
+    "RampConcrete": Material("RampConcrete", (0.55, 0.42, 0.22), 0.8),
+    "RoadPaint": Material("RoadPaint", (0.8, 0.8, 0.78), 0.6),
+    "PlasterOchre": Material("PlasterOchre", (0.62, 0.42, 0.2), 0.9),
+    "PlasterBlue": Material("PlasterBlue", (0.22, 0.35, 0.55), 0.9),
+    "RoofTile": Material("RoofTile", (0.35, 0.12, 0.07), 0.8),
+    "Glass": Material("Glass", (0.04, 0.06, 0.08), 0.15),
+    "Wood": Material("Wood", (0.28, 0.13, 0.05), 0.7),
+    "Metal": Material("Metal", (0.3, 0.3, 0.32), 0.35, metallic=0.9),
+    "LampGlass": Material("LampGlass", (0.9, 0.88, 0.8), 0.3),
+    "Bark": Material("Bark", (0.18, 0.11, 0.06), 0.9),
+    "Leaves": Material("Leaves", (0.07, 0.2, 0.04), 0.8),
+}
+
+AGENT_MATERIALS = {
+    "Skin": Material("Skin", (0.5, 0.33, 0.24), 0.6),
+    "ShirtRed": Material("ShirtRed", (0.5, 0.06, 0.05), 0.8),
+    "ShirtGreen": Material("ShirtGreen", (0.12, 0.35, 0.15), 0.8),
+    "Trousers": Material("Trousers", (0.07, 0.08, 0.12), 0.8),
+    "Frame": Material("Frame", (0.55, 0.57, 0.6), 0.3, metallic=0.9),
+    "Tyre": Material("Tyre", (0.02, 0.02, 0.02), 0.9),
+    "Seat": Material("Seat", (0.03, 0.05, 0.15), 0.8),
+}
+
+
+@dataclass(frozen=True)
+class CameraSpec:
+    name: str
+    eye: tuple[float, float, float]
+    target: tuple[float, float, float]
+    focal_length_mm: float
+    horizontal_aperture_mm: float
+    vertical_aperture_mm: float
+    doc: str
+
+
+CAMERAS = (
+    # 1/3" CCTV sensor (4.8 x 3.6 mm) behind a 2.8 mm lens: ~81 degree horizontal view from 6 m up.
+    CameraSpec("CCTV", (-10.0, -6.2, 5.5), (2.0, 2.5, 0.0), 2.8, 4.8, 3.6,
+               "Wall-mounted CCTV camera on building B, 6 m above the sidewalk."),
+    # Full-frame 36 x 24 mm with a 24 mm lens, held at 1.6 m eye height.
+    CameraSpec("PedestrianEye", (-11.0, -4.6, 1.6), (4.0, 1.5, 1.0), 24.0, 36.0, 24.0,
+               "Pedestrian eye level (1.6 m) on the south sidewalk, looking down the street."),
+    # Same lens at the eye height of a seated wheelchair user (1.2 m).
+    CameraSpec("WheelchairEye", (8.0, 5.6, 1.2), (-2.0, 4.5, 0.7), 24.0, 36.0, 24.0,
+               "Eye level of a seated wheelchair user (1.2 m) on the north sidewalk, looking west."),
+)
+
+
+# --- twin --------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Part:
+    """One mesh of the twin. ``labelled`` is the prim (relative to /World/Twin) that carries the class:
+    the part itself or the model it belongs to. Labels are never nested, so every mesh inherits exactly one."""
+
+    path: str
+    labelled: str
+    label: str
+    mesh: geo.Mesh
+    material: str
+
+
+def _twin_parts() -> list[Part]:
+    """Every mesh of the twin, in a fixed order."""
+    L, W, H = STREET_HALF_LENGTH, ROAD_HALF_WIDTH, KERB_HEIGHT
+    parts = [Part("Road", "Road", "road", geo.box((-L, -W - 0.2, -0.3), (L, W + 0.2, 0.0)), "Asphalt")]
+    # Sidewalks: slabs whose street-side face is the kerb. The north one leaves a gap for the ramp.
+    parts += [
+        Part("SidewalkSouth/Slab", "SidewalkSouth", "sidewalk",
+             geo.box((-L, -W - SIDEWALK_WIDTH, -0.3), (L, -W - 0.2, H)), "Concrete"),
+        Part("SidewalkSouth/Kerb", "SidewalkSouth", "sidewalk", geo.box((-L, -W - 0.2, 0.0), (L, -W, H)), "Granite"),
+    ]
+    x0, x1 = CROSSWALK_X - RAMP_HALF_WIDTH, CROSSWALK_X + RAMP_HALF_WIDTH
+    y_back = W + RAMP_LENGTH
+    parts += [
+        Part("SidewalkNorth/Slab", "SidewalkNorth", "sidewalk", geo.merge(
+            geo.box((-L, W + 0.2, -0.3), (x0, W + SIDEWALK_WIDTH, H)),
+            geo.box((x1, W + 0.2, -0.3), (L, W + SIDEWALK_WIDTH, H)),
+            geo.box((x0, y_back, -0.3), (x1, W + SIDEWALK_WIDTH, H))), "Concrete"),
+        Part("SidewalkNorth/Kerb", "SidewalkNorth", "sidewalk", geo.merge(
+            geo.box((-L, W, 0.0), (x0, W + 0.2, H)), geo.box((x1, W, 0.0), (L, W + 0.2, H))), "Granite"),
+        Part("CurbRamp", "CurbRamp", "curb_ramp", geo.ramp(x0, x1, W, y_back, 0.005, H, -0.3), "RampConcrete"),
+    ]
+    # Zebra bars: 0.5 m wide, 0.5 m apart, 1 cm proud of the asphalt so no surface is coplanar.
+    bars = [geo.box((CROSSWALK_X - 1.5, y, 0.0), (CROSSWALK_X + 1.5, y + 0.5, 0.01))
+            for y in np.arange(-W + 0.25, W - 0.25, 1.0)]
+    parts.append(Part("Crosswalk", "Crosswalk", "crosswalk", geo.merge(*bars), "RoadPaint"))
+    parts += _building("BuildingA", x=(-16.0, -1.0), y=(W + SIDEWALK_WIDTH, 13.0), height=10.0,
+                       facade_y=W + SIDEWALK_WIDTH, facing=-1, material="PlasterOchre")
+    parts += _building("BuildingB", x=(2.0, 18.0), y=(-13.0, -W - SIDEWALK_WIDTH), height=8.0,
+                       facade_y=-W - SIDEWALK_WIDTH, facing=1, material="PlasterBlue")
+    px, py = 6.0, W + 0.6
+    parts += [
+        Part("LightPole/Pole", "LightPole/Pole", "light_pole", geo.merge(
+            geo.cylinder((px, py, H + 3.0), 0.08, 6.0),
+            geo.box((px - 0.04, py - 1.2, H + 5.9), (px + 0.04, py, H + 5.98))), "Metal"),
+        Part("LightPole/Luminaire", "LightPole/Luminaire", "luminaire",
+             geo.box((px - 0.2, py - 1.5, H + 5.75), (px + 0.2, py - 0.9, H + 5.9)), "LampGlass"),
+    ]
+    tx, ty = 12.0, -W - 1.6
+    parts += [
+        Part("Tree/Trunk", "Tree", "vegetation", geo.cylinder((tx, ty, H + 1.5), 0.15, 3.0, sections=12), "Bark"),
+        Part("Tree/Crown", "Tree", "vegetation", geo.ellipsoid((tx, ty, H + 4.2), (1.8, 1.8, 2.0)), "Leaves"),
+    ]
+    bx, by = -4.0, W + SIDEWALK_WIDTH - 0.5
+    parts += [
+        Part("Bench/Seat", "Bench", "furniture", geo.merge(
+            geo.box((bx - 0.9, by - 0.2, H + 0.42), (bx + 0.9, by + 0.2, H + 0.47)),
+            geo.box((bx - 0.9, by + 0.2, H + 0.5), (bx + 0.9, by + 0.25, H + 0.9))), "Wood"),
+        Part("Bench/Legs", "Bench", "furniture", geo.merge(*[
+            geo.box((bx + sx - 0.03, by - 0.18, H), (bx + sx + 0.03, by + 0.22, H + 0.42)) for sx in (-0.8, 0.8)]),
+             "Metal"),
+    ]
+    return parts
+
+
+def _building(name: str, x, y, height: float, facade_y: float, facing: int, material: str) -> list[Part]:
+    """A block with a door and two rows of windows on its street façade (``facing`` = ±1 along y).
+
+    The block and roof are one ``building`` instance (``<name>/Structure``); each door and window is its own.
+    """
+    parts = [Part(f"{name}/Structure/Body", f"{name}/Structure", "building",
+                  geo.box((x[0], y[0], 0.0), (x[1], y[1], height)), material),
+             Part(f"{name}/Structure/Roof", f"{name}/Structure", "building",
+                  geo.box((x[0] - 0.3, y[0] - 0.3, height), (x[1] + 0.3, y[1] + 0.3, height + 0.25)), "RoofTile")]
+    proud = facing * 0.05  # doors and windows stand 5 cm out of the wall, towards the street.
+
+    def on_facade(x0, x1, z0, z1):
+        ya, yb = sorted((facade_y, facade_y + proud))
+        return geo.box((x0, ya, z0), (x1, yb, z1))
+
+    mid = 0.5 * (x[0] + x[1])
+    parts.append(Part(f"{name}/Door", f"{name}/Door", "door", on_facade(mid - 0.6, mid + 0.6, KERB_HEIGHT, 2.4), "Wood"))
+    for floor, z in enumerate((3.2, 6.2)):
+        for k, cx in enumerate(np.linspace(x[0] + 2.0, x[1] - 2.0, 4)):
+            if floor == 0 and abs(cx - mid) < 1.5:
+                continue
+            path = f"{name}/Window_{floor}{k}"
+            parts.append(Part(path, path, "window", on_facade(cx - 0.6, cx + 0.6, z, z + 1.5), "Glass"))
+    return parts
+
+
+def build_twin(meta: StageMetadata = META) -> tuple[Usd.Stage, Usd.Stage]:
+    """The twin layer (geometry, materials) and the semantics layer (label overrides) as two stages."""
+    twin = new_layer(meta, "synthua demo street: twin geometry and UsdPreviewSurface materials (no labels).")
+    twin.SetDefaultPrim(define_xform(twin, "/World", kind=Kind.Tokens.assembly).GetPrim())
+    define_xform(twin, "/World/Twin", kind=Kind.Tokens.group)
+    looks = {name: define_preview_material(twin, f"/World/Looks/{name}", spec) for name, spec in MATERIALS.items()}
+    semantics = new_layer(meta, "synthua demo street: UsdSemantics class labels over the twin (taxonomy 'synthua').")
+    semantics.SetDefaultPrim(semantics.OverridePrim("/World"))
+    labelled: set[str] = set()
+    for part in _twin_parts():
+        path = f"/World/Twin/{part.path}"
+        model = "/World/Twin/" + part.path.split("/")[0]
+        if not twin.GetPrimAtPath(model):
+            set_kind(define_xform(twin, model).GetPrim(), Kind.Tokens.component)
+        parent = path.rsplit("/", 1)[0]
+        if not twin.GetPrimAtPath(parent):
+            define_xform(twin, parent)
+        define_mesh(twin, path, *part.mesh, looks[part.material])
+        if part.labelled not in labelled:
+            apply_label(semantics.OverridePrim(f"/World/Twin/{part.labelled}"), TAXONOMY, part.label)
+            labelled.add(part.labelled)
+    return twin, semantics
+
+
+# --- agents --------------------------------------------------------------------------------------------
+
+def _person_parts(seated: bool) -> dict[str, tuple[geo.Mesh, str]]:
+    """Body parts of a 1.75 m person in local space: feet at z = 0 (standing) or seat height (seated)."""
+    if seated:
+        hip_z = 0.52
+        legs = geo.merge(
+            geo.box((0.0, -0.18, hip_z - 0.07), (0.45, -0.02, hip_z + 0.08)),
+            geo.box((0.0, 0.02, hip_z - 0.07), (0.45, 0.18, hip_z + 0.08)),
+            geo.box((0.36, -0.17, 0.1), (0.48, -0.04, hip_z - 0.07)),
+            geo.box((0.36, 0.04, 0.1), (0.48, 0.17, hip_z - 0.07)))
+        parts = {"Legs": (legs, "Trousers")}
+    else:
+        hip_z = 0.9
+        parts = {}
+    torso = geo.box((-0.12, -0.2, hip_z), (0.12, 0.2, hip_z + 0.6))
+    arms = geo.merge(geo.box((-0.06, -0.28, hip_z + 0.05), (0.06, -0.2, hip_z + 0.58)),
+                     geo.box((-0.06, 0.2, hip_z + 0.05), (0.06, 0.28, hip_z + 0.58)))
+    head = geo.sphere((0.0, 0.0, hip_z + 0.74), 0.12, subdivisions=2)
+    parts.update({"Torso": (geo.merge(torso, arms), "ShirtGreen" if seated else "ShirtRed"), "Head": (head, "Skin")})
+    return parts
+
+
+def _wheelchair_parts() -> dict[str, tuple[geo.Mesh, str]]:
+    """A manual wheelchair facing +X: 0.6 m rear wheels, casters, seat, backrest and frame."""
+    return {
+        "RearWheels": (geo.merge(geo.cylinder((-0.1, -0.3, 0.3), 0.3, 0.03, axis="y", sections=24),
+                                 geo.cylinder((-0.1, 0.3, 0.3), 0.3, 0.03, axis="y", sections=24)), "Tyre"),
+        "Casters": (geo.merge(geo.cylinder((0.38, -0.22, 0.07), 0.07, 0.03, axis="y", sections=12),
+                              geo.cylinder((0.38, 0.22, 0.07), 0.07, 0.03, axis="y", sections=12)), "Tyre"),
+        "Seat": (geo.merge(geo.box((-0.18, -0.24, 0.43), (0.3, 0.24, 0.45)),
+                           geo.box((-0.2, -0.24, 0.45), (-0.18, 0.24, 0.95))), "Seat"),
+        "Frame": (geo.merge(geo.box((-0.2, -0.26, 0.14), (0.42, -0.24, 0.45)),
+                            geo.box((-0.2, 0.24, 0.14), (0.42, 0.26, 0.45)),
+                            geo.box((0.36, -0.2, 0.08), (0.44, 0.2, 0.12))), "Frame"),
+    }
+
+
+def _animate_translate(xform: UsdGeom.Xform, start, end, meta: StageMetadata, heading_deg: float) -> None:
+    op = xform.AddTranslateOp()
+    t0, t1 = meta.start_time_code, meta.end_time_code
+    for t in np.arange(t0, t1 + 1):
+        s = (t - t0) / (t1 - t0)
+        op.Set(Gf.Vec3d(*(np.asarray(start) + s * (np.asarray(end) - np.asarray(start)))), Usd.TimeCode(float(t)))
+    xform.AddRotateZOp().Set(float(heading_deg))
+
+
+def build_agents(meta: StageMetadata = META) -> Usd.Stage:
+    """The agents layer: geometry, labels and time-sampled motion of two people and one wheelchair."""
+    stage = new_layer(meta, "synthua demo street: agents with time-sampled transforms and their own class labels.")
+    world = stage.OverridePrim("/World")
+    stage.SetDefaultPrim(world)
+    define_xform(stage, "/World/Agents", kind=Kind.Tokens.group)
+    looks = {n: define_preview_material(stage, f"/World/Agents/Looks/{n}", s) for n, s in AGENT_MATERIALS.items()}
+    seconds = (meta.end_time_code - meta.start_time_code) / meta.time_codes_per_second
+
+    # Pedestrian: 1.3 m/s along the south sidewalk, legs swinging +-20 degrees once a second.
+    ped = define_xform(stage, "/World/Agents/Pedestrian_01", kind=Kind.Tokens.component)
+    y_south = -ROAD_HALF_WIDTH - 1.3
+    _animate_translate(ped, (-4.0, y_south, KERB_HEIGHT), (-4.0 + 1.3 * seconds, y_south, KERB_HEIGHT), meta, 0.0)
+    apply_label(ped.GetPrim(), TAXONOMY, "person")
+    for name, ((pts, tris), mat) in _person_parts(seated=False).items():
+        define_mesh(stage, f"{ped.GetPath()}/{name}", pts, tris, looks[mat])
+    for side, phase in (("L", 0.0), ("R", np.pi)):
+        leg = define_xform(stage, f"{ped.GetPath()}/Leg{side}", translate=(0.0, 0.1 if side == "L" else -0.1, 0.9))
+        swing = leg.AddRotateYOp()
+        for t in np.arange(meta.start_time_code, meta.end_time_code + 1):
+            angle = 20.0 * np.sin(2 * np.pi * (t - meta.start_time_code) / meta.time_codes_per_second + phase)
+            swing.Set(float(angle), Usd.TimeCode(float(t)))
+        pts, tris = geo.box((-0.07, -0.07, -0.9), (0.07, 0.07, 0.0))
+        define_mesh(stage, f"{leg.GetPath()}/Mesh", pts, tris, looks["Trousers"])
+
+    # Wheelchair user: person and wheelchair are separate models with separate classes and instances.
+    user = define_xform(stage, "/World/Agents/WheelchairUser_01", kind=Kind.Tokens.group)
+    y_north = ROAD_HALF_WIDTH + 1.2
+    _animate_translate(user, (-2.0, y_north, KERB_HEIGHT), (-2.0 + 0.9 * seconds, y_north, KERB_HEIGHT), meta, 0.0)
+    person = define_xform(stage, f"{user.GetPath()}/Person", kind=Kind.Tokens.component)
+    apply_label(person.GetPrim(), TAXONOMY, "person")
+    for name, ((pts, tris), mat) in _person_parts(seated=True).items():
+        define_mesh(stage, f"{person.GetPath()}/{name}", pts, tris, looks[mat])
+    chair = define_xform(stage, f"{user.GetPath()}/Wheelchair", kind=Kind.Tokens.component)
+    apply_label(chair.GetPrim(), TAXONOMY, "manual_wheelchair")
+    for name, ((pts, tris), mat) in _wheelchair_parts().items():
+        define_mesh(stage, f"{chair.GetPath()}/{name}", pts, tris, looks[mat])
+    person.GetPrim().CreateRelationship("synthua:uses", custom=True).SetTargets([chair.GetPath()])
+    return stage
+
+
+# --- cameras, environment, render settings ---------------------------------------------------------------
+
+def build_cameras(meta: StageMetadata = META) -> Usd.Stage:
+    stage = new_layer(meta, "synthua demo street: camera rigs with physical lens values.")
+    stage.SetDefaultPrim(stage.OverridePrim("/World"))
+    define_xform(stage, "/World/Cameras", kind=Kind.Tokens.group)
+    for spec in CAMERAS:
+        author_camera(stage, f"/World/Cameras/{spec.name}", geo.look_at(spec.eye, spec.target),
+                      focal_length_mm=spec.focal_length_mm, horizontal_aperture_mm=spec.horizontal_aperture_mm,
+                      vertical_aperture_mm=spec.vertical_aperture_mm, clip_near_m=0.05, clip_far_m=500.0,
+                      meters_per_unit=meta.meters_per_unit, doc=spec.doc)
+    return stage
+
+
+def build_environment(meta: StageMetadata = META) -> Usd.Stage:
+    """Clear day: a sun 50 degrees high in the south-east and a uniform blue-grey sky."""
+    stage = new_layer(meta, "synthua demo street: clear-day sun and sky (UsdLux).")
+    stage.SetDefaultPrim(stage.OverridePrim("/World"))
+    define_xform(stage, "/World/Environment", kind=Kind.Tokens.group)
+    sun = UsdLux.DistantLight.Define(stage, "/World/Environment/Sun")
+    sun.CreateIntensityAttr(3.0)
+    sun.CreateAngleAttr(0.53)
+    sun.CreateColorAttr(Gf.Vec3f(1.0, 0.96, 0.9))
+    # A distant light shines down its local -Z axis: tilt it 40 degrees off vertical, then turn it.
+    sun_xf = UsdGeom.Xformable(sun.GetPrim())
+    sun_xf.AddRotateZOp().Set(-35.0)
+    sun_xf.AddRotateXOp().Set(40.0)
+    sky = UsdLux.DomeLight.Define(stage, "/World/Environment/Sky")
+    sky.CreateIntensityAttr(0.6)
+    sky.CreateColorAttr(Gf.Vec3f(0.75, 0.85, 1.0))
+    return stage
+
+
+RENDER_VARS = (
+    # name, sourceName, sourceType, dataType
+    ("rgb", "LdrColor", "raw", "color3f"),
+    ("class_id", "synthua:class_id", "primvar", "int"),
+    ("instance_id", "synthua:instance_id", "primvar", "int"),
+    ("depth", "depth", "raw", "float"),
+)
+
+
+def build_render_settings(meta: StageMetadata = META, camera: str = "/World/Cameras/CCTV",
+                          resolution: tuple[int, int] = (1280, 960)) -> Usd.Stage:
+    stage = new_layer(meta, "synthua demo street: UsdRender settings, product and AOVs.")
+    stage.SetDefaultPrim(stage.OverridePrim("/World"))
+    stage.DefinePrim("/Render", "Scope")
+    settings = UsdRender.Settings.Define(stage, "/Render/Settings")
+    settings.CreateResolutionAttr(Gf.Vec2i(*resolution))
+    settings.CreateCameraRel().SetTargets([Sdf.Path(camera)])
+    settings.CreateAspectRatioConformPolicyAttr(UsdRender.Tokens.expandAperture)
+    settings.GetPrim().CreateAttribute("synthua:spp", Sdf.ValueTypeNames.Int, custom=True).Set(64)
+    product = UsdRender.Product.Define(stage, "/Render/Products/Frame")
+    product.CreateProductNameAttr("frame")
+    var_paths = []
+    for name, source, source_type, data_type in RENDER_VARS:
+        var = UsdRender.Var.Define(stage, f"/Render/Vars/{name}")
+        var.CreateSourceNameAttr(source)
+        var.CreateSourceTypeAttr(source_type)
+        var.CreateDataTypeAttr(data_type)
+        var_paths.append(var.GetPath())
+    product.CreateOrderedVarsRel().SetTargets(var_paths)
+    settings.CreateProductsRel().SetTargets([product.GetPath()])
+    stage.GetRootLayer().customLayerData = {"renderSettingsPrimPath": "/Render/Settings"}
+    return stage
+
+
+def write_street_demo(out_dir: str | Path) -> list[Path]:
+    """Write every layer of the demo and ``scenario.usda`` into ``out_dir``; returns the paths written."""
+    out_dir = Path(out_dir)
+    twin, semantics = build_twin()
+    layers = {"twin.usda": twin, "semantics.usda": semantics, "agents.usda": build_agents(),
+              "cameras.usda": build_cameras(), "environment.usda": build_environment(),
+              "render.usda": build_render_settings()}
+    written = [save_layer_atomic(layers[name].GetRootLayer(), out_dir / name) for name in LAYER_FILES]
+    written.append(compose_layers(out_dir / "scenario.usda", [out_dir / name for name in LAYER_FILES],
+                                  doc="synthua demo street scenario: composes the demo layers, strongest first."))
+    return written
