@@ -1,0 +1,66 @@
+import math
+
+import numpy as np
+import pytest
+
+from synthua_usd.cameras import PinholeCamera
+from synthua_usd.errors import InputError
+from synthua_usd.geometry import look_at
+
+
+def camera(**kw):
+    args = dict(path="/cam", focal_length_mm=24.0, horizontal_aperture_mm=36.0, vertical_aperture_mm=24.0,
+                clip_near_m=0.1, clip_far_m=100.0, camera_to_world=look_at((0, -10, 2), (0, 0, 2)))
+    args.update(kw)
+    return PinholeCamera(**args)
+
+
+def test_fov_from_lens():
+    cam = camera()
+    hfov, vfov = cam.fov_deg(360, 240)  # same aspect as the filmback
+    assert hfov == pytest.approx(math.degrees(2 * math.atan(18 / 24)))
+    assert vfov == pytest.approx(math.degrees(2 * math.atan(12 / 24)))
+
+
+def test_expand_aperture_conform():
+    cam = camera()
+    # 4:3 image on a 3:2 filmback: the vertical aperture grows, horizontal stays.
+    assert cam.conformed_aperture_mm(400, 300) == pytest.approx((36.0, 27.0))
+    # 2:1 image: the horizontal grows.
+    assert cam.conformed_aperture_mm(480, 240) == pytest.approx((48.0, 24.0))
+
+
+def test_intrinsics_square_pixels_centred():
+    k = camera().intrinsics(640, 480)
+    assert k[0, 0] == pytest.approx(24 * 640 / 36) and k[0, 0] == k[1, 1]
+    assert (k[0, 2], k[1, 2]) == (320, 240)
+
+
+def test_pixel_rays_reproject_to_their_pixels():
+    cam = camera(camera_to_world=look_at((3, -7, 4), (0, 1, 0.5)))
+    w, h = 64, 48
+    origins, dirs = cam.pixel_center_rays(w, h)
+    points = origins + 5.0 * dirs
+    ext = cam.world_to_camera_opencv()
+    pc = (ext[:3, :3] @ points.T).T + ext[:3, 3]
+    uv = (cam.intrinsics(w, h) @ pc.T).T
+    uv = uv[:, :2] / uv[:, 2:]
+    ys, xs = np.mgrid[0:h, 0:w]
+    assert np.allclose(uv[:, 0], xs.ravel() + 0.5) and np.allclose(uv[:, 1], ys.ravel() + 0.5)
+
+
+def test_image_up_is_world_up():
+    cam = camera()
+    _, dirs = cam.pixel_center_rays(3, 3)
+    assert dirs[1, 2] > dirs[4, 2] > dirs[7, 2]  # top row looks higher than the bottom row
+    assert dirs[3, 0] < dirs[4, 0] < dirs[5, 0]  # left column looks further left (-X) for a +Y view
+
+
+@pytest.mark.parametrize("field,value,text", [
+    ("focal_length_mm", 0.0, "focal_length_mm should be > 0, but was 0.0"),
+    ("vertical_aperture_mm", float("nan"), "vertical_aperture_mm should be > 0"),
+    ("clip_near_m", 200.0, "clipping range should satisfy 0 < near < far"),
+])
+def test_bad_values_are_refused_with_the_value(field, value, text):
+    with pytest.raises(InputError, match=text.replace("(", r"\(")):
+        camera(**{field: value})

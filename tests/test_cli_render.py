@@ -1,0 +1,101 @@
+"""`synthua render` end to end on tiny images, and every kind of bad input it must refuse."""
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from conftest import DATA, SCENARIO, STAGES
+from synthua_usd.backends.frame_files import FILES
+from synthua_usd.backends.images import read_image
+from synthua_usd.schemas import validate_document
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    from synthua_usd.cli.main import main
+
+    out = tmp_path_factory.mktemp("render") / "cctv"
+    code = main(["render", str(SCENARIO), "--camera", "/World/Cameras/CCTV", "--frame", "12", "--width", "64",
+                 "--height", "48", "--spp", "2", "--out", str(out)])
+    assert code == 0
+    return out
+
+
+def test_writes_every_file(rendered):
+    assert sorted(p.name for p in rendered.iterdir()) == sorted(FILES)
+
+
+def test_frame_json_is_schema_valid_and_describes_the_images(rendered, class_map):
+    doc = json.loads((rendered / "frame.json").read_text())
+    validate_document(doc, "frame", "frame.json")
+    assert doc["image"] == {"width": 64, "height": 48}
+    assert doc["time_code"] == 12 and doc["render"]["spp"] == 2
+    assert doc["files"]["depth"]["kind"] == "z"
+    assert len(doc["class_map"]["classes"]) == 37
+    classes, _ = read_image(rendered / "class.png")
+    ids, counts = np.unique(classes, return_counts=True)
+    assert doc["class_pixel_counts"] == {class_map.by_id(int(i)).name: int(n) for i, n in zip(ids, counts)}
+    inst, spec = read_image(rendered / "instance.png")
+    assert inst.dtype == np.uint16
+    for entry in doc["instances"]:
+        assert entry["pixel_count"] == int((inst == entry["id"]).sum())
+
+
+def test_semantic_png_is_the_class_palette(rendered, class_map):
+    classes, _ = read_image(rendered / "class.png")
+    semantic, _ = read_image(rendered / "semantic.png")
+    assert np.array_equal(semantic, class_map.palette()[classes[..., 0]])
+
+
+def test_intrinsics_match_the_camera(rendered):
+    doc = json.loads((rendered / "frame.json").read_text())
+    k = np.array(doc["camera"]["K"])
+    hfov = doc["camera"]["fov_deg"][0]
+    assert k[0, 0] == pytest.approx(32 / np.tan(np.radians(hfov) / 2))
+
+
+def test_render_defaults_come_from_render_settings(run_cli, tmp_path, monkeypatch):
+    # No --camera: the UsdRender settings' camera is used; size and spp given to keep it tiny.
+    code, out, _ = run_cli("render", SCENARIO, "--width", "16", "--height", "12", "--spp", "1", "--out", tmp_path / "o")
+    assert code == 0 and "rendered /World/Cameras/CCTV at frame 1" in out
+
+
+BAD = {
+    "missing stage": (lambda tmp: [tmp / "nope.usda"], "nope.usda: file not found"),
+    "malformed stage": (lambda tmp: [DATA / "invalid" / "malformed.usda"], "not a readable USD stage"),
+    "unknown camera": (lambda tmp: [SCENARIO, "--camera", "/World/Cameras/Nope"],
+                       "no camera at '/World/Cameras/Nope'; cameras in the stage: /World/Cameras/CCTV"),
+    "not a camera": (lambda tmp: [SCENARIO, "--camera", "/World/Twin/Road"], "/World/Twin/Road: prim of type 'Mesh' is not a UsdGeom.Camera"),
+    "frame out of range": (lambda tmp: [SCENARIO, "--frame", "500"], "frame 500 is outside the stage's time range [1, 48]"),
+    "label not in class map": (lambda tmp: [DATA / "invalid" / "unknown_label.usda", "--camera", "/World/Cam"],
+                               "/World/Ground: label 'spaceship' is not a class of"),
+    "class map fails schema": (lambda tmp: [SCENARIO, "--class-map", DATA / "invalid" / "schema_missing_color.json"],
+                               "schema_missing_color.json: classes[1]: 'color' is a required property"),
+    "bad spp": (lambda tmp: [SCENARIO, "--spp", "0"], "Invalid value for '--spp'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_input_exits_2_with_one_line_and_writes_nothing(run_cli, tmp_path, case):
+    make_args, text = BAD[case]
+    out = tmp_path / "out"
+    code, stdout, err = run_cli("render", *make_args(tmp_path), "--width", "8", "--height", "6", "--spp", "1",
+                                "--out", out) if case != "bad spp" else \
+        run_cli("render", *make_args(tmp_path), "--width", "8", "--height", "6", "--out", out)
+    assert code == 2, (stdout, err)
+    assert text in err, err
+    if case != "bad spp":
+        assert len(err.strip().splitlines()) == 1 and err.startswith("synthua: error: ")
+    assert not out.exists()
+
+
+def test_rerender_replaces_files_in_place(run_cli, tmp_path):
+    out = tmp_path / "o"
+    args = ("render", SCENARIO, "--width", "8", "--height", "6", "--spp", "1", "--out", out)
+    assert run_cli(*args)[0] == 0
+    first = (out / "frame.json").read_text()
+    assert run_cli(*args)[0] == 0
+    assert sorted(p.name for p in out.iterdir()) == sorted(FILES)  # no temporary files left behind
+    assert json.loads(first)["instances"] == json.loads((out / "frame.json").read_text())["instances"]

@@ -1,0 +1,64 @@
+"""Image files: colour management checked against colour-science, id maps raw, atomic writes."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from synthua_usd.backends import images
+
+
+def test_display_conversion_is_the_srgb_transfer_function():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import colour
+    lin = np.linspace(0.0, 1.0, 64 * 3, dtype=np.float32).reshape(8, 8, 3)
+    expected = np.round(np.clip(colour.cctf_encoding(lin, function="sRGB"), 0, 1) * 255)
+    got = images.linear_to_display(lin).astype(float)
+    assert np.abs(got - expected).max() <= 1.0
+
+
+def test_display_conversion_clips_highlights():
+    out = images.linear_to_display(np.full((2, 2, 3), 4.0, np.float32))
+    assert (out == 255).all()
+
+
+def test_exr_roundtrip_is_tagged_linear(tmp_path):
+    rgb = np.random.default_rng(0).random((6, 5, 3), dtype=np.float32) * 3
+    images.write_linear_exr(tmp_path / "rgb.exr", rgb)
+    pixels, spec = images.read_image(tmp_path / "rgb.exr")
+    assert np.array_equal(pixels, rgb)
+    assert spec.getattribute("oiio:ColorSpace") == "lin_rec709_scene"
+
+
+@pytest.mark.parametrize("dtype,top", [(np.uint8, 255), (np.uint16, 65535)])
+def test_id_png_roundtrip_is_raw(tmp_path, dtype, top):
+    ids = np.random.default_rng(1).integers(0, top, (7, 9)).astype(dtype)
+    images.write_id_png(tmp_path / "ids.png", ids)
+    pixels, spec = images.read_image(tmp_path / "ids.png")
+    assert pixels.shape == (7, 9, 1) and pixels.dtype == dtype
+    assert np.array_equal(pixels[..., 0], ids)
+
+
+def test_depth_exr_carries_its_definition(tmp_path):
+    depth = np.arange(12, dtype=np.float32).reshape(3, 4)
+    images.write_depth_exr(tmp_path / "d.exr", depth, "z-depth in metres")
+    pixels, spec = images.read_image(tmp_path / "d.exr")
+    assert np.array_equal(pixels[..., 0], depth)
+    assert spec.channelnames == ("Z",) and spec.getattribute("synthua:depth") == "z-depth in metres"
+
+
+def test_failed_write_leaves_no_file(tmp_path, monkeypatch):
+    target = tmp_path / "rgb.exr"
+    target.write_bytes(b"previous")
+
+    class Broken:
+        @staticmethod
+        def create(path):
+            return None
+
+    monkeypatch.setattr(images.oiio, "ImageOutput", Broken)
+    with pytest.raises(OSError, match="cannot open it for writing"):
+        images.write_linear_exr(target, np.zeros((2, 2, 3), np.float32))
+    assert target.read_bytes() == b"previous"
+    assert [p.name for p in tmp_path.iterdir()] == ["rgb.exr"]

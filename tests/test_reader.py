@@ -1,0 +1,81 @@
+import numpy as np
+import pytest
+from pxr import Usd
+
+from conftest import DATA
+from synthua_usd.errors import StageError, UnsupportedPrimError
+from synthua_usd.usd.reader import _fan_triangulate, read_snapshot
+from synthua_usd.usd.stage_io import open_stage
+
+
+@pytest.fixture(scope="module")
+def snap(demo_stage, class_map):
+    return read_snapshot(demo_stage, 1.0, class_map)
+
+
+def test_demo_snapshot_contents(snap):
+    assert len(snap.meshes) == 46
+    assert {l.kind for l in snap.lights} == {"distant", "dome"}
+    assert all(m.instance_id > 0 and m.class_id > 0 for m in snap.meshes)
+    assert [i.id for i in snap.instances] == list(range(1, len(snap.instances) + 1))
+
+
+def test_person_and_wheelchair_are_distinct_instances_with_a_relation(snap):
+    by_path = {i.prim_path: i for i in snap.instances}
+    person = by_path["/World/Agents/WheelchairUser_01/Person"]
+    chair = by_path["/World/Agents/WheelchairUser_01/Wheelchair"]
+    assert person.id != chair.id and (person.class_name, chair.class_name) == ("person", "manual_wheelchair")
+    assert dict(person.relations) == {"uses": chair.prim_path}
+
+
+def test_world_transform_follows_the_animation(demo_stage, class_map):
+    def head_centre(t):
+        s = read_snapshot(demo_stage, t, class_map)
+        (head,) = [m for m in s.meshes if m.prim_path == "/World/Agents/Pedestrian_01/Head"]
+        return head.points.mean(axis=0)
+
+    a, b = head_centre(1.0), head_centre(25.0)
+    # 1.3 m/s along +X; frames 1 -> 25 are one second at 24 time codes per second.
+    assert b - a == pytest.approx([1.3, 0.0, 0.0], abs=1e-5)
+
+
+def test_instance_ids_are_stable_across_frames(demo_stage, class_map):
+    a = read_snapshot(demo_stage, 1.0, class_map).instances
+    b = read_snapshot(demo_stage, 48.0, class_map).instances
+    assert a == b
+
+
+def test_tiny_scene_primitives_and_materials(class_map):
+    stage = open_stage(DATA / "valid" / "tiny_scene.usda")
+    snap = read_snapshot(stage, 1.0, class_map)
+    ground, box = snap.meshes
+    assert ground.triangles.shape == (2, 3)  # one quad, fan-triangulated
+    assert box.points.min(axis=0) == pytest.approx([-0.5, -0.5, 0.0])  # Cube size 1 translated up 0.5
+    assert box.points.max(axis=0) == pytest.approx([0.5, 0.5, 1.0])
+    assert snap.instance(box.instance_id).class_name == "person"  # alias 'Pedestrian'
+    assert snap.materials[ground.material_key].key == "default"
+
+
+def test_fan_triangulation_skips_degenerate_faces_and_holes():
+    counts = np.array([4, 2, 3])
+    indices = np.array([0, 1, 2, 3, 4, 5, 6, 7, 8])
+    tris = _fan_triangulate(counts, indices, holes={2})
+    assert tris.tolist() == [[0, 1, 2], [0, 2, 3]]
+
+
+def test_unknown_label_is_an_error_naming_the_prim(class_map):
+    stage = open_stage(DATA / "invalid" / "unknown_label.usda")
+    with pytest.raises(StageError, match="/World/Ground: label 'spaceship' is not a class"):
+        read_snapshot(stage, 1.0, class_map)
+
+
+def test_unsupported_gprim_lists_supported_types(class_map):
+    stage = open_stage(DATA / "invalid" / "unsupported_gprim.usda")
+    with pytest.raises(UnsupportedPrimError, match="gprim type 'Points' is not supported; supported types: "
+                                                   "Capsule, Cone, Cube, Cylinder, Mesh, Sphere"):
+        read_snapshot(stage, 1.0, class_map)
+
+
+def test_frame_outside_time_range(demo_stage, class_map):
+    with pytest.raises(StageError, match=r"frame 99 is outside the stage's time range \[1, 48\]"):
+        read_snapshot(demo_stage, 99.0, class_map)
