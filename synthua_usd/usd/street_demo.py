@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdLux, UsdRender
+from pxr import Gf, Kind, Usd, UsdGeom
 
 from synthua_usd import geometry as geo
 from synthua_usd.scene import Material
@@ -23,6 +23,7 @@ from synthua_usd.usd.authoring import (StageMetadata, apply_label, define_mesh, 
                                        define_xform, new_layer, save_layer_atomic, set_kind)
 from synthua_usd.usd.cameras import author_camera
 from synthua_usd.usd.compose import compose_layers
+from synthua_usd.usd.scenario_layers import build_environment, build_render_settings
 
 TAXONOMY = "synthua"
 META = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=24.0,
@@ -310,66 +311,13 @@ def build_cameras(meta: StageMetadata = META) -> Usd.Stage:
     return stage
 
 
-def build_environment(meta: StageMetadata = META) -> Usd.Stage:
-    """Clear day: a sun 50 degrees high in the south-east and a uniform blue-grey sky."""
-    stage = new_layer(meta, "synthua demo street: clear-day sun and sky (UsdLux).")
-    stage.SetDefaultPrim(stage.OverridePrim("/World"))
-    define_xform(stage, "/World/Environment", kind=Kind.Tokens.group)
-    sun = UsdLux.DistantLight.Define(stage, "/World/Environment/Sun")
-    sun.CreateIntensityAttr(3.0)
-    sun.CreateAngleAttr(0.53)
-    sun.CreateColorAttr(Gf.Vec3f(1.0, 0.96, 0.9))
-    # A distant light shines down its local -Z axis: tilt it 40 degrees off vertical, then turn it.
-    sun_xf = UsdGeom.Xformable(sun.GetPrim())
-    sun_xf.AddRotateZOp().Set(-35.0)
-    sun_xf.AddRotateXOp().Set(40.0)
-    sky = UsdLux.DomeLight.Define(stage, "/World/Environment/Sky")
-    sky.CreateIntensityAttr(0.6)
-    sky.CreateColorAttr(Gf.Vec3f(0.75, 0.85, 1.0))
-    return stage
-
-
-RENDER_VARS = (
-    # name, sourceName, sourceType, dataType
-    ("rgb", "LdrColor", "raw", "color3f"),
-    ("class_id", "synthua:class_id", "primvar", "int"),
-    ("instance_id", "synthua:instance_id", "primvar", "int"),
-    ("depth", "depth", "raw", "float"),
-)
-
-
-def build_render_settings(meta: StageMetadata = META, camera: str = "/World/Cameras/CCTV",
-                          resolution: tuple[int, int] = (1280, 960)) -> Usd.Stage:
-    stage = new_layer(meta, "synthua demo street: UsdRender settings, product and AOVs.")
-    stage.SetDefaultPrim(stage.OverridePrim("/World"))
-    stage.DefinePrim("/Render", "Scope")
-    settings = UsdRender.Settings.Define(stage, "/Render/Settings")
-    settings.CreateResolutionAttr(Gf.Vec2i(*resolution))
-    settings.CreateCameraRel().SetTargets([Sdf.Path(camera)])
-    settings.CreateAspectRatioConformPolicyAttr(UsdRender.Tokens.expandAperture)
-    settings.GetPrim().CreateAttribute("synthua:spp", Sdf.ValueTypeNames.Int, custom=True).Set(64)
-    product = UsdRender.Product.Define(stage, "/Render/Products/Frame")
-    product.CreateProductNameAttr("frame")
-    var_paths = []
-    for name, source, source_type, data_type in RENDER_VARS:
-        var = UsdRender.Var.Define(stage, f"/Render/Vars/{name}")
-        var.CreateSourceNameAttr(source)
-        var.CreateSourceTypeAttr(source_type)
-        var.CreateDataTypeAttr(data_type)
-        var_paths.append(var.GetPath())
-    product.CreateOrderedVarsRel().SetTargets(var_paths)
-    settings.CreateProductsRel().SetTargets([product.GetPath()])
-    stage.GetRootLayer().customLayerData = {"renderSettingsPrimPath": "/Render/Settings"}
-    return stage
-
-
 def write_street_demo(out_dir: str | Path) -> list[Path]:
     """Write every layer of the demo and ``scenario.usda`` into ``out_dir``; returns the paths written."""
     out_dir = Path(out_dir)
     twin, semantics = build_twin()
     layers = {"twin.usda": twin, "semantics.usda": semantics, "agents.usda": build_agents(),
-              "cameras.usda": build_cameras(), "environment.usda": build_environment(),
-              "render.usda": build_render_settings()}
+              "cameras.usda": build_cameras(), "environment.usda": build_environment(META),
+              "render.usda": build_render_settings(META)}
     written = [save_layer_atomic(layers[name].GetRootLayer(), out_dir / name) for name in LAYER_FILES]
     written.append(compose_layers(out_dir / "scenario.usda", [out_dir / name for name in LAYER_FILES],
                                   doc="synthua demo street scenario: composes the demo layers, strongest first."))

@@ -1,0 +1,21 @@
+"""Importers: real city data → :class:`synthua_usd.twin.TwinModel` (plain data; no USD, no renderer).
+
+Each importer module parses and validates one kind of input and returns a TwinModel; it never writes
+files. ``IMPORTERS`` maps the kind names of ``synthua twin import KIND`` to them.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from synthua_usd.twin import TwinModel
+
+Importer = Callable[..., TwinModel]
+
+
+def importers() -> dict[str, Importer]:
+    """Kind name → importer function; imported lazily so optional dependencies fail only when used."""
+    from synthua_usd.importers import cityjson, footprints, mesh, pointcloud
+
+    return {"mesh": mesh.import_mesh, "cityjson": cityjson.import_cityjson,
+            "pointcloud": pointcloud.import_pointcloud, "footprints": footprints.import_footprints}

@@ -1,0 +1,136 @@
+"""Meshes (OBJ, PLY, GLB/glTF, STL) through trimesh, keeping the source's object/material structure.
+
+Each source object becomes one prim per class found in it (usually one), with one mesh per material.
+Classes come from :class:`SemanticRules` matched against the object name, material name and group;
+geometry no rule matches gets the rules' default class (``unlabelled``) and is listed in the report.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from synthua_usd.errors import InputError
+from synthua_usd.scene import Material
+from synthua_usd.semantic_rules import SemanticRules
+from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
+
+log = logging.getLogger(__name__)
+
+SUFFIXES = {".obj": "obj", ".ply": "ply", ".glb": "glb", ".gltf": "gltf", ".stl": "stl"}
+#: glTF is Y-up by specification; the others say nothing, and survey/CAD exports are usually Z-up.
+DEFAULT_UP = {"glb": "Y", "gltf": "Y"}
+_Y_TO_Z = trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0])
+
+
+def _srgb8_to_linear(rgb8) -> tuple[float, float, float]:
+    c = np.asarray(rgb8[:3], float) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return tuple(float(v) for v in lin)
+
+
+def _material(geom: trimesh.Trimesh, fallback: str) -> tuple[str, Material]:
+    visual = geom.visual
+    mat = getattr(visual, "material", None)
+    if mat is not None:
+        name = getattr(mat, "name", None) or fallback
+        if hasattr(mat, "baseColorFactor") and mat.baseColorFactor is not None:
+            color = _srgb8_to_linear(np.asarray(mat.baseColorFactor))
+            rough = float(mat.roughnessFactor) if getattr(mat, "roughnessFactor", None) is not None else 0.8
+            metal = float(mat.metallicFactor) if getattr(mat, "metallicFactor", None) is not None else 0.0
+            return name, Material(name, color, rough, metal)
+        if hasattr(mat, "diffuse") and mat.diffuse is not None:
+            return name, Material(name, _srgb8_to_linear(np.asarray(mat.diffuse)), 0.8)
+        return name, Material(name)
+    if getattr(visual, "kind", None) == "vertex" and len(visual.vertex_colors):
+        return fallback, Material(fallback, _srgb8_to_linear(np.asarray(visual.vertex_colors).mean(axis=0)), 0.8)
+    return fallback, Material(fallback)
+
+
+def import_mesh(path: str | Path, rules: SemanticRules, up_axis: str | None = None, scale: float = 1.0,
+                **_ignored) -> TwinModel:
+    """Read a mesh file and assign classes by ``rules``.
+
+    ``up_axis`` is the file's up axis ('Y' or 'Z'; default Y for glTF, Z otherwise); ``scale`` converts
+    file units to metres.
+    """
+    path = Path(path)
+    kind = SUFFIXES.get(path.suffix.lower())
+    if kind is None:
+        raise InputError(f"{path}: unsupported mesh format '{path.suffix}'; expected one of {', '.join(SUFFIXES)}")
+    if not path.is_file():
+        raise InputError(f"{path}: file not found")
+    if not (np.isfinite(scale) and scale > 0):
+        raise InputError(f"scale should be > 0, but was {scale}")
+    up = (up_axis or DEFAULT_UP.get(kind, "Z")).upper()
+    if up not in ("Y", "Z"):
+        raise InputError(f"up axis should be Y or Z, but was {up_axis!r}")
+    try:
+        scene = trimesh.load(str(path), force="scene", split_objects=True, split_groups=False)
+    except Exception as exc:  # trimesh raises many types for malformed files
+        raise InputError(f"{path}: cannot read as {kind.upper()}: {exc}") from None
+    # Object name -> class -> parts, in file order.
+    grouped: dict[str, dict[str, list[TwinPart]]] = defaultdict(lambda: defaultdict(list))
+    materials: dict[str, Material] = {}
+    unmatched: list[str] = []
+    matched_by: dict[str, int] = defaultdict(int)
+    nodes = list(scene.graph.nodes_geometry)
+    if not nodes:
+        raise InputError(f"{path}: no geometry")
+    for node in nodes:
+        transform, geom_name = scene.graph[node]
+        geom = scene.geometry[geom_name]
+        if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
+            continue
+        points = trimesh.transform_points(np.asarray(geom.vertices, float), transform)
+        if not np.all(np.isfinite(points)):
+            raise InputError(f"{path}: object '{node}' has NaN or infinite coordinates")
+        if up == "Y":
+            points = trimesh.transform_points(points, _Y_TO_Z)
+        points *= scale
+        mat_name, material = _material(geom, "default")
+        materials.setdefault(mat_name, material)
+        obj = _object_name(node, geom_name, mat_name, kind, path)
+        fields = {"object": obj, "material": mat_name, "group": geom_name}
+        label, rule = rules.classify(fields)
+        if rule is None:
+            unmatched.append(geom_name)
+        else:
+            matched_by[f"rules[{rule}]"] += 1
+        grouped[obj][label].append(TwinPart(prim_name(mat_name, "Mesh"), points, np.asarray(geom.faces, np.int64),
+                                            mat_name, {"source_group": geom_name, "source_material": mat_name}))
+    objects = []
+    for obj, by_class in grouped.items():
+        for label, parts in by_class.items():
+            path_ = prim_name(obj) if len(by_class) == 1 else f"{prim_name(obj)}/{prim_name(label)}"
+            objects.append(TwinObject(path_, label, tuple(_unique_part_names(parts)), {"source_object": obj}))
+    if unmatched:
+        log.warning("%s: %d of %d meshes matched no rule and are labelled '%s': %s", path, len(unmatched),
+                    len(nodes), rules.default, ", ".join(unmatched[:5]) + (" ..." if len(unmatched) > 5 else ""))
+    model = TwinModel(objects=tuple(unique_paths(objects)), materials=materials, source=str(path),
+                      report={"meshes": len(nodes), "unmatched": unmatched, "matched_by": dict(matched_by),
+                              "rules": rules.source})
+    return model
+
+
+def _object_name(node: str, geom_name: str, material: str, kind: str, path: Path) -> str:
+    """The source object a geometry came from. trimesh names OBJ pieces '<object>_<material>'."""
+    if kind == "obj" and geom_name.endswith(f"_{material}") and len(geom_name) > len(material) + 1:
+        return geom_name[: -len(material) - 1]
+    if kind in ("ply", "stl"):
+        return path.stem
+    return node
+
+
+def _unique_part_names(parts: list[TwinPart]) -> list[TwinPart]:
+    seen: dict[str, int] = {}
+    out = []
+    for p in parts:
+        n = seen.get(p.name, 0)
+        seen[p.name] = n + 1
+        out.append(p if n == 0 else TwinPart(f"{p.name}_{n + 1}", p.points, p.triangles, p.material, p.attributes))
+    return out
