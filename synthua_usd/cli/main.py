@@ -318,6 +318,19 @@ def survey_gcp(surveyed: Path, model: Path, threshold_m: float, as_json: bool) -
     return EXIT_OK if report.passed else EXIT_FINDINGS
 
 
+@create.command("district")
+@click.argument("out_dir", type=click.Path(path_type=Path))
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Layout seed.")
+def create_district(out_dir: Path, seed: int) -> int:
+    """Write the Largo da Ordem demo district as a full scenario into OUT_DIR: twin, semantics, cameras
+    (CCTV, pedestrian and wheelchair eye level, UAV), environment, render settings and scenario.usda."""
+    from synthua_usd.pipeline.district import write_district_scenario
+
+    for path in write_district_scenario(out_dir, seed):
+        click.echo(f"wrote {path}")
+    return EXIT_OK
+
+
 # --- render --------------------------------------------------------------------------------------------------
 
 @cli.command()

@@ -1,0 +1,403 @@
+"""The procedural demo district, modelled on Largo da Ordem (Curitiba): about 150 m x 100 m, Z up.
+
+Layout (metres; x east, y north): an asphalt road along the south (y -45..-37) with sidewalks; a sloped
+cobbled street (x -5..5) climbing 3 m from the road (y -33) to the largo (y 5); the paved largo
+(y 5..34) with the Sunday market, benches, trees, a bicycle rack, dogs and pigeons; the church at its
+north end; rows of two- and three-storey houses with doors, windows and murals along every street;
+steps with railings down a grass slope west of the street; crosswalks with a curb ramp at each end;
+light poles and lanterns, signage, manhole covers, a bus stop with a bus, parked cars and motorcycles,
+and a few mobility aids standing unattended (a walker by a bench, a wheelchair by the church door).
+
+Everything random comes from one ``numpy.random.Generator`` seeded by the caller, drawn in a fixed
+order, so the same seed gives the same :class:`TwinModel` (and byte-identical layers).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from synthua_usd import geometry as geo
+from synthua_usd.assets import Piece, buildings, devices, market, nature, place, street, vehicles
+from synthua_usd.scene import Material
+from synthua_usd.twin import TwinModel, TwinObject, TwinPart
+
+ROAD_Y = (-45.0, -37.0)
+ROAD_SIDEWALK_S = (-49.5, -45.0)
+ROAD_SIDEWALK_N = (-37.0, -33.0)
+STREET_X = (-5.0, 5.0)
+STREET_SIDEWALK_W = 3.0
+STREET_Y = (-33.0, 5.0)
+PLAZA_X = (-45.0, 45.0)
+PLAZA_Y = (5.0, 34.0)
+PLAZA_Z = 3.0
+PAVER_H = 0.04
+KERB_H = 0.15
+HALF_X = 75.0
+CROSSWALK_XS = (-30.0, 30.0)
+STREET_CROSSWALK_Y = -29.0
+RAMP_LEN = 1.8   # 15 cm over 1.8 m: 1:12
+RAMP_HALF_W = 1.2
+
+WALL_COLOURS = [(0.62, 0.42, 0.2), (0.22, 0.35, 0.55), (0.6, 0.55, 0.45), (0.55, 0.2, 0.15), (0.35, 0.5, 0.3),
+                (0.7, 0.62, 0.35), (0.45, 0.3, 0.45), (0.75, 0.72, 0.66)]
+PAINTS = ["PaintRed", "PaintBlue", "PaintBlack", "PaintWhite", "PaintSilver"]
+
+MATERIALS = {m.key: m for m in [
+    Material("Asphalt", (0.045, 0.045, 0.05), 0.9), Material("Concrete", (0.36, 0.35, 0.33), 0.85),
+    Material("Granite", (0.48, 0.47, 0.46), 0.7), Material("RampConcrete", (0.55, 0.42, 0.22), 0.8),
+    Material("RoadPaint", (0.8, 0.8, 0.78), 0.6), Material("Mortar", (0.12, 0.11, 0.1), 0.95),
+    Material("Cobble0", (0.2, 0.19, 0.18), 0.75), Material("Cobble1", (0.28, 0.26, 0.23), 0.75),
+    Material("Cobble2", (0.16, 0.16, 0.17), 0.7), Material("PaverLight", (0.55, 0.53, 0.5), 0.8),
+    Material("PaverDark", (0.12, 0.12, 0.12), 0.8),
+    Material("Stucco", (0.8, 0.78, 0.72), 0.9), Material("Whitewash", (0.85, 0.84, 0.8), 0.9),
+    Material("RoofTile", (0.35, 0.12, 0.07), 0.8), Material("Glass", (0.04, 0.06, 0.08), 0.15),
+    Material("DoorWood", (0.25, 0.12, 0.05), 0.7), Material("Wood", (0.35, 0.2, 0.08), 0.7),
+    Material("Mural0", (0.1, 0.35, 0.6), 0.8), Material("Mural1", (0.7, 0.25, 0.4), 0.8),
+    Material("Mural2", (0.8, 0.6, 0.1), 0.8),
+    Material("Iron", (0.06, 0.06, 0.065), 0.5, metallic=0.8), Material("LampGlass", (0.9, 0.88, 0.8), 0.3),
+    Material("SignRed", (0.6, 0.03, 0.03), 0.5), Material("SignBlue", (0.03, 0.12, 0.5), 0.5),
+    Material("Tyre", (0.02, 0.02, 0.02), 0.9), Material("Seat", (0.03, 0.05, 0.15), 0.8),
+    Material("Frame", (0.55, 0.57, 0.6), 0.3, metallic=0.9), Material("CaneWhite", (0.85, 0.85, 0.85), 0.4),
+    Material("CaneRed", (0.6, 0.03, 0.03), 0.4),
+    Material("PaintRed", (0.45, 0.03, 0.03), 0.3, metallic=0.3), Material("PaintBlue", (0.03, 0.1, 0.4), 0.3, metallic=0.3),
+    Material("PaintBlack", (0.02, 0.02, 0.02), 0.3, metallic=0.3),
+    Material("PaintWhite", (0.75, 0.75, 0.75), 0.3, metallic=0.3),
+    Material("PaintSilver", (0.45, 0.46, 0.48), 0.3, metallic=0.6), Material("PaintOrange", (0.7, 0.25, 0.02), 0.4),
+    Material("CanvasWhite", (0.8, 0.8, 0.78), 0.9), Material("CanvasRed", (0.55, 0.06, 0.05), 0.9),
+    Material("CanvasBlue", (0.06, 0.15, 0.5), 0.9), Material("CanvasYellow", (0.75, 0.55, 0.05), 0.9),
+    Material("Goods", (0.5, 0.3, 0.15), 0.8), Material("PlasticWhite", (0.8, 0.8, 0.8), 0.5),
+    Material("Bark", (0.18, 0.11, 0.06), 0.9), Material("Leaves", (0.07, 0.2, 0.04), 0.8),
+    Material("Grass", (0.1, 0.28, 0.05), 0.95), Material("Fur", (0.35, 0.22, 0.1), 0.9),
+    Material("Feathers", (0.35, 0.36, 0.4), 0.8),
+] + [Material(f"Wall{i}", c, 0.9) for i, c in enumerate(WALL_COLOURS)]}
+
+
+def street_z(y: float | np.ndarray) -> float | np.ndarray:
+    """Height of the cobbled street's bed at ``y``: 0 at the road, PLAZA_Z at the largo."""
+    t = np.clip((np.asarray(y, float) - STREET_Y[0]) / (STREET_Y[1] - STREET_Y[0]), 0.0, 1.0)
+    return t * PLAZA_Z
+
+
+def _shear(mesh: geo.Mesh) -> geo.Mesh:
+    """Lift a mesh by the street's slope at each vertex's y (planar faces stay planar: the slope is linear)."""
+    pts, tris = mesh
+    return pts + np.column_stack([np.zeros(len(pts)), np.zeros(len(pts)), street_z(pts[:, 1])]), tris
+
+
+def _ramp_along_x(x_low, x_high, y0, y1, z_low, z_high, z_base) -> geo.Mesh:
+    """A wedge rising along x (``x_low`` may exceed ``x_high``)."""
+    pts, tris = geo.ramp(y0, y1, x_low, x_high, z_low, z_high, z_base)
+    return pts[:, [1, 0, 2]], tris[:, ::-1]
+
+
+class _Builder:
+    """Collects objects in order; names are made unique per folder."""
+
+    def __init__(self) -> None:
+        self.objects: list[TwinObject] = []
+        self._counts: dict[str, int] = {}
+
+    def add(self, folder: str, stem: str, label: str, pieces: list[Piece], **attributes) -> str:
+        n = self._counts.get(f"{folder}/{stem}", 0)
+        self._counts[f"{folder}/{stem}"] = n + 1
+        path = f"{folder}/{stem}_{n:03d}"
+        parts = tuple(TwinPart(p.name if i == 0 or p.name not in [q.name for q in pieces[:i]] else f"{p.name}_{i}",
+                               p.mesh[0], p.mesh[1], p.material) for i, p in enumerate(pieces))
+        self.objects.append(TwinObject(path, label, parts, attributes))
+        return path
+
+
+def _cobbles(rng: np.random.Generator, x0, x1, y0, y1, size, gap, height, materials) -> list[Piece]:
+    """Stones in running bond; heights jittered by up to 1 cm; split into chunks of ~5 m along y."""
+    sx, sy = size
+    pieces = []
+    for cy0 in np.arange(y0, y1, 5.0):
+        cy1 = min(cy0 + 5.0, y1)
+        boxes: dict[str, list[geo.Mesh]] = {m: [] for m in materials}
+        row = 0
+        y = cy0
+        while y + sy <= cy1 + 1e-9:
+            x = x0 + (sx / 2 if row % 2 else 0.0)
+            while x + sx <= x1 + 1e-9:
+                h = height - rng.uniform(0.0, 0.01)
+                mat = materials[int(rng.integers(len(materials)))]
+                boxes[mat].append(geo.box((x + gap / 2, y + gap / 2, 0.0), (x + sx - gap / 2, y + sy - gap / 2, h)))
+                x += sx
+            y += sy
+            row += 1
+        for mat, items in boxes.items():
+            if items:
+                pieces.append(Piece(f"Stones_{int(cy0 - y0):03d}_{mat}", geo.merge(*items), mat))
+    return pieces
+
+
+def _sidewalk_x_strip(x0, x1, y_kerb, y_back, gaps: list[float], z_of=None) -> list[Piece]:
+    """A sidewalk along x whose kerb faces the road at ``y_kerb``; curb-ramp gaps centred at ``gaps``.
+    Returns slab and kerb pieces (the kerb is 20 cm of granite along the road edge)."""
+    sgn = 1.0 if y_back > y_kerb else -1.0
+    cuts = sorted(gaps)
+    spans, start = [], x0
+    for g in cuts:
+        spans.append((start, g - RAMP_HALF_W))
+        start = g + RAMP_HALF_W
+    spans.append((start, x1))
+    slab, kerb = [], []
+    yk0, yk1 = sorted((y_kerb, y_kerb + sgn * 0.2))
+    ys0, ys1 = sorted((y_kerb + sgn * 0.2, y_back))
+    for a, b in spans:
+        if b - a > 0.01:
+            slab.append(geo.box((a, ys0, -0.3), (b, ys1, KERB_H)))
+            kerb.append(geo.box((a, yk0, -0.3), (b, yk1, KERB_H)))
+    for g in cuts:  # behind each ramp the sidewalk continues at full height
+        yb0, yb1 = sorted((y_kerb + sgn * RAMP_LEN, y_back))
+        slab.append(geo.box((g - RAMP_HALF_W, yb0, -0.3), (g + RAMP_HALF_W, yb1, KERB_H)))
+    return [Piece("Slab", geo.merge(*slab), "Concrete"), Piece("Kerb", geo.merge(*kerb), "Granite")]
+
+
+def build_district(seed: int = 0) -> TwinModel:
+    """The district for ``seed`` as a :class:`TwinModel` (local metres, origin at the layout's centre)."""
+    rng = np.random.default_rng(seed)
+    b = _Builder()
+    _streets(b, rng)
+    _buildings(b, rng)
+    _furniture(b, rng)
+    _market(b, rng)
+    _vehicles(b, rng)
+    _nature(b, rng)
+    _mobility_aids(b)
+    return TwinModel(objects=tuple(b.objects), materials=dict(MATERIALS), source=f"largo-da-ordem demo district (seed {seed})",
+                     report={"seed": seed})
+
+
+def _streets(b: _Builder, rng: np.random.Generator) -> None:
+    L = HALF_X
+    # Open ground under everything, 2 cm below the road so that no two surfaces are coplanar.
+    b.add("Nature", "Ground", "grass", [Piece("Surface", geo.box((-L, -50.0, -0.5), (L, 50.0, -0.02)), "Grass")])
+    b.add("Streets", "AsphaltRoad", "road", [Piece("Surface", geo.box((-L, ROAD_Y[0], -0.3), (L, ROAD_Y[1], 0.0)), "Asphalt")])
+    # Road sidewalks, with curb ramps at the crosswalks; the north one stops at the cobbled street.
+    b.add("Sidewalks", "RoadSouth", "sidewalk", _sidewalk_x_strip(-L, L, ROAD_Y[0], ROAD_SIDEWALK_S[0], list(CROSSWALK_XS)))
+    for side, (x0, x1) in (("RoadNorthWest", (-L, STREET_X[0] - STREET_SIDEWALK_W)),
+                           ("RoadNorthEast", (STREET_X[1] + STREET_SIDEWALK_W, L))):
+        gaps = [g for g in CROSSWALK_XS if x0 < g < x1]
+        b.add("Sidewalks", side, "sidewalk", _sidewalk_x_strip(x0, x1, ROAD_Y[1], ROAD_SIDEWALK_N[1], gaps))
+    for x in CROSSWALK_XS:
+        for y_kerb, sgn in ((ROAD_Y[0], -1.0), (ROAD_Y[1], 1.0)):
+            ya, yb = sorted((y_kerb, y_kerb + sgn * RAMP_LEN))
+            low, high = (yb, ya) if sgn < 0 else (ya, yb)
+            pts, tris = geo.ramp(x - RAMP_HALF_W, x + RAMP_HALF_W, low, high, 0.005, KERB_H, -0.3)
+            b.add("CurbRamps", "Ramp", "curb_ramp", [Piece("Surface", (pts, tris), "RampConcrete")])
+        bars = [geo.box((x - 1.5, y, 0.0), (x + 1.5, y + 0.5, 0.01)) for y in np.arange(ROAD_Y[0] + 0.25, ROAD_Y[1] - 0.4, 1.0)]
+        b.add("Crosswalks", "Zebra", "crosswalk", [Piece("Bars", geo.merge(*bars), "RoadPaint")])
+    # The cobbled street: a mortar bed and stones, sloping up to the largo.
+    x0, x1 = STREET_X
+    bed = _shear(geo.box((x0, STREET_Y[0], -0.5), (x1, STREET_Y[1], 0.0)))
+    stones = [Piece(p.name, _shear(p.mesh), p.material)
+              for p in _cobbles(rng, x0, x1, STREET_Y[0], STREET_Y[1], (0.18, 0.14), 0.015, 0.07, ["Cobble0", "Cobble1", "Cobble2"])]
+    b.add("Streets", "CobbledStreet", "street_road", [Piece("Bed", bed, "Mortar")] + stones, surface="cobblestone")
+    # Its sidewalks (sheared with the slope) and a crosswalk near the bottom with ramps on both sides.
+    cy = STREET_CROSSWALK_Y
+    for side, (kx, sgn) in (("StreetWest", (x0, -1.0)), ("StreetEast", (x1, 1.0))):
+        xa, xb = sorted((kx + sgn * 0.2, kx + sgn * STREET_SIDEWALK_W))
+        ka, kb = sorted((kx, kx + sgn * 0.2))
+        ra, rb = sorted((kx, kx + sgn * RAMP_LEN))
+        slab = [geo.box((xa, STREET_Y[0], -0.5), (xb, cy - RAMP_HALF_W, KERB_H)),
+                geo.box((xa, cy + RAMP_HALF_W, -0.5), (xb, STREET_Y[1], KERB_H))]
+        back_a, back_b = sorted((kx + sgn * RAMP_LEN, kx + sgn * STREET_SIDEWALK_W))
+        slab.append(geo.box((back_a, cy - RAMP_HALF_W, -0.5), (back_b, cy + RAMP_HALF_W, KERB_H)))
+        kerb = [geo.box((ka, STREET_Y[0], -0.5), (kb, cy - RAMP_HALF_W, KERB_H)),
+                geo.box((ka, cy + RAMP_HALF_W, -0.5), (kb, STREET_Y[1], KERB_H))]
+        b.add("Sidewalks", side, "sidewalk", [Piece("Slab", _shear(geo.merge(*slab)), "Concrete"),
+                                              Piece("Kerb", _shear(geo.merge(*kerb)), "Granite")])
+        low, high = (ra, rb) if sgn > 0 else (rb, ra)
+        b.add("CurbRamps", "Ramp", "curb_ramp",
+              [Piece("Surface", _shear(_ramp_along_x(low, high, cy - RAMP_HALF_W, cy + RAMP_HALF_W, 0.075, KERB_H, -0.5)),
+                     "RampConcrete")])
+    bars = [geo.box((x, cy - 1.5, 0.072), (x + 0.5, cy + 1.5, 0.085)) for x in np.arange(x0 + 0.25, x1 - 0.4, 1.0)]
+    b.add("Crosswalks", "Zebra", "crosswalk", [Piece("Bars", _shear(geo.merge(*bars)), "RoadPaint")])
+    # The largo: a slab paved with light and dark stones (Curitiba's petit-pavé).
+    pavers = _cobbles(rng, PLAZA_X[0], PLAZA_X[1], PLAZA_Y[0], PLAZA_Y[1], (0.35, 0.35), 0.02, PAVER_H,
+                      ["PaverLight", "PaverLight", "PaverDark"])
+    b.add("Sidewalks", "Largo", "sidewalk",
+          [Piece("Bed", geo.box((PLAZA_X[0], PLAZA_Y[0], PLAZA_Z - 3.5), (PLAZA_X[1], PLAZA_Y[1], PLAZA_Z)), "Mortar")]
+          + [Piece(p.name, (p.mesh[0] + [0, 0, PLAZA_Z], p.mesh[1]), p.material) for p in pavers])
+    # Grass slope west of the street, steps down it, railings along the steps and the slope's top edge.
+    gx0, gx1, gy0 = -45.0, -19.0, -21.0
+    slope = geo.ramp(gx0, gx1, gy0, PLAZA_Y[0], KERB_H, PLAZA_Z, -0.5)
+    b.add("Nature", "GrassSlope", "grass", [Piece("Surface", slope, "Grass")])
+    n_steps, rise = 19, (PLAZA_Z - KERB_H) / 19
+    tread = (PLAZA_Y[0] - gy0) / n_steps
+    flight = place(street.steps(3.0, n_steps, rise, tread), (-30.0, gy0, KERB_H), 90.0)
+    b.add("Steps", "Flight", "sidewalk", flight, surface="steps")
+    for x in (-31.6, -28.4):
+        b.add("Railings", "Railing", "railing",
+              street.railing((x, gy0, KERB_H), (x, PLAZA_Y[0], PLAZA_Z), height=1.0))
+    b.add("Railings", "Railing", "railing", street.railing((gx0, PLAZA_Y[0] - 0.1, PLAZA_Z), (-31.8, PLAZA_Y[0] - 0.1, PLAZA_Z)))
+    b.add("Railings", "Railing", "railing", street.railing((-28.2, PLAZA_Y[0] - 0.1, PLAZA_Z), (gx1, PLAZA_Y[0] - 0.1, PLAZA_Z)))
+    # Manhole covers on the road, the cobbles and the largo.
+    for x, y, z in [(-55.0, -41.0, 0.0), (12.0, -39.5, 0.0), (48.0, -43.0, 0.0), (0.0, -12.0, None), (-20.0, 28.0, PLAZA_Z + PAVER_H)]:
+        z = float(street_z(y)) + 0.07 if z is None else z
+        b.add("Covers", "Manhole", "cover", place(street.manhole_cover(), (x, y, z)))
+
+
+def _buildings(b: _Builder, rng: np.random.Generator) -> None:
+    def house(folder, at, heading, width, depth, storeys, mural, foundation):
+        wall = f"Wall{int(rng.integers(len(WALL_COLOURS)))}"
+        parts = buildings.row_house(rng, width, depth, storeys, wall, foundation_m=foundation, mural=mural)
+        stem = b.add(folder, "House", "building", place(parts.structure, at, heading), storeys=storeys)
+        for door in parts.doors:
+            b.objects.append(_sub(stem, "Door", len([o for o in b.objects if o.path.startswith(stem + "/Door")]), "door",
+                                  place(door, at, heading)))
+        for k, window in enumerate(parts.windows):
+            b.objects.append(_sub(stem, "Window", k, "window", place(window, at, heading)))
+        for k, mural_p in enumerate(parts.murals):
+            b.objects.append(_sub(stem, "Mural", k, "mural", place(mural_p, at, heading)))
+
+    depth = 11.0
+    # Along the cobbled street, stepping up with the slope; fronts on the sidewalks' back edge.
+    for side, front_x, heading in (("StreetWest", STREET_X[0] - STREET_SIDEWALK_W, 0.0),
+                                   ("StreetEast", STREET_X[1] + STREET_SIDEWALK_W, 180.0)):
+        y = STREET_Y[0] + 4.5
+        while y < STREET_Y[1] - 3.0:
+            width = float(rng.uniform(5.5, 8.5))
+            width = min(width, STREET_Y[1] - y)
+            cy = y + width / 2
+            cx = front_x - depth / 2 if heading == 0.0 else front_x + depth / 2
+            z = float(street_z(cy)) + KERB_H
+            house(f"Buildings/{side}", (cx, cy, z), heading, width, depth, int(rng.integers(2, 4)),
+                  bool(rng.random() < 0.35), foundation=3.5)
+            y += width
+    # Along the asphalt road's north side, facing south.
+    for x_from, x_to in ((-HALF_X + 1.0, -46.0), (STREET_X[1] + STREET_SIDEWALK_W + 12.0, HALF_X - 1.0)):
+        x = x_from
+        while x < x_to - 4.0:
+            width = min(float(rng.uniform(6.0, 9.0)), x_to - x)
+            house("Buildings/RoadNorth", (x + width / 2, ROAD_SIDEWALK_N[1] + depth / 2, KERB_H), -90.0, width, depth,
+                  int(rng.integers(2, 4)), bool(rng.random() < 0.3), foundation=0.5)
+            x += width
+    # Framing the largo, west and east.
+    for x_front, heading in ((PLAZA_X[0], 0.0), (PLAZA_X[1], 180.0)):
+        y = PLAZA_Y[0] + 1.0
+        while y < PLAZA_Y[1] + 10.0:
+            width = float(rng.uniform(6.0, 9.0))
+            cx = x_front - depth / 2 if heading == 0.0 else x_front + depth / 2
+            house("Buildings/Largo", (cx, y + width / 2, PLAZA_Z + PAVER_H), heading, width, depth,
+                  int(rng.integers(2, 4)), bool(rng.random() < 0.3), foundation=3.5)
+            y += width
+    # The church at the north end of the largo, facing south.
+    parts = buildings.church(width=14.0, depth=14.0)
+    at, heading = (0.0, PLAZA_Y[1] + 7.5, PLAZA_Z + PAVER_H), -90.0
+    stem = b.add("Buildings", "Church", "building", place(parts.structure, at, heading), name="Igreja da Ordem")
+    for k, door in enumerate(parts.doors):
+        b.objects.append(_sub(stem, "Door", k, "door", place(door, at, heading)))
+    for k, window in enumerate(parts.windows):
+        b.objects.append(_sub(stem, "Window", k, "window", place(window, at, heading)))
+
+
+def _sub(stem: str, kind: str, k: int, label: str, pieces: list[Piece]) -> TwinObject:
+    """A door, window or mural of a building: its own instance beside the building's structure."""
+    folder, name = stem.rsplit("/", 1)
+    return TwinObject(f"{folder}/{name}_{kind}_{k:02d}", label,
+                      tuple(TwinPart(p.name, p.mesh[0], p.mesh[1], p.material) for p in pieces))
+
+
+def _furniture(b: _Builder, rng: np.random.Generator) -> None:
+    pz = PLAZA_Z + PAVER_H
+    # Lanterns along the cobbled street's sidewalks and round the largo; arm lights along the road.
+    for x, heading in ((STREET_X[0] - 0.6, 0.0), (STREET_X[1] + 0.6, 180.0)):
+        for y in np.arange(STREET_Y[0] + 6.0, STREET_Y[1], 12.0):
+            pole, lamp = street.light_pole(4.0)
+            at = (x, y, float(street_z(y)) + KERB_H)
+            b.add("Lighting", "Pole", "light_pole", place(pole, at, heading))
+            b.add("Lighting", "Lantern", "luminaire", place(lamp, at, heading))
+    for x in np.arange(PLAZA_X[0] + 5.0, PLAZA_X[1], 15.0):
+        for y in (PLAZA_Y[0] + 1.0, PLAZA_Y[1] - 1.0):
+            pole, lamp = street.light_pole(4.0)
+            b.add("Lighting", "Pole", "light_pole", place(pole, (x, y, pz)))
+            b.add("Lighting", "Lantern", "luminaire", place(lamp, (x, y, pz)))
+    for x in np.arange(-HALF_X + 8.0, HALF_X, 20.0):
+        for y, heading in ((ROAD_Y[1] + 0.5, -90.0), (ROAD_Y[0] - 0.5, 90.0)):
+            pole, lamp = street.light_pole(7.0, arm=1.8)
+            b.add("Lighting", "Pole", "light_pole", place(pole, (x, y, KERB_H), heading))
+            b.add("Lighting", "Luminaire", "luminaire", place(lamp, (x, y, KERB_H), heading))
+    # Benches round the largo.
+    for x in np.arange(PLAZA_X[0] + 10.0, PLAZA_X[1] - 5.0, 15.0):
+        b.add("Furniture", "Bench", "furniture", place(street.bench(), (x, PLAZA_Y[0] + 3.0, pz), 90.0))
+    # Signage: street names at the corners, a stop sign where the street meets the road, the bus stop.
+    for x in (STREET_X[0] - 1.0, STREET_X[1] + 1.0):
+        b.add("Signage", "StreetName", "signage", place(street.sign(kind="street"), (x, ROAD_SIDEWALK_N[0] + 1.0, KERB_H), -90.0))
+    b.add("Signage", "Stop", "signage", place(street.sign(kind="stop"), (STREET_X[1] + 0.8, STREET_Y[0] + 1.5, KERB_H), -90.0))
+    b.add("Signage", "BusStop", "signage", place(street.sign(kind="bus"), (38.0, ROAD_Y[1] + 0.7, KERB_H), -90.0))
+    b.add("Furniture", "BusShelter", "furniture", place(street.bus_shelter(), (44.0, ROAD_SIDEWALK_N[1] - 1.0, KERB_H), -90.0))
+    b.add("Furniture", "BikeRack", "furniture", place(street.bike_rack(), (36.0, PLAZA_Y[0] + 6.0, pz)))
+
+
+def _market(b: _Builder, rng: np.random.Generator) -> None:
+    pz = PLAZA_Z + PAVER_H
+    canvases = ["CanvasWhite", "CanvasRed", "CanvasBlue", "CanvasYellow"]
+    for y, heading in ((13.0, 90.0), (24.0, -90.0)):
+        for x in np.arange(-27.0, 25.0, 3.6):
+            if rng.random() < 0.15:
+                continue  # a gap in the row
+            canvas = canvases[int(rng.integers(len(canvases)))]
+            b.add("Market", "Tent", "tent", place(market.tent(3.0, canvas=canvas), (x, y, pz), heading))
+            b.add("Market", "Stand", "stand", place(market.stand(2.4), (x + 0.2 * np.sign(heading), y, pz), heading))
+    # A café corner: tables, chairs and umbrellas.
+    for k, (x, y) in enumerate([(31.0, 12.0), (34.5, 12.5), (32.0, 16.5), (35.5, 17.0), (33.5, 21.0)]):
+        x += float(rng.uniform(-0.4, 0.4))
+        b.add("Market", "Table", "table", place(market.table(), (x, y, pz)))
+        for a in (0.0, 120.0, 240.0):
+            off = 0.75 * np.array([np.cos(np.radians(a)), np.sin(np.radians(a))])
+            b.add("Market", "Chair", "chair", place(market.chair(), (x + off[0], y + off[1], pz), a))
+        if k % 2 == 0:
+            b.add("Market", "Umbrella", "umbrella", place(market.umbrella(canvas=canvases[k % 4]), (x, y, pz)))
+
+
+def _vehicles(b: _Builder, rng: np.random.Generator) -> None:
+    lane = ROAD_Y[0] + 1.3
+    for x_from, x_to in ((-70.0, -36.0), (-24.0, 24.0), (36.0, 55.0)):
+        x = x_from
+        while x < x_to - 4.5:
+            if rng.random() < 0.7:
+                paint = PAINTS[int(rng.integers(len(PAINTS)))]
+                b.add("Vehicles", "Car", "car", place(vehicles.car(float(rng.uniform(3.9, 4.6)), paint=paint), (x + 2.3, lane, 0.0)))
+            x += 6.0
+    b.add("Vehicles", "Bus", "bus", place(vehicles.bus(), (44.0, ROAD_Y[1] - 1.6, 0.0), 180.0))
+    for k in range(3):
+        b.add("Vehicles", "Motorcycle", "motorcycle", place(vehicles.motorcycle(), (60.0 + 1.2 * k, lane, 0.0), 60.0))
+    for k in range(4):
+        b.add("Vehicles", "Bicycle", "bicycle", place(vehicles.bicycle(), (36.0 + 0.3, PLAZA_Y[0] + 4.9 + 0.75 * k, PLAZA_Z + PAVER_H), 90.0))
+
+
+def _nature(b: _Builder, rng: np.random.Generator) -> None:
+    pz = PLAZA_Z + PAVER_H
+    for x, y in [(-38.0, 9.0), (-38.0, 30.0), (38.0, 30.0), (-14.0, 30.0), (14.0, 30.0)]:
+        b.add("Nature", "GrassBed", "grass", place(nature.grass_bed(4.0, 4.0), (x, y, pz)))
+        b.add("Nature", "Tree", "vegetation", place(nature.tree(rng, float(rng.uniform(6.0, 8.0))), (x, y, pz + 0.22)))
+    for x in np.arange(-40.0, -21.0, 9.0):
+        b.add("Nature", "Tree", "vegetation", place(nature.tree(rng, float(rng.uniform(5.0, 7.0))), (x, -14.0, 1.0)))
+    b.add("Nature", "Araucaria", "vegetation", place(nature.araucaria(12.0), (-20.0, -4.0, 2.2)))
+    for k in range(3):
+        at = (float(rng.uniform(-20, 20)), float(rng.uniform(16, 22)), pz)
+        b.add("Animals", "Dog", "animal", place(nature.dog(float(rng.uniform(0.8, 1.2))), at, float(rng.uniform(0, 360))))
+    cx, cy = float(rng.uniform(-10, 10)), float(rng.uniform(28, 31))
+    for k in range(12):
+        at = (cx + float(rng.normal(0, 1.2)), cy + float(rng.normal(0, 0.8)), pz)
+        b.add("Animals", "Pigeon", "animal", place(nature.pigeon(), at, float(rng.uniform(0, 360))))
+
+
+def _mobility_aids(b: _Builder) -> None:
+    """Devices standing unattended so that every class appears in the twin; the agents layer brings
+    devices in use, with their users."""
+    pz = PLAZA_Z + PAVER_H
+    spots = {
+        "walker": ((-20.0, PLAZA_Y[0] + 2.2, pz), 0.0),
+        "manual_wheelchair": ((3.0, PLAZA_Y[1] - 1.5, pz), -90.0),
+        "electric_wheelchair": ((41.5, ROAD_SIDEWALK_N[1] - 1.2, KERB_H), 180.0),
+        "crutch": ((31.5, 12.5, pz), 0.0),
+        "smart_cane": ((-4.6, PLAZA_Y[0] + 2.6, pz), 0.0),
+        "wooden_cane": ((10.4, PLAZA_Y[0] + 2.6, pz), 0.0),
+        "orthopedic_cane": ((25.4, PLAZA_Y[0] + 2.6, pz), 0.0),
+        "tripod_cane": ((-19.4, PLAZA_Y[0] + 2.6, pz), 0.0),
+    }
+    for name, (at, heading) in spots.items():
+        b.add("MobilityAids", name.title().replace("_", ""), name, place(devices.DEVICES[name](), at, heading))

@@ -1,0 +1,64 @@
+"""The demo district as layers: ``synthua twin demo`` writes its twin and semantics; ``write_district_scenario``
+adds camera rigs, environment and render settings for the shipped scenario in ``stages/district``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from synthua_usd.largo_district import PLAZA_Z, build_district, street_z
+from synthua_usd.taxonomy import ClassMap
+from synthua_usd.usd.authoring import StageMetadata
+from synthua_usd.usd.twin_writer import write_twin
+
+META = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=24.0, start_time_code=1.0,
+                     end_time_code=48.0, default_prim="World")
+
+#: name, eye (x, y, z), target, focal mm, filmback mm (w, h), purpose.
+DISTRICT_CAMERAS = (
+    ("CCTV_Largo", (-30.0, 6.0, PLAZA_Z + 6.0), (0.0, 20.0, PLAZA_Z), 2.8, (4.8, 3.6),
+     "CCTV on a largo lamp post, 6 m up, over the market."),
+    ("CCTV_Street", (6.5, -34.0, 6.0), (0.0, -10.0, 1.0), 2.8, (4.8, 3.6),
+     "CCTV at the foot of the cobbled street, looking up the slope."),
+    ("PedestrianEye_Street", (-6.5, -30.0, float(street_z(-30.0)) + 0.15 + 1.6), (-2.0, 0.0, PLAZA_Z + 1.0), 24.0,
+     (36.0, 24.0), "Pedestrian eye level (1.6 m) on the cobbled street's west sidewalk, looking uphill."),
+    ("WheelchairEye_Largo", (-12.0, 7.0, PLAZA_Z + 1.24), (10.0, 25.0, PLAZA_Z + 1.0), 24.0, (36.0, 24.0),
+     "Seated wheelchair user's eye level (1.2 m) in the largo."),
+    ("UAV_Oblique", (-60.0, -70.0, 55.0), (0.0, 0.0, 0.0), 24.0, (36.0, 24.0),
+     "UAV, oblique 45 degrees over the district."),
+)
+
+
+def write_district(out_dir: str | Path, seed: int = 0, class_map: ClassMap | None = None) -> dict:
+    """Write ``twin.usda`` and ``semantics.usda`` of the district for ``seed``; returns counts and paths."""
+    model = build_district(seed)
+    files = write_twin(model, out_dir, class_map or ClassMap.default(), META)
+    return {"files": files, "objects": len(model.objects), "triangles": model.triangle_count(),
+            "classes": model.label_counts()}
+
+
+def write_district_scenario(out_dir: str | Path, seed: int = 0) -> list[Path]:
+    """The district's twin and semantics plus cameras, environment, render settings and ``scenario.usda``."""
+    from synthua_usd import geometry as geo
+    from synthua_usd.usd.authoring import define_xform, new_layer, save_layer_atomic
+    from synthua_usd.usd.cameras import author_camera
+    from synthua_usd.usd.compose import compose_layers
+    from synthua_usd.usd.scenario_layers import build_environment, build_render_settings
+    from pxr import Kind
+
+    out_dir = Path(out_dir)
+    files = list(write_district(out_dir, seed)["files"])
+    cams = new_layer(META, "Largo da Ordem demo district: camera rigs with physical lens values.")
+    cams.SetDefaultPrim(cams.OverridePrim("/World"))
+    define_xform(cams, "/World/Cameras", kind=Kind.Tokens.group)
+    for name, eye, target, focal, (fw, fh), doc in DISTRICT_CAMERAS:
+        author_camera(cams, f"/World/Cameras/{name}", geo.look_at(eye, target), focal_length_mm=focal,
+                      horizontal_aperture_mm=fw, vertical_aperture_mm=fh, clip_near_m=0.05, clip_far_m=1000.0,
+                      meters_per_unit=1.0, doc=doc)
+    layers = {"cameras.usda": cams, "environment.usda": build_environment(META),
+              "render.usda": build_render_settings(META, camera="/World/Cameras/CCTV_Largo")}
+    for name, stage in layers.items():
+        files.append(save_layer_atomic(stage.GetRootLayer(), out_dir / name))
+    order = ["render.usda", "environment.usda", "cameras.usda", "semantics.usda", "twin.usda"]
+    files.append(compose_layers(out_dir / "scenario.usda", [out_dir / n for n in order],
+                                doc=f"Largo da Ordem demo district (seed {seed}) scenario."))
+    return files
