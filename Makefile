@@ -9,13 +9,18 @@ SCENARIO := stages/scenario.usda
 setup:
 	@bash tools/setup.sh
 
-## Validate the shipped demo scenario and render its CCTV and pedestrian-eye cameras into out/demo/.
+DISTRICT := stages/district/scenario.usda
+
+## Validate the shipped scenarios and render the demo street's CCTV and pedestrian-eye cameras and the
+## Largo da Ordem district's largo CCTV into out/demo/.
 demo: setup
 	$(BIN)/synthua validate stage $(SCENARIO)
 	$(BIN)/synthua inspect $(SCENARIO)
 	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/CCTV --frame 24 --out $(DEMO_OUT)/cctv
 	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/PedestrianEye --frame 24 --out $(DEMO_OUT)/pedestrian_eye
-	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/cctv and $(DEMO_OUT)/pedestrian_eye"
+	$(BIN)/synthua validate stage $(DISTRICT)
+	$(BIN)/synthua render $(DISTRICT) --camera /World/Cameras/CCTV_Largo --out $(DEMO_OUT)/district_cctv_largo
+	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}"
 
 ## The whole test suite (slow tests included).
 test: setup
@@ -24,6 +29,7 @@ test: setup
 ## Regenerate the committed demo layers in stages/ from the library code.
 stages: setup
 	$(BIN)/synthua create street stages
+	$(BIN)/synthua create district stages/district --seed 0
 
 ## Render and label timings (not a test: numbers to compare by hand).
 bench: setup

@@ -74,8 +74,9 @@ def plan_flight(p: FlightPlanInput) -> FlightPlan:
     w = footprint_m(p.altitude_m, p.fov_deg)
     frontal = (1.0 - p.frontal_overlap) * w
     lateral = (1.0 - p.lateral_overlap) * w
-    lines = math.ceil(p.area_width_m / lateral) + 1
-    per_line = math.ceil(p.area_length_m / frontal) + 1
+    # A tolerance keeps 300 m / 100 m at 3 spans although tan() leaves 99.999... m.
+    lines = math.ceil(p.area_width_m / lateral - 1e-9) + 1
+    per_line = math.ceil(p.area_length_m / frontal - 1e-9) + 1
     gsd = None
     if p.sensor_width_mm is not None:
         gsd = p.sensor_width_mm * p.altitude_m / (p.focal_length_mm * p.image_width_px)

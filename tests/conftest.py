@@ -36,3 +36,14 @@ def demo_stage():
     from synthua_usd.usd.stage_io import open_stage
 
     return open_stage(SCENARIO)
+
+
+THIRD_PARTY = SHARED / "data" / "third_party"
+
+
+def third_party(*parts: str) -> Path:
+    """A file of ../shared/data/third_party, or skip the test when the shared folder is not beside the clone."""
+    path = THIRD_PARTY.joinpath(*parts)
+    if not path.exists():
+        pytest.skip(f"{path} is absent: third-party test data lives in ../shared beside the repository (CI has it)")
+    return path

@@ -71,7 +71,7 @@ def build_overview_cameras(meta: StageMetadata, bounds_min, bounds_max, street_p
     Full-frame 24 mm lenses."""
     lo, hi = np.asarray(bounds_min, float), np.asarray(bounds_max, float)
     centre = (lo + hi) / 2
-    radius = max(float(np.linalg.norm(hi[:2] - lo[:2])) / 2, 5.0)
+    radius = max(float(np.linalg.norm(hi[:2] - lo[:2])) / 2, 1.0)
     # 24 mm on 36 x 24 mm sees ~74 x 53 degrees; 1.4 radii away the extent's circle fits at 45 degrees.
     dist = 1.4 * radius
     eye = centre + np.array([-dist * 0.5, -dist * 0.5, dist * 0.7071])

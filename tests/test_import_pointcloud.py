@@ -1,0 +1,111 @@
+import numpy as np
+import pytest
+import trimesh
+
+from conftest import third_party
+from synthua_usd.errors import InputError
+from synthua_usd.importers.pointcloud import fit_plane, import_pointcloud
+
+
+def write_las(path, xyz, classes=None):
+    import laspy
+
+    header = laspy.LasHeader(point_format=3, version="1.2")
+    header.scales = np.array([0.001, 0.001, 0.001])
+    header.offsets = xyz.min(axis=0) if len(xyz) else np.zeros(3)
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+    if classes is not None:
+        las.classification = classes
+    las.write(str(path))
+    return path
+
+
+def street_corner(rng, n_ground=3000, n_wall=2000, noise=0.002):
+    """A 20 x 20 m ground at z = 100 (tilted 2 %) and a façade x = 510 m, 8 m tall; millimetre noise."""
+    g = np.column_stack([rng.uniform(490, 510, n_ground), rng.uniform(0, 20, n_ground), np.zeros(n_ground)])
+    g[:, 2] = 100.0 + 0.02 * (g[:, 0] - 490) + rng.normal(0, noise, n_ground)
+    w = np.column_stack([510.0 + rng.normal(0, noise, n_wall), rng.uniform(0, 20, n_wall), rng.uniform(100.5, 108, n_wall)])
+    return g, w
+
+
+@pytest.fixture(scope="module")
+def corner(tmp_path_factory):
+    rng = np.random.default_rng(7)
+    g, w = street_corner(rng)
+    path = write_las(tmp_path_factory.mktemp("las") / "corner.las", np.concatenate([g, w]))
+    return path, g, w, import_pointcloud(path, max_deviation_m=0.005, plane_threshold_m=0.01)
+
+
+def test_ransac_finds_ground_and_facade(corner):
+    _, g, w, model = corner
+    segs = {s["name"]: s for s in model.report["segments"]}
+    assert {"Plane_00_ground", "Plane_01_facade"} <= set(segs)
+    assert segs["Plane_00_ground"]["label"] == "road" and segs["Plane_01_facade"]["label"] == "building"
+    assert segs["Plane_00_ground"]["points"] == pytest.approx(len(g), rel=0.01)
+    assert segs["Plane_01_facade"]["points"] == pytest.approx(len(w), rel=0.01)
+
+
+def test_least_squares_plane_matches_an_independent_fit():
+    rng = np.random.default_rng(3)
+    pts = np.column_stack([rng.uniform(0, 10, 500), rng.uniform(0, 10, 500), np.zeros(500)])
+    pts[:, 2] = 0.1 * pts[:, 0] - 0.05 * pts[:, 1] + 2.0 + rng.normal(0, 0.001, 500)
+    normal, d = fit_plane(pts)
+    # Ordinary least squares z = a x + b y + c, then n ~ (-a, -b, 1).
+    (a, b, c), *_ = np.linalg.lstsq(np.column_stack([pts[:, 0], pts[:, 1], np.ones(500)]), pts[:, 2], rcond=None)
+    expected = np.array([-a, -b, 1.0]) / np.linalg.norm([-a, -b, 1.0])
+    assert normal == pytest.approx(expected, abs=1e-4)
+    assert -d / normal[2] == pytest.approx(c, abs=1e-3)
+
+
+def test_simplification_stays_within_the_deviation_and_is_measured(corner):
+    _, g, w, model = corner
+    for seg, obj in zip(model.report["segments"], model.objects):
+        assert seg["simplification_deviation_m"] <= 0.005
+        assert seg["faces"] < seg["faces_reconstructed"] / 10  # planes collapse to few triangles
+    # Independent check with trimesh: distance from the input points to the simplified meshes (local frame).
+    offset = np.array(model.origin_offset_m)
+    ground = model.objects[0].parts[0]
+    mesh = trimesh.Trimesh(ground.points, ground.triangles, process=False)
+    _, dist, _ = trimesh.proximity.closest_point(mesh, g - offset)
+    seg = model.report["segments"][0]
+    assert dist.max() == pytest.approx(seg["residual_max_m"], abs=2e-4)
+    assert dist.max() < 0.01  # 2 mm noise, 1 cm RANSAC threshold
+
+
+def test_las_classification_is_used(tmp_path):
+    rng = np.random.default_rng(1)
+    g, w = street_corner(rng, 800, 600)
+    classes = np.concatenate([np.full(len(g), 2, np.uint8), np.full(len(w), 6, np.uint8)])
+    model = import_pointcloud(write_las(tmp_path / "c.las", np.concatenate([g, w]), classes))
+    assert model.label_counts() == {"building": 1, "road": 1}
+    assert {s["source"] for s in model.report["segments"]} == {"las:2", "las:6"}
+
+
+@pytest.mark.slow
+def test_third_party_las_and_laz():
+    flat = import_pointcloud(third_party("las", "plane.laz"))
+    big = max(flat.report["segments"], key=lambda s: s["points"])
+    assert big["label"] == "road" and big["simplification_deviation_m"] <= 0.005
+    assert big["faces"] < big["faces_reconstructed"]
+    simple = import_pointcloud(third_party("las", "simple.las"))
+    assert any(s["source"] == "las:2" and s["label"] == "road" for s in simple.report["segments"])
+    assert all(s["simplification_deviation_m"] <= 0.005 for s in simple.report["segments"])
+
+
+def test_bad_point_clouds(tmp_path):
+    with pytest.raises(InputError, match="unsupported point cloud format '.xyz'"):
+        import_pointcloud(tmp_path / "a.xyz")
+    ply = tmp_path / "nan.ply"
+    trimesh.PointCloud(np.array([[0, 0, 0], [1, np.nan, 0], [0, 1, 0]], float)).export(ply)
+    with pytest.raises(InputError, match="1 points have NaN or infinite coordinates"):
+        import_pointcloud(ply)
+    with pytest.raises(InputError, match="max_deviation_m should be > 0"):
+        import_pointcloud(ply, max_deviation_m=0)
+    empty = write_las(tmp_path / "empty.las", np.zeros((0, 3)))
+    with pytest.raises(InputError, match="has no points"):
+        import_pointcloud(empty)
+    broken = tmp_path / "broken.las"
+    broken.write_bytes(b"LASF" + b"\x00" * 20)
+    with pytest.raises(InputError, match="cannot read as LAS/LAZ"):
+        import_pointcloud(broken)

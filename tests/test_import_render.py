@@ -1,0 +1,62 @@
+"""Imported twins render through the existing path, with labels."""
+
+import numpy as np
+import pytest
+
+from conftest import third_party
+from reference_raycast import reference_labels
+from synthua_usd.pipeline.frame import FrameRequest, run_frame
+
+
+def import_and_render(run_cli, tmp_path, kind, source, camera="/World/Cameras/Overview", size=(96, 64)):
+    out = tmp_path / "twin"
+    code, stdout, err = run_cli("twin", "import", kind, source, "--out", out)
+    assert code == 0, err
+    result = run_frame(FrameRequest(stage_path=out / "scenario.usda", out_dir=tmp_path / "frame", camera_path=camera,
+                                    width=size[0], height=size[1], spp=2))
+    return stdout, result
+
+
+@pytest.mark.slow
+def test_delft_import_renders_with_labels(run_cli, tmp_path):
+    stdout, result = import_and_render(run_cli, tmp_path, "cityjson", third_party("cityjson", "delft.json"))
+    assert "570 objects" in stdout
+    counts = result.document["class_pixel_counts"]
+    assert counts.get("building", 0) > 0 and counts.get("road", 0) > 0
+    ref_class, _ = reference_labels(result.snapshot, result.camera, 96, 64)
+    assert np.mean(ref_class == result.rendered.class_ids) >= 0.999
+
+
+@pytest.mark.slow
+def test_pointcloud_import_renders_with_labels(run_cli, tmp_path):
+    stdout, result = import_and_render(run_cli, tmp_path, "pointcloud", third_party("las", "plane.laz"))
+    assert "simplification deviation" in stdout
+    counts = result.document["class_pixel_counts"]
+    assert counts.get("road", 0) > 0.2 * 96 * 64
+
+
+def test_import_report_is_written(run_cli, tmp_path):
+    import json
+
+    from conftest import DATA
+
+    code, _, _ = run_cli("twin", "import", "cityjson", DATA / "valid" / "lod2_house.city.json", "--out", tmp_path)
+    assert code == 0
+    report = json.loads((tmp_path / "import_report.json").read_text())
+    assert report["classes"] == {"building": 1, "door": 1, "road": 1, "unlabelled": 1}
+    assert report["origin_offset_m"] == pytest.approx([676010.0, 7185999.0, 900.0])
+    from pxr import Sdf
+
+    layer = Sdf.Layer.FindOrOpen(str(tmp_path / "twin.usda"))
+    assert layer.customLayerData["synthua:crs"].endswith("EPSG/0/31982")
+    assert list(layer.customLayerData["synthua:origin_offset_m"]) == pytest.approx([676010.0, 7185999.0, 900.0])
+
+
+def test_import_bad_input_exit_2_nothing_written(run_cli, tmp_path):
+    from conftest import DATA
+
+    code, _, err = run_cli("twin", "import", "cityjson", DATA / "invalid" / "cityjson_no_crs.city.json", "--out",
+                           tmp_path / "o")
+    assert code == 2 and "metadata.referenceSystem is missing" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
