@@ -19,7 +19,7 @@ demo: setup
 	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/CCTV --frame 24 --out $(DEMO_OUT)/cctv
 	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/PedestrianEye --frame 24 --out $(DEMO_OUT)/pedestrian_eye
 	$(BIN)/synthua validate stage $(DISTRICT)
-	$(BIN)/synthua render $(DISTRICT) --camera /World/Cameras/CCTV_Largo --out $(DEMO_OUT)/district_cctv_largo
+	$(BIN)/synthua render $(DISTRICT) --camera /World/Cameras/CCTV_Largo --frame 24 --out $(DEMO_OUT)/district_cctv_largo
 	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}"
 
 ## The whole test suite (slow tests included).

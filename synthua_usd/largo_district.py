@@ -26,7 +26,7 @@ ROAD_SIDEWALK_S = (-49.5, -45.0)
 ROAD_SIDEWALK_N = (-37.0, -33.0)
 STREET_X = (-5.0, 5.0)
 STREET_SIDEWALK_W = 3.0
-STREET_Y = (-33.0, 5.0)
+STREET_Y = (-33.0, 5.0)      # the slope; the street itself reaches down to the road (ROAD_Y[1])
 PLAZA_X = (-45.0, 45.0)
 PLAZA_Y = (5.0, 34.0)
 PLAZA_Z = 3.0
@@ -190,9 +190,10 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
         b.add("Crosswalks", "Zebra", "crosswalk", [Piece("Bars", geo.merge(*bars), "RoadPaint")])
     # The cobbled street: a mortar bed and stones, sloping up to the largo.
     x0, x1 = STREET_X
-    bed = _shear(geo.box((x0, STREET_Y[0], -0.5), (x1, STREET_Y[1], 0.0)))
+    y_start = ROAD_Y[1]
+    bed = _shear(geo.box((x0, y_start, -0.5), (x1, STREET_Y[1], 0.0)))
     stones = [Piece(p.name, _shear(p.mesh), p.material)
-              for p in _cobbles(rng, x0, x1, STREET_Y[0], STREET_Y[1], (0.18, 0.14), 0.015, 0.07, ["Cobble0", "Cobble1", "Cobble2"])]
+              for p in _cobbles(rng, x0, x1, y_start, STREET_Y[1], (0.18, 0.14), 0.015, 0.07, ["Cobble0", "Cobble1", "Cobble2"])]
     b.add("Streets", "CobbledStreet", "street_road", [Piece("Bed", bed, "Mortar")] + stones, surface="cobblestone")
     # Its sidewalks (sheared with the slope) and a crosswalk near the bottom with ramps on both sides.
     cy = STREET_CROSSWALK_Y
@@ -200,11 +201,11 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
         xa, xb = sorted((kx + sgn * 0.2, kx + sgn * STREET_SIDEWALK_W))
         ka, kb = sorted((kx, kx + sgn * 0.2))
         ra, rb = sorted((kx, kx + sgn * RAMP_LEN))
-        slab = [geo.box((xa, STREET_Y[0], -0.5), (xb, cy - RAMP_HALF_W, KERB_H)),
+        slab = [geo.box((xa, y_start, -0.5), (xb, cy - RAMP_HALF_W, KERB_H)),
                 geo.box((xa, cy + RAMP_HALF_W, -0.5), (xb, STREET_Y[1], KERB_H))]
         back_a, back_b = sorted((kx + sgn * RAMP_LEN, kx + sgn * STREET_SIDEWALK_W))
         slab.append(geo.box((back_a, cy - RAMP_HALF_W, -0.5), (back_b, cy + RAMP_HALF_W, KERB_H)))
-        kerb = [geo.box((ka, STREET_Y[0], -0.5), (kb, cy - RAMP_HALF_W, KERB_H)),
+        kerb = [geo.box((ka, y_start, -0.5), (kb, cy - RAMP_HALF_W, KERB_H)),
                 geo.box((ka, cy + RAMP_HALF_W, -0.5), (kb, STREET_Y[1], KERB_H))]
         b.add("Sidewalks", side, "sidewalk", [Piece("Slab", _shear(geo.merge(*slab)), "Concrete"),
                                               Piece("Kerb", _shear(geo.merge(*kerb)), "Granite")])

@@ -42,12 +42,29 @@ def test_curb_ramp_at_both_ends_of_every_road_crosswalk(seed0):
 
 @pytest.mark.slow
 def test_committed_district_is_seed_0_and_deterministic(tmp_path):
-    from synthua_usd.pipeline.district import write_district
+    from synthua_usd.pipeline.district import write_district_scenario
 
-    written = write_district(tmp_path, seed=0)["files"]
+    written = write_district_scenario(tmp_path, seed=0)
+    assert sorted(p.name for p in written) == sorted(p.name for p in DISTRICT.iterdir())
     for path in written:
         assert filecmp.cmp(path, DISTRICT / path.name, shallow=False), \
             f"stages/district/{path.name} differs from seed 0: run `synthua create district stages/district`"
+
+
+@pytest.mark.slow
+def test_district_agents_include_aid_users_in_camera_views(tmp_path):
+    from synthua_usd.pipeline.frame import FrameRequest, run_frame
+
+    aids = {"manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
+            "orthopedic_cane", "tripod_cane"}
+    seen = 0
+    for cam in ("CCTV_Largo", "CCTV_Street", "PedestrianEye_Street", "WheelchairEye_Largo"):
+        doc = run_frame(FrameRequest(stage_path=DISTRICT / "scenario.usda", out_dir=tmp_path / cam,
+                                     camera_path=f"/World/Cameras/{cam}", frame=24, width=160, height=120,
+                                     spp=1)).document
+        seen += any(i["class_name"] in aids and i["pixel_count"] and i["prim_path"].startswith("/World/Agents/")
+                    for i in doc["instances"])
+    assert seen >= 3  # "most camera views" show a mobility-aid user
 
 
 @pytest.mark.slow
@@ -79,7 +96,7 @@ def test_district_labels_agree_with_embree(tmp_path):
     assert np.mean(ref_class == result.rendered.class_ids) >= 0.9999
     assert np.mean(ref_inst == result.rendered.instance_ids) >= 0.9999
     visible = {i["class_name"] for i in result.document["instances"] if i["pixel_count"]}
-    assert {"street_road", "sidewalk", "building", "window", "crosswalk", "curb_ramp"} <= visible
+    assert {"street_road", "sidewalk", "building", "window", "curb_ramp", "person"} <= visible
 
 
 def test_twin_demo_cli(run_cli, tmp_path):

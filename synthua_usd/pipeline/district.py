@@ -10,6 +10,9 @@ from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.authoring import StageMetadata
 from synthua_usd.usd.twin_writer import write_twin
 
+#: Persons per m² of walkable area in the shipped scenario: about 130 people on ~4,500 m², free walking.
+AGENT_DENSITY = 0.03
+
 META = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=24.0, start_time_code=1.0,
                      end_time_code=48.0, default_prim="World")
 
@@ -36,8 +39,9 @@ def write_district(out_dir: str | Path, seed: int = 0, class_map: ClassMap | Non
             "classes": model.label_counts()}
 
 
-def write_district_scenario(out_dir: str | Path, seed: int = 0) -> list[Path]:
-    """The district's twin and semantics plus cameras, environment, render settings and ``scenario.usda``."""
+def write_district_scenario(out_dir: str | Path, seed: int = 0, agents: bool = True) -> list[Path]:
+    """The district's twin and semantics plus cameras, environment, render settings, a populated agents layer
+    (``AGENT_DENSITY``, default aid share) and ``scenario.usda`` composing them."""
     from synthua_usd import geometry as geo
     from synthua_usd.usd.authoring import define_xform, new_layer, save_layer_atomic
     from synthua_usd.usd.cameras import author_camera
@@ -59,6 +63,15 @@ def write_district_scenario(out_dir: str | Path, seed: int = 0) -> list[Path]:
     for name, stage in layers.items():
         files.append(save_layer_atomic(stage.GetRootLayer(), out_dir / name))
     order = ["render.usda", "environment.usda", "cameras.usda", "semantics.usda", "twin.usda"]
-    files.append(compose_layers(out_dir / "scenario.usda", [out_dir / n for n in order],
+    scenario = out_dir / "scenario.usda"
+    compose_layers(scenario, [out_dir / n for n in order], doc=f"Largo da Ordem demo district (seed {seed}) scenario.")
+    if agents:
+        from synthua_usd.pipeline.populate import PopulateRequest, populate
+
+        report = populate(PopulateRequest(scenario, out_dir / "agents.usda", density_per_m2=AGENT_DENSITY,
+                                          frames=int(META.end_time_code - META.start_time_code + 1), seed=seed))
+        files += report.files
+        order.insert(3, "agents.usda")
+    files.append(compose_layers(scenario, [out_dir / n for n in order],
                                 doc=f"Largo da Ordem demo district (seed {seed}) scenario."))
     return files

@@ -1,0 +1,1 @@
+"""Agents: walkable graphs, profiles, populations and collision-free motion (plain data; no USD)."""

@@ -1,0 +1,107 @@
+"""Populations: how many agents (Poisson in the walkable area), who they are, and where they go.
+
+Density is persons per m² of walkable area. Above ``MAX_DENSITY`` (5 /m², where crowd crush begins; the
+paper's 15 /m² is physically impossible) it is refused; above ``LOS_WARN_DENSITY`` (0.7 /m², the start
+of Fruin's walkway level of service E: movement constrained) it is accepted with a warning.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import networkx as nx
+import numpy as np
+
+from synthua_usd.agents.profiles import AID_PROFILES, PROFILES, AgentProfile
+from synthua_usd.agents.walkable import WalkableGrid, shortest_path
+from synthua_usd.errors import InputError
+
+log = logging.getLogger(__name__)
+
+MAX_DENSITY = 5.0
+LOS_WARN_DENSITY = 0.7
+#: A default that puts a mobility-aid user in most camera views of the demo district.
+DEFAULT_AID_SHARE = 0.3
+
+
+def check_density(density_per_m2: float) -> None:
+    """Refuse impossible densities with the reason; warn above the level-of-service threshold."""
+    if not (np.isfinite(density_per_m2) and density_per_m2 > 0):
+        raise InputError(f"density should be > 0 persons/m², but was {density_per_m2}")
+    if density_per_m2 > MAX_DENSITY:
+        raise InputError(f"density {density_per_m2:g} persons/m² is physically impossible for moving people: crowd "
+                         f"crush begins near 5-6 persons/m² (the paper's 15/m² cannot happen); use at most "
+                         f"{MAX_DENSITY:g}, and below {LOS_WARN_DENSITY:g} for free walking")
+    if density_per_m2 > LOS_WARN_DENSITY:
+        log.warning("density %g persons/m² is beyond level of service D (%g/m²): people can barely move; "
+                    "collision-free placement may drop agents", density_per_m2, LOS_WARN_DENSITY)
+
+
+def sample_count(rng: np.random.Generator, density_per_m2: float, area_m2: float) -> int:
+    """N ~ Poisson(λ = density x walkable area)."""
+    check_density(density_per_m2)
+    return int(rng.poisson(density_per_m2 * area_m2))
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """One agent's route: ``waypoints`` (k, 3) world metres along the walkable graph, and where to pause."""
+
+    profile: AgentProfile
+    speed_mps: float
+    waypoints: np.ndarray
+    surfaces: tuple[str, ...]
+    start_offset_m: float
+    pause_before_crossing_s: float
+    group: int | None = None
+
+
+def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, count: int, aid_share: float,
+                min_route_m: float = 15.0) -> list[Plan]:
+    """Routes for ``count`` agents: ``aid_share`` of them (rounded stochastically) use mobility aids.
+
+    Each agent walks between two random reachable cells at least ``min_route_m`` apart, starting at a
+    random point along its route; about a third of pedestrians come in groups of two or three, who share
+    a route and walk 0.9 m apart.
+    """
+    if not 0.0 <= aid_share <= 1.0:
+        raise InputError(f"aid share should be a fraction in [0, 1], but was {aid_share}")
+    nodes = sorted(graph.nodes)
+    if not nodes:
+        raise InputError("the twin has no walkable surface (sidewalk, crosswalk, curb_ramp, street_road)")
+    pos = np.array([graph.nodes[n]["pos"] for n in nodes])
+    plans: list[Plan] = []
+    group_id = 0
+    while len(plans) < count:
+        is_aid = rng.random() < aid_share
+        profile = PROFILES[AID_PROFILES[int(rng.integers(len(AID_PROFILES)))]] if is_aid else PROFILES["pedestrian"]
+        route = _route(rng, graph, nodes, pos, profile, min_route_m)
+        if route is None:
+            continue
+        waypoints, surfaces = route
+        length = float(np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum())
+        speed = float(np.clip(rng.normal(profile.speed_mps, profile.speed_sd_mps), 0.5 * profile.speed_mps,
+                              1.5 * profile.speed_mps))
+        offset = float(rng.uniform(0, 0.8 * length))
+        pause = float(rng.uniform(1.0, 4.0))
+        size = int(rng.choice([2, 3])) if (not is_aid and rng.random() < 0.3) else 1
+        size = min(size, count - len(plans))
+        gid = group_id if size > 1 else None
+        group_id += size > 1
+        for k in range(size):
+            plans.append(Plan(profile, speed, waypoints, surfaces, max(offset - 0.9 * k, 0.0), pause, gid))
+    return plans
+
+
+def _route(rng, graph, nodes, pos, profile, min_route_m):
+    for _ in range(20):
+        a, b = rng.integers(len(nodes), size=2)
+        if np.linalg.norm(pos[a, :2] - pos[b, :2]) < min_route_m:
+            continue
+        try:
+            path = shortest_path(graph, nodes[a], nodes[b], profile)
+        except nx.NetworkXNoPath:
+            continue
+        return (np.array([graph.nodes[n]["pos"] for n in path]), tuple(graph.nodes[n]["surface"] for n in path))
+    return None

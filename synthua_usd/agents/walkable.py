@@ -1,0 +1,178 @@
+"""The walkable graph: a 2-D grid over the twin whose cells lie on walkable surfaces, joined to their
+eight neighbours by edges that know their length, slope and whether they step over a kerb.
+
+Walkable classes: sidewalk, crosswalk, curb_ramp and the cobbled street_road; the asphalt road only
+inside a crosswalk's footprint. A cell's surface is found by casting a vertical ray (Embree through
+trimesh) and taking the highest walkable hit with 2 m of headroom free of other geometry, so that
+benches, poles and stands block their cells while tent canopies do not.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import networkx as nx
+import numpy as np
+import trimesh
+
+from synthua_usd.agents.profiles import AgentProfile
+from synthua_usd.errors import InputError
+
+WALKABLE = ("sidewalk", "crosswalk", "curb_ramp", "street_road")
+CROSSING_ONLY = "road"
+#: Between neighbouring cells, a rise of more than STEP_M that is also steeper than KERB_SLOPE is a kerb
+#: or a stair riser (stepped, not rolled); a curb ramp (1:12) stays below it even across a diagonal.
+#: Above MAX_STEP_M it is a wall.
+STEP_M = 0.03
+KERB_SLOPE = 0.125
+MAX_STEP_M = 0.22
+HEADROOM_M = 2.0
+
+
+@dataclass(frozen=True, eq=False)
+class WalkableGrid:
+    """Cells of ``cell_m`` metres. ``z`` (ny, nx) float64 surface height (NaN where not walkable); ``surface``
+    (ny, nx) object array of class names ('' where not walkable). Cell (i, j) centre is at
+    (x0 + (j + 0.5) cell, y0 + (i + 0.5) cell)."""
+
+    x0: float
+    y0: float
+    cell_m: float
+    z: np.ndarray = field(repr=False)
+    surface: np.ndarray = field(repr=False)
+
+    @property
+    def walkable(self) -> np.ndarray:
+        return ~np.isnan(self.z)
+
+    def centre(self, i: int, j: int) -> np.ndarray:
+        return np.array([self.x0 + (j + 0.5) * self.cell_m, self.y0 + (i + 0.5) * self.cell_m, self.z[i, j]])
+
+    def cell_of(self, x: float, y: float) -> tuple[int, int]:
+        return int((y - self.y0) // self.cell_m), int((x - self.x0) // self.cell_m)
+
+    def area_m2(self) -> float:
+        return float(self.walkable.sum()) * self.cell_m ** 2
+
+
+def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, cell_m: float = 0.5) -> WalkableGrid:
+    """Rasterise walkable surfaces. ``vertices`` (n, 3) world metres, Z up; ``faces`` (m, 3); ``face_class``
+    (m,) class name per face."""
+    if len(faces) == 0:
+        raise InputError("the twin has no geometry to walk on")
+    mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    nx_, ny_ = int(math.ceil((hi[0] - lo[0]) / cell_m)), int(math.ceil((hi[1] - lo[1]) / cell_m))
+    xs = lo[0] + (np.arange(nx_) + 0.5) * cell_m
+    ys = lo[1] + (np.arange(ny_) + 0.5) * cell_m
+    gx, gy = np.meshgrid(xs, ys)
+    origins = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, hi[2] + 10.0)])
+    dirs = np.tile([0.0, 0.0, -1.0], (len(origins), 1))
+    locations, ray_idx, tri_idx = mesh.ray.intersects_location(origins, dirs, multiple_hits=True)
+    classes = np.asarray(face_class, object)
+    normals_up = mesh.face_normals[:, 2] > 0.5
+    z = np.full(gx.size, np.nan)
+    surface = np.full(gx.size, "", object)
+    crosswalk_boxes = _footprints(vertices, faces, classes, "crosswalk")
+    order = np.lexsort((-locations[:, 2], ray_idx))
+    ray_sorted, loc_sorted, tri_sorted = ray_idx[order], locations[order], tri_idx[order]
+    starts = np.searchsorted(ray_sorted, np.arange(len(origins)))
+    ends = np.searchsorted(ray_sorted, np.arange(len(origins)), side="right")
+    for r in range(len(origins)):
+        hits = range(starts[r], ends[r])
+        for k in hits:
+            cls = classes[tri_sorted[k]]
+            if not normals_up[tri_sorted[k]]:
+                continue
+            walk = cls in WALKABLE or (cls == CROSSING_ONLY and _inside(origins[r, :2], crosswalk_boxes))
+            if not walk:
+                continue
+            zk = loc_sorted[k, 2]
+            blocked = any(zk + 0.05 < loc_sorted[m, 2] < zk + HEADROOM_M for m in hits if m != k)
+            if not blocked:
+                z[r] = zk
+                surface[r] = "crosswalk" if cls == CROSSING_ONLY else cls
+            break  # the highest walkable surface decides the cell, free or blocked
+    return WalkableGrid(float(lo[0]), float(lo[1]), cell_m, z.reshape(ny_, nx_), surface.reshape(ny_, nx_))
+
+
+def _footprints(vertices, faces, classes, name) -> list[tuple[float, float, float, float]]:
+    """x/y bounding boxes of connected groups of ``name`` faces (one per crosswalk, roughly)."""
+    idx = np.flatnonzero(classes == name)
+    if len(idx) == 0:
+        return []
+    sub = trimesh.Trimesh(vertices, faces[idx], process=False, validate=False)
+    # Bars of one crosswalk are 0.5 m apart: merge components whose boxes are within 1 m.
+    boxes = []
+    for comp in trimesh.graph.connected_components(sub.face_adjacency, nodes=np.arange(len(idx))):
+        pts = vertices[faces[idx[comp]].ravel()]
+        boxes.append([pts[:, 0].min(), pts[:, 1].min(), pts[:, 0].max(), pts[:, 1].max()])
+    merged = True
+    while merged:
+        merged = False
+        for a in range(len(boxes)):
+            for b in range(a + 1, len(boxes)):
+                A, B = boxes[a], boxes[b]
+                if A[0] - 1 <= B[2] and B[0] - 1 <= A[2] and A[1] - 1 <= B[3] and B[1] - 1 <= A[3]:
+                    boxes[a] = [min(A[0], B[0]), min(A[1], B[1]), max(A[2], B[2]), max(A[3], B[3])]
+                    del boxes[b]
+                    merged = True
+                    break
+            if merged:
+                break
+    return [tuple(b) for b in boxes]
+
+
+def _inside(xy, boxes) -> bool:
+    return any(b[0] - 0.3 <= xy[0] <= b[2] + 0.3 and b[1] - 0.3 <= xy[1] <= b[3] + 0.3 for b in boxes)
+
+
+def walkable_graph(grid: WalkableGrid) -> nx.Graph:
+    """Nodes (i, j) with ``pos`` (3,) and ``surface``; edges with ``length_m`` (3-D), ``dz_m``, ``slope``,
+    ``kerb`` (a step: see STEP_M, KERB_SLOPE) and ``cobbles``. Rises above MAX_STEP_M are not edges."""
+    g = nx.Graph()
+    ok = grid.walkable
+    ny_, nx_ = ok.shape
+    for i, j in zip(*np.nonzero(ok)):
+        g.add_node((int(i), int(j)), pos=grid.centre(i, j), surface=grid.surface[i, j])
+    for di, dj in ((0, 1), (1, 0), (1, 1), (1, -1)):
+        for i, j in zip(*np.nonzero(ok)):
+            a, b = i + di, j + dj
+            if not (0 <= a < ny_ and 0 <= b < nx_ and ok[a, b]):
+                continue
+            dz = grid.z[a, b] - grid.z[i, j]
+            if abs(dz) > MAX_STEP_M:
+                continue
+            run = grid.cell_m * math.hypot(di, dj)
+            kerb = abs(dz) > STEP_M and abs(dz) / run > KERB_SLOPE
+            g.add_edge((int(i), int(j)), (int(a), int(b)), length_m=math.hypot(run, dz), dz_m=float(dz),
+                       slope=abs(dz) / run, kerb=kerb,
+                       cobbles="street_road" in (grid.surface[i, j], grid.surface[a, b]))
+    return g
+
+
+def edge_cost(profile: AgentProfile):
+    """networkx weight function: travel time in seconds, or None where ``profile`` cannot pass."""
+    def cost(u, v, data) -> float | None:
+        if data["kerb"]:
+            if not profile.can_step_kerb:
+                return None
+            return data["length_m"] / profile.speed_mps + 0.5  # a step costs a moment
+        if data["slope"] > profile.max_slope:
+            return None
+        t = data["length_m"] / profile.speed_mps
+        t *= 1.0 + profile.slope_penalty * max(0.0, data["slope"] - 0.02)
+        if data["cobbles"]:
+            t *= profile.cobble_factor
+        return t
+    return cost
+
+
+def shortest_path(graph: nx.Graph, start, goal, profile: AgentProfile) -> list[tuple[int, int]]:
+    """A* over travel time; the heuristic (straight-line distance at the profile's speed) never
+    overestimates, since every cost multiplier is at least 1."""
+    def heuristic(a, b):
+        return float(np.linalg.norm(graph.nodes[a]["pos"][:2] - graph.nodes[b]["pos"][:2])) / profile.speed_mps
+
+    return nx.astar_path(graph, start, goal, heuristic=heuristic, weight=edge_cost(profile))
