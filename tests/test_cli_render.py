@@ -1,12 +1,11 @@
 """`synthua render` end to end on tiny images, and every kind of bad input it must refuse."""
 
 import json
-import shutil
 
 import numpy as np
 import pytest
 
-from conftest import DATA, SCENARIO, STAGES
+from conftest import DATA, SCENARIO
 from synthua_usd.backends.frame_files import FILES
 from synthua_usd.backends.images import read_image
 from synthua_usd.schemas import validate_document

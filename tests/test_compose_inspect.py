@@ -1,7 +1,7 @@
 import pytest
 from pxr import Sdf
 
-from conftest import DATA, SCENARIO, STAGES
+from conftest import SCENARIO, STAGES
 from synthua_usd.errors import StageError
 from synthua_usd.usd.compose import compose_layers
 

@@ -48,8 +48,8 @@ def test_twin_layer_has_no_labels_and_semantics_layer_only_overs():
 
 
 def test_person_and_wheelchair_are_separate_labelled_models(demo_stage):
-    person = demo_stage.GetPrimAtPath("/World/Agents/WheelchairUser_01/Person")
-    chair = demo_stage.GetPrimAtPath("/World/Agents/WheelchairUser_01/Wheelchair")
+    person = demo_stage.GetPrimAtPath("/World/Agents/Agent_0001/Person")
+    chair = demo_stage.GetPrimAtPath("/World/Agents/Agent_0001/ManualWheelchair")
     labels = lambda p: list(UsdSemantics.LabelsAPI(p, "synthua").GetLabelsAttr().Get())
     assert labels(person) == ["person"] and labels(chair) == ["manual_wheelchair"]
     assert person.GetRelationship("synthua:uses").GetTargets() == [chair.GetPath()]
@@ -58,7 +58,7 @@ def test_person_and_wheelchair_are_separate_labelled_models(demo_stage):
 
 def test_agents_move_over_at_least_24_frames(demo_stage):
     assert demo_stage.GetEndTimeCode() - demo_stage.GetStartTimeCode() + 1 >= 24
-    for path in ("/World/Agents/Pedestrian_01", "/World/Agents/WheelchairUser_01"):
+    for path in ("/World/Agents/Agent_0000", "/World/Agents/Agent_0001"):
         xf = UsdGeom.Xformable(demo_stage.GetPrimAtPath(path))
         samples = xf.GetTimeSamples()
         assert len(samples) >= 24

@@ -1,6 +1,6 @@
 import numpy as np
 import pytest
-from pxr import Usd
+from pxr import UsdGeom
 
 from conftest import DATA
 from synthua_usd.errors import StageError, UnsupportedPrimError
@@ -13,8 +13,8 @@ def snap(demo_stage, class_map):
     return read_snapshot(demo_stage, 1.0, class_map)
 
 
-def test_demo_snapshot_contents(snap):
-    assert len(snap.meshes) == 46
+def test_demo_snapshot_contents(snap, demo_stage):
+    assert len(snap.meshes) == sum(1 for p in demo_stage.Traverse() if p.IsA(UsdGeom.Gprim))
     assert {l.kind for l in snap.lights} == {"distant", "dome"}
     assert all(m.instance_id > 0 and m.class_id > 0 for m in snap.meshes)
     assert [i.id for i in snap.instances] == list(range(1, len(snap.instances) + 1))
@@ -22,8 +22,8 @@ def test_demo_snapshot_contents(snap):
 
 def test_person_and_wheelchair_are_distinct_instances_with_a_relation(snap):
     by_path = {i.prim_path: i for i in snap.instances}
-    person = by_path["/World/Agents/WheelchairUser_01/Person"]
-    chair = by_path["/World/Agents/WheelchairUser_01/Wheelchair"]
+    person = by_path["/World/Agents/Agent_0001/Person"]
+    chair = by_path["/World/Agents/Agent_0001/ManualWheelchair"]
     assert person.id != chair.id and (person.class_name, chair.class_name) == ("person", "manual_wheelchair")
     assert dict(person.relations) == {"uses": chair.prim_path}
 
@@ -31,7 +31,7 @@ def test_person_and_wheelchair_are_distinct_instances_with_a_relation(snap):
 def test_world_transform_follows_the_animation(demo_stage, class_map):
     def head_centre(t):
         s = read_snapshot(demo_stage, t, class_map)
-        (head,) = [m for m in s.meshes if m.prim_path == "/World/Agents/Pedestrian_01/Head"]
+        (head,) = [m for m in s.meshes if m.prim_path == "/World/Agents/Agent_0000/Person/Head"]
         return head.points.mean(axis=0)
 
     a, b = head_centre(1.0), head_centre(25.0)

@@ -50,8 +50,8 @@ def test_person_and_wheelchair_get_different_ids_and_classes(frame):
     if frame.camera.path == "/World/Cameras/WheelchairEye":
         pytest.skip("the check needs both visible; the CCTV and pedestrian cameras see them")
     by_path = {i["prim_path"]: i for i in frame.document["instances"]}
-    person = by_path["/World/Agents/WheelchairUser_01/Person"]
-    chair = by_path["/World/Agents/WheelchairUser_01/Wheelchair"]
+    person = by_path["/World/Agents/Agent_0001/Person"]
+    chair = by_path["/World/Agents/Agent_0001/ManualWheelchair"]
     assert person["pixel_count"] > 0 and chair["pixel_count"] > 0
     assert person["id"] != chair["id"]
     assert (person["class_name"], chair["class_name"]) == ("person", "manual_wheelchair")

@@ -16,13 +16,12 @@ frame.json         camera, image, render settings, class map, instances with pix
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
+from synthua_usd.atomic import atomic_path
 from synthua_usd.backends import images
 from synthua_usd.schemas import validate_document
 
@@ -33,16 +32,8 @@ FILES = ("rgb.exr", "rgb.png", "class.png", "semantic.png", "instance.png", "dep
 
 
 def write_json_atomic(path: Path, document: dict) -> Path:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            json.dump(document, fh, indent=2, ensure_ascii=False)
-            fh.write("\n")
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(document, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     return path
 
 

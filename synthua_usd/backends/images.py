@@ -8,12 +8,12 @@ Every write goes to a temporary file in the target folder and is renamed into pl
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import OpenImageIO as oiio
+
+from synthua_usd.atomic import atomic_path
 
 LINEAR_SPACE = "lin_rec709_scene"
 DISPLAY_SPACE = "srgb_rec709_scene"
@@ -30,22 +30,15 @@ def _write(path: Path, pixels: np.ndarray, fmt: str, attributes: dict[str, str] 
         spec.channelnames = tuple(channel_names)
     for key, value in (attributes or {}).items():
         spec.attribute(key, value)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        out = oiio.ImageOutput.create(tmp)
-        if out is None or not out.open(tmp, spec):
+    with atomic_path(path) as tmp:
+        out = oiio.ImageOutput.create(str(tmp))
+        if out is None or not out.open(str(tmp), spec):
             raise OSError(f"{path}: OpenImageIO cannot open it for writing: {oiio.geterror()}")
         # ImageBuf/ImageOutput want (H, W, C); a 2-D array would be read as the wrong shape.
         ok = out.write_image(np.ascontiguousarray(pixels))
         out.close()
         if not ok:
             raise OSError(f"{path}: OpenImageIO failed to write: {out.geterror()}")
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return path
 
 

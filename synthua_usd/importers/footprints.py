@@ -8,7 +8,6 @@ building is one ``building`` instance with ``Walls`` and ``Roof`` parts.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 from pxr import Gf, Kind, Sdf, Usd
 
 from synthua_usd.agents.motion import Trajectory

@@ -7,14 +7,13 @@ instance name.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdSemantics, UsdShade, Vt
 
+from synthua_usd.atomic import atomic_path
 from synthua_usd.scene import Material
 
 
@@ -52,16 +51,9 @@ def save_layer_atomic(layer: Sdf.Layer, path: str | Path) -> Path:
     """Export ``layer`` as ``.usda`` text to ``path`` through a temporary file and a rename."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        if not layer.Export(tmp):
+    with atomic_path(path) as tmp:
+        if not layer.Export(str(tmp)):
             raise OSError(f"{path}: USD could not write the layer")
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; layers are meant to be shared.
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return path
 
 

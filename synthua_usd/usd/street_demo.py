@@ -5,6 +5,7 @@ z = 0.15, kerb 15 cm) run beside it; the north sidewalk has one curb ramp where 
 Building A stands north, building B south. One pedestrian walks along the south sidewalk; one manual
 wheelchair user rolls along the north sidewalk towards the ramp.
 
+The agents layer is written by the same code as populated crowds (:mod:`synthua_usd.usd.agents_writer`).
 ``write_street_demo`` writes twin, semantics, agents, cameras, environment and render layers and a
 ``scenario.usda`` that composes them by sublayers. Output is deterministic: no randomness, fixed order.
 """
@@ -15,10 +16,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pxr import Gf, Kind, Usd, UsdGeom
+from pxr import Kind, Usd
 
 from synthua_usd import geometry as geo
+from synthua_usd.agents.motion import simulate
+from synthua_usd.agents.population import Plan
+from synthua_usd.agents.profiles import PROFILES
+from synthua_usd.assets.people import PersonLook
 from synthua_usd.scene import Material
+from synthua_usd.usd.agents_writer import build_agents_layer
 from synthua_usd.usd.authoring import (StageMetadata, apply_label, define_mesh, define_preview_material,
                                        define_xform, new_layer, save_layer_atomic, set_kind)
 from synthua_usd.usd.cameras import author_camera
@@ -55,17 +61,6 @@ MATERIALS = {
     "Bark": Material("Bark", (0.18, 0.11, 0.06), 0.9),
     "Leaves": Material("Leaves", (0.07, 0.2, 0.04), 0.8),
 }
-
-AGENT_MATERIALS = {
-    "Skin": Material("Skin", (0.5, 0.33, 0.24), 0.6),
-    "ShirtRed": Material("ShirtRed", (0.5, 0.06, 0.05), 0.8),
-    "ShirtGreen": Material("ShirtGreen", (0.12, 0.35, 0.15), 0.8),
-    "Trousers": Material("Trousers", (0.07, 0.08, 0.12), 0.8),
-    "Frame": Material("Frame", (0.55, 0.57, 0.6), 0.3, metallic=0.9),
-    "Tyre": Material("Tyre", (0.02, 0.02, 0.02), 0.9),
-    "Seat": Material("Seat", (0.03, 0.05, 0.15), 0.8),
-}
-
 
 @dataclass(frozen=True)
 class CameraSpec:
@@ -211,90 +206,22 @@ def build_twin(meta: StageMetadata = META) -> tuple[Usd.Stage, Usd.Stage]:
 
 # --- agents --------------------------------------------------------------------------------------------
 
-def _person_parts(seated: bool) -> dict[str, tuple[geo.Mesh, str]]:
-    """Body parts of a 1.75 m person in local space: feet at z = 0 (standing) or seat height (seated)."""
-    if seated:
-        hip_z = 0.52
-        legs = geo.merge(
-            geo.box((0.0, -0.18, hip_z - 0.07), (0.45, -0.02, hip_z + 0.08)),
-            geo.box((0.0, 0.02, hip_z - 0.07), (0.45, 0.18, hip_z + 0.08)),
-            geo.box((0.36, -0.17, 0.1), (0.48, -0.04, hip_z - 0.07)),
-            geo.box((0.36, 0.04, 0.1), (0.48, 0.17, hip_z - 0.07)))
-        parts = {"Legs": (legs, "Trousers")}
-    else:
-        hip_z = 0.9
-        parts = {}
-    torso = geo.box((-0.12, -0.2, hip_z), (0.12, 0.2, hip_z + 0.6))
-    arms = geo.merge(geo.box((-0.06, -0.28, hip_z + 0.05), (0.06, -0.2, hip_z + 0.58)),
-                     geo.box((-0.06, 0.2, hip_z + 0.05), (0.06, 0.28, hip_z + 0.58)))
-    head = geo.sphere((0.0, 0.0, hip_z + 0.74), 0.12, subdivisions=2)
-    parts.update({"Torso": (geo.merge(torso, arms), "ShirtGreen" if seated else "ShirtRed"), "Head": (head, "Skin")})
-    return parts
-
-
-def _wheelchair_parts() -> dict[str, tuple[geo.Mesh, str]]:
-    """A manual wheelchair facing +X: 0.6 m rear wheels, casters, seat, backrest and frame."""
-    return {
-        "RearWheels": (geo.merge(geo.cylinder((-0.1, -0.3, 0.3), 0.3, 0.03, axis="y", sections=24),
-                                 geo.cylinder((-0.1, 0.3, 0.3), 0.3, 0.03, axis="y", sections=24)), "Tyre"),
-        "Casters": (geo.merge(geo.cylinder((0.38, -0.22, 0.07), 0.07, 0.03, axis="y", sections=12),
-                              geo.cylinder((0.38, 0.22, 0.07), 0.07, 0.03, axis="y", sections=12)), "Tyre"),
-        "Seat": (geo.merge(geo.box((-0.18, -0.24, 0.43), (0.3, 0.24, 0.45)),
-                           geo.box((-0.2, -0.24, 0.45), (-0.18, 0.24, 0.95))), "Seat"),
-        "Frame": (geo.merge(geo.box((-0.2, -0.26, 0.14), (0.42, -0.24, 0.45)),
-                            geo.box((-0.2, 0.24, 0.14), (0.42, 0.26, 0.45)),
-                            geo.box((0.36, -0.2, 0.08), (0.44, 0.2, 0.12))), "Frame"),
-    }
-
-
-def _animate_translate(xform: UsdGeom.Xform, start, end, meta: StageMetadata, heading_deg: float) -> None:
-    op = xform.AddTranslateOp()
-    t0, t1 = meta.start_time_code, meta.end_time_code
-    for t in np.arange(t0, t1 + 1):
-        s = (t - t0) / (t1 - t0)
-        op.Set(Gf.Vec3d(*(np.asarray(start) + s * (np.asarray(end) - np.asarray(start)))), Usd.TimeCode(float(t)))
-    xform.AddRotateZOp().Set(float(heading_deg))
-
-
 def build_agents(meta: StageMetadata = META) -> Usd.Stage:
-    """The agents layer: geometry, labels and time-sampled motion of two people and one wheelchair."""
-    stage = new_layer(meta, "synthua demo street: agents with time-sampled transforms and their own class labels.")
-    world = stage.OverridePrim("/World")
-    stage.SetDefaultPrim(world)
-    define_xform(stage, "/World/Agents", kind=Kind.Tokens.group)
-    looks = {n: define_preview_material(stage, f"/World/Agents/Looks/{n}", s) for n, s in AGENT_MATERIALS.items()}
-    seconds = (meta.end_time_code - meta.start_time_code) / meta.time_codes_per_second
-
-    # Pedestrian: 1.3 m/s along the south sidewalk, legs swinging +-20 degrees once a second.
-    ped = define_xform(stage, "/World/Agents/Pedestrian_01", kind=Kind.Tokens.component)
-    y_south = -ROAD_HALF_WIDTH - 1.3
-    _animate_translate(ped, (-4.0, y_south, KERB_HEIGHT), (-4.0 + 1.3 * seconds, y_south, KERB_HEIGHT), meta, 0.0)
-    apply_label(ped.GetPrim(), TAXONOMY, "person")
-    for name, ((pts, tris), mat) in _person_parts(seated=False).items():
-        define_mesh(stage, f"{ped.GetPath()}/{name}", pts, tris, looks[mat])
-    for side, phase in (("L", 0.0), ("R", np.pi)):
-        leg = define_xform(stage, f"{ped.GetPath()}/Leg{side}", translate=(0.0, 0.1 if side == "L" else -0.1, 0.9))
-        swing = leg.AddRotateYOp()
-        for t in np.arange(meta.start_time_code, meta.end_time_code + 1):
-            angle = 20.0 * np.sin(2 * np.pi * (t - meta.start_time_code) / meta.time_codes_per_second + phase)
-            swing.Set(float(angle), Usd.TimeCode(float(t)))
-        pts, tris = geo.box((-0.07, -0.07, -0.9), (0.07, 0.07, 0.0))
-        define_mesh(stage, f"{leg.GetPath()}/Mesh", pts, tris, looks["Trousers"])
-
-    # Wheelchair user: person and wheelchair are separate models with separate classes and instances.
-    user = define_xform(stage, "/World/Agents/WheelchairUser_01", kind=Kind.Tokens.group)
-    y_north = ROAD_HALF_WIDTH + 1.2
-    _animate_translate(user, (-2.0, y_north, KERB_HEIGHT), (-2.0 + 0.9 * seconds, y_north, KERB_HEIGHT), meta, 0.0)
-    person = define_xform(stage, f"{user.GetPath()}/Person", kind=Kind.Tokens.component)
-    apply_label(person.GetPrim(), TAXONOMY, "person")
-    for name, ((pts, tris), mat) in _person_parts(seated=True).items():
-        define_mesh(stage, f"{person.GetPath()}/{name}", pts, tris, looks[mat])
-    chair = define_xform(stage, f"{user.GetPath()}/Wheelchair", kind=Kind.Tokens.component)
-    apply_label(chair.GetPrim(), TAXONOMY, "manual_wheelchair")
-    for name, ((pts, tris), mat) in _wheelchair_parts().items():
-        define_mesh(stage, f"{chair.GetPath()}/{name}", pts, tris, looks[mat])
-    person.GetPrim().CreateRelationship("synthua:uses", custom=True).SetTargets([chair.GetPath()])
-    return stage
+    """The agents layer: a pedestrian walking east on the south sidewalk at 1.3 m/s and a manual wheelchair
+    user rolling east on the north sidewalk at 0.9 m/s, written like any populated agents layer."""
+    y_south, y_north = -ROAD_HALF_WIDTH - 1.3, ROAD_HALF_WIDTH + 1.2
+    plans = [
+        Plan(PROFILES["pedestrian"], 1.3, np.array([(-4.0, y_south, KERB_HEIGHT), (4.0, y_south, KERB_HEIGHT)]),
+             ("sidewalk", "sidewalk"), 0.0, 0.0),
+        Plan(PROFILES["manual_wheelchair"], 0.9, np.array([(-2.0, y_north, KERB_HEIGHT), (4.0, y_north, KERB_HEIGHT)]),
+             ("sidewalk", "sidewalk"), 0.0, 0.0),
+    ]
+    trajectories, dropped = simulate(plans, int(meta.end_time_code - meta.start_time_code + 1), meta.time_codes_per_second)
+    if dropped:  # fixed, far-apart routes: this would be a bug here, not bad input
+        raise RuntimeError(f"demo street: {dropped} scripted agents collided")
+    looks = [PersonLook(1.75, 1.0, "Skin2", "Shirt0", "Trousers0"), PersonLook(1.7, 1.05, "Skin1", "Shirt2", "Trousers1")]
+    return build_agents_layer(trajectories, looks, meta, TAXONOMY,
+                              "synthua demo street: agents with time-sampled transforms and their own class labels.")
 
 
 # --- cameras, environment, render settings ---------------------------------------------------------------
