@@ -232,3 +232,18 @@ def test_populated_layer_composes_renders_and_exports_person_device_pairs(run_cl
         assert person["class_name"] == "person" and device["class_name"] in aid_classes
         assert person["id"] != device["id"]
     assert any(p["pixel_count"] and d["pixel_count"] for p, d in pairs)
+
+
+def test_walk_on_roads_for_twins_without_sidewalks(run_cli, tmp_path):
+    from conftest import DATA
+
+    assert run_cli("twin", "import", "cityjson", DATA / "valid" / "lod2_house.city.json", "--out", tmp_path)[0] == 0
+    code, _, err = run_cli("agents", "populate", tmp_path / "scenario.usda", "--out", tmp_path / "a.usda")
+    assert code == 2 and "add --walk-on road" in err and not (tmp_path / "a.usda").exists()
+    code, out, err = run_cli("agents", "populate", tmp_path / "scenario.usda", "--walk-on", "sidewalk,road",
+                             "--density", "0.05", "--frames", "6", "--out", tmp_path / "a.usda")
+    assert code == 0, err
+    assert "walkable area 134 m²" in out  # 20 x 7 m road less its 2 x 3 m hole
+    code, _, err = run_cli("agents", "populate", tmp_path / "scenario.usda", "--walk-on", "lava",
+                           "--out", tmp_path / "b.usda")
+    assert code == 2 and "walkable classes ['lava'] are not classes" in err

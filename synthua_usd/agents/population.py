@@ -69,7 +69,8 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
         raise InputError(f"aid share should be a fraction in [0, 1], but was {aid_share}")
     nodes = sorted(graph.nodes)
     if not nodes:
-        raise InputError("the twin has no walkable surface (sidewalk, crosswalk, curb_ramp, street_road)")
+        raise InputError("the twin has no walkable surface of the walkable classes (default sidewalk, crosswalk, "
+                         "curb_ramp, street_road); for twins whose roads include sidewalks add --walk-on road")
     pos = np.array([graph.nodes[n]["pos"] for n in nodes])
     plans: list[Plan] = []
     group_id = 0

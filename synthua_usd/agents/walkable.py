@@ -56,9 +56,11 @@ class WalkableGrid:
         return float(self.walkable.sum()) * self.cell_m ** 2
 
 
-def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, cell_m: float = 0.5) -> WalkableGrid:
+def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, cell_m: float = 0.5,
+               walkable: tuple[str, ...] = WALKABLE) -> WalkableGrid:
     """Rasterise walkable surfaces. ``vertices`` (n, 3) world metres, Z up; ``faces`` (m, 3); ``face_class``
-    (m,) class name per face."""
+    (m,) class name per face; ``walkable`` the classes people walk on (the road counts inside crosswalks
+    whatever this says; add ``road`` for twins whose roads include their sidewalks, as CityJSON's often do)."""
     if len(faces) == 0:
         raise InputError("the twin has no geometry to walk on")
     mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
@@ -85,14 +87,14 @@ def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, 
             cls = classes[tri_sorted[k]]
             if not normals_up[tri_sorted[k]]:
                 continue
-            walk = cls in WALKABLE or (cls == CROSSING_ONLY and _inside(origins[r, :2], crosswalk_boxes))
+            walk = cls in walkable or (cls == CROSSING_ONLY and _inside(origins[r, :2], crosswalk_boxes))
             if not walk:
                 continue
             zk = loc_sorted[k, 2]
             blocked = any(zk + 0.05 < loc_sorted[m, 2] < zk + HEADROOM_M for m in hits if m != k)
             if not blocked:
                 z[r] = zk
-                surface[r] = "crosswalk" if cls == CROSSING_ONLY else cls
+                surface[r] = "crosswalk" if cls == CROSSING_ONLY and cls not in walkable else cls
             break  # the highest walkable surface decides the cell, free or blocked
     return WalkableGrid(float(lo[0]), float(lo[1]), cell_m, z.reshape(ny_, nx_), surface.reshape(ny_, nx_))
 

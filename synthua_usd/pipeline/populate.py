@@ -11,7 +11,7 @@ import numpy as np
 
 from synthua_usd.agents.motion import min_separation, simulate
 from synthua_usd.agents.population import DEFAULT_AID_SHARE, check_density, plan_agents, sample_count
-from synthua_usd.agents.walkable import build_grid, walkable_graph
+from synthua_usd.agents.walkable import WALKABLE, build_grid, walkable_graph
 from synthua_usd.assets.people import PersonLook
 from synthua_usd.errors import InputError
 from synthua_usd.taxonomy import ClassMap
@@ -33,6 +33,7 @@ class PopulateRequest:
     seed: int = 0
     cell_m: float = 0.5
     class_map_path: Path | None = None
+    walkable: tuple[str, ...] = WALKABLE
 
 
 @dataclass
@@ -58,13 +59,17 @@ def populate(request: PopulateRequest) -> PopulateReport:
     if not 0.0 <= request.aid_share <= 1.0:
         raise InputError(f"aid share should be a fraction in [0, 1], but was {request.aid_share}")
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    unknown = [c for c in request.walkable if class_map.resolve(c) is None]
+    if unknown:
+        raise InputError(f"walkable classes {unknown} are not classes of {class_map.source}")
     stage = open_stage(request.stage_path)
     start = stage.GetStartTimeCode() if stage.HasAuthoredTimeCodeRange() else 1.0
     fps = stage.GetTimeCodesPerSecond()
     snapshot = read_snapshot(stage, start, class_map)
     verts, faces, owner = snapshot.world_triangles()
     names = np.array([class_map.by_id(m.class_id).name for m in snapshot.meshes], object)
-    grid = build_grid(verts, faces, names[owner] if len(owner) else np.zeros(0, object), request.cell_m)
+    grid = build_grid(verts, faces, names[owner] if len(owner) else np.zeros(0, object), request.cell_m,
+                      tuple(class_map.resolve(c).name for c in request.walkable))
     graph = walkable_graph(grid)
     rng = np.random.default_rng(request.seed)
     count = sample_count(rng, request.density_per_m2, grid.area_m2())
