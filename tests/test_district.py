@@ -103,3 +103,12 @@ def test_twin_demo_cli(run_cli, tmp_path):
     code, out, _ = run_cli("twin", "demo", "--seed", "2", "--out", tmp_path)
     assert code == 0 and "district seed 2:" in out
     assert sorted(p.name for p in tmp_path.iterdir()) == ["semantics.usda", "twin.usda"]
+
+
+@pytest.mark.slow
+def test_repopulating_ignores_the_agents_already_there(run_cli, tmp_path):
+    # The shipped agents were populated before any agents existed; re-populating the scenario that now
+    # holds them must give the same layer, byte for byte.
+    code, _, err = run_cli("agents", "populate", DISTRICT / "scenario.usda", "--out", tmp_path / "agents.usda")
+    assert code == 0, err
+    assert filecmp.cmp(tmp_path / "agents.usda", DISTRICT / "agents.usda", shallow=False)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +15,7 @@ from synthua_usd.agents.walkable import WALKABLE, build_grid, walkable_graph
 from synthua_usd.assets.people import PersonLook
 from synthua_usd.errors import InputError
 from synthua_usd.taxonomy import ClassMap
-from synthua_usd.usd.agents_writer import write_agents_layer
+from synthua_usd.usd.agents_writer import AGENTS_ROOT, write_agents_layer
 from synthua_usd.usd.authoring import StageMetadata
 from synthua_usd.usd.reader import read_snapshot
 from synthua_usd.usd.stage_io import open_stage
@@ -51,7 +51,10 @@ class PopulateReport:
 
 
 def populate(request: PopulateRequest) -> PopulateReport:
-    """Walkable graph → Poisson population → routes (A*) → collision-free motion → agents layer."""
+    """Walkable graph → Poisson population → routes (A*) → collision-free motion → agents layer.
+
+    Agents already in the stage (under ``/World/Agents``) are ignored: the new layer is meant to replace
+    them. Everything else, parked devices of the twin included, is terrain or obstacle."""
     t0 = time.perf_counter()
     check_density(request.density_per_m2)
     if request.frames < 1:
@@ -66,6 +69,8 @@ def populate(request: PopulateRequest) -> PopulateReport:
     start = stage.GetStartTimeCode() if stage.HasAuthoredTimeCodeRange() else 1.0
     fps = stage.GetTimeCodesPerSecond()
     snapshot = read_snapshot(stage, start, class_map)
+    # Agents already in the stage (an earlier agents layer) are not part of the twin.
+    snapshot = replace(snapshot, meshes=tuple(m for m in snapshot.meshes if not m.prim_path.startswith(AGENTS_ROOT + "/")))
     verts, faces, owner = snapshot.world_triangles()
     names = np.array([class_map.by_id(m.class_id).name for m in snapshot.meshes], object)
     grid = build_grid(verts, faces, names[owner] if len(owner) else np.zeros(0, object), request.cell_m,

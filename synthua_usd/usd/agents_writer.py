@@ -20,6 +20,8 @@ DEVICE_MATERIALS = [Material("Tyre", (0.02, 0.02, 0.02), 0.9), Material("Seat", 
                     Material("CaneWhite", (0.85, 0.85, 0.85), 0.4), Material("CaneRed", (0.6, 0.03, 0.03), 0.4),
                     Material("Wood", (0.35, 0.2, 0.08), 0.7)]
 
+AGENTS_ROOT = "/World/Agents"
+
 #: Where a device stands relative to its user (local frame: user faces +X): offsets per device.
 DEVICE_PLACEMENT = {"walker": [(0.42, 0.0)], "crutch": [(0.12, 0.3), (0.12, -0.3)],
                     "smart_cane": [(0.3, -0.25)], "wooden_cane": [(0.12, -0.3)], "orthopedic_cane": [(0.12, -0.3)],
@@ -34,13 +36,13 @@ def build_agents_layer(trajectories: list[Trajectory], looks: list[PersonLook], 
                        taxonomy: str, doc: str) -> Usd.Stage:
     stage = new_layer(meta, doc)
     stage.SetDefaultPrim(stage.OverridePrim("/World"))
-    define_xform(stage, "/World/Agents", kind=Kind.Tokens.group)
-    mats = {m.key: define_preview_material(stage, f"/World/Agents/Looks/{m.key}", m)
+    define_xform(stage, AGENTS_ROOT, kind=Kind.Tokens.group)
+    mats = {m.key: define_preview_material(stage, f"{AGENTS_ROOT}/Looks/{m.key}", m)
             for m in SKINS + SHIRTS + TROUSERS + DEVICE_MATERIALS}
     times = [Usd.TimeCode(meta.start_time_code + f) for f in range(len(trajectories[0].positions))] if trajectories else []
     for i, (traj, look) in enumerate(zip(trajectories, looks)):
         profile = traj.plan.profile
-        root = define_xform(stage, f"/World/Agents/Agent_{i:04d}", kind=Kind.Tokens.group)
+        root = define_xform(stage, f"{AGENTS_ROOT}/Agent_{i:04d}", kind=Kind.Tokens.group)
         translate, heading = root.AddTranslateOp(), root.AddRotateZOp()
         for t, p, h in zip(times, traj.positions, traj.headings_deg):
             translate.Set(Gf.Vec3d(*map(float, p)), t)
