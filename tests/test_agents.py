@@ -247,3 +247,22 @@ def test_walk_on_roads_for_twins_without_sidewalks(run_cli, tmp_path):
     code, _, err = run_cli("agents", "populate", tmp_path / "scenario.usda", "--walk-on", "lava",
                            "--out", tmp_path / "b.usda")
     assert code == 2 and "walkable classes ['lava'] are not classes" in err
+
+
+def test_some_agents_walk_to_a_bench_and_stay():
+    verts, faces, classes = crossing_scene()
+    bench_v, bench_f = geo.box((-14.0, 5.5, 0.45), (-12.0, 6.0, 0.5))  # a bench seat on the north sidewalk
+    verts = np.concatenate([verts, bench_v])
+    faces = np.concatenate([faces, bench_f + len(verts) - len(bench_v)])
+    classes = np.concatenate([classes, np.array(["furniture"] * len(bench_f), object)])
+    grid = build_grid(verts, faces, classes, cell_m=0.5)
+    graph = walkable_graph(grid)
+    beside = set(grid.cells_beside("furniture"))
+    assert beside
+    plans = plan_agents(np.random.default_rng(2), graph, grid, 3, aid_share=0.0, rest_share=1.0)
+    assert all(p.rests for p in plans)
+    trajs, _ = simulate(plans, frames=24 * 8, fps=24.0)
+    for t in trajs:
+        end = t.positions[-1]
+        assert grid.cell_of(end[0], end[1]) in beside
+        assert np.allclose(t.positions[-24:], end)  # resting for at least the last second

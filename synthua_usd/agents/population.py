@@ -55,15 +55,17 @@ class Plan:
     start_offset_m: float
     pause_before_crossing_s: float
     group: int | None = None
+    rests: bool = False  # walks to a bench and stays there
 
 
 def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, count: int, aid_share: float,
-                min_route_m: float = 15.0) -> list[Plan]:
+                min_route_m: float = 15.0, rest_share: float = 0.15) -> list[Plan]:
     """Routes for ``count`` agents: ``aid_share`` of them (rounded stochastically) use mobility aids.
 
     Each agent walks between two random reachable cells at least ``min_route_m`` apart, starting at a
     random point along its route; about a third of pedestrians come in groups of two or three, who share
-    a route and walk 0.9 m apart.
+    a route and walk 0.9 m apart. ``rest_share`` of single agents head for a bench (a cell beside street
+    furniture) and arrive within the first seconds, then stay there.
     """
     if not 0.0 <= aid_share <= 1.0:
         raise InputError(f"aid share should be a fraction in [0, 1], but was {aid_share}")
@@ -72,32 +74,38 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
         raise InputError("the twin has no walkable surface of the walkable classes (default sidewalk, crosswalk, "
                          "curb_ramp, street_road); for twins whose roads include sidewalks add --walk-on road")
     pos = np.array([graph.nodes[n]["pos"] for n in nodes])
+    benches = sorted(set(grid.cells_beside("furniture")) & set(graph.nodes))
     plans: list[Plan] = []
     group_id = 0
     while len(plans) < count:
         is_aid = rng.random() < aid_share
         profile = PROFILES[AID_PROFILES[int(rng.integers(len(AID_PROFILES)))]] if is_aid else PROFILES["pedestrian"]
-        route = _route(rng, graph, nodes, pos, profile, min_route_m)
+        rests = bool(benches) and rng.random() < rest_share
+        route = _route(rng, graph, nodes, pos, profile, min_route_m, benches if rests else None)
         if route is None:
             continue
         waypoints, surfaces = route
         length = float(np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum())
         speed = float(np.clip(rng.normal(profile.speed_mps, profile.speed_sd_mps), 0.5 * profile.speed_mps,
                               1.5 * profile.speed_mps))
-        offset = float(rng.uniform(0, 0.8 * length))
+        # Resting agents are 1-3 m from their bench at the first frame; the others anywhere on the way.
+        offset = max(length - float(rng.uniform(1.0, 3.0)), 0.0) if rests else float(rng.uniform(0, 0.8 * length))
         pause = float(rng.uniform(1.0, 4.0))
-        size = int(rng.choice([2, 3])) if (not is_aid and rng.random() < 0.3) else 1
+        size = int(rng.choice([2, 3])) if (not is_aid and not rests and rng.random() < 0.3) else 1
         size = min(size, count - len(plans))
         gid = group_id if size > 1 else None
         group_id += size > 1
         for k in range(size):
-            plans.append(Plan(profile, speed, waypoints, surfaces, max(offset - 0.9 * k, 0.0), pause, gid))
+            plans.append(Plan(profile, speed, waypoints, surfaces, max(offset - 0.9 * k, 0.0), pause, gid, rests))
     return plans
 
 
-def _route(rng, graph, nodes, pos, profile, min_route_m):
+def _route(rng, graph, nodes, pos, profile, min_route_m, goals=None):
+    index = {n: k for k, n in enumerate(nodes)}
     for _ in range(20):
         a, b = rng.integers(len(nodes), size=2)
+        if goals:
+            b = index[goals[int(rng.integers(len(goals)))]]
         if np.linalg.norm(pos[a, :2] - pos[b, :2]) < min_route_m:
             continue
         try:

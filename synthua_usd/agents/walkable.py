@@ -41,6 +41,19 @@ class WalkableGrid:
     cell_m: float
     z: np.ndarray = field(repr=False)
     surface: np.ndarray = field(repr=False)
+    blocker: np.ndarray | None = field(default=None, repr=False)  # (ny, nx) class of what blocks a cell, or ''
+
+    def cells_beside(self, class_name: str) -> list[tuple[int, int]]:
+        """Walkable cells next to a cell blocked by ``class_name`` (e.g. the seats of benches)."""
+        if self.blocker is None:
+            return []
+        hit = self.blocker == class_name
+        near = np.zeros_like(hit)
+        near[1:] |= hit[:-1]
+        near[:-1] |= hit[1:]
+        near[:, 1:] |= hit[:, :-1]
+        near[:, :-1] |= hit[:, 1:]
+        return [(int(i), int(j)) for i, j in zip(*np.nonzero(near & self.walkable))]
 
     @property
     def walkable(self) -> np.ndarray:
@@ -76,6 +89,7 @@ def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, 
     normals_up = mesh.face_normals[:, 2] > 0.5
     z = np.full(gx.size, np.nan)
     surface = np.full(gx.size, "", object)
+    blocker = np.full(gx.size, "", object)
     crosswalk_boxes = _footprints(vertices, faces, classes, "crosswalk")
     order = np.lexsort((-locations[:, 2], ray_idx))
     ray_sorted, loc_sorted, tri_sorted = ray_idx[order], locations[order], tri_idx[order]
@@ -91,12 +105,15 @@ def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, 
             if not walk:
                 continue
             zk = loc_sorted[k, 2]
-            blocked = any(zk + 0.05 < loc_sorted[m, 2] < zk + HEADROOM_M for m in hits if m != k)
-            if not blocked:
+            above = [m for m in hits if m != k and zk + 0.05 < loc_sorted[m, 2] < zk + HEADROOM_M]
+            if above:
+                blocker[r] = classes[tri_sorted[above[-1]]]  # the lowest thing in the way
+            else:
                 z[r] = zk
                 surface[r] = "crosswalk" if cls == CROSSING_ONLY and cls not in walkable else cls
             break  # the highest walkable surface decides the cell, free or blocked
-    return WalkableGrid(float(lo[0]), float(lo[1]), cell_m, z.reshape(ny_, nx_), surface.reshape(ny_, nx_))
+    return WalkableGrid(float(lo[0]), float(lo[1]), cell_m, z.reshape(ny_, nx_), surface.reshape(ny_, nx_),
+                        blocker.reshape(ny_, nx_))
 
 
 def _footprints(vertices, faces, classes, name) -> list[tuple[float, float, float, float]]:

@@ -50,6 +50,8 @@ def build_agents_layer(trajectories: list[Trajectory], looks: list[PersonLook], 
         prim = root.GetPrim()
         prim.CreateAttribute("synthua:profile", Sdf.ValueTypeNames.String, custom=True).Set(profile.name)
         prim.CreateAttribute("synthua:speed_mps", Sdf.ValueTypeNames.Double, custom=True).Set(traj.plan.speed_mps)
+        if traj.plan.rests:
+            prim.CreateAttribute("synthua:behaviour", Sdf.ValueTypeNames.String, custom=True).Set("rests_at_bench")
         if traj.plan.group is not None:
             prim.CreateAttribute("synthua:group", Sdf.ValueTypeNames.Int, custom=True).Set(traj.plan.group)
         person_xf = define_xform(stage, f"{root.GetPath()}/Person")
