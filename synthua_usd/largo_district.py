@@ -101,8 +101,12 @@ class _Builder:
         n = self._counts.get(f"{folder}/{stem}", 0)
         self._counts[f"{folder}/{stem}"] = n + 1
         path = f"{folder}/{stem}_{n:03d}"
-        parts = tuple(TwinPart(p.name if i == 0 or p.name not in [q.name for q in pieces[:i]] else f"{p.name}_{i}",
-                               p.mesh[0], p.mesh[1], p.material) for i, p in enumerate(pieces))
+        parts, seen = [], set()
+        for i, p in enumerate(pieces):
+            name = f"{p.name}_{i}" if p.name in seen else p.name  # repeated piece names get their index
+            seen.add(p.name)
+            parts.append(TwinPart(name, p.mesh[0], p.mesh[1], p.material))
+        parts = tuple(parts)
         self.objects.append(TwinObject(path, label, parts, attributes))
         return path
 
@@ -245,9 +249,8 @@ def _buildings(b: _Builder, rng: np.random.Generator) -> None:
         wall = f"Wall{int(rng.integers(len(WALL_COLOURS)))}"
         parts = buildings.row_house(rng, width, depth, storeys, wall, foundation_m=foundation, mural=mural)
         stem = b.add(folder, "House", "building", place(parts.structure, at, heading), storeys=storeys)
-        for door in parts.doors:
-            b.objects.append(_sub(stem, "Door", len([o for o in b.objects if o.path.startswith(stem + "/Door")]), "door",
-                                  place(door, at, heading)))
+        for k, door in enumerate(parts.doors):
+            b.objects.append(_sub(stem, "Door", k, "door", place(door, at, heading)))
         for k, window in enumerate(parts.windows):
             b.objects.append(_sub(stem, "Window", k, "window", place(window, at, heading)))
         for k, mural_p in enumerate(parts.murals):
