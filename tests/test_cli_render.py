@@ -98,3 +98,13 @@ def test_rerender_replaces_files_in_place(run_cli, tmp_path):
     assert run_cli(*args)[0] == 0
     assert sorted(p.name for p in out.iterdir()) == sorted(FILES)  # no temporary files left behind
     assert json.loads(first)["instances"] == json.loads((out / "frame.json").read_text())["instances"]
+
+
+def test_scalar_variant_on_request(run_cli, tmp_path):
+    code, out, err = run_cli("render", SCENARIO, "--variant", "scalar_rgb", "--width", "32", "--height", "24",
+                             "--spp", "1", "--out", tmp_path / "s")
+    assert code == 0, err
+    doc = json.loads((tmp_path / "s" / "frame.json").read_text())
+    assert doc["render"]["variant"] == "scalar_rgb"
+    code, _, err = run_cli("render", SCENARIO, "--variant", "teapot_rgb", "--out", tmp_path / "t")
+    assert code == 2 and "variant 'teapot_rgb' is not in this Mitsuba build" in err and not (tmp_path / "t").exists()

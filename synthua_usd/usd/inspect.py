@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import textwrap
 from collections import Counter
 from dataclasses import dataclass, field
 
@@ -38,7 +39,9 @@ class StageSummary:
                  f"time       {'static' if not self.time_range else f'{self.time_range[0]:g}..{self.time_range[1]:g}'}"
                  f" at {self.time_codes_per_second:g} time codes/s",
                  f"prims      {self.prim_count} ({self.gprim_count} renderable gprims, ~{self.triangle_estimate} triangles)",
-                 "classes    " + ("  ".join(f"{k}:{v}" for k, v in sorted(self.classes.items())) or "(none)")]
+                 "classes    " + ("\n           ".join(textwrap.wrap(
+                     "  ".join(f"{k}:{v}" for k, v in sorted(self.classes.items())), 88, break_on_hyphens=False))
+                     or "(none)")]
         if self.unlabelled_gprims:
             lines.append(f"           {self.unlabelled_gprims} gprims without a class")
         lines.append("cameras    " + ("\n           ".join(
