@@ -124,3 +124,18 @@ class PinholeCamera:
 def _check_size(width: int, height: int) -> None:
     if not (isinstance(width, int) and isinstance(height, int) and width > 0 and height > 0):
         raise InputError(f"image size should be positive integers, but was {width}x{height}")
+
+
+@dataclass(frozen=True)
+class CameraRig:
+    """A camera to author: placed at ``eye`` looking at ``target`` (world metres, Z up) with a physical lens."""
+
+    name: str
+    eye: tuple[float, float, float]
+    target: tuple[float, float, float]
+    focal_length_mm: float
+    horizontal_aperture_mm: float
+    vertical_aperture_mm: float
+    doc: str
+    clip_near_m: float = 0.05
+    clip_far_m: float = 1000.0

@@ -7,6 +7,7 @@ import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdLux, UsdRender
 
 from synthua_usd import geometry as geo
+from synthua_usd.cameras import CameraRig
 from synthua_usd.usd.authoring import StageMetadata, define_xform, new_layer
 from synthua_usd.usd.cameras import author_camera
 
@@ -89,4 +90,17 @@ def build_overview_cameras(meta: StageMetadata, bounds_min, bounds_max, street_p
     author_camera(stage, "/World/Cameras/Street", geo.look_at(street_eye, street_eye + [10 * d[0], 10 * d[1], -0.5]),
                   focal_length_mm=24, horizontal_aperture_mm=36, vertical_aperture_mm=24, clip_near_m=0.05,
                   clip_far_m=far, meters_per_unit=meta.meters_per_unit, doc="Eye level at the twin's centre.")
+    return stage
+
+
+def build_camera_layer(meta: StageMetadata, rigs: tuple[CameraRig, ...], doc: str) -> Usd.Stage:
+    """A cameras layer: every rig as ``/World/Cameras/<name>``."""
+    stage = new_layer(meta, doc)
+    stage.SetDefaultPrim(stage.OverridePrim("/World"))
+    define_xform(stage, "/World/Cameras", kind=Kind.Tokens.group)
+    for rig in rigs:
+        author_camera(stage, f"/World/Cameras/{rig.name}", geo.look_at(rig.eye, rig.target),
+                      focal_length_mm=rig.focal_length_mm, horizontal_aperture_mm=rig.horizontal_aperture_mm,
+                      vertical_aperture_mm=rig.vertical_aperture_mm, clip_near_m=rig.clip_near_m,
+                      clip_far_m=rig.clip_far_m, meters_per_unit=meta.meters_per_unit, doc=rig.doc)
     return stage

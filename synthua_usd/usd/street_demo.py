@@ -19,6 +19,7 @@ import numpy as np
 from pxr import Kind, Usd
 
 from synthua_usd import geometry as geo
+from synthua_usd.cameras import CameraRig
 from synthua_usd.agents.motion import simulate
 from synthua_usd.agents.population import Plan
 from synthua_usd.agents.profiles import PROFILES
@@ -27,9 +28,8 @@ from synthua_usd.scene import Material
 from synthua_usd.usd.agents_writer import build_agents_layer
 from synthua_usd.usd.authoring import (StageMetadata, apply_label, define_mesh, define_preview_material,
                                        define_xform, new_layer, save_layer_atomic, set_kind)
-from synthua_usd.usd.cameras import author_camera
 from synthua_usd.usd.compose import compose_layers
-from synthua_usd.usd.scenario_layers import build_environment, build_render_settings
+from synthua_usd.usd.scenario_layers import build_camera_layer, build_environment, build_render_settings
 
 TAXONOMY = "synthua"
 META = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=24.0,
@@ -62,27 +62,16 @@ MATERIALS = {
     "Leaves": Material("Leaves", (0.07, 0.2, 0.04), 0.8),
 }
 
-@dataclass(frozen=True)
-class CameraSpec:
-    name: str
-    eye: tuple[float, float, float]
-    target: tuple[float, float, float]
-    focal_length_mm: float
-    horizontal_aperture_mm: float
-    vertical_aperture_mm: float
-    doc: str
-
-
 CAMERAS = (
     # 1/3" CCTV sensor (4.8 x 3.6 mm) behind a 2.8 mm lens: ~81 degree horizontal view from 6 m up.
-    CameraSpec("CCTV", (-10.0, -6.2, 5.5), (2.0, 2.5, 0.0), 2.8, 4.8, 3.6,
-               "Wall-mounted CCTV camera on building B, 6 m above the sidewalk."),
+    CameraRig("CCTV", (-10.0, -6.2, 5.5), (2.0, 2.5, 0.0), 2.8, 4.8, 3.6,
+              "Wall-mounted CCTV camera on building B, 6 m above the sidewalk.", clip_far_m=500.0),
     # Full-frame 36 x 24 mm with a 24 mm lens, held at 1.6 m eye height.
-    CameraSpec("PedestrianEye", (-11.0, -4.6, 1.6), (4.0, 1.5, 1.0), 24.0, 36.0, 24.0,
-               "Pedestrian eye level (1.6 m) on the south sidewalk, looking down the street."),
+    CameraRig("PedestrianEye", (-11.0, -4.6, 1.6), (4.0, 1.5, 1.0), 24.0, 36.0, 24.0,
+              "Pedestrian eye level (1.6 m) on the south sidewalk, looking down the street.", clip_far_m=500.0),
     # Same lens at the eye height of a seated wheelchair user (1.2 m).
-    CameraSpec("WheelchairEye", (8.0, 5.6, 1.2), (-2.0, 4.5, 0.7), 24.0, 36.0, 24.0,
-               "Eye level of a seated wheelchair user (1.2 m) on the north sidewalk, looking west."),
+    CameraRig("WheelchairEye", (8.0, 5.6, 1.2), (-2.0, 4.5, 0.7), 24.0, 36.0, 24.0,
+              "Eye level of a seated wheelchair user (1.2 m) on the north sidewalk, looking west.", clip_far_m=500.0),
 )
 
 
@@ -227,15 +216,7 @@ def build_agents(meta: StageMetadata = META) -> Usd.Stage:
 # --- cameras, environment, render settings ---------------------------------------------------------------
 
 def build_cameras(meta: StageMetadata = META) -> Usd.Stage:
-    stage = new_layer(meta, "synthua demo street: camera rigs with physical lens values.")
-    stage.SetDefaultPrim(stage.OverridePrim("/World"))
-    define_xform(stage, "/World/Cameras", kind=Kind.Tokens.group)
-    for spec in CAMERAS:
-        author_camera(stage, f"/World/Cameras/{spec.name}", geo.look_at(spec.eye, spec.target),
-                      focal_length_mm=spec.focal_length_mm, horizontal_aperture_mm=spec.horizontal_aperture_mm,
-                      vertical_aperture_mm=spec.vertical_aperture_mm, clip_near_m=0.05, clip_far_m=500.0,
-                      meters_per_unit=meta.meters_per_unit, doc=spec.doc)
-    return stage
+    return build_camera_layer(meta, CAMERAS, "synthua demo street: camera rigs with physical lens values.")
 
 
 def write_street_demo(out_dir: str | Path) -> list[Path]:

@@ -6,13 +6,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from pxr import Gf, Kind, Sdf
 
 from synthua_usd.errors import InputError
 from synthua_usd.taxonomy import ClassMap
-from synthua_usd.twin import TwinModel
+from synthua_usd.twin import TwinModel, prim_name
 from synthua_usd.usd.authoring import (StageMetadata, apply_label, define_mesh, define_preview_material,
                                        define_xform, new_layer, save_layer_atomic, set_kind)
+from synthua_usd.usd.compose import compose_layers
+from synthua_usd.usd.scenario_layers import build_environment, build_overview_cameras, build_render_settings
 
 TWIN_ROOT = "/World/Twin"
 
@@ -63,8 +66,6 @@ def write_twin(model: TwinModel, out_dir: str | Path, class_map: ClassMap,
 
 
 def _safe(key: str) -> str:
-    from synthua_usd.twin import prim_name
-
     return prim_name(key, "Material")
 
 
@@ -84,11 +85,6 @@ def _set_custom(prim, key: str, value) -> None:
 def write_twin_scenario(model: TwinModel, out_dir: str | Path, class_map: ClassMap) -> list[Path]:
     """The twin and semantics layers, plus automatic cameras, a clear-day environment, render settings and
     ``scenario.usda`` composing them, so that an import renders with ``synthua render`` as it is."""
-    import numpy as np
-
-    from synthua_usd.usd.compose import compose_layers
-    from synthua_usd.usd.scenario_layers import build_environment, build_overview_cameras, build_render_settings
-
     out_dir = Path(out_dir)
     meta = StageMetadata(start_time_code=1, end_time_code=1)
     points = [p.points for o in model.objects for p in o.parts if len(p.points)]
@@ -111,8 +107,6 @@ def write_twin_scenario(model: TwinModel, out_dir: str | Path, class_map: ClassM
 def _street_view(model: TwinModel, points):
     """A ground point on the road (or sidewalk) part nearest the twin's centre, and the road's main
     direction there; (None, (1, 0)) when the twin has no road."""
-    import numpy as np
-
     centre = (points.min(axis=0) + points.max(axis=0)) / 2
     best = None
     for obj in model.objects:
