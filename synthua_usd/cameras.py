@@ -127,8 +127,9 @@ def _check_size(width: int, height: int) -> None:
 
 
 @dataclass(frozen=True)
-class CameraRig:
-    """A camera to author: placed at ``eye`` looking at ``target`` (world metres, Z up) with a physical lens."""
+class CameraSpec:
+    """One camera to author: placed at ``eye`` looking at ``target`` (world metres, Z up) with a physical
+    lens (mm); ``name`` becomes the prim name under ``/World/Cameras``."""
 
     name: str
     eye: tuple[float, float, float]

@@ -102,10 +102,11 @@ class SceneSnapshot:
     def triangle_count(self) -> int:
         return int(sum(len(m.triangles) for m in self.meshes))
 
-    def world_triangles(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """All triangles in one soup: vertices (n, 3), faces (m, 3), and (m,) int64 mesh index per face."""
+    def world_triangles(self, meshes=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """All triangles of ``meshes`` (default: every mesh) in one soup: vertices (n, 3), faces (m, 3), and
+        (m,) int64 index into ``meshes`` per face."""
         verts, faces, owner, offset = [], [], [], 0
-        for i, m in enumerate(self.meshes):
+        for i, m in enumerate(self.meshes if meshes is None else meshes):
             verts.append(m.points)
             faces.append(m.triangles + offset)
             owner.append(np.full(len(m.triangles), i, np.int64))

@@ -52,7 +52,7 @@ class ClassMap:
     @classmethod
     def from_document(cls, document: dict, source: str = "(in memory)") -> "ClassMap":
         # Imported here: the rules module builds on this one's data types.
-        from synthua_usd.classmap_rules import check_classmap_rules
+        from synthua_usd.classmap_checks import check_classmap_rules
         from synthua_usd.findings import Severity
 
         validate_document(document, "classmap", source)

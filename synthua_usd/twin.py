@@ -1,7 +1,7 @@
 """A digital twin as plain data: labelled objects made of triangle meshes, before it becomes USD layers.
 
 Importers (:mod:`synthua_usd.importers`) and procedural generators produce a :class:`TwinModel`;
-:func:`synthua_usd.usd.twin_writer.write_twin` turns it into a twin layer and a semantics layer.
+:func:`synthua_usd.usd.twin_writer.author_twin` turns it into a twin layer and a semantics layer.
 Coordinates are local metres, Z up; ``origin_offset_m`` is what was subtracted from the source.
 """
 
@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from synthua_usd.errors import InputError
+from synthua_usd.geometry import Mesh
 from synthua_usd.scene import Material
 
 _NAME_OK = re.compile(r"[^A-Za-z0-9_]")
@@ -26,13 +27,36 @@ def prim_name(text: str, fallback: str = "Object") -> str:
 
 @dataclass(frozen=True, eq=False)
 class TwinPart:
-    """One mesh: ``points`` (n, 3) float64 local metres, ``triangles`` (m, 3) int64, a material key."""
+    """One named mesh with a material, before it becomes a USD ``Mesh`` prim.
+
+    ``points`` (n, 3) float64, metres, in the frame of the twin (procedural assets: the asset's own frame
+    until :func:`synthua_usd.assets.place` moves them); ``triangles`` (m, 3) int64, counter-clockwise seen
+    from outside; ``material`` a key of the twin's materials (:mod:`synthua_usd.materials` for ours).
+
+    Its job: the unit importers and procedural assets produce and the twin writer authors. It carries
+    the part name and source attributes that become prim names and ``synthua:`` attributes; it has no
+    class (its :class:`TwinObject` has) and no world placement beyond its points. Builders of raw
+    geometry use :data:`synthua_usd.geometry.Mesh`; renderers see :class:`synthua_usd.scene.MeshItem`.
+    """
 
     name: str
     points: np.ndarray = field(repr=False)
     triangles: np.ndarray = field(repr=False)
     material: str
     attributes: dict = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, name: str, mesh: Mesh, material: str, **attributes) -> "TwinPart":
+        """A part from a ``(points, triangles)`` mesh of :mod:`synthua_usd.geometry`."""
+        return cls(name, np.asarray(mesh[0], np.float64), np.asarray(mesh[1], np.int64), material, attributes)
+
+    @property
+    def mesh(self) -> Mesh:
+        return self.points, self.triangles
+
+    def moved(self, points: np.ndarray) -> "TwinPart":
+        """The same part with new ``points`` (same topology)."""
+        return TwinPart(self.name, points, self.triangles, self.material, self.attributes)
 
     def __post_init__(self) -> None:
         if self.points.ndim != 2 or self.points.shape[1] != 3:
@@ -69,6 +93,20 @@ class TwinModel:
 
     def triangle_count(self) -> int:
         return int(sum(len(p.triangles) for o in self.objects for p in o.parts))
+
+    def labelled_triangles(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """All triangles in one soup: vertices (n, 3) float64, faces (m, 3) int64 and the class label of
+        each face (m,) object, as the walkable grid of the agents wants them."""
+        verts, faces, labels, offset = [], [], [], 0
+        for obj in self.objects:
+            for part in obj.parts:
+                verts.append(part.points)
+                faces.append(part.triangles + offset)
+                labels.append(np.full(len(part.triangles), obj.label, object))
+                offset += len(part.points)
+        if not verts:
+            return np.zeros((0, 3)), np.zeros((0, 3), np.int64), np.zeros(0, object)
+        return np.concatenate(verts), np.concatenate(faces), np.concatenate(labels)
 
     def label_counts(self) -> dict[str, int]:
         out: dict[str, int] = {}

@@ -6,7 +6,7 @@ import pytest
 from pxr import Sdf, Usd, UsdGeom, UsdRender, UsdSemantics
 
 from conftest import SCENARIO, STAGES
-from synthua_usd.usd.street_demo import LAYER_FILES, write_street_demo
+from synthua_usd.demo.street import LAYER_FILES, write_street_demo
 
 
 def test_committed_layers_match_the_generator(tmp_path):

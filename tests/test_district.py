@@ -7,7 +7,7 @@ import pytest
 
 from conftest import STAGES
 from reference_raycast import reference_labels
-from synthua_usd.largo_district import CROSSWALK_XS, ROAD_Y, build_district
+from synthua_usd.demo.district import CROSSWALK_XS, ROAD_Y, build_district
 
 DISTRICT = STAGES / "district"
 
@@ -80,7 +80,7 @@ def test_another_seed_gives_another_plausible_layout(seed0, class_map):
 
 @pytest.mark.slow
 def test_district_scenario_validates_clean(class_map):
-    from synthua_usd.usd.rules import validate_stage
+    from synthua_usd.usd.stage_checks import validate_stage
     from synthua_usd.usd.stage_io import open_stage
 
     assert validate_stage(open_stage(DISTRICT / "scenario.usda"), class_map) == []

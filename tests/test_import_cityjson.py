@@ -6,7 +6,7 @@ import pytest
 from conftest import DATA, third_party
 from synthua_usd.errors import InputError
 from synthua_usd.importers.cityjson import import_cityjson
-from synthua_usd.semantic_rules import SemanticRules
+from synthua_usd.class_assignment import AssignmentRules
 
 
 def test_lod2_semantic_surfaces_and_holes():
@@ -40,7 +40,7 @@ def test_origin_and_crs_are_kept():
 
 
 def test_rules_override_the_type_table(class_map):
-    rules = SemanticRules.from_document({"rules": [{"field": "type", "pattern": "^WaterBody$", "class": "grass"}]},
+    rules = AssignmentRules.from_document({"rules": [{"field": "type", "pattern": "^WaterBody$", "class": "grass"}]},
                                         class_map)
     model = import_cityjson(DATA / "valid" / "lod2_house.city.json", rules)
     assert {o.path: o.label for o in model.objects}["WaterBody/water_1"] == "grass"

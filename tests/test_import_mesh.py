@@ -5,12 +5,12 @@ import trimesh
 from conftest import DATA
 from synthua_usd.errors import InputError
 from synthua_usd.importers.mesh import import_mesh
-from synthua_usd.semantic_rules import SemanticRules
+from synthua_usd.class_assignment import AssignmentRules
 
 
 @pytest.fixture
 def rules(class_map):
-    return SemanticRules.load(DATA / "valid" / "mesh_rules.json", class_map)
+    return AssignmentRules.load(DATA / "valid" / "mesh_rules.json", class_map)
 
 
 def by_path(model):
@@ -47,7 +47,7 @@ def test_glb_is_y_up_and_named_by_node(tmp_path, class_map):
     scene.add_geometry(box, node_name="Kiosk", geom_name="kiosk_mesh")
     path = tmp_path / "kiosk.glb"
     scene.export(path)
-    rules = SemanticRules.from_document({"rules": [{"field": "object", "pattern": "kiosk", "class": "stand"}]}, class_map)
+    rules = AssignmentRules.from_document({"rules": [{"field": "object", "pattern": "kiosk", "class": "stand"}]}, class_map)
     model = import_mesh(path, rules)
     (obj,) = model.objects
     assert obj.path == "Kiosk" and obj.label == "stand"
@@ -59,7 +59,7 @@ def test_glb_is_y_up_and_named_by_node(tmp_path, class_map):
 def test_single_mesh_formats_use_the_file_name(tmp_path, class_map, suffix):
     path = tmp_path / f"bench_01.{suffix}"
     trimesh.creation.box(extents=(2, 0.5, 0.5)).export(path)
-    rules = SemanticRules.from_document({"rules": [{"field": "object", "pattern": "bench", "class": "furniture"}]},
+    rules = AssignmentRules.from_document({"rules": [{"field": "object", "pattern": "bench", "class": "furniture"}]},
                                         class_map)
     model = import_mesh(path, rules, scale=0.5)
     (obj,) = model.objects

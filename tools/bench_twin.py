@@ -31,7 +31,7 @@ def main() -> int:
 
     from synthua_usd.importers.cityjson import import_cityjson
     from synthua_usd.importers.pointcloud import import_pointcloud
-    from synthua_usd.largo_district import build_district
+    from synthua_usd.demo.district import build_district
     from synthua_usd.pipeline.populate import PopulateRequest, populate
 
     model = timed("district: build (seed 0)", lambda: build_district(0))

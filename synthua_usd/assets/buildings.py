@@ -12,17 +12,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from synthua_usd import geometry as geo
-from synthua_usd.assets import Piece
+from synthua_usd.twin import TwinPart
 
 STOREY_M = 3.2
 
 
 @dataclass
 class BuildingParts:
-    structure: list[Piece]
-    doors: list[list[Piece]] = field(default_factory=list)
-    windows: list[list[Piece]] = field(default_factory=list)
-    murals: list[list[Piece]] = field(default_factory=list)
+    structure: list[TwinPart]
+    doors: list[list[TwinPart]] = field(default_factory=list)
+    windows: list[list[TwinPart]] = field(default_factory=list)
+    murals: list[list[TwinPart]] = field(default_factory=list)
 
 
 def _facade_box(front_x, y0, y1, z0, z1, proud=0.06):
@@ -35,13 +35,13 @@ def row_house(rng: np.random.Generator, width: float, depth: float, storeys: int
     tiled roof; optionally a painted mural panel on the upper façade."""
     d, w = depth / 2, width / 2
     height = storeys * STOREY_M
-    structure = [Piece("Walls", geo.box((-d, -w, -foundation_m), (d, w, height)), wall),
-                 Piece("Cornice", geo.box((d, -w, height - 0.3), (d + 0.25, w, height)), "Stucco"),
-                 Piece("Roof", geo.merge(geo.ramp(-w, w, -d - 0.3, 0.0, height, height + 2.2, height),
+    structure = [TwinPart.of("Walls", geo.box((-d, -w, -foundation_m), (d, w, height)), wall),
+                 TwinPart.of("Cornice", geo.box((d, -w, height - 0.3), (d + 0.25, w, height)), "Stucco"),
+                 TwinPart.of("Roof", geo.merge(geo.ramp(-w, w, -d - 0.3, 0.0, height, height + 2.2, height),
                                          geo.ramp(-w, w, d + 0.3, 0.0, height, height + 2.2, height)), "RoofTile")]
     # The ramp builder rises along y; turn the roof so its ridge runs along the street (y).
     pts, tris = structure[2].mesh
-    structure[2] = Piece("Roof", (pts[:, [1, 0, 2]], tris[:, ::-1]), "RoofTile")
+    structure[2] = TwinPart.of("Roof", (pts[:, [1, 0, 2]], tris[:, ::-1]), "RoofTile")
     bays = max(int(width // 2.6), 1)
     centres = np.linspace(-w + width / (2 * bays), w - width / (2 * bays), bays)
     door_bay = int(rng.integers(bays))
@@ -50,15 +50,15 @@ def row_house(rng: np.random.Generator, width: float, depth: float, storeys: int
         z0 = floor * STOREY_M
         for k, cy in enumerate(centres):
             if floor == 0 and k == door_bay:
-                parts.doors.append([Piece("Door", _facade_box(d, cy - 0.55, cy + 0.55, 0.0, 2.4), "DoorWood")])
+                parts.doors.append([TwinPart.of("Door", _facade_box(d, cy - 0.55, cy + 0.55, 0.0, 2.4), "DoorWood")])
             elif floor == 0:
-                parts.windows.append([Piece("Window", _facade_box(d, cy - 0.5, cy + 0.5, z0 + 0.9, z0 + 2.3), "Glass")])
+                parts.windows.append([TwinPart.of("Window", _facade_box(d, cy - 0.5, cy + 0.5, z0 + 0.9, z0 + 2.3), "Glass")])
             elif not (mural and floor == storeys - 1 and k == bays // 2):
-                parts.windows.append([Piece("Window", _facade_box(d, cy - 0.45, cy + 0.45, z0 + 0.8, z0 + 2.4), "Glass")])
+                parts.windows.append([TwinPart.of("Window", _facade_box(d, cy - 0.45, cy + 0.45, z0 + 0.8, z0 + 2.4), "Glass")])
     if mural and storeys >= 2:
         cy = centres[bays // 2]
         z0 = (storeys - 1) * STOREY_M
-        parts.murals.append([Piece("Mural", _facade_box(d, cy - 1.1, cy + 1.1, z0 + 0.4, z0 + 2.6, 0.03),
+        parts.murals.append([TwinPart.of("Mural", _facade_box(d, cy - 1.1, cy + 1.1, z0 + 0.4, z0 + 2.6, 0.03),
                                    f"Mural{int(rng.integers(3))}")])
     return parts
 
@@ -69,21 +69,21 @@ def church(width: float = 16.0, depth: float = 24.0, foundation_m: float = 1.0) 
     nave_h, tower_w, tower_h = 11.0, 5.0, 22.0
     tx0 = d - tower_w
     structure = [
-        Piece("Nave", geo.box((-d, -w, -foundation_m), (d - 0.01, w, nave_h)), "Whitewash"),
-        Piece("NaveRoof", _gable(-d, d, w + 0.3, nave_h, nave_h + 4.0), "RoofTile"),
-        Piece("Tower", geo.box((tx0, -tower_w / 2, -foundation_m), (d + 0.5, tower_w / 2, tower_h)), "Whitewash"),
-        Piece("Spire", _pyramid((d + 0.5 + tx0) / 2, 0.0, tower_h, tower_w / 2 + 0.2, 5.0), "RoofTile"),
+        TwinPart.of("Nave", geo.box((-d, -w, -foundation_m), (d - 0.01, w, nave_h)), "Whitewash"),
+        TwinPart.of("NaveRoof", _gable(-d, d, w + 0.3, nave_h, nave_h + 4.0), "RoofTile"),
+        TwinPart.of("Tower", geo.box((tx0, -tower_w / 2, -foundation_m), (d + 0.5, tower_w / 2, tower_h)), "Whitewash"),
+        TwinPart.of("Spire", _pyramid((d + 0.5 + tx0) / 2, 0.0, tower_h, tower_w / 2 + 0.2, 5.0), "RoofTile"),
     ]
     parts = BuildingParts(structure)
-    parts.doors.append([Piece("Door", _facade_box(d + 0.5, -1.0, 1.0, 0.0, 4.0), "DoorWood")])
+    parts.doors.append([TwinPart.of("Door", _facade_box(d + 0.5, -1.0, 1.0, 0.0, 4.0), "DoorWood")])
     for y in (-w + 2.0, w - 2.0):
-        parts.doors.append([Piece("Door", _facade_box(d, y - 0.6, y + 0.6, 0.0, 2.8), "DoorWood")])
+        parts.doors.append([TwinPart.of("Door", _facade_box(d, y - 0.6, y + 0.6, 0.0, 2.8), "DoorWood")])
     for z0 in (6.0, 14.0):
-        parts.windows.append([Piece("Window", _facade_box(d + 0.5, -0.7, 0.7, z0, z0 + 2.5), "Glass")])
+        parts.windows.append([TwinPart.of("Window", _facade_box(d + 0.5, -0.7, 0.7, z0, z0 + 2.5), "Glass")])
     for x in np.linspace(-d + 3.0, tx0 - 2.0, 4):
         for y, sign in ((-w, -1), (w, 1)):
             lo, hi = sorted((y, y + sign * 0.06))
-            parts.windows.append([Piece("Window", geo.box((x - 0.7, lo, 4.0), (x + 0.7, hi, 8.5)), "Glass")])
+            parts.windows.append([TwinPart.of("Window", geo.box((x - 0.7, lo, 4.0), (x + 0.7, hi, 8.5)), "Glass")])
     return parts
 
 

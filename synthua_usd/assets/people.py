@@ -12,16 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from synthua_usd import geometry as geo
-from synthua_usd.scene import Material
-
-SKINS = [Material(f"Skin{i}", c, 0.6) for i, c in enumerate(
-    [(0.62, 0.45, 0.36), (0.55, 0.37, 0.27), (0.45, 0.29, 0.2), (0.32, 0.2, 0.13), (0.2, 0.12, 0.08), (0.12, 0.07, 0.05)])]
-SHIRTS = [Material(f"Shirt{i}", c, 0.85) for i, c in enumerate(
-    [(0.5, 0.06, 0.05), (0.05, 0.15, 0.45), (0.12, 0.35, 0.15), (0.7, 0.6, 0.1), (0.6, 0.6, 0.6), (0.05, 0.05, 0.05),
-     (0.45, 0.15, 0.4), (0.8, 0.35, 0.1)])]
-TROUSERS = [Material(f"Trousers{i}", c, 0.85) for i, c in enumerate(
-    [(0.07, 0.08, 0.12), (0.15, 0.2, 0.35), (0.25, 0.2, 0.15), (0.3, 0.3, 0.3), (0.04, 0.04, 0.04)])]
-
+from synthua_usd.materials import SHIRTS, SKINS, TROUSERS
 
 @dataclass(frozen=True)
 class PersonLook:

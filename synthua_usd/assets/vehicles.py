@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from synthua_usd import geometry as geo
-from synthua_usd.assets import Piece
+from synthua_usd.twin import TwinPart
 
 
 def _wheels(xs, half_track, radius, width, sections=16):
@@ -11,36 +11,36 @@ def _wheels(xs, half_track, radius, width, sections=16):
                        for x in xs for y in (-half_track, half_track)])
 
 
-def car(length: float = 4.2, width: float = 1.75, paint: str = "PaintRed") -> list[Piece]:
+def car(length: float = 4.2, width: float = 1.75, paint: str = "PaintRed") -> list[TwinPart]:
     l, w = length / 2, width / 2
-    return [Piece("Body", geo.merge(geo.box((-l, -w, 0.3), (l, w, 0.95)),
+    return [TwinPart.of("Body", geo.merge(geo.box((-l, -w, 0.3), (l, w, 0.95)),
                                     geo.box((-l * 0.55, -w * 0.92, 0.95), (l * 0.35, w * 0.92, 1.45))), paint),
-            Piece("Windows", geo.merge(geo.box((l * 0.35, -w * 0.85, 0.98), (l * 0.36, w * 0.85, 1.4)),
+            TwinPart.of("Windows", geo.merge(geo.box((l * 0.35, -w * 0.85, 0.98), (l * 0.36, w * 0.85, 1.4)),
                                        geo.box((-l * 0.56, -w * 0.85, 0.98), (-l * 0.55, w * 0.85, 1.4))), "Glass"),
-            Piece("Wheels", _wheels((-l * 0.65, l * 0.65), w - 0.1, 0.31, 0.2), "Tyre")]
+            TwinPart.of("Wheels", _wheels((-l * 0.65, l * 0.65), w - 0.1, 0.31, 0.2), "Tyre")]
 
 
-def bus(length: float = 12.0, width: float = 2.55) -> list[Piece]:
+def bus(length: float = 12.0, width: float = 2.55) -> list[TwinPart]:
     l, w = length / 2, width / 2
-    return [Piece("Body", geo.box((-l, -w, 0.35), (l, w, 3.1)), "PaintOrange"),
-            Piece("Windows", geo.merge(geo.box((-l * 0.9, -w - 0.01, 1.4), (l * 0.95, w + 0.01, 2.6)),
+    return [TwinPart.of("Body", geo.box((-l, -w, 0.35), (l, w, 3.1)), "PaintOrange"),
+            TwinPart.of("Windows", geo.merge(geo.box((-l * 0.9, -w - 0.01, 1.4), (l * 0.95, w + 0.01, 2.6)),
                                        geo.box((l, -w * 0.9, 1.1), (l + 0.01, w * 0.9, 2.8))), "Glass"),
-            Piece("Wheels", _wheels((-l * 0.6, l * 0.55), w - 0.15, 0.5, 0.3), "Tyre")]
+            TwinPart.of("Wheels", _wheels((-l * 0.6, l * 0.55), w - 0.15, 0.5, 0.3), "Tyre")]
 
 
-def motorcycle() -> list[Piece]:
-    return [Piece("Body", geo.merge(geo.box((-0.5, -0.15, 0.4), (0.55, 0.15, 0.75)),
+def motorcycle() -> list[TwinPart]:
+    return [TwinPart.of("Body", geo.merge(geo.box((-0.5, -0.15, 0.4), (0.55, 0.15, 0.75)),
                                     geo.box((0.45, -0.35, 0.95), (0.5, 0.35, 1.0)),
                                     geo.box((0.45, -0.03, 0.4), (0.5, 0.03, 0.98))), "PaintBlack"),
-            Piece("Wheels", geo.merge(geo.cylinder((-0.7, 0, 0.32), 0.32, 0.12, axis="y", sections=16),
+            TwinPart.of("Wheels", geo.merge(geo.cylinder((-0.7, 0, 0.32), 0.32, 0.12, axis="y", sections=16),
                                       geo.cylinder((0.75, 0, 0.32), 0.32, 0.12, axis="y", sections=16)), "Tyre")]
 
 
-def bicycle() -> list[Piece]:
-    return [Piece("Frame", geo.merge(geo.box((-0.45, -0.015, 0.33), (0.45, 0.015, 0.36)),
+def bicycle() -> list[TwinPart]:
+    return [TwinPart.of("Frame", geo.merge(geo.box((-0.45, -0.015, 0.33), (0.45, 0.015, 0.36)),
                                      geo.box((-0.2, -0.015, 0.36), (-0.17, 0.015, 0.85)),
                                      geo.box((-0.28, -0.1, 0.85), (-0.08, 0.1, 0.9)),
                                      geo.box((0.38, -0.015, 0.36), (0.41, 0.015, 0.95)),
                                      geo.box((0.38, -0.25, 0.95), (0.41, 0.25, 0.98))), "PaintBlue"),
-            Piece("Wheels", geo.merge(geo.cylinder((-0.55, 0, 0.34), 0.34, 0.03, axis="y", sections=16),
+            TwinPart.of("Wheels", geo.merge(geo.cylinder((-0.55, 0, 0.34), 0.34, 0.03, axis="y", sections=16),
                                       geo.cylinder((0.55, 0, 0.34), 0.34, 0.03, axis="y", sections=16)), "Tyre")]

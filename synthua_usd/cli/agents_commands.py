@@ -22,14 +22,15 @@ def agents() -> None:
                    "crush); warned above 0.7 (level of service E).")
 @click.option("--aid-share", type=float, default=0.3, show_default=True,
               help="Fraction of agents using a mobility aid (wheelchairs, walker, crutches, canes).")
-@click.option("--frames", type=click.IntRange(1), default=48, show_default=True, help="Time samples to author.")
-@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed: same seed, same bytes.")
+@click.option("--frames", type=click.IntRange(1, 100_000), default=48, show_default=True,
+              help="Time codes to author (one sample per time code).")
+@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Seed: same seed, same bytes.")
 @click.option("--cell-m", type=float, default=0.5, show_default=True, help="Walkable grid cell size (metres).")
 @click.option("--walk-on", default="sidewalk,crosswalk,curb_ramp,street_road", show_default=True,
               help="Comma-separated classes people walk on; the road always counts inside crosswalks. Add 'road' "
                    "for imported twins whose roads include their sidewalks (CityJSON often).")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
-@click.option("--out", "out_path", type=click.Path(path_type=Path), required=True, help="The agents layer to write (.usda).")
+@click.option("--out", "out_path", type=click.Path(path_type=Path), required=True, help="The agents layer to write (.usdc binary, or .usda text).")
 def agents_populate(stage: Path, density: float, aid_share: float, frames: int, seed: int, cell_m: float,
                     walk_on: str, class_map: Path | None, out_path: Path) -> int:
     """Populate TWIN_OR_SCENARIO with walking people and mobility-aid users; write them as a layer.
@@ -41,18 +42,18 @@ def agents_populate(stage: Path, density: float, aid_share: float, frames: int, 
     Compose the layer into a scenario with `synthua compose`, e.g.
       synthua compose my.usda agents.usda stages/district/render.usda ... stages/district/twin.usda
     """
+    from synthua_usd.agents.crowd import CrowdParams
     from synthua_usd.pipeline.populate import PopulateRequest, populate
 
-    if not (cell_m > 0):
-        from synthua_usd.errors import InputError
-
-        raise InputError(f"--cell-m should be > 0, but was {cell_m}")
     walkable = tuple(c.strip() for c in walk_on.split(",") if c.strip())
-    report = populate(PopulateRequest(stage, out_path, density, aid_share, frames, seed, cell_m, class_map, walkable))
-    click.echo(f"walkable area {report.walkable_area_m2:.0f} m², expected {report.expected:.1f} agents, sampled "
-               f"{report.sampled}, placed {report.placed} ({report.aid_users} with mobility aids), dropped "
-               f"{report.dropped} (no collision-free start)")
-    click.echo(f"profiles {report.by_profile}")
-    click.echo(f"minimum gap between agents over {frames} frames: {report.min_separation_m:.3f} m; {report.seconds:.1f} s")
-    click.echo(f"wrote {out_path}")
+    params = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=frames, seed=seed, cell_m=cell_m,
+                         walkable=walkable)
+    crowd, path, seconds = populate(PopulateRequest(stage, out_path, params, class_map))
+    r = crowd.report
+    click.echo(f"walkable area {r['walkable_area_m2']:.0f} m², expected {r['expected']:.1f} agents, sampled "
+               f"{r['sampled']}, placed {r['placed']} ({r['aid_users']} with mobility aids), dropped "
+               f"{r['dropped']} (no collision-free start)")
+    click.echo(f"profiles {r['by_profile']}")
+    click.echo(f"minimum gap between agents over {frames} time codes: {r['min_separation_m']:.3f} m; {seconds:.1f} s")
+    click.echo(f"wrote {path}")
     return EXIT_OK

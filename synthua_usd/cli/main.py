@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import sys
 import time
 from pathlib import Path
@@ -21,9 +22,6 @@ from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.twin_commands import twin
 from synthua_usd.errors import SynthuaError
 from synthua_usd.findings import Finding, Severity
-
-log = logging.getLogger("synthua")
-
 
 
 def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
@@ -81,7 +79,7 @@ def validate_classes(file: Path | None, as_json: bool, strict: bool) -> int:
     Runs the JSON Schema first, then rules it cannot express: unique ids, names, aliases and colours,
     id 0 = black 'unlabelled', and a minimum CIEDE2000 distance between class colours.
     """
-    from synthua_usd.classmap_rules import check_classmap
+    from synthua_usd.classmap_checks import check_classmap
     from synthua_usd.schemas import bundled_path, read_json
 
     path = file or bundled_path("classmap.json")
@@ -100,7 +98,7 @@ def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: b
     label is in the class map, cameras have valid physical lens values, stage metadata is stated, and
     render settings name a real camera.
     """
-    from synthua_usd.usd.rules import validate_stage as run_rules
+    from synthua_usd.usd.stage_checks import validate_stage as run_rules
     from synthua_usd.usd.stage_io import open_stage
 
     cmap = load_class_map(class_map)
@@ -135,7 +133,7 @@ def compose(out: Path, layers: tuple[Path, ...]) -> int:
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map used to read labels.")
 def inspect(stage: Path, class_map: Path | None) -> int:
     """Print what STAGE holds: layer stack, prims per class, cameras, lights and time range."""
-    from synthua_usd.usd.inspect import summarize
+    from synthua_usd.usd.summary import summarize
     from synthua_usd.usd.stage_io import open_stage
 
     click.echo(summarize(open_stage(stage), load_class_map(class_map)).format())
@@ -150,64 +148,112 @@ def create() -> None:
 @create.command("street")
 @click.argument("out_dir", type=click.Path(path_type=Path))
 def create_street(out_dir: Path) -> int:
-    """Write the demo street (twin, semantics, agents, cameras, environment, render layers and
+    """Write the demo street (twin.usdc, semantics, agents.usdc, cameras, environment and render layers and
     scenario.usda) into OUT_DIR. Deterministic: the same version writes the same bytes."""
-    from synthua_usd.usd.street_demo import write_street_demo
+    from synthua_usd.demo.street import street_scenario
+    from synthua_usd.usd.scenario_writer import write_scenario
 
-    for path in write_street_demo(out_dir):
+    for path in write_scenario(street_scenario(), out_dir):
         click.echo(f"wrote {path}")
     return EXIT_OK
 
 
 @create.command("district")
 @click.argument("out_dir", type=click.Path(path_type=Path))
-@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Layout seed.")
+@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Layout and crowd seed.")
 def create_district(out_dir: Path, seed: int) -> int:
-    """Write the Largo da Ordem demo district as a full scenario into OUT_DIR: twin, semantics, cameras
-    (CCTV, pedestrian and wheelchair eye level, UAV), environment, render settings and scenario.usda."""
-    from synthua_usd.pipeline.district import write_district_scenario
+    """Write the Largo da Ordem demo district as a full scenario into OUT_DIR: twin, semantics, a populated
+    agents layer, cameras (CCTV, pedestrian and wheelchair eye level, UAV), environment, render settings
+    and scenario.usda."""
+    from synthua_usd.demo.district import district_scenario
+    from synthua_usd.usd.scenario_writer import write_scenario
 
-    for path in write_district_scenario(out_dir, seed):
+    for path in write_scenario(district_scenario(seed), out_dir):
         click.echo(f"wrote {path}")
     return EXIT_OK
 
 
 # --- render --------------------------------------------------------------------------------------------------
 
+def _time_codes(ctx, param, values: tuple[str, ...]) -> tuple[float, ...]:
+    """``--frame 24 --frame 1:48:8 --frame 1,12``: single time codes, comma lists, and START:END[:STEP]
+    ranges with END included when the steps reach it."""
+    out: list[float] = []
+    for value in values:
+        for item in value.split(","):
+            item = item.strip()
+            try:
+                if ":" in item:
+                    parts = [float(x) for x in item.split(":")]
+                    if len(parts) not in (2, 3):
+                        raise ValueError
+                    start, end, step = parts[0], parts[1], parts[2] if len(parts) == 3 else 1.0
+                    if not (all(map(math.isfinite, parts)) and step > 0 and end >= start):
+                        raise ValueError
+                    count = int(math.floor((end - start) / step + 1e-9)) + 1
+                    if count > 100_000:
+                        raise click.BadParameter(f"{item!r} holds {count} time codes; at most 100000", ctx, param)
+                    out += [start + k * step for k in range(count)]
+                else:
+                    number = float(item)
+                    if not math.isfinite(number):
+                        raise ValueError
+                    out.append(number)
+            except ValueError:
+                raise click.BadParameter(f"{item!r} is not a time code, a comma list or START:END[:STEP] with "
+                                         f"finite numbers, STEP > 0 and END >= START", ctx, param) from None
+    return tuple(dict.fromkeys(out))
+
+
 @cli.command()
 @click.argument("scenario", type=click.Path(path_type=Path))
-@click.option("--camera", help="Camera prim path, e.g. /World/Cameras/CCTV [default: the render settings' camera].")
-@click.option("--frame", type=float, help="Time code to render [default: the stage's start time code].")
+@click.option("--camera", "cameras", multiple=True,
+              help="Camera prim path, e.g. /World/Cameras/CCTV; repeat for several [default: the render "
+                   "settings' camera].")
+@click.option("--frame", "--time-code", "time_codes", multiple=True, callback=_time_codes,
+              help="Time code(s) to render: 24, 1,12,24 or 1:48:8 (START:END:STEP); repeatable "
+                   "[default: the stage's start time code].")
 @click.option("--width", type=click.IntRange(1, 16384), help="Image width in pixels [default: render settings, else 1280].")
 @click.option("--height", type=click.IntRange(1, 16384), help="Image height in pixels [default: render settings, else 960].")
 @click.option("--spp", type=click.IntRange(1, 65536), help="RGB samples per pixel [default: render settings, else 64]. "
                                                           "Labels always use one ray per pixel centre.")
-@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Sampler seed of the RGB pass.")
+@click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed of the RGB pass.")
 @click.option("--variant", help="Mitsuba variant (cuda_ad_rgb, llvm_ad_rgb, scalar_rgb) [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder (created).")
-def render(scenario: Path, camera: str | None, frame: float | None, width: int | None, height: int | None,
-           spp: int | None, seed: int, variant: str | None, class_map: Path | None, out_dir: Path) -> int:
-    """Render one frame of SCENARIO into --out.
+def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ...], width: int | None,
+           height: int | None, spp: int | None, seed: int, variant: str | None, class_map: Path | None,
+           out_dir: Path) -> int:
+    """Render SCENARIO from each --camera at each time code into --out.
 
     \b
-    Writes rgb.exr (scene-linear Rec.709), rgb.png (display sRGB), class.png (8-bit class ids),
-    semantic.png (class colours), instance.png (16-bit instance ids, 0 = none), depth.exr (z-depth in
-    metres, 0 = no hit) and frame.json (camera intrinsics/extrinsics, class map, instances with pixel
-    counts). Nothing is written unless every input checks out.
+    One frame writes its files into --out; several write --out/<camera name>/<time code>/, e.g.
+      synthua render stages/scenario.usda --camera /World/Cameras/CCTV \\
+          --camera /World/Cameras/PedestrianEye --frame 1:48:8 --out out/sweep
+    renders 12 frames from one loaded scene (only the camera and what moves are updated between them).
+    \b
+    Files per frame (the stage's UsdRender vars choose; all when it names none): rgb.exr
+    (scene-linear Rec.709) and rgb.png (display sRGB), class.png (8-bit class ids) and semantic.png
+    (class colours), instance.png (16-bit instance ids, 0 = none), depth.exr (z-depth in metres,
+    0 = no hit), and always frame.json (camera intrinsics/extrinsics, class map, instances with pixel
+    counts). Nothing is written unless every input checks out, and nothing is replaced unless every
+    frame rendered.
     """
-    from synthua_usd.pipeline.frame import FrameRequest, run_frame
+    from synthua_usd.pipeline.frame import FrameRequest, run_frames
 
     t0 = time.perf_counter()
-    result = run_frame(FrameRequest(stage_path=scenario, out_dir=out_dir, camera_path=camera, frame=frame,
-                                    width=width, height=height, spp=spp, seed=seed, variant=variant,
-                                    class_map_path=class_map), show_progress=sys.stderr.isatty())
-    doc = result.document
-    visible = sum(1 for i in doc["instances"] if i["pixel_count"])
-    click.echo(f"rendered {doc['camera']['prim_path']} at frame {doc['time_code']:g}: "
-               f"{doc['image']['width']}x{doc['image']['height']}, {doc['render']['spp']} spp, "
-               f"{doc['render']['variant']}, {visible} visible instances, {time.perf_counter() - t0:.1f} s")
-    click.echo(f"wrote {len(result.files)} files to {out_dir}")
+    run = run_frames(FrameRequest(stage_path=scenario, out_dir=out_dir, camera_paths=cameras, time_codes=time_codes,
+                                  width=width, height=height, spp=spp, seed=seed, variant=variant,
+                                  class_map_path=class_map), show_progress=sys.stderr.isatty())
+    for frame in run.frames:
+        doc = frame.document
+        visible = sum(1 for i in doc["instances"] if i["pixel_count"])
+        click.echo(f"rendered {doc['camera']['prim_path']} at time code {doc['time_code']:g}: "
+                   f"{doc['image']['width']}x{doc['image']['height']}, {doc['render']['spp']} spp, "
+                   f"{doc['render']['variant']}, {visible} visible instances -> {frame.out_dir}")
+    files = sum(len(f.files) for f in run.frames)
+    click.echo(f"wrote {files} files for {len(run.frames)} frames to {out_dir} in {time.perf_counter() - t0:.1f} s "
+               f"({run.loads} scene load{'s' if run.loads != 1 else ''})")
     return EXIT_OK
 
 

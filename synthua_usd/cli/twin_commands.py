@@ -21,7 +21,7 @@ def twin() -> None:
 @click.argument("kind", type=click.Choice(["mesh", "cityjson", "pointcloud", "footprints"]))
 @click.argument("input_path", metavar="INPUT", type=click.Path(path_type=Path))
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True,
-              help="Folder for twin.usda, semantics.usda, cameras/environment/render layers, scenario.usda "
+              help="Folder for twin.usdc, semantics.usda, cameras/environment/render layers, scenario.usda "
                    "and import_report.json.")
 @click.option("--rules", type=click.Path(path_type=Path),
               help="Semantic rules JSON (schemas/semantic_rules.schema.json): (field, regex) -> class. "
@@ -50,14 +50,13 @@ def twin_import(kind: str, input_path: Path, out_dir: Path, rules: Path | None, 
 
     Geometry no rule matches is labelled 'unlabelled' (class 0) and listed in import_report.json.
     """
-    from synthua_usd.backends.frame_files import write_json_atomic
+    from synthua_usd.class_assignment import AssignmentRules
     from synthua_usd.errors import InputError
     from synthua_usd.importers import importers
-    from synthua_usd.semantic_rules import SemanticRules
-    from synthua_usd.usd.twin_writer import write_twin_scenario
+    from synthua_usd.pipeline.twin_import import write_import
 
     cmap = load_class_map(class_map)
-    loaded_rules = SemanticRules.load(rules, cmap) if rules else None
+    loaded_rules = AssignmentRules.load(rules, cmap) if rules else None
     if kind == "mesh" and loaded_rules is None:
         raise InputError("mesh import needs --rules FILE: meshes carry no classes of their own "
                          "(see schemas/semantic_rules.schema.json)")
@@ -66,11 +65,10 @@ def twin_import(kind: str, input_path: Path, out_dir: Path, rules: Path | None, 
                               max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
                               storey_height_m=storey_height_m, show_progress=sys.stderr.isatty())
     seconds = time.perf_counter() - t0
-    written = write_twin_scenario(model, out_dir, cmap)
     report = {"kind": kind, "input": str(input_path), "seconds": round(seconds, 3), "objects": len(model.objects),
               "triangles": model.triangle_count(), "classes": model.label_counts(), "crs": model.crs,
               "origin_offset_m": list(model.origin_offset_m), **model.report}
-    written.append(write_json_atomic(out_dir / "import_report.json", report))
+    written = write_import(model, out_dir, cmap, report)
     click.echo(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
                f"{model.triangle_count()} triangles, classes {model.label_counts()}")
     for seg in model.report.get("segments", []):
@@ -87,18 +85,20 @@ def twin_import(kind: str, input_path: Path, out_dir: Path, rules: Path | None, 
 
 
 @twin.command("demo")
-@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Layout seed.")
+@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Layout seed.")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder.")
 def twin_demo(seed: int, out_dir: Path) -> int:
-    """Write the procedural Largo da Ordem demo district (twin.usda, semantics.usda) for SEED.
+    """Write the procedural Largo da Ordem demo district (twin.usdc, semantics.usda) for SEED.
 
     The same seed writes byte-identical layers; another seed another plausible layout.
     """
-    from synthua_usd.pipeline.district import write_district
+    from synthua_usd.demo.district import META, build_district
+    from synthua_usd.usd.scenario_writer import write_twin_layers
 
-    result = write_district(out_dir, seed=seed)
-    click.echo(f"district seed {seed}: {result['objects']} objects, {result['triangles']} triangles, "
-               f"{len(result['classes'])} classes")
-    for path in result["files"]:
+    model = build_district(seed)
+    files = write_twin_layers(model, out_dir, load_class_map(None), META)
+    click.echo(f"district seed {seed}: {len(model.objects)} objects, {model.triangle_count()} triangles, "
+               f"{len(model.label_counts())} classes")
+    for path in files:
         click.echo(f"wrote {path}")
     return EXIT_OK

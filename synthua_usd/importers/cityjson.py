@@ -20,7 +20,7 @@ from synthua_usd.errors import InputError
 from synthua_usd.importers.crs import require_projected_metres
 from synthua_usd.scene import Material
 from synthua_usd.schemas import read_json
-from synthua_usd.semantic_rules import SemanticRules
+from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 
 log = logging.getLogger(__name__)
@@ -103,7 +103,7 @@ def _triangulate(rings: list[list[int]], vertices: np.ndarray) -> np.ndarray:
     return tri
 
 
-def import_cityjson(path: str | Path, rules: SemanticRules | None = None, lod: str | None = None,
+def import_cityjson(path: str | Path, rules: AssignmentRules | None = None, lod: str | None = None,
                     show_progress: bool = False, **_ignored) -> TwinModel:
     """Read a CityJSON file into labelled objects grouped by city object type."""
     path = Path(path)

@@ -1,7 +1,7 @@
 """Meshes (OBJ, PLY, GLB/glTF, STL) through trimesh, keeping the source's object/material structure.
 
 Each source object becomes one prim per class found in it (usually one), with one mesh per material.
-Classes come from :class:`SemanticRules` matched against the object name, material name and group;
+Classes come from :class:`AssignmentRules` matched against the object name, material name and group;
 geometry no rule matches gets the rules' default class (``unlabelled``) and is listed in the report.
 """
 
@@ -16,7 +16,7 @@ import trimesh
 
 from synthua_usd.errors import InputError
 from synthua_usd.scene import Material
-from synthua_usd.semantic_rules import SemanticRules
+from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 
 log = logging.getLogger(__name__)
@@ -51,7 +51,7 @@ def _material(geom: trimesh.Trimesh, fallback: str) -> tuple[str, Material]:
     return fallback, Material(fallback)
 
 
-def import_mesh(path: str | Path, rules: SemanticRules, up_axis: str | None = None, scale: float = 1.0,
+def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = None, scale: float = 1.0,
                 **_ignored) -> TwinModel:
     """Read a mesh file and assign classes by ``rules``.
 

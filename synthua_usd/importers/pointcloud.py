@@ -26,7 +26,7 @@ from tqdm import tqdm
 
 from synthua_usd.errors import InputError
 from synthua_usd.scene import Material
-from synthua_usd.semantic_rules import SemanticRules
+from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart
 
 log = logging.getLogger(__name__)
@@ -215,7 +215,7 @@ def simplify_within(points: np.ndarray, triangles: np.ndarray, cloud: np.ndarray
                       float(residual["RMS"]))
 
 
-def import_pointcloud(path: str | Path, rules: SemanticRules | None = None, max_deviation_m: float = 0.005,
+def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, max_deviation_m: float = 0.005,
                       plane_threshold_m: float = 0.02, min_plane_points: int = 50, seed: int = 0,
                       show_progress: bool = False, **_ignored) -> TwinModel:
     """Segment, reconstruct and simplify a point cloud; the report holds the measured deviations."""
@@ -277,7 +277,7 @@ def import_pointcloud(path: str | Path, rules: SemanticRules | None = None, max_
                      origin_offset_m=tuple(float(v) for v in origin), crs=crs, report=report)
 
 
-def _rule_or(rules: SemanticRules | None, fields: dict, default: str) -> str:
+def _rule_or(rules: AssignmentRules | None, fields: dict, default: str) -> str:
     if rules is None:
         return default
     label, rule = rules.classify(fields)

@@ -1,38 +1,53 @@
-"""Render one frame of a scenario to a folder: the job behind ``synthua render``."""
+"""Render frames of a scenario to a folder: the job behind ``synthua render``.
+
+Several (camera, time code) pairs render from one :class:`RenderSession` (one scene load). One frame
+writes its files straight into the output folder; several write ``<camera name>/<time code>/`` below it.
+All frames are written into a staging folder and moved into place together, so a failed run leaves the
+output folder as it was.
+"""
 
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from synthua_usd import __version__
-from synthua_usd.backends.frame_files import DEPTH_DEFINITION, write_frame
-from synthua_usd.backends.mitsuba.render import RenderedFrame, render_frame
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.errors import StageError
+from synthua_usd.atomic import output_set
+from synthua_usd.backends.frame_files import write_frame
+from synthua_usd.backends.mitsuba.render import RenderedFrame
+from synthua_usd.backends.mitsuba.session import RenderSession
+from synthua_usd.cameras import CONFORM_EXPAND, PinholeCamera
+from synthua_usd.errors import InputError, StageError
+from synthua_usd.outputs import OUTPUT_NAMES, RenderOutput, select_outputs
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.cameras import read_camera
-from synthua_usd.usd.reader import read_snapshot
+from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.render_settings import render_defaults
 from synthua_usd.usd.stage_io import check_time_code, open_stage
 
 log = logging.getLogger(__name__)
 
+#: Frames one ``synthua render`` call may hold (each is a folder of files).
+MAX_FRAMES = 10_000
+
 
 @dataclass(frozen=True)
 class FrameRequest:
-    """What to render. Unset camera, size and spp come from the stage's UsdRender settings."""
+    """What to render: every camera at every time code. Empty ``camera_paths`` take the render settings'
+    camera; empty ``time_codes`` the stage's start time code; unset size and spp come from the stage's
+    UsdRender settings, else from :class:`RenderConfig`'s defaults."""
 
     stage_path: Path
     out_dir: Path
-    camera_path: str | None = None
-    frame: float | None = None
+    camera_paths: tuple[str, ...] = ()
+    time_codes: tuple[float, ...] = ()
     width: int | None = None
     height: int | None = None
     spp: int | None = None
@@ -43,6 +58,8 @@ class FrameRequest:
 
 @dataclass(frozen=True, eq=False)
 class FrameResult:
+    """One rendered frame: where it went, its ``frame.json`` document and its buffers."""
+
     out_dir: Path
     files: list[Path]
     document: dict
@@ -51,35 +68,73 @@ class FrameResult:
     rendered: RenderedFrame
 
 
-def run_frame(request: FrameRequest, show_progress: bool = False) -> FrameResult:
-    """Check every input, render, then write. Nothing is written unless every check passed."""
+@dataclass(eq=False)
+class RenderRun:
+    """Every frame of one request, and the session's counters (loads, reloads)."""
+
+    frames: list[FrameResult] = field(default_factory=list)
+    loads: int = 0
+    reloads: int = 0
+
+
+def time_code_folder(time_code: float) -> str:
+    """``0024`` for time code 24, ``0024.500`` for 24.5: folder names that sort in time order."""
+    return f"{int(time_code):04d}" if float(time_code).is_integer() else f"{time_code:08.3f}"
+
+
+def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
+    """Check every input, render every frame from one session, then move all files into place together."""
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
     stage = open_stage(request.stage_path)
     defaults = render_defaults(stage)
-    frame = request.frame if request.frame is not None else stage.GetStartTimeCode()
-    check_time_code(stage, frame)
-    camera_path = request.camera_path or defaults.camera_path
-    if camera_path is None:
+    unknown = [n for n in defaults.var_names if n not in OUTPUT_NAMES]
+    if unknown:
+        log.warning("render vars %s are not outputs synthua writes (known: %s); ignoring them",
+                    unknown, ", ".join(OUTPUT_NAMES))
+    outputs = select_outputs([n for n in defaults.var_names if n in OUTPUT_NAMES])
+    time_codes = request.time_codes or (stage.GetStartTimeCode(),)
+    for tc in time_codes:
+        check_time_code(stage, tc)
+    camera_paths = request.camera_paths or ((defaults.camera_path,) if defaults.camera_path else ())
+    if not camera_paths:
         raise StageError(f"{request.stage_path}: no --camera given and no UsdRender settings name one")
-    camera = read_camera(stage, camera_path, frame)
-    width, height = defaults.resolution or (1280, 960)
+    frames = [(cam, tc) for cam in camera_paths for tc in time_codes]
+    if len(frames) > MAX_FRAMES:
+        raise InputError(f"{len(frames)} frames requested ({len(camera_paths)} cameras x {len(time_codes)} time "
+                         f"codes); one render call holds at most {MAX_FRAMES}")
+    for cam in camera_paths:  # every camera is checked before anything renders
+        read_camera(stage, cam, time_codes[0])
+    width, height = defaults.resolution or (RenderConfig.width, RenderConfig.height)
     config = RenderConfig(width=request.width or width, height=request.height or height,
                           spp=request.spp or defaults.spp or RenderConfig.spp, seed=request.seed,
                           variant=request.variant)
-    snapshot = read_snapshot(stage, frame, class_map)
-    rendered = render_frame(snapshot, camera, config, show_progress=show_progress)
-    doc = frame_document(request, stage_frame=frame, camera=camera, config=config, snapshot=snapshot,
-                         rendered=rendered, class_map=class_map)
-    t0 = time.perf_counter()
-    files = write_frame(request.out_dir, rgb=rendered.rgb, class_ids=rendered.class_ids,
-                        instance_ids=rendered.instance_ids, z_depth=rendered.hits.z_m,
-                        palette=class_map.palette(), frame_doc=doc)
-    log.info("wrote %d files to %s in %.2f s", len(files), request.out_dir, time.perf_counter() - t0)
-    return FrameResult(request.out_dir, files, doc, snapshot, camera, rendered)
+    reader = StageReader(stage, class_map)
+    session = RenderSession(config)
+    run = RenderRun()
+    single = len(frames) == 1
+    want_rgb = any(o.var == "rgb" for o in outputs)
+    with output_set(request.out_dir) as staging:
+        bar = tqdm(frames, unit="frame", desc="render", disable=not show_progress or single)
+        for cam_path, tc in bar:
+            snapshot = reader.snapshot(tc)
+            camera = read_camera(stage, cam_path, tc)
+            rendered = session.render(snapshot, camera, rgb=want_rgb, show_progress=show_progress and single)
+            rel = Path() if single else Path(cam_path.rsplit("/", 1)[-1]) / time_code_folder(tc)
+            doc = frame_document(request.stage_path, outputs, time_code=tc, camera=camera, config=config,
+                                 snapshot=snapshot, rendered=rendered, class_map=class_map)
+            t0 = time.perf_counter()
+            written = write_frame(staging / rel, outputs, rgb=rendered.rgb, class_ids=rendered.class_ids,
+                                  instance_ids=rendered.instance_ids, z_depth=rendered.hits.z_m,
+                                  palette=class_map.palette(), frame_doc=doc)
+            log.info("wrote %d files for %s at %g in %.2f s", len(written), cam_path, tc, time.perf_counter() - t0)
+            files = [request.out_dir / rel / p.name for p in written]
+            run.frames.append(FrameResult(request.out_dir / rel, files, doc, snapshot, camera, rendered))
+    run.loads, run.reloads = session.loads, session.reloads
+    return run
 
 
-def frame_document(request: FrameRequest, *, stage_frame: float, camera: PinholeCamera, config: RenderConfig,
-                   snapshot: SceneSnapshot, rendered: RenderedFrame, class_map: ClassMap) -> dict:
+def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_code: float, camera: PinholeCamera,
+                   config: RenderConfig, snapshot: SceneSnapshot, rendered: RenderedFrame, class_map: ClassMap) -> dict:
     """The content of ``frame.json`` (schema: ``schemas/frame.schema.json``)."""
     w, h = config.width, config.height
     inst_counts = np.bincount(rendered.instance_ids.ravel(), minlength=len(snapshot.instances) + 1)
@@ -93,8 +148,8 @@ def frame_document(request: FrameRequest, *, stage_frame: float, camera: Pinhole
     return {
         "$schema": "frame.schema.json",
         "generator": f"synthua-usd {__version__}",
-        "stage": str(request.stage_path),
-        "time_code": stage_frame,
+        "stage": str(stage_path),
+        "time_code": time_code,
         "image": {"width": w, "height": h},
         "camera": {
             "prim_path": camera.path,
@@ -102,7 +157,7 @@ def frame_document(request: FrameRequest, *, stage_frame: float, camera: Pinhole
             "horizontal_aperture_mm": camera.horizontal_aperture_mm,
             "vertical_aperture_mm": camera.vertical_aperture_mm,
             "conformed_aperture_mm": [hap, vap],
-            "aspect_ratio_conform_policy": "expandAperture",
+            "aspect_ratio_conform_policy": CONFORM_EXPAND,
             "fov_deg": list(camera.fov_deg(w, h)),
             "clipping_range_m": [camera.clip_near_m, camera.clip_far_m],
             "K": camera.intrinsics(w, h).tolist(),
@@ -114,15 +169,7 @@ def frame_document(request: FrameRequest, *, stage_frame: float, camera: Pinhole
         "render": {"renderer": "mitsuba", "variant": rendered.variant, "spp": config.spp,
                    "max_depth": config.max_depth, "pixel_filter": config.pixel_filter, "seed": config.seed,
                    "labels": "one ray through each pixel centre", "seconds": rendered.seconds},
-        "files": {
-            "rgb_exr": {"path": "rgb.exr", "colorspace": "lin_rec709_scene"},
-            "rgb_png": {"path": "rgb.png", "colorspace": "srgb_rec709_scene"},
-            "class": {"path": "class.png", "dtype": "uint8", "meaning": "class id (class_map), 0 = unlabelled"},
-            "semantic": {"path": "semantic.png", "colorspace": "srgb_rec709_scene", "meaning": "class colour"},
-            "instance": {"path": "instance.png", "dtype": "uint16", "meaning": "instance id (instances), 0 = none"},
-            "depth": {"path": "depth.exr", "dtype": "float32", "channel": "Z", "kind": "z",
-                      "meaning": DEPTH_DEFINITION},
-        },
+        "files": {f.key: f.document() for o in outputs for f in o.files},
         "class_map": {"source": class_map.source, "taxonomy": class_map.taxonomy,
                       "classes": [c.to_dict() for c in class_map.classes]},
         "class_pixel_counts": {class_map.by_id(i).name: int(n) for i, n in enumerate(class_counts) if n},

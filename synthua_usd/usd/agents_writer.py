@@ -4,21 +4,14 @@ separately labelled device linked from the person by a ``synthua:uses`` relation
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from pxr import Gf, Kind, Sdf, Usd
 
-from synthua_usd.agents.motion import Trajectory
+from synthua_usd.agents.crowd import Crowd
 from synthua_usd.assets import devices
-from synthua_usd.assets.people import SHIRTS, SKINS, TROUSERS, PersonLook, person, swing_deg
-from synthua_usd.scene import Material
-from synthua_usd.usd.authoring import (StageMetadata, apply_label, define_mesh, define_preview_material, define_xform,
-                                       new_layer, save_layer_atomic, set_kind)
-
-DEVICE_MATERIALS = [Material("Tyre", (0.02, 0.02, 0.02), 0.9), Material("Seat", (0.03, 0.05, 0.15), 0.8),
-                    Material("Frame", (0.55, 0.57, 0.6), 0.3, metallic=0.9),
-                    Material("CaneWhite", (0.85, 0.85, 0.85), 0.4), Material("CaneRed", (0.6, 0.03, 0.03), 0.4),
-                    Material("Wood", (0.35, 0.2, 0.08), 0.7)]
+from synthua_usd.assets.people import person, swing_deg
+from synthua_usd.materials import PALETTE
+from synthua_usd.scenario import StageMetadata
+from synthua_usd.usd.authoring import apply_label, define_mesh, define_preview_material, define_xform, new_layer, set_kind
 
 AGENTS_ROOT = "/World/Agents"
 
@@ -32,13 +25,15 @@ def _name(class_name: str) -> str:
     return "".join(part.title() for part in class_name.split("_"))
 
 
-def build_agents_layer(trajectories: list[Trajectory], looks: list[PersonLook], meta: StageMetadata,
-                       taxonomy: str, doc: str) -> Usd.Stage:
-    stage = new_layer(meta, doc)
+def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.Stage:
+    """The agents layer of ``crowd``: time samples from ``meta.start_time_code``, labels of ``taxonomy``."""
+    trajectories, looks = crowd.trajectories, crowd.looks
+    stage = new_layer(meta, crowd.doc)
     stage.SetDefaultPrim(stage.OverridePrim("/World"))
     define_xform(stage, AGENTS_ROOT, kind=Kind.Tokens.group)
-    mats = {m.key: define_preview_material(stage, f"{AGENTS_ROOT}/Looks/{m.key}", m)
-            for m in SKINS + SHIRTS + TROUSERS + DEVICE_MATERIALS}
+    used = {look.skin for look in looks} | {look.shirt for look in looks} | {look.trousers for look in looks}
+    used |= {p.material for t in trajectories if t.plan.profile.device for p in devices.DEVICES[t.plan.profile.device]()}
+    mats = {key: define_preview_material(stage, f"{AGENTS_ROOT}/Looks/{key}", PALETTE[key]) for key in sorted(used)}
     times = [Usd.TimeCode(meta.start_time_code + f) for f in range(len(trajectories[0].positions))] if trajectories else []
     for i, (traj, look) in enumerate(zip(trajectories, looks)):
         profile = traj.plan.profile
@@ -74,13 +69,8 @@ def build_agents_layer(trajectories: list[Trajectory], looks: list[PersonLook], 
             apply_label(device_xf.GetPrim(), taxonomy, profile.device)
             pieces = devices.DEVICES[profile.device]()
             for k, (dx, dy) in enumerate(DEVICE_PLACEMENT.get(profile.device, [(0.0, 0.0)])):
-                for name, (pts, tris), mat in pieces:
-                    define_mesh(stage, f"{device_xf.GetPath()}/{name}{'' if k == 0 else f'_{k}'}",
-                                pts + [dx, dy, 0.0], tris, mats[mat])
+                for part in pieces:
+                    define_mesh(stage, f"{device_xf.GetPath()}/{part.name}{'' if k == 0 else f'_{k}'}",
+                                part.points + [dx, dy, 0.0], part.triangles, mats[part.material])
             person_xf.GetPrim().CreateRelationship("synthua:uses", custom=True).SetTargets([device_xf.GetPath()])
     return stage
-
-
-def write_agents_layer(path: str | Path, trajectories, looks, meta: StageMetadata, taxonomy: str, doc: str) -> Path:
-    stage = build_agents_layer(trajectories, looks, meta, taxonomy, doc)
-    return save_layer_atomic(stage.GetRootLayer(), Path(path))

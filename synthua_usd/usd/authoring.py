@@ -1,32 +1,20 @@
 """Small helpers that author layers the way every synthua layer is authored.
 
-Every layer states ``upAxis``, ``metersPerUnit``, ``defaultPrim`` and ``timeCodesPerSecond``; meshes carry
+Every layer states (:class:`synthua_usd.scenario.StageMetadata`) ``upAxis``, ``metersPerUnit``, ``defaultPrim`` and ``timeCodesPerSecond``; meshes carry
 extents; materials are UsdPreviewSurface; labels use UsdSemantics.LabelsAPI with the taxonomy as
 instance name.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdSemantics, UsdShade, Vt
 
 from synthua_usd.atomic import atomic_path
+from synthua_usd.scenario import StageMetadata
 from synthua_usd.scene import Material
-
-
-@dataclass(frozen=True)
-class StageMetadata:
-    """Metadata every synthua layer states explicitly."""
-
-    up_axis: str = "Z"
-    meters_per_unit: float = 1.0
-    time_codes_per_second: float = 24.0
-    start_time_code: float = 1.0
-    end_time_code: float = 48.0
-    default_prim: str = "World"
 
 
 def new_layer(meta: StageMetadata, doc: str) -> Usd.Stage:
@@ -48,7 +36,8 @@ def apply_metadata(stage: Usd.Stage, meta: StageMetadata) -> None:
 
 
 def save_layer_atomic(layer: Sdf.Layer, path: str | Path) -> Path:
-    """Export ``layer`` as ``.usda`` text to ``path`` through a temporary file and a rename."""
+    """Export ``layer`` to ``path`` through a temporary file and a rename; the suffix picks the format
+    (``.usda`` text, ``.usdc`` binary crate)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp:

@@ -11,11 +11,7 @@ from pxr import Gf, Usd, UsdGeom
 
 from synthua_usd.cameras import PinholeCamera
 from synthua_usd.errors import StageError
-
-
-def lens_unit_mm(meters_per_unit: float) -> float:
-    """Millimetres in one USD lens unit (a tenth of a scene unit)."""
-    return 100.0 * meters_per_unit
+from synthua_usd.usd.prim_checks import camera_findings, lens_unit_mm, raise_first_error
 
 
 def author_camera(stage: Usd.Stage, path: str, camera_to_world: np.ndarray, *, focal_length_mm: float,
@@ -44,7 +40,8 @@ def camera_paths(stage: Usd.Stage) -> list[str]:
 def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
     """The camera at ``path`` at ``time_code`` in mm and world metres.
 
-    Raises :class:`StageError` for a missing prim, a prim that is not a camera, or an orthographic camera.
+    Raises :class:`StageError` for a missing prim, a prim that is not a camera, or any error of
+    :func:`synthua_usd.usd.prim_checks.camera_findings` (the check ``synthua validate stage`` runs too).
     """
     prim = stage.GetPrimAtPath(path) if path.startswith("/") else Usd.Prim()
     if not prim or not prim.IsActive():
@@ -54,14 +51,8 @@ def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
         raise StageError(f"{path}: prim of type '{prim.GetTypeName()}' is not a UsdGeom.Camera")
     cam = UsdGeom.Camera(prim)
     t = Usd.TimeCode(time_code)
-    if cam.GetProjectionAttr().Get(t) != UsdGeom.Tokens.perspective:
-        raise StageError(f"{path}: projection '{cam.GetProjectionAttr().Get(t)}' is not supported; "
-                         f"expected 'perspective'")
-    for name in ("horizontalApertureOffset", "verticalApertureOffset"):
-        offset = prim.GetAttribute(name).Get(t)
-        if offset:
-            raise StageError(f"{path}: {name} = {offset} is not supported; expected 0 (no lens shift)")
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    raise_first_error(camera_findings(prim, t, mpu))
     unit = lens_unit_mm(mpu)
     near, far = cam.GetClippingRangeAttr().Get(t)
     m = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(t), float).T

@@ -2,7 +2,8 @@
 
 Gprims are triangulated in world space (metres) by a handler registered per prim type; materials are
 UsdPreviewSurface constants; lights are UsdLux distant and dome lights. Each gprim gets the class and
-instance of the labelled prim above it (see :mod:`synthua_usd.usd.semantics`).
+instance of the labelled prim above it (see :mod:`synthua_usd.usd.semantics`). What the reader refuses it
+finds with the checks of :mod:`synthua_usd.usd.prim_checks`, which ``synthua validate stage`` runs too.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from synthua_usd import geometry as geo
 from synthua_usd.errors import StageError, UnsupportedPrimError
 from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
+from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
 from synthua_usd.usd.stage_io import check_time_code, meters_per_unit
 
@@ -36,18 +38,11 @@ def gprim_handler(type_name: str):
 
 @gprim_handler("Mesh")
 def _mesh(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
-    mesh = UsdGeom.Mesh(prim)
-    points = np.asarray(mesh.GetPointsAttr().Get(t) or [], np.float64).reshape(-1, 3)
-    counts = np.asarray(mesh.GetFaceVertexCountsAttr().Get(t) or [], np.int64)
-    indices = np.asarray(mesh.GetFaceVertexIndicesAttr().Get(t) or [], np.int64)
-    if counts.sum() != len(indices):
-        raise StageError(f"{prim.GetPath()}: faceVertexCounts sum to {counts.sum()} but there are "
-                         f"{len(indices)} faceVertexIndices")
-    if len(indices) and (indices.min() < 0 or indices.max() >= len(points)):
-        raise StageError(f"{prim.GetPath()}: faceVertexIndices reach {indices.max()} but there are {len(points)} points")
-    holes = set(np.asarray(mesh.GetHoleIndicesAttr().Get(t) or [], np.int64).tolist())
+    findings, (points, counts, indices) = mesh_topology(prim, t)
+    raise_first_error(findings)
+    holes = set(np.asarray(UsdGeom.Mesh(prim).GetHoleIndicesAttr().Get(t) or [], np.int64).tolist())
     tris = _fan_triangulate(counts, indices, holes)
-    if mesh.GetOrientationAttr().Get(t) == UsdGeom.Tokens.leftHanded:
+    if UsdGeom.Mesh(prim).GetOrientationAttr().Get(t) == UsdGeom.Tokens.leftHanded:
         tris = tris[:, ::-1]
     return points, tris
 
@@ -152,8 +147,22 @@ def _light_power(light: UsdLux.LightAPI, t: Usd.TimeCode) -> tuple[float, tuple[
     return intensity, tuple(float(c) for c in light.GetColorAttr().Get(t))
 
 
+#: UsdLux types the translator has an emitter for.
+LIGHT_TYPES = ("DistantLight", "DomeLight")
+
+
+def unsupported_light_message(prim: Usd.Prim) -> str | None:
+    """Why render would refuse the light ``prim``, or None when it is supported."""
+    if prim.GetTypeName() in LIGHT_TYPES:
+        return None
+    return f"light type '{prim.GetTypeName()}' is not supported; supported lights: {', '.join(LIGHT_TYPES)}"
+
+
 def _read_light(prim: Usd.Prim, t: Usd.TimeCode) -> Light:
     path = str(prim.GetPath())
+    message = unsupported_light_message(prim)
+    if message:
+        raise UnsupportedPrimError(f"{path}: {message}")
     power, color = _light_power(UsdLux.LightAPI(prim), t)
     if prim.IsA(UsdLux.DistantLight):
         m = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(t), float).T
@@ -165,8 +174,7 @@ def _read_light(prim: Usd.Prim, t: Usd.TimeCode) -> Light:
         if UsdLux.DomeLight(prim).GetTextureFileAttr().Get(t):
             log.warning("%s: dome textures are not supported yet; using its colour and intensity", path)
         return Light(path, "dome", color, radiance=power)
-    raise UnsupportedPrimError(f"{path}: light type '{prim.GetTypeName()}' is not supported; "
-                               f"supported lights: DistantLight, DomeLight")
+    raise AssertionError(f"{path}: LIGHT_TYPES lists a type with no reader")
 
 
 # --- the snapshot -------------------------------------------------------------------------------------------
@@ -174,8 +182,9 @@ def _read_light(prim: Usd.Prim, t: Usd.TimeCode) -> Light:
 def collect_instances(stage: Usd.Stage, class_map: ClassMap) -> dict[str, Instance]:
     """Every labelled prim above a gprim (visible or not, so ids stay stable over time), by prim path.
 
-    Ids are 1-based in prim-path order. Raises :class:`StageError` for labels missing from the class map
-    and for label sites that hold more than one label.
+    Ids are 1-based in prim-path order. Raises :class:`StageError` for the errors of
+    :func:`synthua_usd.usd.prim_checks.label_findings` (labels missing from the class map, label sites
+    holding more than one label) and for more instances than 16-bit maps hold.
     """
     sites: dict[str, tuple[str, ...]] = {}
     for prim in Usd.PrimRange.Stage(stage, Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)):
@@ -185,14 +194,8 @@ def collect_instances(stage: Usd.Stage, class_map: ClassMap) -> dict[str, Instan
                 sites.setdefault(found[0].prim_path, found[0].labels)
     out = {}
     for k, path in enumerate(sorted(sites), start=1):
-        labels = sites[path]
-        if len(labels) != 1:
-            raise StageError(f"{path}: has {len(labels)} labels {list(labels)} in taxonomy '{class_map.taxonomy}'; "
-                             f"expected exactly one")
-        cls = class_map.resolve(labels[0])
-        if cls is None:
-            raise StageError(f"{path}: label '{labels[0]}' is not a class of {class_map.source}; "
-                             f"use one of its class names or aliases")
+        raise_first_error(label_findings(path, sites[path], class_map))
+        cls = class_map.resolve(sites[path][0])
         out[path] = Instance(id=k, prim_path=path, class_id=cls.id, class_name=cls.name, isthing=cls.isthing,
                              relations=_relations(stage.GetPrimAtPath(path)))
     if len(out) > 65535:
@@ -210,43 +213,98 @@ def _relations(prim: Usd.Prim) -> tuple[tuple[str, str], ...]:
     return tuple(sorted(out))
 
 
-def read_snapshot(stage: Usd.Stage, time_code: float, class_map: ClassMap) -> SceneSnapshot:
-    """Everything renderable in ``stage`` at ``time_code`` (checked against the stage's time range)."""
-    check_time_code(stage, time_code)
-    t = Usd.TimeCode(time_code)
-    mpu = meters_per_unit(stage)
-    instances = collect_instances(stage, class_map)
-    xcache = UsdGeom.XformCache(t)
-    materials: dict[str, Material] = {}
-    meshes = []
-    unlabelled = []
-    for prim in renderable_gprims(stage, t):
-        type_name = prim.GetTypeName()
-        handler = GPRIM_HANDLERS.get(type_name)
-        if handler is None:
-            raise UnsupportedPrimError(f"{prim.GetPath()}: gprim type '{type_name}' is not supported; supported "
-                                       f"types: {', '.join(sorted(GPRIM_HANDLERS))}")
-        points, tris = handler(prim, t)
+def unsupported_gprim_message(prim: Usd.Prim) -> str | None:
+    """Why render would refuse ``prim``, or None when a handler triangulates it."""
+    if prim.GetTypeName() in GPRIM_HANDLERS:
+        return None
+    return (f"gprim type '{prim.GetTypeName()}' is not supported; supported types: "
+            f"{', '.join(sorted(GPRIM_HANDLERS))}")
+
+
+def _might_vary(prim: Usd.Prim, memo: dict[str, bool]) -> bool:
+    """Whether ``prim``'s world transform may change over time (its own or an ancestor's xform ops)."""
+    key = str(prim.GetPath())
+    if key not in memo:
+        own = prim.IsA(UsdGeom.Xformable) and UsdGeom.Xformable(prim).TransformMightBeTimeVarying()
+        parent = prim.GetParent()
+        memo[key] = bool(own) or (bool(parent) and not parent.IsPseudoRoot() and _might_vary(parent, memo))
+    return memo[key]
+
+
+class StageReader:
+    """Reads a composed stage as :class:`SceneSnapshot` values, one per time code, cheaply.
+
+    Instances, materials and the meshes of gprims that cannot change over time are read once; a snapshot
+    at another time code re-reads only the gprims whose transform or geometry is time-varying and reuses
+    the very same :class:`MeshItem` objects for the rest (so a backend can tell what moved by identity).
+    """
+
+    def __init__(self, stage: Usd.Stage, class_map: ClassMap) -> None:
+        self.stage = stage
+        self.class_map = class_map
+        self.meters_per_unit = meters_per_unit(stage)
+        self.instances = collect_instances(stage, class_map)
+        self._materials: dict[str, Material] = {}
+        self._static: dict[str, MeshItem | None] = {}
+        self._varying: dict[str, bool] = {}
+        self._xform_memo: dict[str, bool] = {}
+        self._warned_unlabelled = False
+
+    def _is_varying(self, prim: Usd.Prim) -> bool:
+        key = str(prim.GetPath())
+        if key not in self._varying:
+            geometry = any(a.ValueMightBeTimeVarying() for a in prim.GetAttributes() if a.HasAuthoredValue())
+            self._varying[key] = geometry or _might_vary(prim, self._xform_memo)
+        return self._varying[key]
+
+    def _mesh_item(self, prim: Usd.Prim, t: Usd.TimeCode, xcache: UsdGeom.XformCache) -> MeshItem | None:
+        message = unsupported_gprim_message(prim)
+        if message:
+            raise UnsupportedPrimError(f"{prim.GetPath()}: {message}")
+        points, tris = GPRIM_HANDLERS[prim.GetTypeName()](prim, t)
         if len(tris) == 0:
-            continue
+            return None
         m = np.array(xcache.GetLocalToWorldTransform(prim), float)  # row-vector convention
-        world = (points @ m[:3, :3] + m[3, :3]) * mpu
+        world = (points @ m[:3, :3] + m[3, :3]) * self.meters_per_unit
         if np.linalg.det(m[:3, :3]) < 0:  # a mirroring transform flips the winding
             tris = tris[:, ::-1]
         if not np.all(np.isfinite(world)):
-            raise StageError(f"{prim.GetPath()}: has non-finite point coordinates at time {time_code:g}")
-        sites = label_sites(prim, class_map.taxonomy)
-        inst = instances.get(sites[0].prim_path) if sites else None
-        if inst is None:
-            unlabelled.append(str(prim.GetPath()))
-        meshes.append(MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
-                               material_key=_material_for(prim, t, materials).key,
-                               instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0))
-    if unlabelled:
-        log.warning("%d gprims have no '%s' label and render as class 0 (unlabelled), e.g. %s",
-                    len(unlabelled), class_map.taxonomy, unlabelled[0])
-    lights = tuple(_read_light(p, t) for p in stage.Traverse() if p.HasAPI(UsdLux.LightAPI))
-    if not lights:
-        log.warning("%s: no UsdLux lights; RGB will be black", stage.GetRootLayer().identifier)
-    return SceneSnapshot(time_code=time_code, up_axis=str(UsdGeom.GetStageUpAxis(stage)), meshes=tuple(meshes),
-                         materials=materials, lights=lights, instances=tuple(sorted(instances.values(), key=lambda i: i.id)))
+            raise StageError(f"{prim.GetPath()}: has non-finite point coordinates at time {t.GetValue():g}")
+        sites = label_sites(prim, self.class_map.taxonomy)
+        inst = self.instances.get(sites[0].prim_path) if sites else None
+        return MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
+                        material_key=_material_for(prim, t, self._materials).key,
+                        instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0)
+
+    def snapshot(self, time_code: float) -> SceneSnapshot:
+        """Everything renderable at ``time_code`` (checked against the stage's time range)."""
+        check_time_code(self.stage, time_code)
+        t = Usd.TimeCode(time_code)
+        xcache = UsdGeom.XformCache(t)
+        meshes = []
+        for prim in renderable_gprims(self.stage, t):
+            key = str(prim.GetPath())
+            if self._is_varying(prim):
+                item = self._mesh_item(prim, t, xcache)
+            else:
+                if key not in self._static:
+                    self._static[key] = self._mesh_item(prim, t, xcache)
+                item = self._static[key]
+            if item is not None:
+                meshes.append(item)
+        unlabelled = [m.prim_path for m in meshes if m.instance_id == 0]
+        if unlabelled and not self._warned_unlabelled:
+            self._warned_unlabelled = True
+            log.warning("%d gprims have no '%s' label and render as class 0 (unlabelled), e.g. %s",
+                        len(unlabelled), self.class_map.taxonomy, unlabelled[0])
+        lights = tuple(_read_light(p, t) for p in self.stage.Traverse() if p.HasAPI(UsdLux.LightAPI))
+        if not lights:
+            log.warning("%s: no UsdLux lights; RGB will be black", self.stage.GetRootLayer().identifier)
+        return SceneSnapshot(time_code=time_code, up_axis=str(UsdGeom.GetStageUpAxis(self.stage)),
+                             meshes=tuple(meshes), materials=dict(self._materials), lights=lights,
+                             instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)))
+
+
+def read_snapshot(stage: Usd.Stage, time_code: float, class_map: ClassMap) -> SceneSnapshot:
+    """Everything renderable in ``stage`` at one ``time_code`` (a one-off :class:`StageReader`)."""
+    return StageReader(stage, class_map).snapshot(time_code)

@@ -8,7 +8,6 @@ samples, so edges would not match any pixel-centre reference. Labels come from r
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,8 +16,6 @@ from tqdm import tqdm
 from synthua_usd.cameras import PinholeCamera
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import SceneSnapshot
-from synthua_usd.backends.mitsuba import variants
-from synthua_usd.backends.mitsuba.translate import Translation, translate
 
 #: RGB is rendered in passes of at most this many samples per pixel so a progress bar can move.
 SPP_PER_PASS = 16
@@ -50,11 +47,6 @@ class RenderedFrame:
     seconds: dict
 
 
-def load_scene(mi, translation: Translation):
-    # optimize=False: Mitsuba would otherwise merge meshes and lose the identity labels depend on.
-    return mi.load_dict(translation.scene, optimize=False)
-
-
 def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False) -> np.ndarray:
     """(H, W, 3) float32 linear RGB: the mean of passes of at most SPP_PER_PASS samples each."""
     passes = math.ceil(config.spp / SPP_PER_PASS)
@@ -70,9 +62,10 @@ def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False) -> 
     return (total / config.spp).astype(np.float32)
 
 
-def trace_pixel_centres(mi, scene, translation: Translation, camera: PinholeCamera, width: int, height: int) -> LabelHits:
-    """One primary ray through each pixel centre; first hit per pixel."""
-    keys = {rec.shape_id: i for i, rec in enumerate(translation.shapes)}
+def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCamera, width: int, height: int) -> LabelHits:
+    """One primary ray through each pixel centre of the scene's sensor; first hit per pixel. ``shape_ids``
+    are the Mitsuba ids of the snapshot's meshes, in order."""
+    keys = {key: i for i, key in enumerate(shape_ids)}
     sensor = scene.sensors()[0]
     if mi.variant().startswith("scalar"):
         mesh_index, distance, dirs = _trace_scalar(mi, scene, sensor, keys, width, height)
@@ -130,23 +123,3 @@ def label_maps(hits: LabelHits, snapshot: SceneSnapshot) -> tuple[np.ndarray, np
     class_of = np.array([0] + [m.class_id for m in snapshot.meshes], np.uint8)
     inst_of = np.array([0] + [m.instance_id for m in snapshot.meshes], np.uint16)
     return class_of[hits.mesh_index + 1], inst_of[hits.mesh_index + 1]
-
-
-def render_frame(snapshot: SceneSnapshot, camera: PinholeCamera, config: RenderConfig,
-                 show_progress: bool = False) -> RenderedFrame:
-    """Translate, load, render RGB and trace labels for one frame."""
-    seconds = {}
-    t0 = time.perf_counter()
-    mi = variants.activate(config.variant)
-    translation = translate(mi, snapshot, camera, config)
-    scene = load_scene(mi, translation)
-    seconds["translate_load"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    hits = trace_pixel_centres(mi, scene, translation, camera, config.width, config.height)
-    class_ids, instance_ids = label_maps(hits, snapshot)
-    seconds["labels"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    rgb = render_rgb(mi, scene, config, show_progress)
-    seconds["rgb"] = time.perf_counter() - t0
-    return RenderedFrame(rgb=rgb, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
-                         variant=mi.variant(), seconds=seconds)

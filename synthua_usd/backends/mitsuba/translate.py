@@ -1,7 +1,9 @@
-"""SceneSnapshot + camera → Mitsuba scene description (a ``mi.load_dict`` dict), with its shape table.
+"""SceneSnapshot + camera → the dict ``mi.load_dict`` loads, and the shape key of every mesh.
 
-A pure function of its inputs: nothing is rendered and no global state is touched; the caller passes the
-``mitsuba`` module with its variant already active (:func:`synthua_usd.backends.mitsuba.variants.activate`).
+Nothing is rendered and no global state is touched; the caller passes the ``mitsuba`` module with its
+variant already active (:func:`synthua_usd.backends.mitsuba.variants.activate`). The dict is not pure
+data: meshes and BSDFs in it are Mitsuba objects built from the snapshot's arrays (``mi.Mesh``), which
+is how Mitsuba's Python API takes triangle soups without a file.
 """
 
 from __future__ import annotations
@@ -15,23 +17,14 @@ from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import Light, Material, SceneSnapshot
 
 
-@dataclass(frozen=True)
-class ShapeRecord:
-    """One row of the instance table: Mitsuba shape id ↔ prim path ↔ class id ↔ instance id."""
-
-    shape_id: str
-    prim_path: str
-    class_id: int
-    instance_id: int
-
-
 @dataclass(frozen=True, eq=False)
 class Translation:
-    """``scene`` is the dict for ``mi.load_dict(scene, optimize=False)``; ``shapes`` is aligned with the
-    snapshot's meshes. Loading must keep ``optimize=False``: merging meshes would lose instance identity."""
+    """``scene`` is the dict for ``mi.load_dict(scene, optimize=False)``; ``shape_ids`` (the Mitsuba shape
+    ids) is aligned with the snapshot's meshes. Loading must keep ``optimize=False``: merging meshes would
+    lose the instance identity labels depend on."""
 
     scene: dict
-    shapes: tuple[ShapeRecord, ...]
+    shape_ids: tuple[str, ...]
 
 
 def shape_id(index: int) -> str:
@@ -56,10 +49,15 @@ def emitter_dict(light: Light) -> dict:
     raise ValueError(f"{light.prim_path}: light kind '{light.kind}' has no Mitsuba emitter; expected distant or dome")
 
 
+def sensor_to_world(mi, camera: PinholeCamera):
+    """The camera's pose as Mitsuba's ``to_world`` (Mitsuba cameras look down +Z; ``look_at`` converts)."""
+    _, up, forward = camera.axes()
+    origin = camera.origin
+    return mi.ScalarTransform4f().look_at(origin=origin.tolist(), target=(origin + forward).tolist(), up=up.tolist())
+
+
 def sensor_dict(mi, camera: PinholeCamera, config: RenderConfig, spp: int | None = None) -> dict:
     """A perspective sensor with the camera's conformed horizontal field of view."""
-    right, up, forward = camera.axes()
-    origin = camera.origin
     fov_x, _ = camera.fov_deg(config.width, config.height)
     return {
         "type": "perspective",
@@ -67,8 +65,7 @@ def sensor_dict(mi, camera: PinholeCamera, config: RenderConfig, spp: int | None
         "fov_axis": "x",
         "near_clip": camera.clip_near_m,
         "far_clip": camera.clip_far_m,
-        "to_world": mi.ScalarTransform4f().look_at(origin=origin.tolist(), target=(origin + forward).tolist(),
-                                                    up=up.tolist()),
+        "to_world": sensor_to_world(mi, camera),
         "film": {"type": "hdrfilm", "width": config.width, "height": config.height, "pixel_format": "rgb",
                  "rfilter": {"type": config.pixel_filter}},
         "sampler": {"type": "independent", "sample_count": spp or config.spp, "seed": config.seed},
@@ -94,7 +91,7 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
     scene: dict = {"type": "scene",
                    "integrator": {"type": "path", "max_depth": config.max_depth},
                    "sensor": sensor_dict(mi, camera, config)}
-    shapes = []
+    shape_ids = []
     for i, item in enumerate(snapshot.meshes):
         key = shape_id(i)
         material = snapshot.materials[item.material_key]
@@ -102,7 +99,7 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
         if any(material.emissive_color):
             emitter = mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": list(material.emissive_color)}})
         scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[item.material_key], emitter)
-        shapes.append(ShapeRecord(key, item.prim_path, item.class_id, item.instance_id))
+        shape_ids.append(key)
     for k, light in enumerate(snapshot.lights):
         scene[f"light_{k:03d}"] = emitter_dict(light)
-    return Translation(scene=scene, shapes=tuple(shapes))
+    return Translation(scene=scene, shape_ids=tuple(shape_ids))

@@ -10,6 +10,7 @@ and a few mobility aids standing unattended (a walker by a bench, a wheelchair b
 
 Everything random comes from one ``numpy.random.Generator`` seeded by the caller, drawn in a fixed
 order, so the same seed gives the same :class:`TwinModel` (and byte-identical layers).
+:func:`district_scenario` adds cameras, a populated crowd, environment and render settings.
 """
 
 from __future__ import annotations
@@ -17,8 +18,12 @@ from __future__ import annotations
 import numpy as np
 
 from synthua_usd import geometry as geo
-from synthua_usd.assets import Piece, buildings, devices, market, nature, place, street, vehicles
-from synthua_usd.scene import Material
+from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
+from synthua_usd.assets import buildings, devices, market, nature, place, street, vehicles
+from synthua_usd.cameras import CameraSpec
+from synthua_usd.materials import WALL_COLOURS, subset
+from synthua_usd.scenario import ScenarioSpec, StageMetadata
+from synthua_usd.taxonomy import ClassMap
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart
 
 ROAD_Y = (-45.0, -37.0)
@@ -38,38 +43,7 @@ STREET_CROSSWALK_Y = -29.0
 RAMP_LEN = 1.8   # 15 cm over 1.8 m: 1:12
 RAMP_HALF_W = 1.2
 
-WALL_COLOURS = [(0.62, 0.42, 0.2), (0.22, 0.35, 0.55), (0.6, 0.55, 0.45), (0.55, 0.2, 0.15), (0.35, 0.5, 0.3),
-                (0.7, 0.62, 0.35), (0.45, 0.3, 0.45), (0.75, 0.72, 0.66)]
 PAINTS = ["PaintRed", "PaintBlue", "PaintBlack", "PaintWhite", "PaintSilver"]
-
-MATERIALS = {m.key: m for m in [
-    Material("Asphalt", (0.045, 0.045, 0.05), 0.9), Material("Concrete", (0.36, 0.35, 0.33), 0.85),
-    Material("Granite", (0.48, 0.47, 0.46), 0.7), Material("RampConcrete", (0.55, 0.42, 0.22), 0.8),
-    Material("RoadPaint", (0.8, 0.8, 0.78), 0.6), Material("Mortar", (0.12, 0.11, 0.1), 0.95),
-    Material("Cobble0", (0.2, 0.19, 0.18), 0.75), Material("Cobble1", (0.28, 0.26, 0.23), 0.75),
-    Material("Cobble2", (0.16, 0.16, 0.17), 0.7), Material("PaverLight", (0.55, 0.53, 0.5), 0.8),
-    Material("PaverDark", (0.12, 0.12, 0.12), 0.8),
-    Material("Stucco", (0.8, 0.78, 0.72), 0.9), Material("Whitewash", (0.85, 0.84, 0.8), 0.9),
-    Material("RoofTile", (0.35, 0.12, 0.07), 0.8), Material("Glass", (0.04, 0.06, 0.08), 0.15),
-    Material("DoorWood", (0.25, 0.12, 0.05), 0.7), Material("Wood", (0.35, 0.2, 0.08), 0.7),
-    Material("Mural0", (0.1, 0.35, 0.6), 0.8), Material("Mural1", (0.7, 0.25, 0.4), 0.8),
-    Material("Mural2", (0.8, 0.6, 0.1), 0.8),
-    Material("Iron", (0.06, 0.06, 0.065), 0.5, metallic=0.8), Material("LampGlass", (0.9, 0.88, 0.8), 0.3),
-    Material("SignRed", (0.6, 0.03, 0.03), 0.5), Material("SignBlue", (0.03, 0.12, 0.5), 0.5),
-    Material("Tyre", (0.02, 0.02, 0.02), 0.9), Material("Seat", (0.03, 0.05, 0.15), 0.8),
-    Material("Frame", (0.55, 0.57, 0.6), 0.3, metallic=0.9), Material("CaneWhite", (0.85, 0.85, 0.85), 0.4),
-    Material("CaneRed", (0.6, 0.03, 0.03), 0.4),
-    Material("PaintRed", (0.45, 0.03, 0.03), 0.3, metallic=0.3), Material("PaintBlue", (0.03, 0.1, 0.4), 0.3, metallic=0.3),
-    Material("PaintBlack", (0.02, 0.02, 0.02), 0.3, metallic=0.3),
-    Material("PaintWhite", (0.75, 0.75, 0.75), 0.3, metallic=0.3),
-    Material("PaintSilver", (0.45, 0.46, 0.48), 0.3, metallic=0.6), Material("PaintOrange", (0.7, 0.25, 0.02), 0.4),
-    Material("CanvasWhite", (0.8, 0.8, 0.78), 0.9), Material("CanvasRed", (0.55, 0.06, 0.05), 0.9),
-    Material("CanvasBlue", (0.06, 0.15, 0.5), 0.9), Material("CanvasYellow", (0.75, 0.55, 0.05), 0.9),
-    Material("Goods", (0.5, 0.3, 0.15), 0.8), Material("PlasticWhite", (0.8, 0.8, 0.8), 0.5),
-    Material("Bark", (0.18, 0.11, 0.06), 0.9), Material("Leaves", (0.07, 0.2, 0.04), 0.8),
-    Material("Grass", (0.1, 0.28, 0.05), 0.95), Material("Fur", (0.35, 0.22, 0.1), 0.9),
-    Material("Feathers", (0.35, 0.36, 0.4), 0.8),
-] + [Material(f"Wall{i}", c, 0.9) for i, c in enumerate(WALL_COLOURS)]}
 
 
 def street_z(y: float | np.ndarray) -> float | np.ndarray:
@@ -97,21 +71,21 @@ class _Builder:
         self.objects: list[TwinObject] = []
         self._counts: dict[str, int] = {}
 
-    def add(self, folder: str, stem: str, label: str, pieces: list[Piece], **attributes) -> str:
+    def add(self, folder: str, stem: str, label: str, pieces: list[TwinPart], **attributes) -> str:
         n = self._counts.get(f"{folder}/{stem}", 0)
         self._counts[f"{folder}/{stem}"] = n + 1
         path = f"{folder}/{stem}_{n:03d}"
         parts, seen = [], set()
         for i, p in enumerate(pieces):
-            name = f"{p.name}_{i}" if p.name in seen else p.name  # repeated piece names get their index
+            name = f"{p.name}_{i}" if p.name in seen else p.name  # repeated part names get their index
             seen.add(p.name)
-            parts.append(TwinPart(name, p.mesh[0], p.mesh[1], p.material))
+            parts.append(p if name == p.name else TwinPart(name, p.points, p.triangles, p.material))
         parts = tuple(parts)
         self.objects.append(TwinObject(path, label, parts, attributes))
         return path
 
 
-def _cobbles(rng: np.random.Generator, x0, x1, y0, y1, size, gap, height, materials) -> list[Piece]:
+def _cobbles(rng: np.random.Generator, x0, x1, y0, y1, size, gap, height, materials) -> list[TwinPart]:
     """Stones in running bond; heights jittered by up to 1 cm; split into chunks of ~5 m along y."""
     sx, sy = size
     pieces = []
@@ -131,11 +105,11 @@ def _cobbles(rng: np.random.Generator, x0, x1, y0, y1, size, gap, height, materi
             row += 1
         for mat, items in boxes.items():
             if items:
-                pieces.append(Piece(f"Stones_{int(cy0 - y0):03d}_{mat}", geo.merge(*items), mat))
+                pieces.append(TwinPart.of(f"Stones_{int(cy0 - y0):03d}_{mat}", geo.merge(*items), mat))
     return pieces
 
 
-def _sidewalk_x_strip(x0, x1, y_kerb, y_back, gaps: list[float], z_of=None) -> list[Piece]:
+def _sidewalk_x_strip(x0, x1, y_kerb, y_back, gaps: list[float], z_of=None) -> list[TwinPart]:
     """A sidewalk along x whose kerb faces the road at ``y_kerb``; curb-ramp gaps centred at ``gaps``.
     Returns slab and kerb pieces (the kerb is 20 cm of granite along the road edge)."""
     sgn = 1.0 if y_back > y_kerb else -1.0
@@ -155,7 +129,7 @@ def _sidewalk_x_strip(x0, x1, y_kerb, y_back, gaps: list[float], z_of=None) -> l
     for g in cuts:  # behind each ramp the sidewalk continues at full height
         yb0, yb1 = sorted((y_kerb + sgn * RAMP_LEN, y_back))
         slab.append(geo.box((g - RAMP_HALF_W, yb0, -0.3), (g + RAMP_HALF_W, yb1, KERB_H)))
-    return [Piece("Slab", geo.merge(*slab), "Concrete"), Piece("Kerb", geo.merge(*kerb), "Granite")]
+    return [TwinPart.of("Slab", geo.merge(*slab), "Concrete"), TwinPart.of("Kerb", geo.merge(*kerb), "Granite")]
 
 
 def build_district(seed: int = 0) -> TwinModel:
@@ -169,15 +143,15 @@ def build_district(seed: int = 0) -> TwinModel:
     _vehicles(b, rng)
     _nature(b, rng)
     _mobility_aids(b)
-    return TwinModel(objects=tuple(b.objects), materials=dict(MATERIALS), source=f"largo-da-ordem demo district (seed {seed})",
+    return TwinModel(objects=tuple(b.objects), materials=subset(p.material for o in b.objects for p in o.parts), source=f"largo-da-ordem demo district (seed {seed})",
                      report={"seed": seed})
 
 
 def _streets(b: _Builder, rng: np.random.Generator) -> None:
     L = HALF_X
     # Open ground under everything, 2 cm below the road so that no two surfaces are coplanar.
-    b.add("Nature", "Ground", "grass", [Piece("Surface", geo.box((-L, -50.0, -0.5), (L, 50.0, -0.02)), "Grass")])
-    b.add("Streets", "AsphaltRoad", "road", [Piece("Surface", geo.box((-L, ROAD_Y[0], -0.3), (L, ROAD_Y[1], 0.0)), "Asphalt")])
+    b.add("Nature", "Ground", "grass", [TwinPart.of("Surface", geo.box((-L, -50.0, -0.5), (L, 50.0, -0.02)), "Grass")])
+    b.add("Streets", "AsphaltRoad", "road", [TwinPart.of("Surface", geo.box((-L, ROAD_Y[0], -0.3), (L, ROAD_Y[1], 0.0)), "Asphalt")])
     # Road sidewalks, with curb ramps at the crosswalks; the north one stops at the cobbled street.
     b.add("Sidewalks", "RoadSouth", "sidewalk", _sidewalk_x_strip(-L, L, ROAD_Y[0], ROAD_SIDEWALK_S[0], list(CROSSWALK_XS)))
     for side, (x0, x1) in (("RoadNorthWest", (-L, STREET_X[0] - STREET_SIDEWALK_W)),
@@ -189,16 +163,16 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
             ya, yb = sorted((y_kerb, y_kerb + sgn * RAMP_LEN))
             low, high = (yb, ya) if sgn < 0 else (ya, yb)
             pts, tris = geo.ramp(x - RAMP_HALF_W, x + RAMP_HALF_W, low, high, 0.005, KERB_H, -0.3)
-            b.add("CurbRamps", "Ramp", "curb_ramp", [Piece("Surface", (pts, tris), "RampConcrete")])
+            b.add("CurbRamps", "Ramp", "curb_ramp", [TwinPart.of("Surface", (pts, tris), "RampConcrete")])
         bars = [geo.box((x - 1.5, y, 0.0), (x + 1.5, y + 0.5, 0.01)) for y in np.arange(ROAD_Y[0] + 0.25, ROAD_Y[1] - 0.4, 1.0)]
-        b.add("Crosswalks", "Zebra", "crosswalk", [Piece("Bars", geo.merge(*bars), "RoadPaint")])
+        b.add("Crosswalks", "Zebra", "crosswalk", [TwinPart.of("Bars", geo.merge(*bars), "RoadPaint")])
     # The cobbled street: a mortar bed and stones, sloping up to the largo.
     x0, x1 = STREET_X
     y_start = ROAD_Y[1]
     bed = _shear(geo.box((x0, y_start, -0.5), (x1, STREET_Y[1], 0.0)))
-    stones = [Piece(p.name, _shear(p.mesh), p.material)
+    stones = [TwinPart.of(p.name, _shear(p.mesh), p.material)
               for p in _cobbles(rng, x0, x1, y_start, STREET_Y[1], (0.18, 0.14), 0.015, 0.07, ["Cobble0", "Cobble1", "Cobble2"])]
-    b.add("Streets", "CobbledStreet", "street_road", [Piece("Bed", bed, "Mortar")] + stones, surface="cobblestone")
+    b.add("Streets", "CobbledStreet", "street_road", [TwinPart.of("Bed", bed, "Mortar")] + stones, surface="cobblestone")
     # Its sidewalks (sheared with the slope) and a crosswalk near the bottom with ramps on both sides.
     cy = STREET_CROSSWALK_Y
     for side, (kx, sgn) in (("StreetWest", (x0, -1.0)), ("StreetEast", (x1, 1.0))):
@@ -211,24 +185,24 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
         slab.append(geo.box((back_a, cy - RAMP_HALF_W, -0.5), (back_b, cy + RAMP_HALF_W, KERB_H)))
         kerb = [geo.box((ka, y_start, -0.5), (kb, cy - RAMP_HALF_W, KERB_H)),
                 geo.box((ka, cy + RAMP_HALF_W, -0.5), (kb, STREET_Y[1], KERB_H))]
-        b.add("Sidewalks", side, "sidewalk", [Piece("Slab", _shear(geo.merge(*slab)), "Concrete"),
-                                              Piece("Kerb", _shear(geo.merge(*kerb)), "Granite")])
+        b.add("Sidewalks", side, "sidewalk", [TwinPart.of("Slab", _shear(geo.merge(*slab)), "Concrete"),
+                                              TwinPart.of("Kerb", _shear(geo.merge(*kerb)), "Granite")])
         low, high = (ra, rb) if sgn > 0 else (rb, ra)
         b.add("CurbRamps", "Ramp", "curb_ramp",
-              [Piece("Surface", _shear(_ramp_along_x(low, high, cy - RAMP_HALF_W, cy + RAMP_HALF_W, 0.075, KERB_H, -0.5)),
+              [TwinPart.of("Surface", _shear(_ramp_along_x(low, high, cy - RAMP_HALF_W, cy + RAMP_HALF_W, 0.075, KERB_H, -0.5)),
                      "RampConcrete")])
     bars = [geo.box((x, cy - 1.5, 0.072), (x + 0.5, cy + 1.5, 0.085)) for x in np.arange(x0 + 0.25, x1 - 0.4, 1.0)]
-    b.add("Crosswalks", "Zebra", "crosswalk", [Piece("Bars", _shear(geo.merge(*bars)), "RoadPaint")])
+    b.add("Crosswalks", "Zebra", "crosswalk", [TwinPart.of("Bars", _shear(geo.merge(*bars)), "RoadPaint")])
     # The largo: a slab paved with light and dark stones (Curitiba's petit-pavé).
     pavers = _cobbles(rng, PLAZA_X[0], PLAZA_X[1], PLAZA_Y[0], PLAZA_Y[1], (0.35, 0.35), 0.02, PAVER_H,
                       ["PaverLight", "PaverLight", "PaverDark"])
     b.add("Sidewalks", "Largo", "sidewalk",
-          [Piece("Bed", geo.box((PLAZA_X[0], PLAZA_Y[0], PLAZA_Z - 3.5), (PLAZA_X[1], PLAZA_Y[1], PLAZA_Z)), "Mortar")]
-          + [Piece(p.name, (p.mesh[0] + [0, 0, PLAZA_Z], p.mesh[1]), p.material) for p in pavers])
+          [TwinPart.of("Bed", geo.box((PLAZA_X[0], PLAZA_Y[0], PLAZA_Z - 3.5), (PLAZA_X[1], PLAZA_Y[1], PLAZA_Z)), "Mortar")]
+          + [TwinPart.of(p.name, (p.mesh[0] + [0, 0, PLAZA_Z], p.mesh[1]), p.material) for p in pavers])
     # Grass slope west of the street, steps down it, railings along the steps and the slope's top edge.
     gx0, gx1, gy0 = -45.0, -19.0, -21.0
     slope = geo.ramp(gx0, gx1, gy0, PLAZA_Y[0], KERB_H, PLAZA_Z, -0.5)
-    b.add("Nature", "GrassSlope", "grass", [Piece("Surface", slope, "Grass")])
+    b.add("Nature", "GrassSlope", "grass", [TwinPart.of("Surface", slope, "Grass")])
     n_steps, rise = 19, (PLAZA_Z - KERB_H) / 19
     tread = (PLAZA_Y[0] - gy0) / n_steps
     flight = place(street.steps(3.0, n_steps, rise, tread), (-30.0, gy0, KERB_H), 90.0)
@@ -297,11 +271,11 @@ def _buildings(b: _Builder, rng: np.random.Generator) -> None:
         b.objects.append(_sub(stem, "Window", k, "window", place(window, at, heading)))
 
 
-def _sub(stem: str, kind: str, k: int, label: str, pieces: list[Piece]) -> TwinObject:
+def _sub(stem: str, kind: str, k: int, label: str, pieces: list[TwinPart]) -> TwinObject:
     """A door, window or mural of a building: its own instance beside the building's structure."""
     folder, name = stem.rsplit("/", 1)
     return TwinObject(f"{folder}/{name}_{kind}_{k:02d}", label,
-                      tuple(TwinPart(p.name, p.mesh[0], p.mesh[1], p.material) for p in pieces))
+                      tuple(pieces))
 
 
 def _furniture(b: _Builder, rng: np.random.Generator) -> None:
@@ -405,3 +379,46 @@ def _mobility_aids(b: _Builder) -> None:
     }
     for name, (at, heading) in spots.items():
         b.add("MobilityAids", name.title().replace("_", ""), name, place(devices.DEVICES[name](), at, heading))
+
+
+# --- the scenario -----------------------------------------------------------------------------------------
+
+#: Persons per m² of walkable area in the shipped scenario: about 130 people on ~4,500 m², free walking.
+AGENT_DENSITY = 0.03
+
+META = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=24.0, start_time_code=1.0,
+                     end_time_code=48.0, default_prim="World")
+
+DISTRICT_CAMERAS = (
+    CameraSpec("CCTV_Largo", (-30.0, 6.0, PLAZA_Z + 6.0), (0.0, 20.0, PLAZA_Z), 2.8, 4.8, 3.6,
+               "CCTV on a largo lamp post, 6 m up, over the market."),
+    CameraSpec("CCTV_Street", (6.5, -34.0, 6.0), (0.0, -10.0, 1.0), 2.8, 4.8, 3.6,
+               "CCTV at the foot of the cobbled street, looking up the slope."),
+    CameraSpec("PedestrianEye_Street", (-6.5, -30.0, float(street_z(-30.0)) + 0.15 + 1.6), (-2.0, 0.0, PLAZA_Z + 1.0),
+               24.0, 36.0, 24.0, "Pedestrian eye level (1.6 m) on the cobbled street's west sidewalk, looking uphill."),
+    CameraSpec("WheelchairEye_Largo", (-12.0, 7.0, PLAZA_Z + 1.24), (10.0, 25.0, PLAZA_Z + 1.0), 24.0, 36.0, 24.0,
+               "Seated wheelchair user's eye level (1.2 m) in the largo."),
+    CameraSpec("UAV_Oblique", (-60.0, -70.0, 55.0), (0.0, 0.0, 0.0), 24.0, 36.0, 24.0,
+               "UAV, oblique 45 degrees over the district."),
+)
+
+
+def district_crowd(model: TwinModel, seed: int = 0, class_map: ClassMap | None = None) -> Crowd:
+    """The shipped crowd: ``AGENT_DENSITY`` on the district's walkable surfaces, default aid share."""
+    class_map = class_map or ClassMap.default()
+    vertices, faces, labels = model.labelled_triangles()
+    # The layers store float32 points: populate on exactly the surfaces a stage reader would see.
+    vertices = vertices.astype(np.float32).astype(np.float64)
+    names = np.array([class_map.resolve(label).name for label in labels], object)
+    params = CrowdParams(density_per_m2=AGENT_DENSITY, time_codes=META.time_code_count,
+                         time_codes_per_second=META.time_codes_per_second, seed=seed)
+    return populate_crowd(vertices, faces, names, params)
+
+
+def district_scenario(seed: int = 0, agents: bool = True) -> ScenarioSpec:
+    """The district for ``seed`` as a scenario: twin, a populated crowd (unless ``agents`` is False), five
+    cameras, a clear day and default render settings aimed through ``CCTV_Largo``."""
+    model = build_district(seed)
+    return ScenarioSpec(doc=f"Largo da Ordem demo district (seed {seed})", metadata=META, twin=model,
+                        cameras=DISTRICT_CAMERAS, render_camera="CCTV_Largo",
+                        crowd=district_crowd(model, seed) if agents else None)

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from pxr import Usd, UsdGeom, UsdLux
 
 from synthua_usd.taxonomy import ClassMap
-from synthua_usd.usd.cameras import lens_unit_mm
+from synthua_usd.usd.prim_checks import lens_unit_mm
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
 from synthua_usd.usd.stage_io import time_range
 

@@ -2,7 +2,7 @@ import pytest
 
 from conftest import DATA
 from synthua_usd.findings import Severity
-from synthua_usd.usd.rules import validate_stage
+from synthua_usd.usd.stage_checks import validate_stage
 from synthua_usd.usd.stage_io import open_stage
 
 

@@ -29,13 +29,13 @@ class Rule:
 
 
 @dataclass(frozen=True)
-class SemanticRules:
+class AssignmentRules:
     rules: tuple[Rule, ...]
     default: str = "unlabelled"
     source: str = "(built in)"
 
     @classmethod
-    def from_document(cls, doc: dict, class_map: ClassMap, source: str = "(in memory)") -> "SemanticRules":
+    def from_document(cls, doc: dict, class_map: ClassMap, source: str = "(in memory)") -> "AssignmentRules":
         validate_document(doc, "semantic_rules", source)
         rules = []
         for i, r in enumerate(doc["rules"]):
@@ -54,7 +54,7 @@ class SemanticRules:
         return cls(tuple(rules), class_map.resolve(default).name, source)
 
     @classmethod
-    def load(cls, path: str | Path, class_map: ClassMap) -> "SemanticRules":
+    def load(cls, path: str | Path, class_map: ClassMap) -> "AssignmentRules":
         return cls.from_document(read_json(path), class_map, str(path))
 
     def classify(self, fields: dict[str, str]) -> tuple[str, int | None]:

@@ -1,7 +1,8 @@
 """Stage validation: OpenUSD's own UsdValidation validators plus synthua's rules.
 
 Each rule is a small object with a name and ``check(context) -> list[Finding]``; rules collect findings
-and never raise on a bad stage. The CLI decides what is fatal.
+and never raise on a bad stage. The CLI decides what is fatal. Rules about what render refuses run the
+very checks the reader runs (:mod:`synthua_usd.usd.prim_checks`), so validation and render agree.
 """
 
 from __future__ import annotations
@@ -9,16 +10,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pxr import Usd, UsdGeom, UsdRender, UsdSemantics, UsdValidation
+from pxr import Usd, UsdGeom, UsdLux, UsdRender, UsdValidation
 
 from synthua_usd.findings import Finding, Severity
 from synthua_usd.taxonomy import ClassMap
-from synthua_usd.usd.cameras import lens_unit_mm
-from synthua_usd.usd.semantics import label_sites, renderable_gprims
-
-#: Plausible physical lens values; outside them the authored numbers are probably in the wrong unit.
-FOCAL_RANGE_MM = (1.0, 2000.0)
-APERTURE_RANGE_MM = (1.0, 100.0)
+from synthua_usd.usd.prim_checks import camera_findings, label_findings, mesh_topology
+from synthua_usd.usd.reader import unsupported_gprim_message, unsupported_light_message
+from synthua_usd.usd.semantics import direct_labels, label_sites, renderable_gprims
 
 
 @dataclass(frozen=True)
@@ -73,7 +71,8 @@ class StageMetadataRule:
 
 
 class GprimClassRule:
-    """Every renderable gprim has exactly one class: one labelled prim on its ancestor chain, one label."""
+    """Every renderable gprim has one labelled prim on its ancestor chain (how many labels that prim holds
+    is :class:`LabelInClassMapRule`'s concern)."""
 
     name = "gprim-has-one-class"
 
@@ -90,29 +89,47 @@ class GprimClassRule:
                 found = ", ".join(f"{s.prim_path} {list(s.labels)}" for s in sites)
                 out.append(Finding(self.name, path, f"inherits labels from {len(sites)} prims ({found}); expected "
                                                     f"one labelled prim per object, remove the nested labels"))
-            elif len(sites[0].labels) != 1:
-                out.append(Finding(self.name, path, f"its labelled prim {sites[0].prim_path} has "
-                                                    f"{len(sites[0].labels)} labels {list(sites[0].labels)}; "
-                                                    f"expected exactly one"))
         return out
 
 
 class LabelInClassMapRule:
-    """Every label of the taxonomy names a class (or alias) of the class map."""
+    """Every labelled prim holds one label of the taxonomy, naming a class (or alias) of the class map."""
 
     name = "label-in-class-map"
 
     def check(self, ctx: RuleContext) -> list[Finding]:
-        tax = ctx.class_map.taxonomy
         out = []
         for prim in ctx.stage.Traverse():
-            if tax not in UsdSemantics.LabelsAPI.GetDirectTaxonomies(prim):
-                continue
-            for label in UsdSemantics.LabelsAPI(prim, tax).GetLabelsAttr().Get() or []:
-                if ctx.class_map.resolve(str(label)) is None:
-                    out.append(Finding(self.name, str(prim.GetPath()),
-                                       f"label '{label}' is not a class of {ctx.class_map.source}; "
-                                       f"use a class name or alias from it (see `synthua inspect`)"))
+            labels = direct_labels(prim, ctx.class_map.taxonomy)
+            if labels is not None:
+                out += label_findings(str(prim.GetPath()), labels, ctx.class_map, self.name)
+        return out
+
+
+class MeshTopologyRule:
+    """Renderable meshes have consistent faces and finite points (what the reader refuses)."""
+
+    name = "mesh-topology"
+
+    def check(self, ctx: RuleContext) -> list[Finding]:
+        t = Usd.TimeCode(ctx.stage.GetStartTimeCode()) if ctx.stage.HasAuthoredTimeCodeRange() else Usd.TimeCode.Default()
+        out = []
+        for prim in renderable_gprims(ctx.stage):
+            if prim.IsA(UsdGeom.Mesh):
+                out += mesh_topology(prim, t, self.name)[0]
+        return out
+
+
+class SupportedPrimRule:
+    """Every renderable gprim and every light is of a type the translator handles."""
+
+    name = "supported-prim"
+
+    def check(self, ctx: RuleContext) -> list[Finding]:
+        out = [Finding(self.name, str(p.GetPath()), unsupported_gprim_message(p))
+               for p in renderable_gprims(ctx.stage) if unsupported_gprim_message(p)]
+        out += [Finding(self.name, str(p.GetPath()), unsupported_light_message(p))
+                for p in ctx.stage.Traverse() if p.HasAPI(UsdLux.LightAPI) and unsupported_light_message(p)]
         return out
 
 
@@ -122,36 +139,10 @@ class CameraLensRule:
     name = "camera-lens"
 
     def check(self, ctx: RuleContext) -> list[Finding]:
-        unit = lens_unit_mm(UsdGeom.GetStageMetersPerUnit(ctx.stage))
-        out = []
-        for prim in ctx.stage.Traverse():
-            if not prim.IsA(UsdGeom.Camera):
-                continue
-            path = str(prim.GetPath())
-            cam = UsdGeom.Camera(prim)
-            if cam.GetProjectionAttr().Get() != UsdGeom.Tokens.perspective:
-                out.append(Finding(self.name, path, f"projection is '{cam.GetProjectionAttr().Get()}'; only "
-                                                    f"'perspective' renders"))
-            for attr, lo_hi in (("focalLength", FOCAL_RANGE_MM), ("horizontalAperture", APERTURE_RANGE_MM),
-                                ("verticalAperture", APERTURE_RANGE_MM)):
-                value = prim.GetAttribute(attr).Get()
-                if value is None or not math.isfinite(value) or value <= 0:
-                    out.append(Finding(self.name, path, f"{attr} is {value}; expected a positive value"))
-                    continue
-                mm = value * unit
-                if not lo_hi[0] <= mm <= lo_hi[1]:
-                    out.append(Finding(self.name, path,
-                                       f"{attr} = {value:g} is {mm:g} mm, outside the plausible {lo_hi[0]:g}-{lo_hi[1]:g} "
-                                       f"mm; USD lens values are in tenths of a scene unit ({unit:g} mm here)",
-                                       Severity.WARNING))
-            for attr in ("horizontalApertureOffset", "verticalApertureOffset"):
-                if prim.GetAttribute(attr).Get():
-                    out.append(Finding(self.name, path, f"{attr} is {prim.GetAttribute(attr).Get()}; lens shift is "
-                                                        f"not supported, expected 0"))
-            near, far = cam.GetClippingRangeAttr().Get()
-            if not 0 < near < far:
-                out.append(Finding(self.name, path, f"clippingRange is ({near:g}, {far:g}); expected 0 < near < far"))
-        return out
+        mpu = UsdGeom.GetStageMetersPerUnit(ctx.stage)
+        t = Usd.TimeCode(ctx.stage.GetStartTimeCode()) if ctx.stage.HasAuthoredTimeCodeRange() else Usd.TimeCode.Default()
+        return [f for prim in ctx.stage.Traverse() if prim.IsA(UsdGeom.Camera)
+                for f in camera_findings(prim, t, mpu, self.name)]
 
 
 class RenderSettingsRule:
@@ -173,11 +164,15 @@ class RenderSettingsRule:
             res = settings.GetResolutionAttr().Get()
             if res is not None and (res[0] <= 0 or res[1] <= 0):
                 out.append(Finding(self.name, str(prim.GetPath()), f"resolution is {tuple(res)}; expected positive"))
+            spp = prim.GetAttribute("synthua:spp")
+            if spp and spp.HasAuthoredValue() and not (isinstance(spp.Get(), int) and spp.Get() >= 1):
+                out.append(Finding(self.name, str(prim.GetPath()), f"synthua:spp is {spp.Get()}; expected an "
+                                                                   f"integer >= 1"))
         return out
 
 
 DEFAULT_RULES = (UsdValidationRule(), StageMetadataRule(), GprimClassRule(), LabelInClassMapRule(),
-                 CameraLensRule(), RenderSettingsRule())
+                 MeshTopologyRule(), SupportedPrimRule(), CameraLensRule(), RenderSettingsRule())
 
 
 def validate_stage(stage: Usd.Stage, class_map: ClassMap, rules=DEFAULT_RULES) -> list[Finding]:

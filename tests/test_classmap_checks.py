@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from conftest import DATA
-from synthua_usd.classmap_rules import MIN_CIEDE2000, check_classmap, ciede2000_matrix
+from synthua_usd.classmap_checks import MIN_CIEDE2000, check_classmap, ciede2000_matrix
 from synthua_usd.findings import Severity
 from synthua_usd.schemas import bundled_path, read_json
 

@@ -2,11 +2,11 @@ import pytest
 
 from conftest import DATA
 from synthua_usd.errors import InputError, SchemaError
-from synthua_usd.semantic_rules import SemanticRules
+from synthua_usd.class_assignment import AssignmentRules
 
 
 def test_first_match_wins_and_default(class_map):
-    rules = SemanticRules.from_document({"rules": [
+    rules = AssignmentRules.from_document({"rules": [
         {"field": "material", "pattern": "glass", "class": "window"},
         {"field": "object", "pattern": "^build", "class": "Buildings"},
         {"field": "any", "pattern": "lamp", "class": "light_pole"},
@@ -24,5 +24,5 @@ def test_first_match_wins_and_default(class_map):
 ])
 def test_bad_rules_files(class_map, name, error, text):
     with pytest.raises(error) as err:
-        SemanticRules.load(DATA / "invalid" / name, class_map)
+        AssignmentRules.load(DATA / "invalid" / name, class_map)
     assert text in str(err.value) and name in str(err.value)

@@ -1,0 +1,107 @@
+"""A render session: one Mitsuba scene loaded once, rendered from any camera at any time code.
+
+The first :meth:`RenderSession.render` translates and loads the snapshot. Later calls compare the new
+snapshot with the loaded one and change only what differs, through Mitsuba's ``traverse()`` parameters:
+the sensor (pose, field of view, clipping) and the vertex positions of meshes that moved (a new
+:class:`MeshItem` object where the reader re-read a time-varying gprim). Mitsuba then rebuilds its
+acceleration structure; the scene, its BSDFs and static meshes stay. A snapshot with other meshes (a
+gprim appeared or disappeared, a mesh changed its topology) or other lights is loaded afresh, and
+``reloads`` counts it.
+
+This is what a dataset worker holds: one session, one scene load, every frame of its share.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from synthua_usd.backends.mitsuba import variants
+from synthua_usd.backends.mitsuba.render import RenderedFrame, label_maps, render_rgb, trace_pixel_centres
+from synthua_usd.backends.mitsuba.translate import Translation, sensor_to_world, translate
+from synthua_usd.cameras import PinholeCamera
+from synthua_usd.render_config import RenderConfig
+from synthua_usd.scene import SceneSnapshot
+
+
+class RenderSession:
+    """Renders RGB and exact labels of snapshots of one scene at a fixed image size and sample count.
+
+    ``variant`` is picked (or checked) once, when the session is made.
+    """
+
+    def __init__(self, config: RenderConfig) -> None:
+        self.config = config
+        self.mi = variants.activate(config.variant)
+        self.variant = self.mi.variant()
+        self.loads = 0
+        self.reloads = 0
+        self._scene = None
+        self._params = None
+        self._translation: Translation | None = None
+        self._snapshot: SceneSnapshot | None = None
+
+    def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera) -> None:
+        self._translation = translate(self.mi, snapshot, camera, self.config)
+        # optimize=False: Mitsuba would otherwise merge meshes and lose the identity labels depend on.
+        self._scene = self.mi.load_dict(self._translation.scene, optimize=False)
+        self._params = self.mi.traverse(self._scene)
+        self._snapshot = snapshot
+        self.loads += 1
+
+    def _same_layout(self, snapshot: SceneSnapshot) -> bool:
+        old = self._snapshot
+        return (len(old.meshes) == len(snapshot.meshes) and old.lights == snapshot.lights
+                and all(a is b or (a.prim_path == b.prim_path and a.triangles.shape == b.triangles.shape
+                                   and a.material_key == b.material_key)
+                        for a, b in zip(old.meshes, snapshot.meshes)))
+
+    def _update(self, snapshot: SceneSnapshot, camera: PinholeCamera) -> int:
+        """Point the sensor at ``camera`` and move what moved; returns how many meshes were updated."""
+        mi, params = self.mi, self._params
+        fov_x, _ = camera.fov_deg(self.config.width, self.config.height)
+        params["sensor.to_world"] = sensor_to_world(mi, camera)
+        params["sensor.x_fov"] = fov_x
+        params["sensor.near_clip"] = camera.clip_near_m
+        params["sensor.far_clip"] = camera.clip_far_m
+        moved = 0
+        for key, old, new in zip(self._translation.shape_ids, self._snapshot.meshes, snapshot.meshes):
+            if old is new or old.points is new.points:
+                continue
+            params[f"{key}.vertex_positions"] = mi.Float(np.ascontiguousarray(new.points, np.float32).ravel())
+            moved += 1
+        params.update()
+        self._snapshot = snapshot
+        return moved
+
+    def render(self, snapshot: SceneSnapshot, camera: PinholeCamera, rgb: bool = True,
+               show_progress: bool = False) -> RenderedFrame:
+        """RGB (unless ``rgb`` is False) and labels of ``snapshot`` seen by ``camera``.
+
+        ``seconds`` in the result holds ``load`` (first load or reload) or ``update``, then ``labels``
+        and ``rgb``."""
+        seconds = {}
+        t0 = time.perf_counter()
+        if self._scene is None:
+            self._load(snapshot, camera)
+            seconds["load"] = time.perf_counter() - t0
+        elif not self._same_layout(snapshot):
+            self._load(snapshot, camera)
+            self.reloads += 1
+            seconds["load"] = time.perf_counter() - t0
+        else:
+            self._update(snapshot, camera)
+            seconds["update"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        w, h = self.config.width, self.config.height
+        hits = trace_pixel_centres(self.mi, self._scene, self._translation.shape_ids, camera, w, h)
+        class_ids, instance_ids = label_maps(hits, snapshot)
+        seconds["labels"] = time.perf_counter() - t0
+        image = None
+        if rgb:
+            t0 = time.perf_counter()
+            image = render_rgb(self.mi, self._scene, self.config, show_progress)
+            seconds["rgb"] = time.perf_counter() - t0
+        return RenderedFrame(rgb=image, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
+                             variant=self.variant, seconds=seconds)

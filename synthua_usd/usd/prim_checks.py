@@ -1,0 +1,102 @@
+"""Checks of single prims that both the reader and ``synthua validate stage`` run.
+
+Each returns findings (never raises); the reader turns the first error into a :class:`StageError`
+(:func:`raise_first_error`), the stage rules of :mod:`synthua_usd.usd.stage_checks` report them all. So
+whatever render refuses, validation reports, with the same words.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pxr import Usd, UsdGeom
+
+from synthua_usd.errors import StageError
+from synthua_usd.findings import Finding, Severity
+from synthua_usd.taxonomy import ClassMap
+
+#: Plausible physical lens values; outside them the authored numbers are probably in the wrong unit.
+FOCAL_RANGE_MM = (1.0, 2000.0)
+APERTURE_RANGE_MM = (1.0, 100.0)
+
+
+def lens_unit_mm(meters_per_unit: float) -> float:
+    """Millimetres in one USD lens unit (a tenth of a scene unit): USD measures focalLength and the
+    apertures in tenths of a scene unit, so millimetres on a centimetre stage."""
+    return 100.0 * meters_per_unit
+
+
+def raise_first_error(findings: list[Finding]) -> None:
+    """Raise :class:`StageError` for the first error among ``findings``; warnings and notes pass."""
+    for f in findings:
+        if f.severity is Severity.ERROR:
+            raise StageError(f"{f.where}: {f.message}")
+
+
+def mesh_topology(prim: Usd.Prim, t: Usd.TimeCode, rule: str = "mesh-topology") -> tuple[list[Finding], tuple]:
+    """Findings for a ``UsdGeom.Mesh`` at ``t`` and, when it has none, its arrays
+    ``(points (n, 3) float64, faceVertexCounts (f,) int64, faceVertexIndices (k,) int64)``."""
+    path = str(prim.GetPath())
+    mesh = UsdGeom.Mesh(prim)
+    points = np.asarray(mesh.GetPointsAttr().Get(t) or [], np.float64).reshape(-1, 3)
+    counts = np.asarray(mesh.GetFaceVertexCountsAttr().Get(t) or [], np.int64)
+    indices = np.asarray(mesh.GetFaceVertexIndicesAttr().Get(t) or [], np.int64)
+    out = []
+    if counts.sum() != len(indices):
+        out.append(Finding(rule, path, f"faceVertexCounts sum to {counts.sum()} but there are {len(indices)} "
+                                       f"faceVertexIndices; expected equal"))
+    if len(counts) and counts.min() < 3:
+        out.append(Finding(rule, path, f"faceVertexCounts has a face of {counts.min()} vertices; expected at least 3"))
+    if len(indices) and (indices.min() < 0 or indices.max() >= len(points)):
+        out.append(Finding(rule, path, f"faceVertexIndices reach {indices.min() if indices.min() < 0 else indices.max()} "
+                                       f"but there are {len(points)} points; expected indices in 0..{len(points) - 1}"))
+    if not np.all(np.isfinite(points)):
+        out.append(Finding(rule, path, "points hold NaN or infinite coordinates; expected finite numbers"))
+    return out, (points, counts, indices)
+
+
+def label_findings(path: str, labels: tuple[str, ...], class_map: ClassMap, rule: str = "label-in-class-map") -> list[Finding]:
+    """A labelled prim holds exactly one label, and it names a class (or alias) of the class map."""
+    if len(labels) != 1:
+        return [Finding("gprim-has-one-class", path, f"has {len(labels)} labels {list(labels)} in taxonomy "
+                                                     f"'{class_map.taxonomy}'; expected exactly one")]
+    if class_map.resolve(labels[0]) is None:
+        return [Finding(rule, path, f"label '{labels[0]}' is not a class of {class_map.source}; use a class name "
+                                    f"or alias from it (see `synthua inspect`)")]
+    return []
+
+
+def camera_findings(prim: Usd.Prim, t: Usd.TimeCode, meters_per_unit: float, rule: str = "camera-lens") -> list[Finding]:
+    """A perspective camera with positive (and plausible) lens values, no lens shift, 0 < near < far, and
+    a finite, invertible transform."""
+    path = str(prim.GetPath())
+    cam = UsdGeom.Camera(prim)
+    unit = lens_unit_mm(meters_per_unit)
+    out = []
+    projection = cam.GetProjectionAttr().Get(t)
+    if projection != UsdGeom.Tokens.perspective:
+        out.append(Finding(rule, path, f"projection '{projection}' is not supported; expected 'perspective'"))
+    for attr, (lo, hi) in (("focalLength", FOCAL_RANGE_MM), ("horizontalAperture", APERTURE_RANGE_MM),
+                           ("verticalAperture", APERTURE_RANGE_MM)):
+        value = prim.GetAttribute(attr).Get(t)
+        if value is None or not math.isfinite(value) or value <= 0:
+            out.append(Finding(rule, path, f"{attr} is {value}; expected a finite value > 0"))
+            continue
+        mm = value * unit
+        if not lo <= mm <= hi:
+            out.append(Finding(rule, path, f"{attr} = {value:g} is {mm:g} mm, outside the plausible {lo:g}-{hi:g} mm; "
+                                           f"USD lens values are in tenths of a scene unit ({unit:g} mm here)",
+                               Severity.WARNING))
+    for attr in ("horizontalApertureOffset", "verticalApertureOffset"):
+        offset = prim.GetAttribute(attr).Get(t)
+        if offset:
+            out.append(Finding(rule, path, f"{attr} = {offset} is not supported; expected 0 (no lens shift)"))
+    near, far = cam.GetClippingRangeAttr().Get(t)
+    if not (math.isfinite(near) and math.isfinite(far) and 0 < near < far):
+        out.append(Finding(rule, path, f"clippingRange is ({near:g}, {far:g}); expected 0 < near < far"))
+    m = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(t), float)
+    if not np.all(np.isfinite(m)) or abs(np.linalg.det(m[:3, :3])) < 1e-12:
+        out.append(Finding(rule, path, "transform is not finite and invertible (a zero scale?); expected a rigid "
+                                       "placement"))
+    return out
