@@ -16,10 +16,10 @@ DISTRICT := stages/district/scenario.usda
 demo: setup
 	$(BIN)/synthua validate stage $(SCENARIO)
 	$(BIN)/synthua inspect $(SCENARIO)
-	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/CCTV --frame 24 --out $(DEMO_OUT)/cctv
-	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/PedestrianEye --frame 24 --out $(DEMO_OUT)/pedestrian_eye
+	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/CCTV --time-code 24 --out $(DEMO_OUT)/cctv
+	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/PedestrianEye --time-code 24 --out $(DEMO_OUT)/pedestrian_eye
 	$(BIN)/synthua validate stage $(DISTRICT)
-	$(BIN)/synthua render $(DISTRICT) --camera /World/Cameras/CCTV_Largo --frame 24 --out $(DEMO_OUT)/district_cctv_largo
+	$(BIN)/synthua render $(DISTRICT) --camera /World/Cameras/CCTV_Largo --time-code 24 --out $(DEMO_OUT)/district_cctv_largo
 	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}"
 
 ## The whole test suite (slow tests included).
@@ -31,9 +31,11 @@ stages: setup
 	$(BIN)/synthua create street stages
 	$(BIN)/synthua create district stages/district --seed 0
 
-## Render and label timings (not a test: numbers to compare by hand).
+## Benchmarks (not tests: ratios and timings measured side by side in one run): rendering through a
+## render session (first load, per-frame update, labels, RGB) and building the district, imports and agents.
 bench: setup
 	$(BIN)/python tools/bench_render.py
+	$(BIN)/python tools/bench_twin.py
 
 clean:
 	rm -rf out .pytest_cache

@@ -124,10 +124,3 @@ def check_classmap(document: object) -> list[Finding]:
     if errors:
         return [Finding("schema", json_pointer(e), e.message) for e in errors]
     return check_classmap_rules(document)  # type: ignore[arg-type]
-
-
-def group_counts(classes: list[dict]) -> dict[str, int]:
-    counts: dict[str, int] = defaultdict(int)
-    for c in classes:
-        counts[c["group"]] += 1
-    return dict(counts)

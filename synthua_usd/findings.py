@@ -34,7 +34,3 @@ class Finding:
         return {"rule": self.rule, "where": self.where, "message": self.message,
                 "severity": self.severity.name.lower()}
 
-
-def worst(findings: list[Finding]) -> Severity | None:
-    """The highest severity among ``findings``, or None when there are none."""
-    return max((f.severity for f in findings), default=None)

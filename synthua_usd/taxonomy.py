@@ -10,9 +10,6 @@ import numpy as np
 from synthua_usd.errors import InputError
 from synthua_usd.schemas import bundled_path, read_json, validate_document
 
-GROUPS = ("accessibility", "person", "vehicle", "infrastructure", "building", "nature", "furniture", "other")
-
-
 @dataclass(frozen=True)
 class SemanticClass:
     """One class. ``color`` is sRGB, 8 bits a channel; ``isthing`` means countable instances."""
@@ -94,6 +91,3 @@ class ClassMap:
         for c in self.classes:
             lut[c.id] = c.color
         return lut
-
-    def to_document(self) -> dict:
-        return {"taxonomy": self.taxonomy, "classes": [c.to_dict() for c in self.classes]}

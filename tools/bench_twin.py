@@ -32,6 +32,7 @@ def main() -> int:
     from synthua_usd.importers.cityjson import import_cityjson
     from synthua_usd.importers.pointcloud import import_pointcloud
     from synthua_usd.demo.district import build_district
+    from synthua_usd.agents.crowd import CrowdParams
     from synthua_usd.pipeline.populate import PopulateRequest, populate
 
     model = timed("district: build (seed 0)", lambda: build_district(0))
@@ -49,11 +50,13 @@ def main() -> int:
     else:
         print(f"(no {third}: imports skipped)")
     with tempfile.TemporaryDirectory() as tmp:
-        report = timed("agents: populate district (0.03/m², 48 frames)",
-                       lambda: populate(PopulateRequest(REPO / "stages" / "district" / "scenario.usda",
-                                                        Path(tmp) / "agents.usda", 0.03, frames=48, seed=0)))
-    print(f"  {report.placed} agents ({report.aid_users} with aids), {report.dropped} dropped, minimum gap "
-          f"{report.min_separation_m:.3f} m on {report.walkable_area_m2:.0f} m² walkable")
+        crowd, _, _ = timed("agents: populate district (0.03/m², 48 time codes)",
+                            lambda: populate(PopulateRequest(REPO / "stages" / "district" / "scenario.usda",
+                                                             Path(tmp) / "agents.usdc",
+                                                             CrowdParams(density_per_m2=0.03, time_codes=48, seed=0))))
+    r = crowd.report
+    print(f"  {r['placed']} agents ({r['aid_users']} with aids), {r['dropped']} dropped, minimum gap "
+          f"{r['min_separation_m']:.3f} m on {r['walkable_area_m2']:.0f} m² walkable")
     return 0
 
 

@@ -24,7 +24,9 @@ apt_install() {
 }
 
 # 1. libLLVM 19 for Mitsuba's LLVM variant (optional: without it synthua falls back to scalar_rgb).
-if ! ls /usr/lib/*/libLLVM*.so.19* /usr/lib/libLLVM*.so.19* >/dev/null 2>&1; then
+# Any match is enough (ls with several patterns fails when one of them matches nothing, so look once).
+if ! compgen -G "/usr/lib/*/libLLVM*.so.19*" >/dev/null && ! compgen -G "/usr/lib/libLLVM*.so.19*" >/dev/null \
+   && ! compgen -G "/usr/lib/llvm-19/lib/libLLVM*.so*" >/dev/null; then
   echo "setup: installing libllvm19 for Mitsuba's llvm_ad_rgb variant"
   apt_install libllvm19 || echo "setup: warning: could not install libllvm19; rendering will use the slower scalar_rgb variant" >&2
 fi

@@ -20,8 +20,8 @@ START_TRIES = 5
 
 @dataclass(frozen=True, eq=False)
 class Trajectory:
-    """``positions`` (frames, 3) world metres on the walkable surface; ``headings_deg`` (frames,) about Z
-    (0 = +X); ``distance_m`` (frames,) travelled so far (drives the walking cycle)."""
+    """``positions`` (T, 3) world metres on the walkable surface, one row per time code; ``headings_deg``
+    (T,) about Z (0 = +X); ``distance_m`` (T,) travelled so far (drives the walking cycle)."""
 
     plan: Plan
     positions: np.ndarray
@@ -41,8 +41,9 @@ def _along(waypoints: np.ndarray, s: float) -> tuple[np.ndarray, np.ndarray, int
     return waypoints[k] + t * seg[k], d, k
 
 
-def simulate(plans: list[Plan], frames: int, fps: float) -> tuple[list[Trajectory], int]:
-    """Trajectories for the agents that fit, and how many were dropped."""
+def simulate(plans: list[Plan], time_codes: int, fps: float) -> tuple[list[Trajectory], int]:
+    """Trajectories sampled at ``time_codes`` consecutive time codes ``1 / fps`` s apart for the agents
+    that fit, and how many were dropped."""
     dt = 1.0 / fps
     placed: list[Trajectory] = []
     dropped = 0
@@ -50,7 +51,7 @@ def simulate(plans: list[Plan], frames: int, fps: float) -> tuple[list[Trajector
         traj = None
         # A start already taken is moved further along the route (a few tries) before giving up.
         for attempt in range(START_TRIES):
-            traj = _simulate_one(replace(plan, start_offset_m=plan.start_offset_m + 2.0 * attempt), frames, dt, placed)
+            traj = _simulate_one(replace(plan, start_offset_m=plan.start_offset_m + 2.0 * attempt), time_codes, dt, placed)
             if traj is not None:
                 break
         if traj is None:
@@ -69,7 +70,7 @@ def _conflicts(p: np.ndarray, r: float, frame: int, placed: list[Trajectory]) ->
     return False
 
 
-def _simulate_one(plan: Plan, frames: int, dt: float, placed: list[Trajectory]) -> Trajectory | None:
+def _simulate_one(plan: Plan, time_codes: int, dt: float, placed: list[Trajectory]) -> Trajectory | None:
     r = plan.profile.radius_m
     wp = plan.waypoints
     s = plan.start_offset_m
@@ -80,7 +81,7 @@ def _simulate_one(plan: Plan, frames: int, dt: float, placed: list[Trajectory]) 
     positions, headings, travelled = [p], [np.degrees(np.arctan2(direction[1], direction[0]))], [0.0]
     waited = 0.0
     entered_crossing = plan.surfaces[k] == "crosswalk"
-    for f in range(1, frames):
+    for f in range(1, time_codes):
         s_next = s + plan.speed_mps * dt
         point_n, dir_n, k_n = _along(wp, s_next)
         # Pause at the kerb before the first crosswalk cell, then go.
@@ -104,10 +105,10 @@ def _simulate_one(plan: Plan, frames: int, dt: float, placed: list[Trajectory]) 
 
 
 def min_separation(trajectories: list[Trajectory]) -> float:
-    """Smallest gap between any two agents' discs over all frames (metres); inf for fewer than two."""
+    """Smallest gap between any two agents' discs over all time codes (metres); inf for fewer than two."""
     if len(trajectories) < 2:
         return float("inf")
-    pos = np.stack([t.positions[:, :2] for t in trajectories])  # (agents, frames, 2)
+    pos = np.stack([t.positions[:, :2] for t in trajectories])  # (agents, time codes, 2)
     radii = np.array([t.plan.profile.radius_m for t in trajectories])
     best = np.inf
     for f in range(pos.shape[1]):

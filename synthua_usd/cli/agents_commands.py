@@ -22,8 +22,8 @@ def agents() -> None:
                    "crush); warned above 0.7 (level of service E).")
 @click.option("--aid-share", type=float, default=0.3, show_default=True,
               help="Fraction of agents using a mobility aid (wheelchairs, walker, crutches, canes).")
-@click.option("--frames", type=click.IntRange(1, 100_000), default=48, show_default=True,
-              help="Time codes to author (one sample per time code).")
+@click.option("--time-codes", "--frames", "time_codes", type=click.IntRange(1, 100_000), default=48, show_default=True,
+              help="Time codes to author, one sample each, from the stage's start time code (--frames is the same).")
 @click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Seed: same seed, same bytes.")
 @click.option("--cell-m", type=float, default=0.5, show_default=True, help="Walkable grid cell size (metres).")
 @click.option("--walk-on", default="sidewalk,crosswalk,curb_ramp,street_road", show_default=True,
@@ -31,22 +31,22 @@ def agents() -> None:
                    "for imported twins whose roads include their sidewalks (CityJSON often).")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--out", "out_path", type=click.Path(path_type=Path), required=True, help="The agents layer to write (.usdc binary, or .usda text).")
-def agents_populate(stage: Path, density: float, aid_share: float, frames: int, seed: int, cell_m: float,
+def agents_populate(stage: Path, density: float, aid_share: float, time_codes: int, seed: int, cell_m: float,
                     walk_on: str, class_map: Path | None, out_path: Path) -> int:
     """Populate TWIN_OR_SCENARIO with walking people and mobility-aid users; write them as a layer.
 
     \b
     The walkable graph covers sidewalks, crosswalks, curb ramps and cobbled streets (the road only on
     crosswalks). Wheelchair and walker users never step a kerb: they cross at curb ramps. Agents pause
-    before crosswalks and never come within 0.1 m of each other (disc to disc) at any frame.
+    before crosswalks and never come within 0.1 m of each other (disc to disc) at any time code.
     Compose the layer into a scenario with `synthua compose`, e.g.
-      synthua compose my.usda agents.usda stages/district/render.usda ... stages/district/twin.usda
+      synthua compose my.usda agents.usdc stages/district/render.usda ... stages/district/twin.usdc
     """
     from synthua_usd.agents.crowd import CrowdParams
     from synthua_usd.pipeline.populate import PopulateRequest, populate
 
     walkable = tuple(c.strip() for c in walk_on.split(",") if c.strip())
-    params = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=frames, seed=seed, cell_m=cell_m,
+    params = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=time_codes, seed=seed, cell_m=cell_m,
                          walkable=walkable)
     crowd, path, seconds = populate(PopulateRequest(stage, out_path, params, class_map))
     r = crowd.report
@@ -54,6 +54,6 @@ def agents_populate(stage: Path, density: float, aid_share: float, frames: int, 
                f"{r['sampled']}, placed {r['placed']} ({r['aid_users']} with mobility aids), dropped "
                f"{r['dropped']} (no collision-free start)")
     click.echo(f"profiles {r['by_profile']}")
-    click.echo(f"minimum gap between agents over {frames} time codes: {r['min_separation_m']:.3f} m; {seconds:.1f} s")
+    click.echo(f"minimum gap between agents over {time_codes} time codes: {r['min_separation_m']:.3f} m; {seconds:.1f} s")
     click.echo(f"wrote {path}")
     return EXIT_OK

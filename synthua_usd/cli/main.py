@@ -1,7 +1,7 @@
 """``synthua``: one command, a subcommand per step. Thin: parse, call the library, print, return a status.
 
 Exit status: 0 success (or a clean validation), 1 validation findings or an unexpected failure,
-2 unusable input (missing or malformed file, unknown camera, frame out of range, bad option).
+2 unusable input (missing or malformed file, unknown camera, time code out of range, bad option).
 """
 
 from __future__ import annotations
@@ -176,7 +176,7 @@ def create_district(out_dir: Path, seed: int) -> int:
 # --- render --------------------------------------------------------------------------------------------------
 
 def _time_codes(ctx, param, values: tuple[str, ...]) -> tuple[float, ...]:
-    """``--frame 24 --frame 1:48:8 --frame 1,12``: single time codes, comma lists, and START:END[:STEP]
+    """``--time-code 24 --time-code 1:48:8 --frame 1,12``: single time codes, comma lists, and START:END[:STEP]
     ranges with END included when the steps reach it."""
     out: list[float] = []
     for value in values:
@@ -210,9 +210,9 @@ def _time_codes(ctx, param, values: tuple[str, ...]) -> tuple[float, ...]:
 @click.option("--camera", "cameras", multiple=True,
               help="Camera prim path, e.g. /World/Cameras/CCTV; repeat for several [default: the render "
                    "settings' camera].")
-@click.option("--frame", "--time-code", "time_codes", multiple=True, callback=_time_codes,
-              help="Time code(s) to render: 24, 1,12,24 or 1:48:8 (START:END:STEP); repeatable "
-                   "[default: the stage's start time code].")
+@click.option("--time-code", "--frame", "time_codes", multiple=True, callback=_time_codes,
+              help="Time code(s) to render: 24, 1,12,24 or 1:48:8 (START:END:STEP); repeatable; --frame is "
+                   "the same option [default: the stage's start time code].")
 @click.option("--width", type=click.IntRange(1, 16384), help="Image width in pixels [default: render settings, else 1280].")
 @click.option("--height", type=click.IntRange(1, 16384), help="Image height in pixels [default: render settings, else 960].")
 @click.option("--spp", type=click.IntRange(1, 65536), help="RGB samples per pixel [default: render settings, else 64]. "
@@ -229,7 +229,7 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     \b
     One frame writes its files into --out; several write --out/<camera name>/<time code>/, e.g.
       synthua render stages/scenario.usda --camera /World/Cameras/CCTV \\
-          --camera /World/Cameras/PedestrianEye --frame 1:48:8 --out out/sweep
+          --camera /World/Cameras/PedestrianEye --time-code 1:48:8 --out out/sweep
     renders 12 frames from one loaded scene (only the camera and what moves are updated between them).
     \b
     Files per frame (the stage's UsdRender vars choose; all when it names none): rgb.exr

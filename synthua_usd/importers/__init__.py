@@ -1,7 +1,7 @@
 """Importers: real city data → :class:`synthua_usd.twin.TwinModel` (plain data; no USD, no renderer).
 
 Each importer module parses and validates one kind of input and returns a TwinModel; it never writes
-files. ``IMPORTERS`` maps the kind names of ``synthua twin import KIND`` to them.
+files. :func:`importers` maps the kind names of ``synthua twin import KIND`` to them.
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ Importer = Callable[..., TwinModel]
 
 
 def importers() -> dict[str, Importer]:
-    """Kind name → importer function; imported lazily so optional dependencies fail only when used."""
+    """Kind name → importer function. The modules are imported on first use: each pulls in heavy
+    libraries of its own (laspy, pymeshlab, pyproj, shapely) that other commands need not load."""
     from synthua_usd.importers import cityjson, footprints, mesh, pointcloud
 
     return {"mesh": mesh.import_mesh, "cityjson": cityjson.import_cityjson,

@@ -249,6 +249,7 @@ class StageReader:
         self._varying: dict[str, bool] = {}
         self._xform_memo: dict[str, bool] = {}
         self._warned_unlabelled = False
+        self._last: SceneSnapshot | None = None
 
     def _is_varying(self, prim: Usd.Prim) -> bool:
         key = str(prim.GetPath())
@@ -277,8 +278,13 @@ class StageReader:
                         instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0)
 
     def snapshot(self, time_code: float) -> SceneSnapshot:
-        """Everything renderable at ``time_code`` (checked against the stage's time range)."""
+        """Everything renderable at ``time_code`` (checked against the stage's time range). Asking for the
+        same time code again returns the same snapshot; a time-varying mesh whose points did not change
+        since the previous snapshot keeps its previous :class:`MeshItem`."""
         check_time_code(self.stage, time_code)
+        if self._last is not None and self._last.time_code == time_code:
+            return self._last
+        previous = {m.prim_path: m for m in self._last.meshes} if self._last is not None else {}
         t = Usd.TimeCode(time_code)
         xcache = UsdGeom.XformCache(t)
         meshes = []
@@ -286,6 +292,10 @@ class StageReader:
             key = str(prim.GetPath())
             if self._is_varying(prim):
                 item = self._mesh_item(prim, t, xcache)
+                before = previous.get(key)
+                if (item is not None and before is not None and np.array_equal(before.points, item.points)
+                        and np.array_equal(before.triangles, item.triangles)):
+                    item = before
             else:
                 if key not in self._static:
                     self._static[key] = self._mesh_item(prim, t, xcache)
@@ -300,9 +310,10 @@ class StageReader:
         lights = tuple(_read_light(p, t) for p in self.stage.Traverse() if p.HasAPI(UsdLux.LightAPI))
         if not lights:
             log.warning("%s: no UsdLux lights; RGB will be black", self.stage.GetRootLayer().identifier)
-        return SceneSnapshot(time_code=time_code, up_axis=str(UsdGeom.GetStageUpAxis(self.stage)),
-                             meshes=tuple(meshes), materials=dict(self._materials), lights=lights,
-                             instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)))
+        self._last = SceneSnapshot(time_code=time_code, up_axis=str(UsdGeom.GetStageUpAxis(self.stage)),
+                                   meshes=tuple(meshes), materials=dict(self._materials), lights=lights,
+                                   instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)))
+        return self._last
 
 
 def read_snapshot(stage: Usd.Stage, time_code: float, class_map: ClassMap) -> SceneSnapshot:

@@ -72,13 +72,13 @@ def time_range(stage: Usd.Stage) -> tuple[float, float] | None:
 
 
 def check_time_code(stage: Usd.Stage, time_code: float) -> None:
-    """Refuse a frame outside the stage's authored time range."""
+    """Refuse a time code outside the stage's authored time range."""
     span = time_range(stage)
     if span is None:
         return
     start, end = span
     if not (start <= time_code <= end):
-        raise StageError(f"{stage.GetRootLayer().identifier}: frame {time_code:g} is outside the stage's time range "
+        raise StageError(f"{stage.GetRootLayer().identifier}: time code {time_code:g} is outside the stage's time range "
                          f"[{start:g}, {end:g}]")
 
 
