@@ -22,3 +22,20 @@ class StageError(InputError):
 
 class UnsupportedPrimError(StageError):
     """A prim type the translator has no handler for."""
+
+
+class OutputError(SynthuaError):
+    """An output cannot be written: a path that is a file where a folder goes (or the reverse), an
+    unwritable folder, a name too long, a full disk. Exit status 2; earlier results stay as they were."""
+
+
+#: Longest piece of user input echoed in a message.
+ECHO_LIMIT = 120
+
+
+def echo(value) -> str:
+    """``value`` as it may appear inside a one-line message: control characters and newlines escaped
+    (``repr`` style, without the quotes), cut to :data:`ECHO_LIMIT` characters."""
+    text = str(value)
+    out = text.encode("unicode_escape").decode("ascii", "backslashreplace") if not text.isprintable() else text
+    return out if len(out) <= ECHO_LIMIT else out[:ECHO_LIMIT - 3] + "..."

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-EXIT_OK, EXIT_FINDINGS, EXIT_INPUT = 0, 1, 2
+from synthua_usd.cli.failures import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK  # noqa: F401 (re-exported)
 
 
 def load_class_map(path: Path | None):

@@ -1,13 +1,13 @@
 """``synthua``: one command, a subcommand per step. Thin: parse, call the library, print, return a status.
 
-Exit status: 0 success (or a clean validation), 1 validation findings or an unexpected failure,
-2 unusable input (missing or malformed file, unknown camera, time code out of range, bad option).
+Exit status: 0 success (or a clean validation), 1 validation findings, 2 unusable input (missing or
+malformed file, unknown camera, time code out of range, bad option, an output that cannot be written),
+3 an unexpected failure (a bug; ``--debug`` shows the traceback).
 """
 
 from __future__ import annotations
 
 import json
-import logging
 import math
 import sys
 import time
@@ -20,7 +20,7 @@ from synthua_usd.cli.agents_commands import agents
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
 from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.twin_commands import twin
-from synthua_usd.errors import SynthuaError
+from synthua_usd.cli.failures import configure_logging, guarded
 from synthua_usd.findings import Finding, Severity
 
 
@@ -41,7 +41,8 @@ def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(__version__, prog_name="synthua")
 @click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
-def cli(verbose: int) -> None:
+@click.option("--debug", is_flag=True, help="Show the Python traceback of an unexpected failure.")
+def cli(verbose: int, debug: bool) -> None:
     """Turn layered OpenUSD street scenes into exactly labelled images.
 
     \b
@@ -58,8 +59,7 @@ def cli(verbose: int) -> None:
           city/cameras.usda city/semantics.usda city/twin.usda
       synthua render city/with_people.usda --camera /World/Cameras/Street --out out/city
     """
-    level = logging.WARNING - 10 * verbose
-    logging.basicConfig(level=max(level, logging.DEBUG), format="synthua: %(levelname)s: %(message)s", force=True)
+    configure_logging(verbose)
 
 
 # --- validate ---------------------------------------------------------------------------------------------
@@ -264,21 +264,15 @@ for _group in (twin, agents, survey):
 # --- entry point ---------------------------------------------------------------------------------------------
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI and return the exit status (the console script passes it to ``sys.exit``)."""
-    try:
-        result = cli.main(args=argv, prog_name="synthua", standalone_mode=False)
-    except click.exceptions.Exit as exc:
-        return exc.exit_code
-    except click.ClickException as exc:
-        exc.show()
-        return EXIT_INPUT
-    except click.Abort:
-        click.echo("synthua: aborted", err=True)
-        return EXIT_FINDINGS
-    except SynthuaError as exc:
-        click.echo(f"synthua: error: {exc}", err=True)
-        return EXIT_INPUT
-    return result if isinstance(result, int) else EXIT_OK
+    """Run the CLI and return the exit status (the console script passes it to ``sys.exit``).
+
+    Every failure is reported as one line by :func:`synthua_usd.cli.failures.guarded`."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in args
+    if debug:
+        args.remove("--debug")
+    status = guarded(lambda: cli.main(args=args, prog_name="synthua", standalone_mode=False), debug)
+    return status if isinstance(status, int) else EXIT_OK
 
 
 def run() -> None:

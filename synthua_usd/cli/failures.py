@@ -1,0 +1,180 @@
+"""The one place where failures become messages: every expected failure is one line
+
+    synthua: error: <file, prim or field>: <what was found>; <what was expected>
+
+with exit status 2; anything unexpected is one short line with exit status 3 (``--debug`` shows the
+traceback). Warnings from libraries (Python ``warnings``, and the diagnostics OpenUSD's C++ code prints
+straight to the process's stderr) are turned into one-line ``synthua: warning:`` messages.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import logging
+import os
+import re
+import sys
+import tempfile
+import traceback
+from typing import Callable, Iterator
+
+import click
+
+from synthua_usd.errors import SynthuaError, echo
+
+EXIT_OK, EXIT_FINDINGS, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
+
+log = logging.getLogger("synthua")
+
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+
+
+def one_line(text: str) -> str:
+    """``text`` with newlines and other control characters escaped, so a message stays one line."""
+    return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), str(text).strip())
+
+
+class OneLineFormatter(logging.Formatter):
+    """``synthua: warning: message`` with the message kept on one line."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        return f"synthua: {record.levelname.lower()}: {one_line(record.getMessage())}"
+
+
+def configure_logging(verbose: int) -> None:
+    handler = logging.StreamHandler()
+    handler.setFormatter(OneLineFormatter())
+    logging.basicConfig(level=max(logging.WARNING - 10 * verbose, logging.DEBUG), handlers=[handler], force=True)
+    logging.captureWarnings(True)  # numpy's and others' warnings become log records, one line each
+
+
+_OS_EXPECTED = {
+    errno.ENOSPC: "free space on the disk",
+    errno.EDQUOT: "free space within the disk quota",
+    errno.EACCES: "a path the user may read or write",
+    errno.EPERM: "a path the user may read or write",
+    errno.EROFS: "a writable file system",
+    errno.ENAMETOOLONG: "names of at most 255 bytes",
+    errno.EISDIR: "a file, not a folder",
+    errno.ENOTDIR: "folders on the way to it, not files",
+    errno.EEXIST: "a path that does not exist yet",
+    errno.ENOENT: "an existing file or folder",
+    errno.EFBIG: "a file within the size limit",
+    errno.ELOOP: "a path without a symbolic-link loop",
+}
+
+
+def describe(exc: BaseException) -> tuple[str, int]:
+    """The one-line message and exit status for a failure."""
+    if isinstance(exc, SynthuaError):
+        return str(exc), EXIT_INPUT
+    if isinstance(exc, OSError):
+        where = exc.filename if exc.filename is not None else "output"
+        found = exc.strerror or type(exc).__name__
+        expected = _OS_EXPECTED.get(exc.errno, "a usable path")
+        return f"{echo(where)}: {found.lower()}; expected {expected}", EXIT_INPUT
+    if isinstance(exc, RecursionError):
+        return "input: nested too deeply to read (recursion limit); expected a document of reasonable depth", EXIT_INPUT
+    if isinstance(exc, MemoryError):
+        return "input: needs more memory than this machine has; expected a smaller size or count", EXIT_INPUT
+    if isinstance(exc, UnicodeDecodeError):
+        return (f"input: byte 0x{exc.object[exc.start]:02x} at offset {exc.start} is not UTF-8; expected UTF-8 text",
+                EXIT_INPUT)
+    if isinstance(exc, OverflowError):
+        return f"input: a number is too large ({echo(exc)}); expected values in the stated ranges", EXIT_INPUT
+    return (f"internal error: {type(exc).__name__}: {echo(exc)} (a bug: run again with --debug for the traceback "
+            f"and report it)", EXIT_INTERNAL)
+
+
+def click_message(exc: click.ClickException) -> str:
+    """click's usage errors (three lines: usage, hint, error) as one line naming the option."""
+    message = exc.format_message().rstrip(".")
+    m = re.match(r"Invalid value for '?([^':]+)'?: (.*)", message, re.S)
+    if m:
+        message = f"{m.group(1)}: {m.group(2).rstrip('.')}"
+    if isinstance(exc, click.UsageError) and exc.ctx is not None:
+        return f"{exc.ctx.command_path}: {message}; see `{exc.ctx.command_path} --help`"
+    return message
+
+
+def guarded(fn: Callable[[], int], debug: bool) -> int:
+    """Run ``fn`` and turn any failure into one line on stderr and an exit status."""
+    try:
+        with native_stderr_as_warnings():
+            return fn()
+    except click.exceptions.Exit as exc:
+        return exc.exit_code
+    except click.ClickException as exc:
+        click.echo(f"synthua: error: {one_line(click_message(exc))}", err=True)
+        return EXIT_INPUT
+    except click.Abort:
+        click.echo("synthua: error: aborted", err=True)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        click.echo("synthua: error: interrupted; earlier results are as they were", err=True)
+        return 130
+    except BaseException as exc:  # noqa: BLE001 - the one place every failure is reported
+        if isinstance(exc, SystemExit):
+            raise
+        if debug:
+            traceback.print_exc()
+        message, status = describe(exc)
+        click.echo(f"synthua: error: {one_line(message)}", err=True)
+        return status
+
+
+_DIAGNOSTIC = re.compile(r"^(Warning|Error|Coding Error|Fatal Error|Status)(?: in [^:]*? at line \d+ of \S+)?:?\s*(?:-- )?")
+
+
+@contextlib.contextmanager
+def native_stderr_as_warnings() -> Iterator[None]:
+    """Collect what native code (OpenUSD's diagnostics) writes to file descriptor 2 and log it as
+    one-line warnings afterwards. Python's own ``sys.stderr`` keeps writing to the terminal. Does
+    nothing when stderr is not file descriptor 2 (e.g. under pytest's capture)."""
+    try:
+        real = sys.stderr.fileno() == 2
+    except (AttributeError, OSError, ValueError):
+        real = False
+    if not real:
+        yield
+        return
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        original = sys.stderr
+        sys.stderr = os.fdopen(os.dup(saved), "w", buffering=1, encoding=original.encoding or "utf-8",
+                               errors="backslashreplace")
+        _rebind_log_handlers(original, sys.stderr)
+        try:
+            yield
+        finally:
+            sys.stderr.flush()
+            os.dup2(saved, 2)
+            os.close(saved)
+            replacement, sys.stderr = sys.stderr, original
+            _rebind_log_handlers(replacement, original)
+            replacement.close()
+            sink.seek(0)
+            for line in _diagnostics(sink.read().decode("utf-8", "backslashreplace")):
+                log.warning("usd: %s", line)
+
+
+def _rebind_log_handlers(old, new) -> None:
+    for handler in logging.getLogger().handlers:
+        if isinstance(handler, logging.StreamHandler) and handler.stream is old:
+            handler.setStream(new)
+
+
+def _diagnostics(text: str) -> list[str]:
+    """Native diagnostic blocks (a header line and its continuation lines) as single lines."""
+    out: list[str] = []
+    for line in text.splitlines():
+        if not line.strip():
+            continue
+        if line[:1].isspace() and out:
+            out[-1] += " " + line.strip()
+        else:
+            out.append(_DIAGNOSTIC.sub("", line.strip()) or line.strip())
+    return out
