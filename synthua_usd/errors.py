@@ -33,9 +33,9 @@ class OutputError(SynthuaError):
 ECHO_LIMIT = 120
 
 
-def echo(value) -> str:
+def echo(value, limit: int = ECHO_LIMIT) -> str:
     """``value`` as it may appear inside a one-line message: control characters and newlines escaped
-    (``repr`` style, without the quotes), cut to :data:`ECHO_LIMIT` characters."""
+    (``repr`` style, without the quotes), cut to ``limit`` characters."""
     text = str(value)
     out = text.encode("unicode_escape").decode("ascii", "backslashreplace") if not text.isprintable() else text
-    return out if len(out) <= ECHO_LIMIT else out[:ECHO_LIMIT - 3] + "..."
+    return out if len(out) <= limit else out[:limit - 3] + "..."

@@ -8,6 +8,7 @@ from synthua_usd.errors import InputError
 
 PIXEL_FILTERS = ("gaussian", "box")
 MAX_SIDE = 16384
+MAX_SPP = 65536
 
 
 @dataclass(frozen=True)
@@ -43,8 +44,8 @@ class RenderConfig:
             value = getattr(self, name)
             if not isinstance(value, int) or not 0 < value <= MAX_SIDE:
                 raise InputError(f"{name} should be an integer in 1..{MAX_SIDE}, but was {value!r}")
-        if not isinstance(self.spp, int) or self.spp < 1:
-            raise InputError(f"spp should be an integer >= 1, but was {self.spp!r}")
+        if not isinstance(self.spp, int) or not 1 <= self.spp <= MAX_SPP:
+            raise InputError(f"spp should be an integer in 1..{MAX_SPP}, but was {self.spp!r}")
         if not isinstance(self.max_depth, int) or self.max_depth < 1:
             raise InputError(f"max_depth should be an integer >= 1, but was {self.max_depth!r}")
         if self.pixel_filter not in PIXEL_FILTERS:

@@ -19,6 +19,10 @@ from synthua_usd.assets.people import PersonLook
 from synthua_usd.errors import InputError
 
 
+#: Most time codes a crowd is animated over (the motion planner's work grows with agents² x time codes).
+MAX_TIME_CODES = 10_000
+
+
 @dataclass(frozen=True)
 class CrowdParams:
     """How to populate. ``density_per_m2`` persons per m² of walkable area; ``aid_share`` the fraction
@@ -35,8 +39,8 @@ class CrowdParams:
 
     def __post_init__(self) -> None:
         check_density(self.density_per_m2)
-        if not (isinstance(self.time_codes, int) and self.time_codes >= 1):
-            raise InputError(f"time codes should be an integer >= 1, but was {self.time_codes!r}")
+        if not (isinstance(self.time_codes, int) and 1 <= self.time_codes <= MAX_TIME_CODES):
+            raise InputError(f"time codes: {self.time_codes!r}; expected an integer in 1..{MAX_TIME_CODES}")
         if not (math.isfinite(self.aid_share) and 0.0 <= self.aid_share <= 1.0):
             raise InputError(f"aid share should be a fraction in [0, 1], but was {self.aid_share}")
         if not (math.isfinite(self.cell_m) and self.cell_m > 0):

@@ -23,6 +23,8 @@ MAX_DENSITY = 5.0
 LOS_WARN_DENSITY = 0.7
 #: A default that puts a mobility-aid user in most camera views of the demo district.
 DEFAULT_AID_SHARE = 0.3
+#: Consecutive agents for whom no route is found before the walkable surface is declared unusable.
+MAX_ROUTE_MISSES = 200
 
 
 def check_density(density_per_m2: float) -> None:
@@ -77,13 +79,21 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
     benches = sorted(set(grid.cells_beside("furniture")) & set(graph.nodes))
     plans: list[Plan] = []
     group_id = 0
+    misses = 0
     while len(plans) < count:
         is_aid = rng.random() < aid_share
         profile = PROFILES[AID_PROFILES[int(rng.integers(len(AID_PROFILES)))]] if is_aid else PROFILES["pedestrian"]
         rests = bool(benches) and rng.random() < rest_share
         route = _route(rng, graph, nodes, pos, profile, min_route_m, benches if rests else None)
         if route is None:
+            misses += 1
+            if misses > MAX_ROUTE_MISSES:
+                area = len(nodes) * grid.cell_m ** 2
+                raise InputError(f"walkable surface: {area:g} m² in {len(nodes)} cells holds no route of at least "
+                                 f"{min_route_m:g} m after {MAX_ROUTE_MISSES} tries; expected connected sidewalks or "
+                                 f"streets (check --walk-on)")
             continue
+        misses = 0
         waypoints, surfaces = route
         length = float(np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum())
         speed = float(np.clip(rng.normal(profile.speed_mps, profile.speed_sd_mps), 0.5 * profile.speed_mps,

@@ -28,6 +28,8 @@ STEP_M = 0.03
 KERB_SLOPE = 0.125
 MAX_STEP_M = 0.22
 HEADROOM_M = 2.0
+#: Most cells a walkable grid may have (each is one downward ray; 4e6 cells is a 1 km square at 0.5 m).
+MAX_CELLS = 4_000_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,7 +80,12 @@ def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, 
         raise InputError("the twin has no geometry to walk on")
     mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
     lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    if not (math.isfinite(cell_m) and cell_m > 0):
+        raise InputError(f"cell size: {cell_m!r}; expected a finite number of metres > 0")
     nx_, ny_ = int(math.ceil((hi[0] - lo[0]) / cell_m)), int(math.ceil((hi[1] - lo[1]) / cell_m))
+    if nx_ * ny_ > MAX_CELLS:
+        raise InputError(f"walkable grid: {hi[0] - lo[0]:.0f} x {hi[1] - lo[1]:.0f} m at {cell_m:g} m cells is "
+                         f"{nx_ * ny_:.3g} cells; expected at most {MAX_CELLS:.0e} (use a larger --cell-m)")
     xs = lo[0] + (np.arange(nx_) + 0.5) * cell_m
     ys = lo[1] + (np.arange(ny_) + 0.5) * cell_m
     gx, gy = np.meshgrid(xs, ys)

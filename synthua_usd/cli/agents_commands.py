@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_OK
+from synthua_usd.cli.common import EXIT_OK, FiniteFloat
 
 # --- agents -----------------------------------------------------------------------------------------------
 
@@ -17,22 +17,25 @@ def agents() -> None:
 
 @agents.command("populate")
 @click.argument("stage", metavar="TWIN_OR_SCENARIO", type=click.Path(path_type=Path))
-@click.option("--density", type=float, default=0.03, show_default=True,
+@click.option("--density", type=FiniteFloat(0.0, 5.0, open_low=True), default=0.03, show_default=True,
               help="Persons per m² of walkable area (Poisson mean = density x area). Refused above 5 (crowd "
                    "crush); warned above 0.7 (level of service E).")
-@click.option("--aid-share", type=float, default=0.3, show_default=True,
+@click.option("--aid-share", type=FiniteFloat(0.0, 1.0), default=0.3, show_default=True,
               help="Fraction of agents using a mobility aid (wheelchairs, walker, crutches, canes).")
-@click.option("--time-codes", "--frames", "time_codes", type=click.IntRange(1, 100_000), default=48, show_default=True,
+@click.option("--time-codes", "--frames", "time_codes", type=click.IntRange(1, 10_000), default=48, show_default=True,
               help="Time codes to author, one sample each, from the stage's start time code (--frames is the same).")
 @click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Seed: same seed, same bytes.")
-@click.option("--cell-m", type=float, default=0.5, show_default=True, help="Walkable grid cell size (metres).")
+@click.option("--cell-m", type=FiniteFloat(0.05, 10.0), default=0.5, show_default=True,
+              help="Walkable grid cell size (metres, 0.05-10).")
 @click.option("--walk-on", default="sidewalk,crosswalk,curb_ramp,street_road", show_default=True,
               help="Comma-separated classes people walk on; the road always counts inside crosswalks. Add 'road' "
                    "for imported twins whose roads include their sidewalks (CityJSON often).")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--out", "out_path", type=click.Path(path_type=Path), required=True, help="The agents layer to write (.usdc binary, or .usda text).")
+@click.option("--allow-external-assets", is_flag=True,
+              help="Accept layers outside the stage's folder tree (refused by default).")
 def agents_populate(stage: Path, density: float, aid_share: float, time_codes: int, seed: int, cell_m: float,
-                    walk_on: str, class_map: Path | None, out_path: Path) -> int:
+                    walk_on: str, class_map: Path | None, out_path: Path, allow_external_assets: bool) -> int:
     """Populate TWIN_OR_SCENARIO with walking people and mobility-aid users; write them as a layer.
 
     \b
@@ -48,7 +51,7 @@ def agents_populate(stage: Path, density: float, aid_share: float, time_codes: i
     walkable = tuple(c.strip() for c in walk_on.split(",") if c.strip())
     params = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=time_codes, seed=seed, cell_m=cell_m,
                          walkable=walkable)
-    crowd, path, seconds = populate(PopulateRequest(stage, out_path, params, class_map))
+    crowd, path, seconds = populate(PopulateRequest(stage, out_path, params, class_map, allow_external_assets))
     r = crowd.report
     click.echo(f"walkable area {r['walkable_area_m2']:.0f} m², expected {r['expected']:.1f} agents, sampled "
                f"{r['sampled']}, placed {r['placed']} ({r['aid_users']} with mobility aids), dropped "

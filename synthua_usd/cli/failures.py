@@ -101,7 +101,9 @@ def click_message(exc: click.ClickException) -> str:
 def guarded(fn: Callable[[], int], debug: bool) -> int:
     """Run ``fn`` and turn any failure into one line on stderr and an exit status."""
     try:
-        with native_stderr_as_warnings():
+        # On failure the error line says what went wrong; OpenUSD's own warnings about the same problem
+        # would only repeat it (--debug shows them).
+        with native_stderr_as_warnings(keep_on_failure=debug):
             return fn()
     except click.exceptions.Exit as exc:
         return exc.exit_code
@@ -124,11 +126,12 @@ def guarded(fn: Callable[[], int], debug: bool) -> int:
         return status
 
 
-_DIAGNOSTIC = re.compile(r"^(Warning|Error|Coding Error|Fatal Error|Status)(?: in [^:]*? at line \d+ of \S+)?:?\s*(?:-- )?")
+_DIAGNOSTIC = re.compile(r"^(?:Warning|Error|Coding Error|Fatal Error|Status):?\s*(?:in \S+ at line \d+ of \S+ -- )?")
+_STAGE_SUFFIX = re.compile(r"\s*\(instantiating stage on stage @[^@]*@ <0x[0-9a-f]+>\)$")
 
 
 @contextlib.contextmanager
-def native_stderr_as_warnings() -> Iterator[None]:
+def native_stderr_as_warnings(keep_on_failure: bool = True) -> Iterator[None]:
     """Collect what native code (OpenUSD's diagnostics) writes to file descriptor 2 and log it as
     one-line warnings afterwards. Python's own ``sys.stderr`` keeps writing to the terminal. Does
     nothing when stderr is not file descriptor 2 (e.g. under pytest's capture)."""
@@ -147,8 +150,10 @@ def native_stderr_as_warnings() -> Iterator[None]:
         sys.stderr = os.fdopen(os.dup(saved), "w", buffering=1, encoding=original.encoding or "utf-8",
                                errors="backslashreplace")
         _rebind_log_handlers(original, sys.stderr)
+        failed = True
         try:
             yield
+            failed = False
         finally:
             sys.stderr.flush()
             os.dup2(saved, 2)
@@ -157,8 +162,9 @@ def native_stderr_as_warnings() -> Iterator[None]:
             _rebind_log_handlers(replacement, original)
             replacement.close()
             sink.seek(0)
-            for line in _diagnostics(sink.read().decode("utf-8", "backslashreplace")):
-                log.warning("usd: %s", line)
+            if keep_on_failure or not failed:
+                for line in _diagnostics(sink.read().decode("utf-8", "backslashreplace")):
+                    log.warning("usd: %s", line)
 
 
 def _rebind_log_handlers(old, new) -> None:
@@ -177,4 +183,4 @@ def _diagnostics(text: str) -> list[str]:
             out[-1] += " " + line.strip()
         else:
             out.append(_DIAGNOSTIC.sub("", line.strip()) or line.strip())
-    return out
+    return [_STAGE_SUFFIX.sub("", line) for line in out]

@@ -91,7 +91,9 @@ def validate_classes(file: Path | None, as_json: bool, strict: bool) -> int:
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map to check labels against.")
 @click.option("--json", "as_json", is_flag=True, help="Print findings as JSON.")
 @click.option("--strict", is_flag=True, help="Exit 1 on notes too.")
-def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: bool) -> int:
+@click.option("--allow-external-assets", is_flag=True,
+              help="Accept layers outside the stage's folder tree (refused by default).")
+def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: bool, allow_external_assets: bool) -> int:
     """Validate a USD STAGE: OpenUSD's UsdValidation validators plus synthua's rules.
 
     synthua's rules: every renderable gprim has exactly one class (directly or from one ancestor), every
@@ -102,7 +104,7 @@ def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: b
     from synthua_usd.usd.stage_io import open_stage
 
     cmap = load_class_map(class_map)
-    return _report(run_rules(open_stage(stage), cmap), as_json, strict)
+    return _report(run_rules(open_stage(stage, allow_external_assets), cmap), as_json, strict)
 
 
 # --- compose / inspect / create ----------------------------------------------------------------------------
@@ -131,12 +133,14 @@ def compose(out: Path, layers: tuple[Path, ...]) -> int:
 @cli.command()
 @click.argument("stage", type=click.Path(path_type=Path))
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map used to read labels.")
-def inspect(stage: Path, class_map: Path | None) -> int:
+@click.option("--allow-external-assets", is_flag=True,
+              help="Accept layers outside the stage's folder tree (refused by default).")
+def inspect(stage: Path, class_map: Path | None, allow_external_assets: bool) -> int:
     """Print what STAGE holds: layer stack, prims per class, cameras, lights and time range."""
     from synthua_usd.usd.summary import summarize
     from synthua_usd.usd.stage_io import open_stage
 
-    click.echo(summarize(open_stage(stage), load_class_map(class_map)).format())
+    click.echo(summarize(open_stage(stage, allow_external_assets), load_class_map(class_map)).format())
     return EXIT_OK
 
 
@@ -221,9 +225,11 @@ def _time_codes(ctx, param, values: tuple[str, ...]) -> tuple[float, ...]:
 @click.option("--variant", help="Mitsuba variant (cuda_ad_rgb, llvm_ad_rgb, scalar_rgb) [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder (created).")
+@click.option("--allow-external-assets", is_flag=True,
+              help="Accept layers outside the stage's folder tree (refused by default).")
 def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ...], width: int | None,
            height: int | None, spp: int | None, seed: int, variant: str | None, class_map: Path | None,
-           out_dir: Path) -> int:
+           out_dir: Path, allow_external_assets: bool) -> int:
     """Render SCENARIO from each --camera at each time code into --out.
 
     \b
@@ -244,7 +250,8 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     t0 = time.perf_counter()
     run = run_frames(FrameRequest(stage_path=scenario, out_dir=out_dir, camera_paths=cameras, time_codes=time_codes,
                                   width=width, height=height, spp=spp, seed=seed, variant=variant,
-                                  class_map_path=class_map), show_progress=sys.stderr.isatty())
+                                  class_map_path=class_map, allow_external_assets=allow_external_assets),
+                     show_progress=sys.stderr.isatty())
     for frame in run.frames:
         doc = frame.document
         visible = sum(1 for i in doc["instances"] if i["pixel_count"])

@@ -25,6 +25,7 @@ from synthua_usd.cameras import CONFORM_EXPAND, PinholeCamera
 from synthua_usd.errors import InputError, StageError
 from synthua_usd.outputs import OUTPUT_NAMES, RenderOutput, select_outputs
 from synthua_usd.render_config import RenderConfig
+from synthua_usd.resources import check_frame_memory
 from synthua_usd.scene import SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.cameras import read_camera
@@ -54,6 +55,7 @@ class FrameRequest:
     seed: int = 0
     variant: str | None = None
     class_map_path: Path | None = None
+    allow_external_assets: bool = False
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,7 +87,7 @@ def time_code_folder(time_code: float) -> str:
 def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     """Check every input, render every frame from one session, then move all files into place together."""
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
-    stage = open_stage(request.stage_path)
+    stage = open_stage(request.stage_path, request.allow_external_assets)
     defaults = render_defaults(stage)
     unknown = [n for n in defaults.var_names if n not in OUTPUT_NAMES]
     if unknown:
@@ -105,10 +107,14 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     for cam in camera_paths:  # every camera is checked before anything renders
         read_camera(stage, cam, time_codes[0])
     width, height = defaults.resolution or (RenderConfig.width, RenderConfig.height)
-    config = RenderConfig(width=request.width or width, height=request.height or height,
-                          spp=request.spp or defaults.spp or RenderConfig.spp, seed=request.seed,
+    spp = request.spp if request.spp is not None else defaults.spp if defaults.spp is not None else RenderConfig.spp
+    config = RenderConfig(width=request.width or width, height=request.height or height, spp=spp, seed=request.seed,
                           variant=request.variant)
     reader = StageReader(stage, class_map)
+    if not reader.snapshot(time_codes[0]).meshes:
+        raise StageError(f"{request.stage_path}: has no renderable geometry (no visible Mesh, Cube, Sphere, Cylinder, "
+                         f"Cone or Capsule); expected a twin to render")
+    check_frame_memory(config.width, config.height)
     session = RenderSession(config)
     run = RenderRun()
     single = len(frames) == 1

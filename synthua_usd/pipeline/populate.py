@@ -24,6 +24,7 @@ class PopulateRequest:
     out_path: Path
     params: CrowdParams = CrowdParams()
     class_map_path: Path | None = None
+    allow_external_assets: bool = False
 
 
 def populate(request: PopulateRequest) -> tuple[Crowd, Path, float]:
@@ -43,7 +44,7 @@ def populate(request: PopulateRequest) -> tuple[Crowd, Path, float]:
     if unknown:
         raise InputError(f"walkable classes {unknown} are not classes of {class_map.source}")
     walkable = tuple(class_map.resolve(c).name for c in request.params.walkable)
-    stage = open_stage(request.stage_path)
+    stage = open_stage(request.stage_path, request.allow_external_assets)
     span = time_range(stage)
     start = span[0] if span else 1.0
     fps = stage.GetTimeCodesPerSecond()

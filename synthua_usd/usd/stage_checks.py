@@ -16,6 +16,7 @@ from synthua_usd.findings import Finding, Severity
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.prim_checks import camera_findings, label_findings, mesh_topology
 from synthua_usd.usd.reader import unsupported_gprim_message, unsupported_light_message
+from synthua_usd.usd.render_settings import settings_findings
 from synthua_usd.usd.semantics import direct_labels, label_sites, renderable_gprims
 
 
@@ -151,28 +152,28 @@ class RenderSettingsRule:
     name = "render-settings"
 
     def check(self, ctx: RuleContext) -> list[Finding]:
+        return [f for prim in ctx.stage.Traverse() if prim.IsA(UsdRender.Settings)
+                for f in settings_findings(UsdRender.Settings(prim), self.name)]
+
+
+class RenderableRule:
+    """What render needs besides valid prims: at least one renderable gprim and one camera."""
+
+    name = "renderable"
+
+    def check(self, ctx: RuleContext) -> list[Finding]:
         out = []
-        for prim in ctx.stage.Traverse():
-            if not prim.IsA(UsdRender.Settings):
-                continue
-            settings = UsdRender.Settings(prim)
-            for target in settings.GetCameraRel().GetForwardedTargets():
-                cam = ctx.stage.GetPrimAtPath(target)
-                if not cam or not cam.IsA(UsdGeom.Camera):
-                    out.append(Finding(self.name, str(prim.GetPath()), f"camera relationship targets {target}, "
-                                                                       f"which is not a camera in this stage"))
-            res = settings.GetResolutionAttr().Get()
-            if res is not None and (res[0] <= 0 or res[1] <= 0):
-                out.append(Finding(self.name, str(prim.GetPath()), f"resolution is {tuple(res)}; expected positive"))
-            spp = prim.GetAttribute("synthua:spp")
-            if spp and spp.HasAuthoredValue() and not (isinstance(spp.Get(), int) and spp.Get() >= 1):
-                out.append(Finding(self.name, str(prim.GetPath()), f"synthua:spp is {spp.Get()}; expected an "
-                                                                   f"integer >= 1"))
+        if not renderable_gprims(ctx.stage):
+            out.append(Finding(self.name, ctx.root, "has no renderable geometry (no visible Mesh, Cube, Sphere, "
+                                                    "Cylinder, Cone or Capsule); expected a twin to render"))
+        if not any(p.IsA(UsdGeom.Camera) for p in ctx.stage.Traverse()):
+            out.append(Finding(self.name, ctx.root, "has no camera; expected a UsdGeom.Camera to render from "
+                                                    "(author one, or compose a cameras layer)"))
         return out
 
 
 DEFAULT_RULES = (UsdValidationRule(), StageMetadataRule(), GprimClassRule(), LabelInClassMapRule(),
-                 MeshTopologyRule(), SupportedPrimRule(), CameraLensRule(), RenderSettingsRule())
+                 MeshTopologyRule(), SupportedPrimRule(), CameraLensRule(), RenderSettingsRule(), RenderableRule())
 
 
 def validate_stage(stage: Usd.Stage, class_map: ClassMap, rules=DEFAULT_RULES) -> list[Finding]:

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdGeom
 
-from synthua_usd.errors import StageError
+from synthua_usd.errors import StageError, echo
 
 USD_SUFFIXES = (".usda", ".usdc", ".usd", ".usdz")
 
@@ -28,26 +29,63 @@ def open_layer(path: str | Path) -> Sdf.Layer:
     try:
         layer = Sdf.Layer.FindOrOpen(str(path))
     except Tf.ErrorException as exc:
-        raise StageError(f"{path}: not a readable USD layer: {_first_line(exc)}") from None
+        raise StageError(f"{path}: not a readable USD layer: {echo(_first_line(exc))}") from None
     if layer is None:
         raise StageError(f"{path}: not a readable USD layer")
     return layer
 
 
-def open_stage(path: str | Path) -> Usd.Stage:
+def open_stage(path: str | Path, allow_external_assets: bool = False) -> Usd.Stage:
     """Open and compose a stage with all payloads loaded.
 
-    Raises :class:`StageError` naming the file when it is missing, not USD, or fails to parse.
+    Raises :class:`StageError` naming the file when it is missing, not USD, or fails to parse; when any
+    sublayer, reference or payload is missing, unreadable or cyclic (OpenUSD only warns and skips it, which
+    would silently render a scene without it); and, unless ``allow_external_assets``, when a layer it
+    composes lies outside the folder tree of the root layer.
     """
     path = Path(path)
     _check_file(path)
     try:
         stage = Usd.Stage.Open(str(path), Usd.Stage.LoadAll)
     except Tf.ErrorException as exc:
-        raise StageError(f"{path}: not a readable USD stage: {_first_line(exc)}") from None
+        raise StageError(f"{path}: not a readable USD stage: {echo(_first_line(exc))}") from None
     if stage is None:
         raise StageError(f"{path}: not a readable USD stage")
+    errors = stage.GetCompositionErrors()
+    if errors:
+        more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+        first = str(errors[0]).strip().removesuffix("skipping.").strip().rstrip(";. ")
+        raise StageError(f"{path}: {echo(first, 400)}{more}; expected every sublayer, reference and payload of the "
+                         f"stage to exist, open and compose without cycles")
+    if not allow_external_assets:
+        check_layers_inside(stage, path)
+    check_stage_metadata(stage, path)
     return stage
+
+
+def check_layers_inside(stage: Usd.Stage, path: Path) -> None:
+    """Refuse layers outside the root layer's folder tree (a scenario that reads ``/etc`` or ``../..``)."""
+    root = path.resolve().parent
+    for layer in stage.GetUsedLayers():
+        if layer.anonymous or not layer.realPath:
+            continue
+        real = Path(layer.realPath).resolve()
+        if not real.is_relative_to(root):
+            raise StageError(f"{path}: composes {echo(real)}, outside the scenario's folder {echo(root)}; expected "
+                             f"layers in that folder tree (pass --allow-external-assets to accept it)")
+
+
+def check_stage_metadata(stage: Usd.Stage, path: Path) -> None:
+    """metersPerUnit finite and > 0, upAxis Y or Z: every length and direction depends on them."""
+    mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    if not (math.isfinite(mpu) and mpu > 0):
+        raise StageError(f"{path}: metersPerUnit is {mpu!r}; expected a finite number > 0 (1 for metres)")
+    up = UsdGeom.GetStageUpAxis(stage)
+    if up not in (UsdGeom.Tokens.y, UsdGeom.Tokens.z):
+        raise StageError(f"{path}: upAxis is {echo(up)!r}; expected 'Y' or 'Z'")
+    fps = stage.GetTimeCodesPerSecond()
+    if not (math.isfinite(fps) and fps > 0):
+        raise StageError(f"{path}: timeCodesPerSecond is {fps!r}; expected a finite number > 0")
 
 
 def _check_file(path: Path) -> None:

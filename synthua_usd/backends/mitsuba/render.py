@@ -90,6 +90,8 @@ def _trace_jit(mi, scene, sensor, keys, width, height):
     registry = np.asarray(dr.reinterpret_array(mi.UInt32, pi.shape), np.int64)
     distance = np.where(valid, np.asarray(pi.t, np.float64), 0.0)
     dirs = np.stack([np.asarray(ray.d[i], np.float64) for i in range(3)], axis=1)
+    if not keys:  # nothing to hit
+        return np.full(len(valid), -1, np.int64), np.zeros(len(valid)), dirs
     # pi.shape holds registry ids, not indices: map them through shapes_dr() beside shapes().
     shape_registry = np.asarray(dr.reinterpret_array(mi.UInt32, scene.shapes_dr()), np.int64)
     shape_mesh = np.array([keys[s.id()] for s in scene.shapes()], np.int64)
