@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
 from pxr import Sdf, UsdGeom
 
-from synthua_usd.errors import StageError
+from synthua_usd.errors import StageError, echo
 from synthua_usd.usd.authoring import save_layer_atomic
 from synthua_usd.usd.stage_io import open_layer
 
@@ -37,7 +38,12 @@ def compose_layers(out_path: str | Path, layer_paths: list[str | Path], doc: str
             found = ", ".join(f"{p}: {v}" for p, v in sorted(values))
             raise StageError(f"{out_path}: layers disagree on {key} ({found}); convert them to one value first")
         if distinct:
-            root.pseudoRoot.SetInfo(key, distinct.pop())
+            value = distinct.pop()
+            if key == "upAxis" and value not in ("Y", "Z"):
+                raise StageError(f"{out_path}: upAxis of the layers is {echo(value)!r}; expected 'Y' or 'Z'")
+            if key != "upAxis" and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise StageError(f"{out_path}: {key} of the layers is {value!r}; expected a finite number > 0")
+            root.pseudoRoot.SetInfo(key, value)
     if not root.pseudoRoot.HasInfo("upAxis"):
         root.pseudoRoot.SetInfo("upAxis", UsdGeom.Tokens.z)
     if not root.pseudoRoot.HasInfo("metersPerUnit"):

@@ -13,7 +13,10 @@ USD_SUFFIXES = (".usda", ".usdc", ".usd", ".usdz")
 
 
 def _first_line(exc: Exception) -> str:
-    text = str(exc).strip()
+    try:
+        text = str(exc).strip()
+    except UnicodeDecodeError:  # OpenUSD quotes the offending bytes, which Python cannot decode
+        return "it holds bytes that are not UTF-8; expected UTF-8 text or a binary crate file"
     # Tf errors carry "Error in '...' at line N in file ... : 'message'"; keep the message.
     for line in text.splitlines():
         if line.strip():
@@ -30,6 +33,9 @@ def open_layer(path: str | Path) -> Sdf.Layer:
         layer = Sdf.Layer.FindOrOpen(str(path))
     except Tf.ErrorException as exc:
         raise StageError(f"{path}: not a readable USD layer: {echo(_first_line(exc))}") from None
+    except UnicodeDecodeError as exc:
+        raise StageError(f"{path}: not a readable USD layer: byte 0x{exc.object[exc.start]:02x} is not UTF-8; "
+                         f"expected UTF-8 text or a binary crate file") from None
     if layer is None:
         raise StageError(f"{path}: not a readable USD layer")
     return layer
@@ -49,6 +55,9 @@ def open_stage(path: str | Path, allow_external_assets: bool = False) -> Usd.Sta
         stage = Usd.Stage.Open(str(path), Usd.Stage.LoadAll)
     except Tf.ErrorException as exc:
         raise StageError(f"{path}: not a readable USD stage: {echo(_first_line(exc))}") from None
+    except UnicodeDecodeError as exc:
+        raise StageError(f"{path}: not a readable USD stage: byte 0x{exc.object[exc.start]:02x} is not UTF-8; "
+                         f"expected UTF-8 text or a binary crate file") from None
     if stage is None:
         raise StageError(f"{path}: not a readable USD stage")
     errors = stage.GetCompositionErrors()
