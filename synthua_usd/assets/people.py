@@ -14,6 +14,16 @@ import numpy as np
 from synthua_usd import geometry as geo
 from synthua_usd.materials import SHIRTS, SKINS, TROUSERS
 
+#: Random looks come in steps of these, so that agents of one size share geometry (USD prototypes).
+HEIGHT_STEP_M = 0.05
+BUILD_STEP = 0.05
+
+
+def _quantise(value: float, step: float) -> float:
+    """``value`` rounded to a multiple of ``step``, as the float nearest that decimal (1.7, not 1.7000000000000002)."""
+    return round(round(value / step) * step, 6)
+
+
 @dataclass(frozen=True)
 class PersonLook:
     """``height_m`` standing height; ``build`` width factor (1 = average)."""
@@ -26,7 +36,11 @@ class PersonLook:
 
     @classmethod
     def random(cls, rng: np.random.Generator) -> "PersonLook":
-        return cls(height_m=float(np.clip(rng.normal(1.70, 0.09), 1.45, 1.98)), build=float(rng.uniform(0.85, 1.25)),
+        """Height N(1.70, 0.09) m clipped to 1.45-1.98 m, build U(0.85, 1.25), both then rounded to
+        :data:`HEIGHT_STEP_M` and :data:`BUILD_STEP` (rounding draws nothing: the rng stream is unchanged)."""
+        height = float(np.clip(rng.normal(1.70, 0.09), 1.45, 1.98))
+        build = float(rng.uniform(0.85, 1.25))
+        return cls(height_m=_quantise(height, HEIGHT_STEP_M), build=_quantise(build, BUILD_STEP),
                    skin=SKINS[int(rng.integers(len(SKINS)))].key, shirt=SHIRTS[int(rng.integers(len(SHIRTS)))].key,
                    trousers=TROUSERS[int(rng.integers(len(TROUSERS)))].key)
 

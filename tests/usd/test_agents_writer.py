@@ -1,0 +1,226 @@
+"""The agents layer: shared (instanceable) person and device prototypes, with every agent keeping its own
+labelled prims, ids, relation, colours and motion."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from conftest import STAGES
+from pxr import Sdf, Usd, UsdShade
+
+from synthua_usd.agents.crowd import CrowdParams, scripted_crowd
+from synthua_usd.agents.motion import simulate
+from synthua_usd.agents.population import Plan
+from synthua_usd.agents.profiles import PROFILES
+from synthua_usd.assets.people import BUILD_STEP, HEIGHT_STEP_M, PersonLook
+from synthua_usd.demo.street import META, street_scenario
+from synthua_usd.usd.agents_writer import AGENTS_ROOT, PROTOTYPES, build_agents_layer
+from synthua_usd.usd.reader import StageReader
+from synthua_usd.usd.scenario_writer import write_scenario
+from synthua_usd.usd.semantics import renderable_gprims
+from synthua_usd.usd.stage_checks import validate_stage
+from synthua_usd.usd.stage_io import open_stage
+
+# Two of one size in different colours (shared shapes, own materials) and one of another size.
+LOOKS = (PersonLook(1.75, 1.0, "Skin2", "Shirt0", "Trousers0"), PersonLook(1.75, 1.0, "Skin4", "Shirt3", "Trousers2"),
+         PersonLook(1.6, 1.1, "Skin1", "Shirt2", "Trousers1"))
+
+
+@pytest.fixture(scope="module")
+def crowd():
+    """Every profile once plus three more pedestrians (12 agents) on a 3 x 4 grid in the street's CCTV view,
+    all walking +x at 1 m/s."""
+    profiles = list(PROFILES) + ["pedestrian"] * 3
+    plans = []
+    for k, name in enumerate(profiles):
+        x, y = -4.0 + 3.0 * (k % 4), -2.4 + 2.4 * (k // 4)
+        plans.append(Plan(PROFILES[name], 1.0, np.array([(x, y, 0.0), (x + 4.0, y, 0.0)]), ("road", "road"), 0.0, 0.0))
+    params = CrowdParams(density_per_m2=0.01, time_codes=META.time_code_count,
+                         time_codes_per_second=META.time_codes_per_second)
+    trajectories, dropped = simulate(plans, params.time_codes, params.time_codes_per_second)
+    assert dropped == 0
+    return scripted_crowd(trajectories, [LOOKS[k % len(LOOKS)] for k in range(len(trajectories))], params)
+
+
+@pytest.fixture(scope="module")
+def scenario(crowd, tmp_path_factory):
+    """The demo street's layers with ``crowd`` as its agents layer (``agents.usdc``)."""
+    out = tmp_path_factory.mktemp("instanced_street")
+    write_scenario(dataclasses.replace(street_scenario(), crowd=crowd), out)
+    return out / "scenario.usda"
+
+
+@pytest.fixture(scope="module")
+def stage(scenario):
+    return open_stage(scenario)
+
+
+@pytest.fixture(scope="module")
+def deinstanced(scenario):
+    """The same scenario with instancing switched off in the session layer: every instance becomes ordinary
+    prims composed from its prototype's specs."""
+    stage = open_stage(scenario)
+    roots = [p.GetPath() for p in stage.Traverse() if p.IsInstance()]
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        for path in roots:
+            stage.GetPrimAtPath(path).SetInstanceable(False)
+    assert not stage.GetPrototypes()
+    return stage
+
+
+def _agents(stage):
+    return [p for p in stage.GetPrimAtPath(AGENTS_ROOT).GetChildren() if p.GetName().startswith("Agent_")]
+
+
+def _part_count(crowd) -> int:
+    """Person parts of ``crowd``: torso, head and four limbs walking; torso, head, legs and arms seated."""
+    return sum(4 if t.plan.profile.seated else 6 for t in crowd.trajectories)
+
+
+def _meshes(snapshot) -> dict:
+    return {m.prim_path: m for m in snapshot.meshes}
+
+
+def test_agents_layer_is_a_crate_and_the_scenario_validates_clean(scenario, stage, class_map):
+    layer = Sdf.Layer.FindOrOpen(str(scenario.parent / "agents.usdc"))
+    assert layer.GetFileFormat().formatId == "usdc"
+    assert validate_stage(stage, class_map) == []
+
+
+def test_prototypes_are_shared_between_agents(stage, crowd):
+    instances = [p for p in stage.Traverse() if p.IsInstance()]
+    assert len(instances) == _part_count(crowd) + 8  # and one per device
+    assert len(stage.GetPrototypes()) < len(instances) / 2
+    person = {p.GetName(): p for p in _agents(stage)[0].GetChild("Person").GetChildren()}
+    assert person["LegL"].GetPrototype() == person["LegR"].GetPrototype()
+    assert person["ArmL"].GetPrototype() == person["ArmR"].GetPrototype()
+
+
+def test_one_shape_takes_each_agents_own_material(stage, crowd):
+    """Agents 9 and 10 are pedestrians of one size in different clothes (LOOKS[0] and LOOKS[1])."""
+    a, b = (_agents(stage)[k].GetChild("Person").GetChild("Torso") for k in (9, 10))
+    assert crowd.looks[9].height_m == crowd.looks[10].height_m and crowd.looks[9].shirt != crowd.looks[10].shirt
+    assert a.GetPrototype() == b.GetPrototype()
+    for root, shirt in ((a, crowd.looks[9].shirt), (b, crowd.looks[10].shirt)):
+        proxy = root.GetChild("Mesh")
+        assert proxy.IsInstanceProxy()
+        bound, _ = UsdShade.MaterialBindingAPI(proxy).ComputeBoundMaterial()
+        assert bound.GetPath() == Sdf.Path(f"{AGENTS_ROOT}/Looks/{shirt}")
+
+
+def test_prototypes_themselves_are_never_rendered(stage):
+    assert stage.GetPrimAtPath(PROTOTYPES).GetSpecifier() == Sdf.SpecifierClass
+    assert not [p for p in renderable_gprims(stage) if str(p.GetPath()).startswith(PROTOTYPES)]
+    assert not [p for p in renderable_gprims(stage) if p.IsInPrototype()]
+
+
+def test_each_agent_keeps_its_own_person_and_device_instance_and_relation(stage, crowd, class_map):
+    snapshot = StageReader(stage, class_map).snapshot(1.0)
+    by_path = {i.prim_path: i for i in snapshot.instances}
+    ids = set()
+    for prim, traj in zip(_agents(stage), crowd.trajectories):
+        person = by_path[f"{prim.GetPath()}/Person"]
+        assert person.class_name == "person"
+        ids.add(person.id)
+        device = traj.plan.profile.device
+        if device is None:
+            assert person.relations == ()
+            continue
+        (name, target), = person.relations
+        assert name == "uses" and by_path[target].class_name == device and target.startswith(f"{prim.GetPath()}/")
+        ids.add(by_path[target].id)
+    assert len(ids) == len(crowd.trajectories) + sum(1 for t in crowd.trajectories if t.plan.profile.device)
+    # Every agent mesh carries the id of its own agent's labelled prim.
+    for mesh in snapshot.meshes:
+        if mesh.prim_path.startswith(AGENTS_ROOT):
+            owner = next(i for i in snapshot.instances if i.id == mesh.instance_id)
+            assert mesh.prim_path.startswith(owner.prim_path + "/")
+
+
+@pytest.mark.parametrize("time_code", [1.0, 24.0, 48.0])
+def test_instanced_and_deinstanced_snapshots_are_identical(stage, deinstanced, crowd, class_map, time_code):
+    a = _meshes(StageReader(stage, class_map).snapshot(time_code))
+    b = _meshes(StageReader(deinstanced, class_map).snapshot(time_code))
+    assert a.keys() == b.keys()
+    # Device meshes: wheelchairs 4 each, walker 2, crutches 2 x 2, smart cane 3, three canes 1, 1, 2.
+    assert sum(1 for p in a if p.startswith(AGENTS_ROOT)) == _part_count(crowd) + 4 + 4 + 2 + 4 + 3 + 1 + 1 + 2
+    for path, m in a.items():
+        n = b[path]
+        assert (m.instance_id, m.class_id, m.material_key) == (n.instance_id, n.class_id, n.material_key), path
+        assert np.array_equal(m.triangles, n.triangles) and np.array_equal(m.points, n.points), path
+
+
+def test_flattened_layer_reads_the_same(stage, class_map):
+    flat = Usd.Stage.Open(stage.Flatten())
+    a = _meshes(StageReader(stage, class_map).snapshot(24.0))
+    b = _meshes(StageReader(flat, class_map).snapshot(24.0))
+    assert a.keys() == b.keys()
+    assert all(np.array_equal(a[k].points, b[k].points) and a[k].instance_id == b[k].instance_id for k in a)
+
+
+def test_label_maps_are_byte_identical_instanced_and_deinstanced(stage, deinstanced, class_map):
+    from synthua_usd.backends.mitsuba.session import RenderSession
+    from synthua_usd.render_config import RenderConfig
+    from synthua_usd.usd.cameras import read_camera
+
+    camera = read_camera(stage, "/World/Cameras/CCTV", 24.0)
+    maps = []
+    for s in (stage, deinstanced):
+        session = RenderSession(RenderConfig(width=160, height=120, spp=1, variant=None))
+        frame = session.render(StageReader(s, class_map).snapshot(24.0), camera, rgb=False)
+        maps.append((frame.class_ids, frame.instance_ids))
+    (ca, ia), (cb, ib) = maps
+    assert ca.tobytes() == cb.tobytes() and ia.tobytes() == ib.tobytes()
+    seen = {i.class_name for i in StageReader(stage, class_map).instances.values() if i.id in set(np.unique(ia).tolist())}
+    assert "person" in seen and len(seen & set(p.device for p in PROFILES.values() if p.device)) >= 4
+
+
+def test_instance_proxies_under_animated_roots_move_between_time_codes(stage, deinstanced, class_map):
+    reader = StageReader(stage, class_map)
+    first, later, again = (_meshes(reader.snapshot(t)) for t in (1.0, 24.0, 1.0))
+    agent = str(_agents(stage)[0].GetPath())  # a pedestrian: walks and swings its limbs
+    for part in ("Person/Torso/Mesh", "Person/LegL/Mesh", "Person/ArmR/Mesh"):
+        path = f"{agent}/{part}"
+        assert not np.allclose(first[path].points, later[path].points)
+        assert np.array_equal(first[path].points, again[path].points)
+    # The leg's swing (its instance root's rotateY) is applied, not only the agent's translation.
+    leg = f"{agent}/Person/LegL/Mesh"
+    body = f"{agent}/Person/Torso/Mesh"
+    shift = later[body].points.mean(0) - first[body].points.mean(0)
+    assert not np.allclose(later[leg].points - first[leg].points, shift, atol=1e-3)
+    device = f"{_agents(stage)[1].GetPath()}/ManualWheelchair/Seat"
+    assert stage.GetPrimAtPath(device).IsInstanceProxy()
+    assert not np.allclose(first[device].points, later[device].points)
+    fresh = _meshes(StageReader(deinstanced, class_map).snapshot(24.0))
+    assert all(np.array_equal(later[k].points, fresh[k].points) for k in later)
+
+
+def test_same_crowd_gives_byte_identical_crate(crowd, tmp_path, class_map):
+    paths = []
+    for name in ("a.usdc", "b.usdc"):
+        built = build_agents_layer(crowd, META, class_map.taxonomy)  # the stage owns its root layer: keep it
+        built.GetRootLayer().Export(str(tmp_path / name))
+        paths.append(tmp_path / name)
+    assert paths[0].read_bytes() == paths[1].read_bytes()
+
+
+def test_random_looks_come_in_steps_and_draw_as_before():
+    """Rounding to the steps draws nothing extra: the generator ends where the unrounded draws leave it."""
+    rng, twin = np.random.default_rng(5), np.random.default_rng(5)
+    looks = [PersonLook.random(rng) for _ in range(200)]
+    for _ in range(200):
+        twin.normal(1.70, 0.09), twin.uniform(0.85, 1.25), twin.integers(6), twin.integers(8), twin.integers(5)
+    assert rng.bit_generator.state == twin.bit_generator.state
+    for look in looks:
+        assert abs(look.height_m / HEIGHT_STEP_M - round(look.height_m / HEIGHT_STEP_M)) < 1e-9
+        assert abs(look.build / BUILD_STEP - round(look.build / BUILD_STEP)) < 1e-9
+    assert len({(l.height_m, l.build) for l in looks}) < 80
+
+
+@pytest.mark.parametrize("layer", ["agents.usdc", "district/agents.usdc"])
+def test_shipped_agents_layers_are_instanced(layer):
+    stage = Usd.Stage.Open(str(STAGES / layer))
+    instances = sum(1 for p in stage.Traverse() if p.IsInstance())
+    assert 0 < len(stage.GetPrototypes()) < instances
