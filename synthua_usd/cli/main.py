@@ -54,9 +54,9 @@ def cli(verbose: int, debug: bool) -> None:
     \b
     Your own city:
       synthua twin import cityjson city.json --out city/     # or mesh, pointcloud, footprints
-      synthua agents populate city/scenario.usda --walk-on sidewalk,road --out city/agents.usda
-      synthua compose city/with_people.usda city/agents.usda city/render.usda city/environment.usda \\
-          city/cameras.usda city/semantics.usda city/twin.usda
+      synthua agents populate city/scenario.usda --walk-on sidewalk,road --out city/agents.usdc
+      synthua compose city/with_people.usda city/agents.usdc city/render.usda city/environment.usda \\
+          city/cameras.usda city/semantics.usda city/twin.usdc
       synthua render city/with_people.usda --camera /World/Cameras/Street --out out/city
     """
     configure_logging(verbose)
@@ -121,7 +121,7 @@ def compose(out: Path, layers: tuple[Path, ...]) -> int:
     \b
     Example:
       synthua compose my.usda stages/render.usda stages/environment.usda stages/cameras.usda \\
-          stages/agents.usda stages/semantics.usda stages/twin.usda
+          stages/agents.usdc stages/semantics.usda stages/twin.usdc
     """
     from synthua_usd.usd.compose import compose_layers
 
