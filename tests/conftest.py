@@ -1,4 +1,8 @@
-"""Shared fixtures: paths, the class map, a CLI runner, and the shipped demo scenario."""
+"""Shared fixtures: paths, the class map, a CLI runner, the shipped demo scenario, and Mitsuba variants.
+
+Only this conftest exists: the test folders mirror the package, and every test module can import
+``conftest``, ``reference_raycast`` and ``reference_images`` because pytest puts tests/ on sys.path.
+"""
 
 from __future__ import annotations
 
@@ -13,7 +17,12 @@ REPO = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parent / "data"
 STAGES = REPO / "stages"
 SCENARIO = STAGES / "scenario.usda"
+DISTRICT = STAGES / "district"
 SHARED = REPO.parent / "shared"
+
+#: The variants every Mitsuba backend test runs on, as Mitsuba's own suite does: scalar (Mitsuba's
+#: kd-tree, one ray at a time) and LLVM (Dr.Jit, Embree). Scalar is slow: keep its images tiny.
+MITSUBA_VARIANTS = ("scalar_rgb", "llvm_ad_rgb")
 
 
 @pytest.fixture(scope="session")
@@ -36,6 +45,26 @@ def demo_stage():
     from synthua_usd.usd.stage_io import open_stage
 
     return open_stage(SCENARIO)
+
+
+def activate_variant(name: str):
+    """The ``mitsuba`` module with ``name`` active, or skip the test when this machine cannot run it."""
+    from synthua_usd.backends.mitsuba import variants
+    from synthua_usd.errors import InputError
+
+    try:
+        return variants.activate(name)
+    except InputError as exc:
+        pytest.skip(f"Mitsuba variant {name} cannot run on this machine: {exc}")
+
+
+@pytest.fixture(scope="module", params=MITSUBA_VARIANTS)
+def variant(request) -> str:
+    """The name of a Mitsuba variant to run the test on; llvm_ad_rgb is skipped, with the reason, where it
+    cannot run (no libLLVM >= 19). Module-scoped so that a module can render once per variant; tests
+    activate it themselves (``variants.activate(variant)``, or a ``RenderSession`` of that variant)."""
+    activate_variant(request.param)
+    return request.param
 
 
 THIRD_PARTY = SHARED / "data" / "third_party"
