@@ -20,6 +20,10 @@ SCENARIO = STAGES / "scenario.usda"
 DISTRICT = STAGES / "district"
 SHARED = REPO.parent / "shared"
 
+#: The paper's eight mobility-aid classes, by their class-map names.
+MOBILITY_AIDS = frozenset({"manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
+                           "orthopedic_cane", "tripod_cane"})
+
 #: The variants every Mitsuba backend test runs on, as Mitsuba's own suite does: scalar (Mitsuba's
 #: kd-tree, one ray at a time) and LLVM (Dr.Jit, Embree). Scalar is slow: keep its images tiny.
 MITSUBA_VARIANTS = ("scalar_rgb", "llvm_ad_rgb")
