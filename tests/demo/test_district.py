@@ -5,16 +5,45 @@ import filecmp
 import numpy as np
 import pytest
 
-from conftest import STAGES
-from reference_raycast import reference_labels
-from synthua_usd.demo.district import CROSSWALK_XS, ROAD_Y, build_district
+from pxr import Usd, UsdGeom
 
-DISTRICT = STAGES / "district"
+from conftest import DISTRICT, MOBILITY_AIDS
+from reference_raycast import reference_labels
+from synthua_usd.demo import district
+from synthua_usd.demo.district import CROSSWALK_XS, ROAD_Y, build_district, district_scenario
+from synthua_usd.pipeline.frame import FrameRequest, run_frames
+from synthua_usd.usd.scenario_writer import write_scenario
+from synthua_usd.usd.stage_checks import validate_stage
+from synthua_usd.usd.stage_io import open_stage
+
+VIEWS = ("CCTV_Largo", "CCTV_Street", "PedestrianEye_Street", "WheelchairEye_Largo")
+W, H = 240, 180
 
 
 @pytest.fixture(scope="module")
-def seed0():
-    return build_district(0)
+def scenario0():
+    """The shipped scenario: the district of seed 0 and its populated crowd (built once for the module)."""
+    return district_scenario(0)
+
+
+@pytest.fixture(scope="module")
+def seed0(scenario0):
+    return scenario0.twin
+
+
+@pytest.fixture(scope="module")
+def seed1():
+    return build_district(1)
+
+
+@pytest.fixture(scope="module")
+def views(tmp_path_factory):
+    """The shipped district rendered from four cameras at time code 24, from one scene load."""
+    run = run_frames(FrameRequest(stage_path=DISTRICT / "scenario.usda", out_dir=tmp_path_factory.mktemp("district"),
+                                  camera_paths=tuple(f"/World/Cameras/{c}" for c in VIEWS), time_codes=(24,),
+                                  width=W, height=H, spp=1))
+    assert run.loads == 1
+    return {frame.camera.path.rsplit("/", 1)[-1]: frame for frame in run.frames}
 
 
 def test_every_class_but_person_appears(seed0, class_map):
@@ -41,10 +70,8 @@ def test_curb_ramp_at_both_ends_of_every_road_crosswalk(seed0):
 
 
 @pytest.mark.slow
-def test_committed_district_is_seed_0_and_deterministic(tmp_path):
-    from synthua_usd.pipeline.district import write_district_scenario
-
-    written = write_district_scenario(tmp_path, seed=0)
+def test_committed_district_is_seed_0_and_deterministic(scenario0, tmp_path):
+    written = write_scenario(scenario0, tmp_path)
     assert sorted(p.name for p in written) == sorted(p.name for p in DISTRICT.iterdir())
     for path in written:
         assert filecmp.cmp(path, DISTRICT / path.name, shallow=False), \
@@ -52,24 +79,16 @@ def test_committed_district_is_seed_0_and_deterministic(tmp_path):
 
 
 @pytest.mark.slow
-def test_district_agents_include_aid_users_in_camera_views(tmp_path):
-    from synthua_usd.pipeline.frame import FrameRequest, run_frame
-
-    aids = {"manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
-            "orthopedic_cane", "tripod_cane"}
-    seen = 0
-    for cam in ("CCTV_Largo", "CCTV_Street", "PedestrianEye_Street", "WheelchairEye_Largo"):
-        doc = run_frame(FrameRequest(stage_path=DISTRICT / "scenario.usda", out_dir=tmp_path / cam,
-                                     camera_path=f"/World/Cameras/{cam}", frame=24, width=160, height=120,
-                                     spp=1)).document
-        seen += any(i["class_name"] in aids and i["pixel_count"] and i["prim_path"].startswith("/World/Agents/")
-                    for i in doc["instances"])
-    assert seen >= 3  # "most camera views" show a mobility-aid user
+def test_district_agents_include_aid_users_in_camera_views(views):
+    seen = [name for name, frame in views.items()
+            if any(i["class_name"] in MOBILITY_AIDS and i["pixel_count"] and i["prim_path"].startswith("/World/Agents/")
+                   for i in frame.document["instances"])]
+    assert len(seen) >= 3, seen  # "most camera views" show a mobility-aid user
 
 
 @pytest.mark.slow
-def test_another_seed_gives_another_plausible_layout(seed0, class_map):
-    other = build_district(1)
+def test_another_seed_gives_another_plausible_layout(seed0, seed1):
+    other = seed1
     assert set(other.label_counts()) == set(seed0.label_counts())
     ours = sorted(o.path for o in seed0.objects)
     theirs = sorted(o.path for o in other.objects)
@@ -80,35 +99,34 @@ def test_another_seed_gives_another_plausible_layout(seed0, class_map):
 
 @pytest.mark.slow
 def test_district_scenario_validates_clean(class_map):
-    from synthua_usd.usd.stage_checks import validate_stage
-    from synthua_usd.usd.stage_io import open_stage
-
     assert validate_stage(open_stage(DISTRICT / "scenario.usda"), class_map) == []
 
 
 @pytest.mark.slow
-def test_district_labels_agree_with_embree(tmp_path):
-    from synthua_usd.pipeline.frame import FrameRequest, run_frame
-
-    result = run_frame(FrameRequest(stage_path=DISTRICT / "scenario.usda", out_dir=tmp_path,
-                                    camera_path="/World/Cameras/CCTV_Street", width=240, height=180, spp=1))
-    ref_class, ref_inst = reference_labels(result.snapshot, result.camera, 240, 180)
-    assert np.mean(ref_class == result.rendered.class_ids) >= 0.9999
-    assert np.mean(ref_inst == result.rendered.instance_ids) >= 0.9999
-    visible = {i["class_name"] for i in result.document["instances"] if i["pixel_count"]}
+def test_district_labels_agree_with_embree(views):
+    frame = views["CCTV_Street"]
+    ref_class, ref_inst = reference_labels(frame.snapshot, frame.camera, W, H)
+    assert np.mean(ref_class == frame.rendered.class_ids) >= 0.9999
+    assert np.mean(ref_inst == frame.rendered.instance_ids) >= 0.9999
+    visible = {i["class_name"] for i in frame.document["instances"] if i["pixel_count"]}
     assert {"street_road", "sidewalk", "building", "window", "curb_ramp", "person"} <= visible
 
 
-def test_twin_demo_cli(run_cli, tmp_path):
-    code, out, _ = run_cli("twin", "demo", "--seed", "2", "--out", tmp_path)
-    assert code == 0 and "district seed 2:" in out
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["semantics.usda", "twin.usda"]
+def test_twin_demo_cli(run_cli, tmp_path, monkeypatch, seed1):
+    # The command's wiring: the seed reaches the builder (tested above) and two layers come out.
+    seeds = []
+    monkeypatch.setattr(district, "build_district", lambda seed: seeds.append(seed) or seed1)
+    code, out, _ = run_cli("twin", "demo", "--seed", "1", "--out", tmp_path)
+    assert code == 0 and seeds == [1] and f"district seed 1: {len(seed1.objects)} objects" in out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["semantics.usda", "twin.usdc"]
+    twin = Usd.Stage.Open(str(tmp_path / "twin.usdc"))
+    assert sum(1 for p in twin.Traverse() if p.IsA(UsdGeom.Mesh)) == sum(len(o.parts) for o in seed1.objects)
 
 
 @pytest.mark.slow
 def test_repopulating_ignores_the_agents_already_there(run_cli, tmp_path):
     # The shipped agents were populated before any agents existed; re-populating the scenario that now
     # holds them must give the same layer, byte for byte.
-    code, _, err = run_cli("agents", "populate", DISTRICT / "scenario.usda", "--out", tmp_path / "agents.usda")
+    code, _, err = run_cli("agents", "populate", DISTRICT / "scenario.usda", "--out", tmp_path / "agents.usdc")
     assert code == 0, err
-    assert filecmp.cmp(tmp_path / "agents.usda", DISTRICT / "agents.usda", shallow=False)
+    assert filecmp.cmp(tmp_path / "agents.usdc", DISTRICT / "agents.usdc", shallow=False)
