@@ -14,8 +14,9 @@ def findings_of(name, class_map, folder="invalid"):
     return validate_stage(open_stage(DATA / folder / name), class_map)
 
 
-def test_tiny_valid_scene_is_clean(class_map):
-    assert findings_of("tiny_scene.usda", class_map, "valid") == []
+@pytest.mark.parametrize("name", ["tiny_scene.usda", "tiny_lit_scene.usda"])
+def test_tiny_valid_scenes_are_clean(class_map, name):
+    assert findings_of(name, class_map, "valid") == []
 
 
 def test_shipped_scenario_is_clean(demo_stage, class_map):
