@@ -51,6 +51,17 @@ def demo_stage():
     return open_stage(SCENARIO)
 
 
+@pytest.fixture(scope="session")
+def tiny(class_map):
+    """(snapshot, camera) of tests/data/valid/tiny_scene.usda at time code 1: a ground quad and a box."""
+    from synthua_usd.usd.cameras import read_camera
+    from synthua_usd.usd.reader import read_snapshot
+    from synthua_usd.usd.stage_io import open_stage
+
+    stage = open_stage(DATA / "valid" / "tiny_scene.usda")
+    return read_snapshot(stage, 1.0, class_map), read_camera(stage, "/World/Cam", 1.0)
+
+
 def activate_variant(name: str):
     """The ``mitsuba`` module with ``name`` active, or skip the test when this machine cannot run it."""
     from synthua_usd.backends.mitsuba import variants

@@ -6,44 +6,41 @@ from synthua_usd.atomic import output_set
 from synthua_usd.errors import InputError
 
 
+def folder(path, **files):
+    """``path`` made with ``files`` (name -> text) in it."""
+    path.mkdir()
+    for name, text in files.items():
+        (path / name).write_text(text)
+    return path
+
+
 def test_a_new_folder_appears_complete(tmp_path):
     with output_set(tmp_path / "out") as staging:
-        (staging / "a").mkdir()
-        (staging / "a" / "f.txt").write_text("new")
+        folder(staging / "a", **{"f.txt": "new"})
         assert not (tmp_path / "out").exists()
     assert (tmp_path / "out" / "a" / "f.txt").read_text() == "new"
     assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no staging folder left
 
 
 def test_files_are_replaced_and_others_kept(tmp_path):
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "f.txt").write_text("old")
-    (out / "mine.txt").write_text("keep")
+    out = folder(tmp_path / "out", **{"f.txt": "old", "mine.txt": "keep"})
     with output_set(out) as staging:
         (staging / "f.txt").write_text("new")
     assert (out / "f.txt").read_text() == "new" and (out / "mine.txt").read_text() == "keep"
 
 
-def test_a_failure_leaves_the_folder_as_it_was(tmp_path):
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "f.txt").write_text("old")
-    with pytest.raises(RuntimeError, match="boom"):
+@pytest.mark.parametrize("staged,error,text", [
+    ({"f.txt": "new"}, RuntimeError, "boom"),  # the command fails after staging
+    ({"f.txt": "new", "CCTV/frame.json": "{}"}, InputError, "is a file where an output folder goes"),
+])
+def test_a_failure_leaves_the_folder_as_it_was(tmp_path, staged, error, text):
+    out = folder(tmp_path / "out", **{"f.txt": "old", "CCTV": "a file"})
+    with pytest.raises(error, match=text):
         with output_set(out) as staging:
-            (staging / "f.txt").write_text("new")
-            raise RuntimeError("boom")
-    assert (out / "f.txt").read_text() == "old"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
-
-
-def test_a_file_where_a_folder_goes_is_refused_before_anything_moves(tmp_path):
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "CCTV").write_text("a file")
-    with pytest.raises(InputError, match="is a file where an output folder goes"):
-        with output_set(out) as staging:
-            (staging / "a.txt").write_text("new")
-            (staging / "CCTV").mkdir()
-            (staging / "CCTV" / "frame.json").write_text("{}")
-    assert sorted(p.name for p in out.iterdir()) == ["CCTV"]
+            for name, content in staged.items():
+                (staging / name).parent.mkdir(exist_ok=True)
+                (staging / name).write_text(content)
+            if error is RuntimeError:
+                raise RuntimeError("boom")
+    assert {p.name: p.read_text() for p in out.iterdir()} == {"f.txt": "old", "CCTV": "a file"}
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]

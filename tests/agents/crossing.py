@@ -3,7 +3,6 @@ with a curb ramp on one side only. Test modules of this folder import it (pytest
 sys.path)."""
 
 import numpy as np
-import pytest
 
 from synthua_usd import geometry as geo
 from synthua_usd.agents.population import plan_agents
@@ -44,8 +43,7 @@ def crossing_scene():
 
 
 
-@pytest.fixture(scope="module")
-def crossing():
+def crossing_network():
     """(grid, graph) of :func:`crossing_scene` with 0.5 m cells."""
     grid = build_grid(*crossing_scene(), cell_m=0.5)
     return grid, walkable_graph(grid)

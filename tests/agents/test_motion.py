@@ -1,12 +1,18 @@
 """Motion: collision-free trajectories on walkable cells, pauses at the kerb."""
 
 import numpy as np
+import pytest
 from scipy.spatial.distance import cdist
 
-from crossing import corridor_plans, crossing, route  # noqa: F401 (crossing is a fixture)
+from crossing import corridor_plans, crossing_network, route
 from synthua_usd.agents.motion import MARGIN_M, simulate
 from synthua_usd.agents.population import Plan
 from synthua_usd.agents.profiles import PROFILES
+
+
+@pytest.fixture(scope="module")
+def crossing():
+    return crossing_network()
 
 
 def test_no_two_agents_overlap_at_any_frame(crossing):

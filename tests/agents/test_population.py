@@ -6,12 +6,17 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from crossing import corridor_plans, crossing, crossing_scene  # noqa: F401 (crossing is a fixture)
+from crossing import corridor_plans, crossing_network, crossing_scene
 from synthua_usd import geometry as geo
 from synthua_usd.agents.motion import simulate
 from synthua_usd.agents.population import check_density, plan_agents, sample_count
 from synthua_usd.agents.walkable import build_grid, walkable_graph
 from synthua_usd.errors import InputError
+
+
+@pytest.fixture(scope="module")
+def crossing():
+    return crossing_network()
 
 
 def test_density_bounds(caplog):

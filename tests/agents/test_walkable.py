@@ -3,9 +3,14 @@
 import networkx as nx
 import pytest
 
-from crossing import crossing, route  # noqa: F401 (crossing is a fixture)
+from crossing import crossing_network, route
 from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.agents.walkable import edge_cost, shortest_path
+
+
+@pytest.fixture(scope="module")
+def crossing():
+    return crossing_network()
 
 
 def test_grid_surfaces(crossing):

@@ -1,22 +1,12 @@
 """Rendering a translated scene: path-traced RGB and exact pixel-centre labels, on tiny images."""
 
 import numpy as np
-import pytest
 
-from conftest import DATA, activate_variant
+from conftest import activate_variant
 from synthua_usd.backends.mitsuba.render import trace_pixel_centres
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.backends.mitsuba.translate import translate
 from synthua_usd.render_config import RenderConfig
-from synthua_usd.usd.cameras import read_camera
-from synthua_usd.usd.reader import read_snapshot
-from synthua_usd.usd.stage_io import open_stage
-
-
-@pytest.fixture(scope="module")
-def tiny(class_map):
-    stage = open_stage(DATA / "valid" / "tiny_scene.usda")
-    return read_snapshot(stage, 1.0, class_map), read_camera(stage, "/World/Cam", 1.0)
 
 
 def test_scalar_and_jit_labels_are_identical(tiny):

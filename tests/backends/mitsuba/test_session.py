@@ -2,12 +2,10 @@
 
 import numpy as np
 
-from conftest import DATA
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import StageReader, read_snapshot
-from synthua_usd.usd.stage_io import open_stage
 
 SIZE = (32, 24)  # scalar traces label rays one at a time: tiny images
 
@@ -51,12 +49,11 @@ def test_one_load_for_several_cameras_and_time_codes(demo_stage, class_map, vari
     assert (session.loads, session.reloads) == (1, 0)
 
 
-def test_another_scene_is_loaded_afresh_and_labelled_exactly(demo_stage, class_map, variant):
+def test_another_scene_is_loaded_afresh_and_labelled_exactly(demo_stage, class_map, tiny, variant):
     config = RenderConfig(width=SIZE[0], height=SIZE[1], spp=1, variant=variant)
     session = RenderSession(config)
     session.render(read_snapshot(demo_stage, 1, class_map), camera(demo_stage, "CCTV", 1), rgb=False)
-    tiny = open_stage(DATA / "valid" / "tiny_scene.usda")
-    snap, cam = read_snapshot(tiny, 1, class_map), read_camera(tiny, "/World/Cam", 1)
+    snap, cam = tiny
     reloaded = session.render(snap, cam, rgb=False)
     assert (session.loads, session.reloads) == (2, 1) and "load" in reloaded.seconds
     fresh = RenderSession(config).render(snap, cam, rgb=False)

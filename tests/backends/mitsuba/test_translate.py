@@ -6,20 +6,12 @@ import numpy as np
 import pytest
 from pxr import UsdGeom
 
-from conftest import DATA
 from synthua_usd.backends.mitsuba import variants
 from synthua_usd.backends.mitsuba.translate import bsdf_dict, translate
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import Material
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import read_snapshot
-from synthua_usd.usd.stage_io import open_stage
-
-
-@pytest.fixture(scope="module")
-def tiny(class_map):
-    stage = open_stage(DATA / "valid" / "tiny_scene.usda")
-    return read_snapshot(stage, 1.0, class_map), read_camera(stage, "/World/Cam", 1.0)
 
 
 def loaded_shapes(mi, translation) -> dict:
