@@ -4,7 +4,7 @@ BIN := $(VENV)/bin
 DEMO_OUT ?= out/demo
 SCENARIO := stages/scenario.usda
 
-.PHONY: setup demo test stages bench clean
+.PHONY: setup demo test refs stages bench clean
 
 setup:
 	@bash tools/setup.sh
@@ -25,6 +25,11 @@ demo: setup
 ## The whole test suite (slow tests included).
 test: setup
 	$(BIN)/python -m pytest -q
+
+## Regenerate the RGB reference images of the tests (tests/data/refs): only when a change of the renders is
+## intended (tools/make_refs.py; the tests compare renders with them statistically).
+refs: setup
+	$(BIN)/python tools/make_refs.py
 
 ## Regenerate the committed demo layers in stages/ from the library code.
 stages: setup

@@ -1,4 +1,8 @@
-"""Shared fixtures: paths, the class map, a CLI runner, and the shipped demo scenario."""
+"""Shared fixtures: paths, the class map, a CLI runner, the shipped demo scenario, and Mitsuba variants.
+
+Only this conftest exists: the test folders mirror the package, and every test module can import
+``conftest``, ``reference_raycast`` and ``reference_images`` because pytest puts tests/ on sys.path.
+"""
 
 from __future__ import annotations
 
@@ -13,7 +17,16 @@ REPO = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parent / "data"
 STAGES = REPO / "stages"
 SCENARIO = STAGES / "scenario.usda"
+DISTRICT = STAGES / "district"
 SHARED = REPO.parent / "shared"
+
+#: The paper's eight mobility-aid classes, by their class-map names.
+MOBILITY_AIDS = frozenset({"manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
+                           "orthopedic_cane", "tripod_cane"})
+
+#: The variants every Mitsuba backend test runs on, as Mitsuba's own suite does: scalar (Mitsuba's
+#: kd-tree, one ray at a time) and LLVM (Dr.Jit, Embree). Scalar is slow: keep its images tiny.
+MITSUBA_VARIANTS = ("scalar_rgb", "llvm_ad_rgb")
 
 
 @pytest.fixture(scope="session")
@@ -36,6 +49,37 @@ def demo_stage():
     from synthua_usd.usd.stage_io import open_stage
 
     return open_stage(SCENARIO)
+
+
+@pytest.fixture(scope="session")
+def tiny(class_map):
+    """(snapshot, camera) of tests/data/valid/tiny_scene.usda at time code 1: a ground quad and a box."""
+    from synthua_usd.usd.cameras import read_camera
+    from synthua_usd.usd.reader import read_snapshot
+    from synthua_usd.usd.stage_io import open_stage
+
+    stage = open_stage(DATA / "valid" / "tiny_scene.usda")
+    return read_snapshot(stage, 1.0, class_map), read_camera(stage, "/World/Cam", 1.0)
+
+
+def activate_variant(name: str):
+    """The ``mitsuba`` module with ``name`` active, or skip the test when this machine cannot run it."""
+    from synthua_usd.backends.mitsuba import variants
+    from synthua_usd.errors import InputError
+
+    try:
+        return variants.activate(name)
+    except InputError as exc:
+        pytest.skip(f"Mitsuba variant {name} cannot run on this machine: {exc}")
+
+
+@pytest.fixture(scope="module", params=MITSUBA_VARIANTS)
+def variant(request) -> str:
+    """The name of a Mitsuba variant to run the test on; llvm_ad_rgb is skipped, with the reason, where it
+    cannot run (no libLLVM >= 19). Module-scoped so that a module can render once per variant; tests
+    activate it themselves (``variants.activate(variant)``, or a ``RenderSession`` of that variant)."""
+    activate_variant(request.param)
+    return request.param
 
 
 THIRD_PARTY = SHARED / "data" / "third_party"

@@ -69,7 +69,9 @@ class RenderSession:
         for key, old, new in zip(self._translation.shape_ids, self._snapshot.meshes, snapshot.meshes):
             if old is new or old.points is new.points:
                 continue
-            params[f"{key}.vertex_positions"] = mi.Float(np.ascontiguousarray(new.points, np.float32).ravel())
+            name = f"{key}.vertex_positions"
+            # The parameter's own array type: mi.Float is a plain float on scalar variants.
+            params[name] = type(params[name])(np.ascontiguousarray(new.points, np.float32).ravel())
             moved += 1
         params.update()
         self._snapshot = snapshot

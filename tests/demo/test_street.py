@@ -6,24 +6,40 @@ import pytest
 from pxr import Sdf, Usd, UsdGeom, UsdRender, UsdSemantics
 
 from conftest import SCENARIO, STAGES
-from synthua_usd.demo.street import LAYER_FILES, write_street_demo
+from synthua_usd.demo.street import street_scenario
+from synthua_usd.scenario import LAYERS, ROOT_FILE
+from synthua_usd.usd.scenario_writer import write_scenario
+
+#: The street has every layer: heavy ones binary, thin ones text.
+LAYER_FILES = tuple(name for _, name in LAYERS)
 
 
-def test_committed_layers_match_the_generator(tmp_path):
-    written = write_street_demo(tmp_path)
-    assert sorted(p.name for p in written) == sorted(LAYER_FILES + ("scenario.usda",))
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    return write_scenario(street_scenario(), tmp_path_factory.mktemp("street"))
+
+
+def test_committed_layers_match_the_generator(written):
+    assert [p.name for p in written] == list(LAYER_FILES + (ROOT_FILE,))
     for path in written:
         assert filecmp.cmp(path, STAGES / path.name, shallow=False), \
             f"stages/{path.name} is stale: run `synthua create street stages`"
 
 
-def test_generator_is_deterministic(tmp_path):
-    a, b = write_street_demo(tmp_path / "a"), write_street_demo(tmp_path / "b")
-    for pa, pb in zip(a, b):
-        assert pa.read_bytes() == pb.read_bytes()
+def test_generator_is_deterministic(written, tmp_path):
+    again = write_scenario(street_scenario(), tmp_path)
+    for pa, pb in zip(written, again, strict=True):
+        assert pa.read_bytes() == pb.read_bytes(), pa.name
 
 
-@pytest.mark.parametrize("name", LAYER_FILES + ("scenario.usda",))
+def test_heavy_layers_are_binary_and_thin_layers_text():
+    for name in LAYER_FILES + (ROOT_FILE,):
+        head = (STAGES / name).read_bytes()[:9]
+        assert head.startswith(b"PXR-USDC" if name.endswith(".usdc") else b"#usda 1.0"), name
+    assert {n for n in LAYER_FILES if n.endswith(".usdc")} == {"twin.usdc", "agents.usdc"}
+
+
+@pytest.mark.parametrize("name", LAYER_FILES + (ROOT_FILE,))
 def test_every_layer_states_its_metadata(name):
     layer = Sdf.Layer.FindOrOpen(str(STAGES / name))
     for key in ("upAxis", "metersPerUnit", "timeCodesPerSecond", "defaultPrim"):
@@ -38,7 +54,7 @@ def test_scenario_composes_the_layers_by_sublayers():
 
 
 def test_twin_layer_has_no_labels_and_semantics_layer_only_overs():
-    twin = Usd.Stage.Open(str(STAGES / "twin.usda"))
+    twin = Usd.Stage.Open(str(STAGES / "twin.usdc"))
     assert not any(UsdSemantics.LabelsAPI.GetDirectTaxonomies(p) for p in twin.Traverse())
     semantics = Sdf.Layer.FindOrOpen(str(STAGES / "semantics.usda"))
     specs = []

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from conftest import DATA, SCENARIO
-from synthua_usd.backends.frame_files import FILES
 from synthua_usd.backends.images import read_image
+from synthua_usd.outputs import file_names
 from synthua_usd.schemas import validate_document
 
 
@@ -23,7 +23,7 @@ def rendered(tmp_path_factory):
 
 
 def test_writes_every_file(rendered):
-    assert sorted(p.name for p in rendered.iterdir()) == sorted(FILES)
+    assert sorted(p.name for p in rendered.iterdir()) == sorted(file_names())
 
 
 def test_frame_json_is_schema_valid_and_describes_the_images(rendered, class_map):
@@ -55,10 +55,10 @@ def test_intrinsics_match_the_camera(rendered):
     assert k[0, 0] == pytest.approx(32 / np.tan(np.radians(hfov) / 2))
 
 
-def test_render_defaults_come_from_render_settings(run_cli, tmp_path, monkeypatch):
+def test_render_defaults_come_from_render_settings(run_cli, tmp_path):
     # No --camera: the UsdRender settings' camera is used; size and spp given to keep it tiny.
     code, out, _ = run_cli("render", SCENARIO, "--width", "16", "--height", "12", "--spp", "1", "--out", tmp_path / "o")
-    assert code == 0 and "rendered /World/Cameras/CCTV at frame 1" in out
+    assert code == 0 and "rendered /World/Cameras/CCTV at time code 1:" in out
 
 
 BAD = {
@@ -66,7 +66,8 @@ BAD = {
     "malformed stage": (lambda tmp: [DATA / "invalid" / "malformed.usda"], "not a readable USD stage"),
     "unknown camera": (lambda tmp: [SCENARIO, "--camera", "/World/Cameras/Nope"],
                        "no camera at '/World/Cameras/Nope'; cameras in the stage: /World/Cameras/CCTV"),
-    "not a camera": (lambda tmp: [SCENARIO, "--camera", "/World/Twin/Road"], "/World/Twin/Road: prim of type 'Mesh' is not a UsdGeom.Camera"),
+    "not a camera": (lambda tmp: [SCENARIO, "--camera", "/World/Twin/Road/Mesh"],
+                     "/World/Twin/Road/Mesh: prim of type 'Mesh' is not a UsdGeom.Camera"),
     "frame out of range": (lambda tmp: [SCENARIO, "--frame", "500"], "frame 500 is outside the stage's time range [1, 48]"),
     "label not in class map": (lambda tmp: [DATA / "invalid" / "unknown_label.usda", "--camera", "/World/Cam"],
                                "/World/Ground: label 'spaceship' is not a class of"),
@@ -90,13 +91,43 @@ def test_bad_input_exits_2_with_one_line_and_writes_nothing(run_cli, tmp_path, c
     assert not out.exists()
 
 
+def test_two_cameras_and_a_time_code_range_write_one_folder_per_frame(run_cli, tmp_path):
+    out = tmp_path / "sweep"
+    code, stdout, err = run_cli("render", SCENARIO, "--camera", "/World/Cameras/CCTV", "--camera",
+                                "/World/Cameras/PedestrianEye", "--frame", "1:48:47", "--width", "16", "--height", "12",
+                                "--spp", "1", "--out", out)
+    assert code == 0, err
+    assert "for 4 frames" in stdout and "(1 scene load)" in stdout
+    folders = sorted(str(p.relative_to(out)) for p in out.glob("*/*"))
+    assert folders == ["CCTV/0001", "CCTV/0048", "PedestrianEye/0001", "PedestrianEye/0048"]
+    for folder in folders:
+        assert sorted(p.name for p in (out / folder).iterdir()) == sorted(file_names()), folder
+        doc = json.loads((out / folder / "frame.json").read_text())
+        assert (doc["camera"]["prim_path"].rsplit("/", 1)[-1], doc["time_code"]) == (folder.split("/")[0],
+                                                                                      int(folder.split("/")[1]))
+    assert not list(tmp_path.glob(".*"))  # no staging folder left beside the output
+
+
+@pytest.mark.parametrize("frames,text", [
+    ("1:48:0", "STEP > 0"),
+    ("48:1", "END >= START"),
+    ("one", "'one' is not a time code"),
+    ("1,500", "frame 500 is outside the stage's time range [1, 48]"),
+])
+def test_bad_time_codes_exit_2_and_write_nothing(run_cli, tmp_path, frames, text):
+    code, _, err = run_cli("render", SCENARIO, "--frame", frames, "--width", "8", "--height", "6", "--spp", "1",
+                           "--out", tmp_path / "o")
+    assert code == 2 and text in err, err
+    assert not (tmp_path / "o").exists()
+
+
 def test_rerender_replaces_files_in_place(run_cli, tmp_path):
     out = tmp_path / "o"
     args = ("render", SCENARIO, "--width", "8", "--height", "6", "--spp", "1", "--out", out)
     assert run_cli(*args)[0] == 0
     first = (out / "frame.json").read_text()
     assert run_cli(*args)[0] == 0
-    assert sorted(p.name for p in out.iterdir()) == sorted(FILES)  # no temporary files left behind
+    assert sorted(p.name for p in out.iterdir()) == sorted(file_names())  # no temporary files left behind
     assert json.loads(first)["instances"] == json.loads((out / "frame.json").read_text())["instances"]
 
 

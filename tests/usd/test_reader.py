@@ -1,10 +1,12 @@
+"""Reading a composed stage into plain scene snapshots: meshes, labels, materials, lights, time."""
+
 import numpy as np
 import pytest
 from pxr import UsdGeom
 
 from conftest import DATA
 from synthua_usd.errors import StageError, UnsupportedPrimError
-from synthua_usd.usd.reader import _fan_triangulate, read_snapshot
+from synthua_usd.usd.reader import StageReader, _fan_triangulate, read_snapshot
 from synthua_usd.usd.stage_io import open_stage
 
 
@@ -43,6 +45,20 @@ def test_instance_ids_are_stable_across_frames(demo_stage, class_map):
     a = read_snapshot(demo_stage, 1.0, class_map).instances
     b = read_snapshot(demo_stage, 48.0, class_map).instances
     assert a == b
+
+
+def test_reader_reuses_static_meshes_and_rereads_moving_ones(demo_stage, class_map):
+    reader = StageReader(demo_stage, class_map)
+    a, b = reader.snapshot(1.0), reader.snapshot(24.0)
+    fresh = read_snapshot(demo_stage, 24.0, class_map)
+    for x, y, z in zip(a.meshes, b.meshes, fresh.meshes, strict=True):
+        assert x.prim_path == y.prim_path == z.prim_path
+        assert np.array_equal(y.points, z.points) and (y.class_id, y.instance_id) == (z.class_id, z.instance_id)
+        if x.prim_path.startswith("/World/Agents/"):  # every agent moves between 1 and 24
+            assert x is not y and not np.array_equal(x.points, y.points), x.prim_path
+        else:
+            assert x is y, x.prim_path
+    assert sum(m.prim_path.startswith("/World/Agents/") for m in a.meshes) > 0
 
 
 def test_tiny_scene_primitives_and_materials(class_map):

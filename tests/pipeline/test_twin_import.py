@@ -5,16 +5,18 @@ import pytest
 
 from conftest import third_party
 from reference_raycast import reference_labels
-from synthua_usd.pipeline.frame import FrameRequest, run_frame
+from synthua_usd.pipeline.frame import FrameRequest, run_frames
+from synthua_usd.pipeline.twin_import import REPORT_FILE
+from synthua_usd.scenario import LAYER_FILE, ROOT_FILE
 
 
 def import_and_render(run_cli, tmp_path, kind, source, camera="/World/Cameras/Overview", size=(96, 64)):
     out = tmp_path / "twin"
     code, stdout, err = run_cli("twin", "import", kind, source, "--out", out)
     assert code == 0, err
-    result = run_frame(FrameRequest(stage_path=out / "scenario.usda", out_dir=tmp_path / "frame", camera_path=camera,
-                                    width=size[0], height=size[1], spp=2))
-    return stdout, result
+    run = run_frames(FrameRequest(stage_path=out / "scenario.usda", out_dir=tmp_path / "frame", camera_paths=(camera,),
+                                  width=size[0], height=size[1], spp=2))
+    return stdout, run.frames[0]
 
 
 @pytest.mark.slow
@@ -42,12 +44,14 @@ def test_import_report_is_written(run_cli, tmp_path):
 
     code, _, _ = run_cli("twin", "import", "cityjson", DATA / "valid" / "lod2_house.city.json", "--out", tmp_path)
     assert code == 0
-    report = json.loads((tmp_path / "import_report.json").read_text())
+    layers = [LAYER_FILE[role] for role in ("render", "environment", "cameras", "semantics", "twin")]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(layers + [ROOT_FILE, REPORT_FILE])
+    report = json.loads((tmp_path / REPORT_FILE).read_text())
     assert report["classes"] == {"building": 1, "door": 1, "road": 1, "unlabelled": 1}
     assert report["origin_offset_m"] == pytest.approx([676010.0, 7185999.0, 900.0])
     from pxr import Sdf
 
-    layer = Sdf.Layer.FindOrOpen(str(tmp_path / "twin.usda"))
+    layer = Sdf.Layer.FindOrOpen(str(tmp_path / "twin.usdc"))
     assert layer.customLayerData["synthua:crs"].endswith("EPSG/0/31982")
     assert list(layer.customLayerData["synthua:origin_offset_m"]) == pytest.approx([676010.0, 7185999.0, 900.0])
 

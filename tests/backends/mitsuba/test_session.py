@@ -1,0 +1,72 @@
+"""A render session loads a scene once and updates it between frames; labels stay exact after updates."""
+
+import numpy as np
+
+from synthua_usd.backends.mitsuba.session import RenderSession
+from synthua_usd.render_config import RenderConfig
+from synthua_usd.usd.cameras import read_camera
+from synthua_usd.usd.reader import StageReader, read_snapshot
+
+SIZE = (32, 24)  # scalar traces label rays one at a time: tiny images
+
+
+def camera(stage, name, time_code):
+    return read_camera(stage, f"/World/Cameras/{name}", time_code)
+
+
+def fresh_labels(stage, class_map, variant, name, time_code):
+    """Labels of one frame from a new session and a new reader: nothing carried over from other frames."""
+    session = RenderSession(RenderConfig(width=SIZE[0], height=SIZE[1], spp=1, variant=variant))
+    return session.render(read_snapshot(stage, time_code, class_map), camera(stage, name, time_code), rgb=False)
+
+
+def test_labels_after_updates_equal_a_fresh_render(demo_stage, class_map, variant):
+    """Time code 24 from the CCTV after 1 (pedestrian eye) and 48 (wheelchair eye) through ONE session:
+    the agents moved and the sensor moved twice, and class and instance maps are byte for byte those of
+    a session that renders only 24."""
+    session = RenderSession(RenderConfig(width=SIZE[0], height=SIZE[1], spp=1, variant=variant))
+    reader = StageReader(demo_stage, class_map)
+    session.render(reader.snapshot(1), camera(demo_stage, "PedestrianEye", 1), rgb=False)
+    session.render(reader.snapshot(48), camera(demo_stage, "WheelchairEye", 48), rgb=False)
+    updated = session.render(reader.snapshot(24), camera(demo_stage, "CCTV", 24), rgb=False)
+    assert (session.loads, session.reloads) == (1, 0) and "update" in updated.seconds
+    fresh = fresh_labels(demo_stage, class_map, variant, "CCTV", 24)
+    assert updated.class_ids.tobytes() == fresh.class_ids.tobytes()
+    assert updated.instance_ids.tobytes() == fresh.instance_ids.tobytes()
+    assert np.array_equal(updated.hits.z_m, fresh.hits.z_m)
+    # Not vacuous: the CCTV sees the agents move between 1 and 24, so a stale scene would differ.
+    before = fresh_labels(demo_stage, class_map, variant, "CCTV", 1)
+    assert (before.instance_ids != fresh.instance_ids).sum() > 0
+
+
+def test_one_load_for_several_cameras_and_time_codes(demo_stage, class_map, variant):
+    session = RenderSession(RenderConfig(width=16, height=12, spp=1, variant=variant))
+    reader = StageReader(demo_stage, class_map)
+    for time_code in (1, 12, 48):
+        for name in ("CCTV", "PedestrianEye", "WheelchairEye"):
+            frame = session.render(reader.snapshot(time_code), camera(demo_stage, name, time_code))
+            assert frame.rgb.shape == (12, 16, 3)
+    assert (session.loads, session.reloads) == (1, 0)
+
+
+def test_another_scene_is_loaded_afresh_and_labelled_exactly(demo_stage, class_map, tiny, variant):
+    config = RenderConfig(width=SIZE[0], height=SIZE[1], spp=1, variant=variant)
+    session = RenderSession(config)
+    session.render(read_snapshot(demo_stage, 1, class_map), camera(demo_stage, "CCTV", 1), rgb=False)
+    snap, cam = tiny
+    reloaded = session.render(snap, cam, rgb=False)
+    assert (session.loads, session.reloads) == (2, 1) and "load" in reloaded.seconds
+    fresh = RenderSession(config).render(snap, cam, rgb=False)
+    assert reloaded.class_ids.tobytes() == fresh.class_ids.tobytes()
+    assert reloaded.instance_ids.tobytes() == fresh.instance_ids.tobytes()
+
+
+def test_rgb_after_updates_matches_a_fresh_render(demo_stage, class_map, variant):
+    """The RGB pass sees the updated scene too: same seed, same image as a fresh session's."""
+    config = RenderConfig(width=SIZE[0], height=SIZE[1], spp=2, seed=5, variant=variant)
+    session = RenderSession(config)
+    reader = StageReader(demo_stage, class_map)
+    session.render(reader.snapshot(1), camera(demo_stage, "PedestrianEye", 1))
+    updated = session.render(reader.snapshot(24), camera(demo_stage, "CCTV", 24))
+    fresh = RenderSession(config).render(read_snapshot(demo_stage, 24, class_map), camera(demo_stage, "CCTV", 24))
+    assert np.allclose(updated.rgb, fresh.rgb, rtol=0, atol=1e-5)

@@ -1,0 +1,65 @@
+"""Translation of a snapshot into a Mitsuba scene description, without rendering, on every variant."""
+
+import math
+
+import numpy as np
+import pytest
+from pxr import UsdGeom
+
+from synthua_usd.backends.mitsuba import variants
+from synthua_usd.backends.mitsuba.translate import bsdf_dict, translate
+from synthua_usd.render_config import RenderConfig
+from synthua_usd.scene import Material
+from synthua_usd.usd.cameras import read_camera
+from synthua_usd.usd.reader import read_snapshot
+
+
+def loaded_shapes(mi, translation) -> dict:
+    """The loaded scene's shapes by Mitsuba id (``optimize=False``, as the render session loads it)."""
+    scene = mi.load_dict(translation.scene, optimize=False)
+    return {s.id(): s for s in scene.shapes()}
+
+
+def test_translation_without_rendering(tiny, variant):
+    snap, cam = tiny
+    mi = variants.activate(variant)
+    tr = translate(mi, snap, cam, RenderConfig(width=64, height=48, spp=4))
+    sensor = tr.scene["sensor"]
+    assert sensor["fov_axis"] == "x"
+    assert sensor["fov"] == pytest.approx(math.degrees(2 * math.atan(36 / 2 / 20)))  # 20 mm on 36 mm film
+    assert (sensor["film"]["width"], sensor["film"]["height"]) == (64, 48)
+    assert sensor["sampler"]["sample_count"] == 4
+    assert tr.scene["light_000"] == {"type": "constant", "radiance": {"type": "rgb", "value": [1.0, 1.0, 1.0]}}
+    # One shape per snapshot mesh, in the snapshot's order: labels look up prim paths and classes by it.
+    assert [m.prim_path for m in snap.meshes] == ["/World/Ground", "/World/Box"]
+    assert [m.class_id for m in snap.meshes] == [1, 18]
+    assert len(tr.shape_ids) == len(set(tr.shape_ids)) == len(snap.meshes)
+
+
+def test_shape_ids_are_aligned_with_the_snapshot_meshes(tiny, variant):
+    snap, cam = tiny
+    mi = variants.activate(variant)
+    tr = translate(mi, snap, cam, RenderConfig(width=8, height=6, spp=1))
+    shapes = loaded_shapes(mi, tr)
+    for key, mesh in zip(tr.shape_ids, snap.meshes, strict=True):
+        shape = shapes[key]
+        assert (shape.vertex_count(), shape.face_count()) == (len(mesh.points), len(mesh.triangles)), mesh.prim_path
+        positions = np.asarray(mi.traverse(shape)["vertex_positions"], np.float32).reshape(-1, 3)
+        assert np.array_equal(positions, mesh.points.astype(np.float32)), mesh.prim_path
+
+
+def test_loading_keeps_one_shape_per_gprim(demo_stage, class_map, variant):
+    mi = variants.activate(variant)
+    snap = read_snapshot(demo_stage, 1.0, class_map)
+    cam = read_camera(demo_stage, "/World/Cameras/CCTV", 1.0)
+    tr = translate(mi, snap, cam, RenderConfig(width=8, height=6, spp=1))
+    shapes = loaded_shapes(mi, tr)
+    gprims = sum(1 for p in demo_stage.Traverse() if p.IsA(UsdGeom.Gprim))
+    assert len(shapes) == len(snap.meshes) == gprims
+    assert set(shapes) == set(tr.shape_ids)
+
+
+def test_preview_surface_to_principled():
+    d = bsdf_dict(Material("m", (0.2, 0.3, 0.4), roughness=1.5, metallic=0.25))
+    assert d == {"type": "principled", "base_color": {"type": "rgb", "value": [0.2, 0.3, 0.4]},
+                 "roughness": 1.0, "metallic": 0.25}
