@@ -7,7 +7,7 @@ from synthua_usd.render_config import RenderConfig
 
 
 def test_render_config_refuses_bad_values():
-    with pytest.raises(InputError, match="spp should be an integer >= 1, but was 0"):
+    with pytest.raises(InputError, match="spp should be an integer in 1..65536, but was 0"):
         RenderConfig(spp=0)
     with pytest.raises(InputError, match=r"unknown keys \['colour'\]"):
         RenderConfig.from_dict({"colour": 1})

@@ -17,7 +17,7 @@ def agents() -> None:
 
 @agents.command("populate")
 @click.argument("stage", metavar="TWIN_OR_SCENARIO", type=click.Path(path_type=Path))
-@click.option("--density", type=FiniteFloat(0.0, 5.0, open_low=True), default=0.03, show_default=True,
+@click.option("--density", type=FiniteFloat(0.0, 1e6, open_low=True), default=0.03, show_default=True,
               help="Persons per m² of walkable area (Poisson mean = density x area). Refused above 5 (crowd "
                    "crush); warned above 0.7 (level of service E).")
 @click.option("--aid-share", type=FiniteFloat(0.0, 1.0), default=0.3, show_default=True,

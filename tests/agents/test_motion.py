@@ -18,7 +18,7 @@ def crossing():
 def test_no_two_agents_overlap_at_any_frame(crossing):
     grid, graph = crossing
     plans = corridor_plans(np.random.default_rng(5), graph, grid, 60)
-    trajs, dropped = simulate(plans, frames=72, fps=24.0)
+    trajs, dropped = simulate(plans, time_codes=72, fps=24.0)
     assert len(trajs) + dropped == 60 and len(trajs) >= 30
     radii = np.array([t.plan.profile.radius_m for t in trajs])
     worst = np.inf
@@ -32,7 +32,7 @@ def test_no_two_agents_overlap_at_any_frame(crossing):
 
 def test_agents_stay_on_walkable_cells(crossing):
     grid, graph = crossing
-    trajs, _ = simulate(corridor_plans(np.random.default_rng(6), graph, grid, 30), frames=48, fps=24.0)
+    trajs, _ = simulate(corridor_plans(np.random.default_rng(6), graph, grid, 30), time_codes=48, fps=24.0)
     for t in trajs:
         for x, y, z in t.positions:
             i, j = grid.cell_of(x, y)
@@ -46,7 +46,7 @@ def test_agents_pause_before_a_crosswalk(crossing):
     wp = np.array([graph.nodes[n]["pos"] for n in path])
     surfaces = tuple(graph.nodes[n]["surface"] for n in path)
     plan = Plan(PROFILES["pedestrian"], 1.3, wp, surfaces, 0.0, pause_before_crossing_s=2.0)
-    (traj,), _ = simulate([plan], frames=24 * 12, fps=24.0)
+    (traj,), _ = simulate([plan], time_codes=24 * 12, fps=24.0)
     still = np.linalg.norm(np.diff(traj.positions[:, :2], axis=0), axis=1) < 1e-9
     run, longest = 0, 0
     for s in still:

@@ -70,7 +70,7 @@ def test_some_agents_walk_to_a_bench_and_stay():
     assert beside
     plans = plan_agents(np.random.default_rng(2), graph, grid, 3, aid_share=0.0, rest_share=1.0)
     assert all(p.rests for p in plans)
-    trajs, _ = simulate(plans, frames=24 * 8, fps=24.0)
+    trajs, _ = simulate(plans, time_codes=24 * 8, fps=24.0)
     for t in trajs:
         end = t.positions[-1]
         assert grid.cell_of(end[0], end[1]) in beside

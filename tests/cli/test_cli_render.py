@@ -68,12 +68,12 @@ BAD = {
                        "no camera at '/World/Cameras/Nope'; cameras in the stage: /World/Cameras/CCTV"),
     "not a camera": (lambda tmp: [SCENARIO, "--camera", "/World/Twin/Road/Mesh"],
                      "/World/Twin/Road/Mesh: prim of type 'Mesh' is not a UsdGeom.Camera"),
-    "frame out of range": (lambda tmp: [SCENARIO, "--frame", "500"], "frame 500 is outside the stage's time range [1, 48]"),
+    "time code out of range": (lambda tmp: [SCENARIO, "--time-code", "500"], "time code 500 is outside the stage's time range [1, 48]"),
     "label not in class map": (lambda tmp: [DATA / "invalid" / "unknown_label.usda", "--camera", "/World/Cam"],
                                "/World/Ground: label 'spaceship' is not a class of"),
     "class map fails schema": (lambda tmp: [SCENARIO, "--class-map", DATA / "invalid" / "schema_missing_color.json"],
                                "schema_missing_color.json: classes[1]: 'color' is a required property"),
-    "bad spp": (lambda tmp: [SCENARIO, "--spp", "0"], "Invalid value for '--spp'"),
+    "bad spp": (lambda tmp: [SCENARIO, "--spp", "0"], "--spp: 0 is not in the range"),
 }
 
 
@@ -94,7 +94,7 @@ def test_bad_input_exits_2_with_one_line_and_writes_nothing(run_cli, tmp_path, c
 def test_two_cameras_and_a_time_code_range_write_one_folder_per_frame(run_cli, tmp_path):
     out = tmp_path / "sweep"
     code, stdout, err = run_cli("render", SCENARIO, "--camera", "/World/Cameras/CCTV", "--camera",
-                                "/World/Cameras/PedestrianEye", "--frame", "1:48:47", "--width", "16", "--height", "12",
+                                "/World/Cameras/PedestrianEye", "--time-code", "1:48:47", "--width", "16", "--height", "12",
                                 "--spp", "1", "--out", out)
     assert code == 0, err
     assert "for 4 frames" in stdout and "(1 scene load)" in stdout
@@ -112,7 +112,7 @@ def test_two_cameras_and_a_time_code_range_write_one_folder_per_frame(run_cli, t
     ("1:48:0", "STEP > 0"),
     ("48:1", "END >= START"),
     ("one", "'one' is not a time code"),
-    ("1,500", "frame 500 is outside the stage's time range [1, 48]"),
+    ("1,500", "time code 500 is outside the stage's time range [1, 48]"),
 ])
 def test_bad_time_codes_exit_2_and_write_nothing(run_cli, tmp_path, frames, text):
     code, _, err = run_cli("render", SCENARIO, "--frame", frames, "--width", "8", "--height", "6", "--spp", "1",

@@ -2,6 +2,7 @@
 frames, and the stage's UsdRender vars choosing which files are written."""
 
 import json
+import shutil
 import logging
 
 import numpy as np
@@ -92,7 +93,8 @@ def tiny_with_vars(folder, var_names, extra_var=None):
         UsdRender.Product(stage.GetPrimAtPath("/Render/Products/Frame")).GetOrderedVarsRel().AddTarget(var.GetPath())
     folder.mkdir()
     stage.GetRootLayer().Export(str(folder / "render.usda"))
-    return compose_layers(folder / "scenario.usda", [folder / "render.usda", DATA / "valid" / "tiny_scene.usda"])
+    shutil.copy(DATA / "valid" / "tiny_scene.usda", folder / "tiny_scene.usda")  # inside the scenario's folder
+    return compose_layers(folder / "scenario.usda", [folder / "render.usda", folder / "tiny_scene.usda"])
 
 
 @pytest.mark.parametrize("var_names", [("class_id", "depth"), ("rgb",), ("instance_id",)])

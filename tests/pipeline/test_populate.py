@@ -14,7 +14,7 @@ from synthua_usd.scenario import LAYER_FILE
 
 
 def test_populate_is_deterministic_per_seed(run_cli, tmp_path):
-    args = ("agents", "populate", SCENARIO, "--density", "0.05", "--frames", "12")
+    args = ("agents", "populate", SCENARIO, "--density", "0.05", "--time-codes", "12")
     assert run_cli(*args, "--seed", "4", "--out", tmp_path / "a.usda")[0] == 0
     assert run_cli(*args, "--seed", "4", "--out", tmp_path / "b.usda")[0] == 0
     assert run_cli(*args, "--seed", "5", "--out", tmp_path / "c.usda")[0] == 0
@@ -30,14 +30,16 @@ def test_populate_refuses_impossible_density_and_writes_nothing(run_cli, tmp_pat
 
 @pytest.mark.slow
 def test_populated_layer_composes_renders_and_exports_person_device_pairs(run_cli, tmp_path):
-    code, out, _ = run_cli("agents", "populate", SCENARIO, "--density", "0.2", "--aid-share", "1.0", "--frames", "24",
+    code, out, _ = run_cli("agents", "populate", SCENARIO, "--density", "0.2", "--aid-share", "1.0", "--time-codes", "24",
                            "--seed", "1", "--out", tmp_path / "crowd.usda")
     assert code == 0 and "with mobility aids" in out
     layers = [tmp_path / "crowd.usda"] + [STAGES / LAYER_FILE[role] for role in ("render", "environment", "cameras",
                                                                                 "semantics", "twin")]
     assert run_cli("compose", tmp_path / "scene.usda", *layers)[0] == 0
-    assert run_cli("validate", "stage", tmp_path / "scene.usda")[0] == 0
-    code, _, err = run_cli("render", tmp_path / "scene.usda", "--camera", "/World/Cameras/CCTV", "--frame", "12",
+    # The scenario lives in tmp_path and composes the repository's layers: external by design here.
+    assert run_cli("validate", "stage", tmp_path / "scene.usda", "--allow-external-assets")[0] == 0
+    code, _, err = run_cli("render", tmp_path / "scene.usda", "--allow-external-assets", "--camera",
+                           "/World/Cameras/CCTV", "--time-code", "12",
                            "--width", "160", "--height", "120", "--spp", "1", "--out", tmp_path / "frame")
     assert code == 0, err
     doc = json.loads((tmp_path / "frame" / "frame.json").read_text())

@@ -11,6 +11,7 @@ from synthua_usd.backends.mitsuba.translate import bsdf_dict, translate
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import Material
 from synthua_usd.usd.cameras import read_camera
+from synthua_usd.usd.semantics import renderable_gprims
 from synthua_usd.usd.reader import read_snapshot
 
 
@@ -54,7 +55,7 @@ def test_loading_keeps_one_shape_per_gprim(demo_stage, class_map, variant):
     cam = read_camera(demo_stage, "/World/Cameras/CCTV", 1.0)
     tr = translate(mi, snap, cam, RenderConfig(width=8, height=6, spp=1))
     shapes = loaded_shapes(mi, tr)
-    gprims = sum(1 for p in demo_stage.Traverse() if p.IsA(UsdGeom.Gprim))
+    gprims = len(renderable_gprims(demo_stage))
     assert len(shapes) == len(snap.meshes) == gprims
     assert set(shapes) == set(tr.shape_ids)
 
