@@ -342,8 +342,10 @@ def _vehicles(b: _Builder, rng: np.random.Generator) -> None:
     b.add("Vehicles", "Bus", "bus", place(vehicles.bus(), (44.0, ROAD_Y[1] - 1.6, 0.0), 180.0))
     for k in range(3):
         b.add("Vehicles", "Motorcycle", "motorcycle", place(vehicles.motorcycle(), (60.0 + 1.2 * k, lane, 0.0), 60.0))
+    # Parked across the rack (whose hoops stand 0.75 m apart along y), one between each pair of hoops: a
+    # bicycle is 1.8 m long and 0.5 m wide, so side by side they keep 0.25 m apart.
     for k in range(4):
-        b.add("Vehicles", "Bicycle", "bicycle", place(vehicles.bicycle(), (36.0 + 0.3, PLAZA_Y[0] + 4.9 + 0.75 * k, PLAZA_Z + PAVER_H), 90.0))
+        b.add("Vehicles", "Bicycle", "bicycle", place(vehicles.bicycle(), (36.0 + 0.3, PLAZA_Y[0] + 4.9 + 0.75 * k, PLAZA_Z + PAVER_H), 0.0))
 
 
 def _nature(b: _Builder, rng: np.random.Generator) -> None:
