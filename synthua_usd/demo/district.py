@@ -42,6 +42,9 @@ CROSSWALK_XS = (-30.0, 30.0)
 STREET_CROSSWALK_Y = -29.0
 RAMP_LEN = 1.8   # 15 cm over 1.8 m: 1:12
 RAMP_HALF_W = 1.2
+SLOPE_X = (-45.0, -19.0)     # the grass slope west of the street, rising along y to the largo
+SLOPE_Y0 = -21.0
+STEPS_X = -30.0              # centre line of the flight of steps up the slope, 3 m wide
 
 PAINTS = ["PaintRed", "PaintBlue", "PaintBlack", "PaintWhite", "PaintSilver"]
 
@@ -50,6 +53,12 @@ def street_z(y: float | np.ndarray) -> float | np.ndarray:
     """Height of the cobbled street's bed at ``y``: 0 at the road, PLAZA_Z at the largo."""
     t = np.clip((np.asarray(y, float) - STREET_Y[0]) / (STREET_Y[1] - STREET_Y[0]), 0.0, 1.0)
     return t * PLAZA_Z
+
+
+def slope_z(y: float) -> float:
+    """Height of the grass slope's surface at ``y``: the kerb's height at its foot, the largo's at its top."""
+    t = (y - SLOPE_Y0) / (PLAZA_Y[0] - SLOPE_Y0)
+    return KERB_H + t * (PLAZA_Z - KERB_H)
 
 
 def _shear(mesh: geo.Mesh) -> geo.Mesh:
@@ -200,18 +209,24 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
           [TwinPart.of("Bed", geo.box((PLAZA_X[0], PLAZA_Y[0], PLAZA_Z - 3.5), (PLAZA_X[1], PLAZA_Y[1], PLAZA_Z)), "Mortar")]
           + [TwinPart.of(p.name, (p.mesh[0] + [0, 0, PLAZA_Z], p.mesh[1]), p.material) for p in pavers])
     # Grass slope west of the street, steps down it, railings along the steps and the slope's top edge.
-    gx0, gx1, gy0 = -45.0, -19.0, -21.0
+    gx0, gx1, gy0 = SLOPE_X[0], SLOPE_X[1], SLOPE_Y0
     slope = geo.ramp(gx0, gx1, gy0, PLAZA_Y[0], KERB_H, PLAZA_Z, -0.5)
     b.add("Nature", "GrassSlope", "grass", [TwinPart.of("Surface", slope, "Grass")])
+    # The flight starts 5 cm in front of the slope's foot: flush, the two front faces would lie in one
+    # plane. Every tread then stands a few millimetres proud of the slope, the top one level with the largo.
     n_steps, rise = 19, (PLAZA_Z - KERB_H) / 19
-    tread = (PLAZA_Y[0] - gy0) / n_steps
-    flight = place(street.steps(3.0, n_steps, rise, tread), (-30.0, gy0, KERB_H), 90.0)
+    foot = gy0 - 0.05
+    tread = (PLAZA_Y[0] - foot) / n_steps
+    flight = place(street.steps(3.0, n_steps, rise, tread), (STEPS_X, foot, KERB_H), 90.0)
     b.add("Steps", "Flight", "sidewalk", flight, surface="steps")
-    for x in (-31.6, -28.4):
+    # Railings stand on the grass (posts planted in the slope), 10 cm short of its edges, the largo and the
+    # houses' back walls, so that no post sticks out over an edge or into a wall.
+    top = PLAZA_Y[0] - 0.1
+    for x in (STEPS_X - 1.6, STEPS_X + 1.6):
         b.add("Railings", "Railing", "railing",
-              street.railing((x, gy0, KERB_H), (x, PLAZA_Y[0], PLAZA_Z), height=1.0))
-    b.add("Railings", "Railing", "railing", street.railing((gx0, PLAZA_Y[0] - 0.1, PLAZA_Z), (-31.8, PLAZA_Y[0] - 0.1, PLAZA_Z)))
-    b.add("Railings", "Railing", "railing", street.railing((-28.2, PLAZA_Y[0] - 0.1, PLAZA_Z), (gx1, PLAZA_Y[0] - 0.1, PLAZA_Z)))
+              street.railing((x, gy0 + 0.1, slope_z(gy0 + 0.1)), (x, top, slope_z(top)), height=1.0))
+    b.add("Railings", "Railing", "railing", street.railing((gx0 + 0.1, top, slope_z(top)), (STEPS_X - 1.8, top, slope_z(top))))
+    b.add("Railings", "Railing", "railing", street.railing((STEPS_X + 1.8, top, slope_z(top)), (gx1 - 0.1, top, slope_z(top))))
     # Manhole covers on the road, the cobbles and the largo.
     for x, y, z in [(-55.0, -41.0, 0.0), (12.0, -39.5, 0.0), (48.0, -43.0, 0.0), (0.0, -12.0, None), (-20.0, 28.0, PLAZA_Z + PAVER_H)]:
         z = float(street_z(y)) + 0.07 if z is None else z
@@ -353,9 +368,11 @@ def _nature(b: _Builder, rng: np.random.Generator) -> None:
     for x, y in [(-38.0, 9.0), (-38.0, 30.0), (38.0, 30.0), (-14.0, 30.0), (14.0, 30.0)]:
         b.add("Nature", "GrassBed", "grass", place(nature.grass_bed(4.0, 4.0), (x, y, pz)))
         b.add("Nature", "Tree", "vegetation", place(nature.tree(rng, float(rng.uniform(6.0, 8.0))), (x, y, pz + 0.22)))
-    for x in np.arange(-40.0, -21.0, 9.0):
-        b.add("Nature", "Tree", "vegetation", place(nature.tree(rng, float(rng.uniform(5.0, 7.0))), (x, -14.0, 1.0)))
-    b.add("Nature", "Araucaria", "vegetation", place(nature.araucaria(12.0), (-20.0, -4.0, 2.2)))
+    # On the grass slope: clear of the steps and their railings, crowns (reaching at most 2.7 m from the
+    # trunk along x or y) clear of each other and of the houses' back walls, trunks planted 10 cm deep.
+    for x in (-41.0, -35.5, -23.0):
+        b.add("Nature", "Tree", "vegetation", place(nature.tree(rng, float(rng.uniform(5.0, 7.0))), (x, -14.0, slope_z(-14.0) - 0.1)))
+    b.add("Nature", "Araucaria", "vegetation", place(nature.araucaria(12.0), (-24.0, -4.0, slope_z(-4.0) - 0.1)))
     for k in range(3):
         at = (float(rng.uniform(-20, 20)), float(rng.uniform(16, 22)), pz)
         b.add("Animals", "Dog", "animal", place(nature.dog(float(rng.uniform(0.8, 1.2))), at, float(rng.uniform(0, 360))))
