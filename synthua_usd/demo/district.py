@@ -62,9 +62,18 @@ def slope_z(y: float) -> float:
 
 
 def _shear(mesh: geo.Mesh) -> geo.Mesh:
-    """Lift a mesh by the street's slope at each vertex's y (planar faces stay planar: the slope is linear)."""
+    """Lift a mesh by the street's slope at each vertex's y. Planar faces stay planar where the mesh lies
+    within one straight stretch of the slope; :func:`_street_box` cuts boxes at the bends."""
     pts, tris = mesh
     return pts + np.column_stack([np.zeros(len(pts)), np.zeros(len(pts)), street_z(pts[:, 1])]), tris
+
+
+def _street_box(min_corner, max_corner) -> geo.Mesh:
+    """A box lifted by the street's slope, cut where the slope starts and ends so that its faces follow the
+    street's bends (a box sheared only at its corners would cut across them, into or above the stones)."""
+    (x0, y0, z0), (x1, y1, z1) = min_corner, max_corner
+    edges = [y0, *(y for y in STREET_Y if y0 < y < y1), y1]
+    return _shear(geo.merge(*[geo.box((x0, a, z0), (x1, b, z1)) for a, b in zip(edges, edges[1:])]))
 
 
 def _ramp_along_x(x_low, x_high, y0, y1, z_low, z_high, z_base) -> geo.Mesh:
@@ -178,7 +187,7 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
     # The cobbled street: a mortar bed and stones, sloping up to the largo.
     x0, x1 = STREET_X
     y_start = ROAD_Y[1]
-    bed = _shear(geo.box((x0, y_start, -0.5), (x1, STREET_Y[1], 0.0)))
+    bed = _street_box((x0, y_start, -0.5), (x1, STREET_Y[1], 0.0))
     stones = [TwinPart.of(p.name, _shear(p.mesh), p.material)
               for p in _cobbles(rng, x0, x1, y_start, STREET_Y[1], (0.18, 0.14), 0.015, 0.07, ["Cobble0", "Cobble1", "Cobble2"])]
     b.add("Streets", "CobbledStreet", "street_road", [TwinPart.of("Bed", bed, "Mortar")] + stones, surface="cobblestone")
@@ -188,14 +197,14 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
         xa, xb = sorted((kx + sgn * 0.2, kx + sgn * STREET_SIDEWALK_W))
         ka, kb = sorted((kx, kx + sgn * 0.2))
         ra, rb = sorted((kx, kx + sgn * RAMP_LEN))
-        slab = [geo.box((xa, y_start, -0.5), (xb, cy - RAMP_HALF_W, KERB_H)),
-                geo.box((xa, cy + RAMP_HALF_W, -0.5), (xb, STREET_Y[1], KERB_H))]
+        slab = [_street_box((xa, y_start, -0.5), (xb, cy - RAMP_HALF_W, KERB_H)),
+                _street_box((xa, cy + RAMP_HALF_W, -0.5), (xb, STREET_Y[1], KERB_H))]
         back_a, back_b = sorted((kx + sgn * RAMP_LEN, kx + sgn * STREET_SIDEWALK_W))
-        slab.append(geo.box((back_a, cy - RAMP_HALF_W, -0.5), (back_b, cy + RAMP_HALF_W, KERB_H)))
-        kerb = [geo.box((ka, y_start, -0.5), (kb, cy - RAMP_HALF_W, KERB_H)),
-                geo.box((ka, cy + RAMP_HALF_W, -0.5), (kb, STREET_Y[1], KERB_H))]
-        b.add("Sidewalks", side, "sidewalk", [TwinPart.of("Slab", _shear(geo.merge(*slab)), "Concrete"),
-                                              TwinPart.of("Kerb", _shear(geo.merge(*kerb)), "Granite")])
+        slab.append(_street_box((back_a, cy - RAMP_HALF_W, -0.5), (back_b, cy + RAMP_HALF_W, KERB_H)))
+        kerb = [_street_box((ka, y_start, -0.5), (kb, cy - RAMP_HALF_W, KERB_H)),
+                _street_box((ka, cy + RAMP_HALF_W, -0.5), (kb, STREET_Y[1], KERB_H))]
+        b.add("Sidewalks", side, "sidewalk", [TwinPart.of("Slab", geo.merge(*slab), "Concrete"),
+                                              TwinPart.of("Kerb", geo.merge(*kerb), "Granite")])
         low, high = (ra, rb) if sgn > 0 else (rb, ra)
         b.add("CurbRamps", "Ramp", "curb_ramp",
               [TwinPart.of("Surface", _shear(_ramp_along_x(low, high, cy - RAMP_HALF_W, cy + RAMP_HALF_W, 0.075, KERB_H, -0.5)),
@@ -227,19 +236,28 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
               street.railing((x, gy0 + 0.1, slope_z(gy0 + 0.1)), (x, top, slope_z(top)), height=1.0))
     b.add("Railings", "Railing", "railing", street.railing((gx0 + 0.1, top, slope_z(top)), (STEPS_X - 1.8, top, slope_z(top))))
     b.add("Railings", "Railing", "railing", street.railing((STEPS_X + 1.8, top, slope_z(top)), (gx1 - 0.1, top, slope_z(top))))
-    # Manhole covers on the road, the cobbles and the largo.
+    # Manhole covers on the road, the cobbles and the largo; the one on the cobbles (z None) tilts with the
+    # street, on its highest stones.
     for x, y, z in [(-55.0, -41.0, 0.0), (12.0, -39.5, 0.0), (48.0, -43.0, 0.0), (0.0, -12.0, None), (-20.0, 28.0, PLAZA_Z + PAVER_H)]:
-        z = float(street_z(y)) + 0.07 if z is None else z
-        b.add("Covers", "Manhole", "cover", place(street.manhole_cover(), (x, y, z)))
+        cover = place(street.manhole_cover(), (x, y, 0.07 if z is None else z))
+        if z is None:
+            cover = [TwinPart.of(p.name, _shear(p.mesh), p.material) for p in cover]
+        b.add("Covers", "Manhole", "cover", cover)
 
 
 def _buildings(b: _Builder, rng: np.random.Generator) -> None:
-    def house(folder, at, heading, width, depth, storeys, mural, foundation):
+    def house(folder, at, heading, width, depth, storeys, mural, foundation, ground_z=None):
+        """``ground_z(y)``: height of a sloping sidewalk in front of the house; its doors stand on it."""
         wall = f"Wall{int(rng.integers(len(WALL_COLOURS)))}"
         parts = buildings.row_house(rng, width, depth, storeys, wall, foundation_m=foundation, mural=mural)
         stem = b.add(folder, "House", "building", place(parts.structure, at, heading), storeys=storeys)
         for k, door in enumerate(parts.doors):
-            b.objects.append(_sub(stem, "Door", k, "door", place(door, at, heading)))
+            door = place(door, at, heading)
+            if ground_z is not None:  # lift the door's sill to the sidewalk's highest point under it
+                pts = np.concatenate([p.points for p in door])
+                lift = max(ground_z(y) for y in pts[:, 1]) - pts[:, 2].min()
+                door = [p.moved(p.points + (0.0, 0.0, lift)) for p in door]
+            b.objects.append(_sub(stem, "Door", k, "door", door))
         for k, window in enumerate(parts.windows):
             b.objects.append(_sub(stem, "Window", k, "window", place(window, at, heading)))
         for k, mural_p in enumerate(parts.murals):
@@ -257,7 +275,7 @@ def _buildings(b: _Builder, rng: np.random.Generator) -> None:
             cx = front_x - depth / 2 if heading == 0.0 else front_x + depth / 2
             z = float(street_z(cy)) + KERB_H
             house(f"Buildings/{side}", (cx, cy, z), heading, width, depth, int(rng.integers(2, 4)),
-                  bool(rng.random() < 0.35), foundation=3.5)
+                  bool(rng.random() < 0.35), foundation=3.5, ground_z=lambda y: float(street_z(y)) + KERB_H)
             y += width
     # Along the asphalt road's north side, facing south.
     for x_from, x_to in ((-HALF_X + 1.0, -46.0), (STREET_X[1] + STREET_SIDEWALK_W + 12.0, HALF_X - 1.0)):
@@ -318,7 +336,8 @@ def _furniture(b: _Builder, rng: np.random.Generator) -> None:
     # Signage: street names at the corners, a stop sign where the street meets the road, the bus stop.
     for x in (STREET_X[0] - 1.0, STREET_X[1] + 1.0):
         b.add("Signage", "StreetName", "signage", place(street.sign(kind="street"), (x, ROAD_SIDEWALK_N[0] + 1.0, KERB_H), -90.0))
-    b.add("Signage", "Stop", "signage", place(street.sign(kind="stop"), (STREET_X[1] + 0.8, STREET_Y[0] + 1.5, KERB_H), -90.0))
+    b.add("Signage", "Stop", "signage", place(street.sign(kind="stop"), (STREET_X[1] + 0.8, STREET_Y[0] + 1.5,
+                                                                       float(street_z(STREET_Y[0] + 1.5)) + KERB_H), -90.0))
     b.add("Signage", "BusStop", "signage", place(street.sign(kind="bus"), (38.0, ROAD_Y[1] + 0.7, KERB_H), -90.0))
     b.add("Furniture", "BusShelter", "furniture", place(street.bus_shelter(), (44.0, ROAD_SIDEWALK_N[1] - 1.0, KERB_H), -90.0))
     b.add("Furniture", "BikeRack", "furniture", place(street.bike_rack(), (36.0, PLAZA_Y[0] + 6.0, pz)))
