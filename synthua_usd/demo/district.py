@@ -167,8 +167,10 @@ def build_district(seed: int = 0) -> TwinModel:
 
 def _streets(b: _Builder, rng: np.random.Generator) -> None:
     L = HALF_X
-    # Open ground under everything, 2 cm below the road so that no two surfaces are coplanar.
-    b.add("Nature", "Ground", "grass", [TwinPart.of("Surface", geo.box((-L, -50.0, -0.5), (L, 50.0, -0.02)), "Grass")])
+    # Open ground under everything, 2 cm below the road so that no two surfaces are coplanar: for the same
+    # reason it reaches 1 m past the road's ends and further down than any bed or slab (their end and
+    # bottom faces would otherwise lie in its own).
+    b.add("Nature", "Ground", "grass", [TwinPart.of("Surface", geo.box((-L - 1.0, -50.0, -1.0), (L + 1.0, 50.0, -0.02)), "Grass")])
     b.add("Streets", "AsphaltRoad", "road", [TwinPart.of("Surface", geo.box((-L, ROAD_Y[0], -0.3), (L, ROAD_Y[1], 0.0)), "Asphalt")])
     # Road sidewalks, with curb ramps at the crosswalks; the north one stops at the cobbled street.
     b.add("Sidewalks", "RoadSouth", "sidewalk", _sidewalk_x_strip(-L, L, ROAD_Y[0], ROAD_SIDEWALK_S[0], list(CROSSWALK_XS)))
