@@ -363,7 +363,7 @@ def _market(b: _Builder, rng: np.random.Generator) -> None:
             off = 0.75 * np.array([np.cos(np.radians(a)), np.sin(np.radians(a))])
             b.add("Market", "Chair", "chair", place(market.chair(), (x + off[0], y + off[1], pz), a))
         if k % 2 == 0:
-            b.add("Market", "Umbrella", "umbrella", place(market.umbrella(canvas=canvases[k % 4]), (x, y, pz)))
+            b.add("Market", "Umbrella", "umbrella", place(market.umbrella(canvas=canvases[k % 4], foot_m=market.TABLE_TOP_M), (x, y, pz)))
 
 
 def _vehicles(b: _Builder, rng: np.random.Generator) -> None:
