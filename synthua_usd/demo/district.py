@@ -397,10 +397,14 @@ def _nature(b: _Builder, rng: np.random.Generator) -> None:
     for k in range(3):
         at = (float(rng.uniform(-20, 20)), float(rng.uniform(16, 22)), pz)
         b.add("Animals", "Dog", "animal", place(nature.dog(float(rng.uniform(0.8, 1.2))), at, float(rng.uniform(0, 360))))
+    # A flock of twelve pigeons, 0.4 m apart at least: a pigeon reaches 0.17 m from its centre, any way it turns.
     cx, cy = float(rng.uniform(-10, 10)), float(rng.uniform(28, 31))
-    for k in range(12):
-        at = (cx + float(rng.normal(0, 1.2)), cy + float(rng.normal(0, 0.8)), pz)
-        b.add("Animals", "Pigeon", "animal", place(nature.pigeon(), at, float(rng.uniform(0, 360))))
+    flock: list[tuple[float, float]] = []
+    while len(flock) < 12:
+        x, y = cx + float(rng.normal(0, 1.2)), cy + float(rng.normal(0, 0.8))
+        if all(np.hypot(x - fx, y - fy) >= 0.4 for fx, fy in flock):
+            flock.append((x, y))
+            b.add("Animals", "Pigeon", "animal", place(nature.pigeon(), (x, y, pz), float(rng.uniform(0, 360))))
 
 
 def _mobility_aids(b: _Builder) -> None:
