@@ -69,7 +69,7 @@ def church(width: float = 16.0, depth: float = 24.0, foundation_m: float = 1.0) 
     nave_h, tower_w, tower_h = 11.0, 5.0, 22.0
     tx0 = d - tower_w
     structure = [
-        TwinPart.of("Nave", geo.box((-d, -w, -foundation_m), (d - 0.01, w, nave_h)), "Whitewash"),
+        TwinPart.of("Nave", geo.box((-d, -w, -foundation_m), (d, w, nave_h)), "Whitewash"),
         TwinPart.of("NaveRoof", _gable(-d, d, w + 0.3, nave_h, nave_h + 4.0), "RoofTile"),
         TwinPart.of("Tower", geo.box((tx0, -tower_w / 2, -foundation_m), (d + 0.5, tower_w / 2, tower_h)), "Whitewash"),
         TwinPart.of("Spire", _pyramid((d + 0.5 + tx0) / 2, 0.0, tower_h, tower_w / 2 + 0.2, 5.0), "RoofTile"),

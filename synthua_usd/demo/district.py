@@ -297,8 +297,10 @@ def _buildings(b: _Builder, rng: np.random.Generator) -> None:
                   int(rng.integers(2, 4)), bool(rng.random() < 0.3), foundation=3.5)
             y += width
     # The church at the north end of the largo, facing south.
-    parts = buildings.church(width=14.0, depth=14.0)
-    at, heading = (0.0, PLAZA_Y[1] + 7.5, PLAZA_Z + PAVER_H), -90.0
+    # The nave's front (its side doors) on the largo's north edge, the tower 0.5 m out onto the largo; the
+    # foundation reaches the open ground below the largo's level, as the houses' do.
+    parts = buildings.church(width=14.0, depth=14.0, foundation_m=3.5)
+    at, heading = (0.0, PLAZA_Y[1] + 7.0, PLAZA_Z + PAVER_H), -90.0
     stem = b.add("Buildings", "Church", "building", place(parts.structure, at, heading), name="Igreja da Ordem")
     for k, door in enumerate(parts.doors):
         b.objects.append(_sub(stem, "Door", k, "door", place(door, at, heading)))
