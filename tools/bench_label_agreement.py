@@ -6,10 +6,14 @@ Usage: python tools/bench_label_agreement.py [--scenario stages/district/scenari
 
 Prints, per camera, the number of pixels whose instance id (and class id) differs between the two
 first-hit casts, then the most frequent disagreeing pairs: pixel count, Mitsuba's instance [class], the reference's instance
-[class], and the median gap between the two first hits along the ray (Mitsuba's minus Embree's, metres).
-A gap near 0 means two instances' surfaces lie on top of each other there (coplanar faces, or a face
-inside another solid): a real ambiguity to fix in the geometry. A pair with a clear gap on one or two
-pixels is a ray grazing an edge, where float rounding decides. Needs the test extra ``embreex``. Not a test.
+[class], the median gap between the two first hits along the ray (Mitsuba's minus Embree's, metres), and
+the median distance from the ray to the nearest triangle edge of either instance (metres).
+
+A ray that passes within a few micrometres of an edge (a silhouette, or the seam where two instances
+touch) is a float edge case: the two casts trace rays that differ by float32 rounding, and either answer
+is right. Anything else (an edge distance of millimetres or more with a gap near 0) means two instances'
+surfaces lie on top of each other there (coplanar faces, or a face inside another solid): a real
+ambiguity to fix in the geometry. Needs the test extra ``embreex``. Not a test.
 """
 
 from __future__ import annotations
@@ -38,6 +42,25 @@ def _reference_distances(snapshot, camera, width: int, height: int, pixels: np.n
     out = np.full(len(pixels), np.inf)
     out[ray] = np.linalg.norm(loc - origins[ray], axis=1)
     return out
+
+
+def _edge_distance(snapshot, instance_id: int, origin: np.ndarray, direction: np.ndarray) -> float:
+    """Metres from the ray (origin, unit direction (3,)) to the nearest triangle edge of ``instance_id``'s
+    meshes; inf for instance 0 (nothing)."""
+    meshes = [m for m in snapshot.meshes if m.instance_id == instance_id]
+    if not meshes:
+        return np.inf
+    verts, faces, _ = snapshot.world_triangles(meshes)
+    best = np.inf
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        start = verts[faces[:, i]]
+        edge = verts[faces[:, j]] - start
+        w = start - origin
+        ee, ed, wd, ew = np.einsum("ij,ij->i", edge, edge), edge @ direction, w @ direction, np.einsum("ij,ij->i", edge, w)
+        s = np.clip((ed * wd - ew) / np.maximum(ee - ed * ed, 1e-18), 0.0, 1.0)   # along the edge
+        t = np.maximum(wd + s * ed, 0.0)                                            # along the ray
+        best = min(best, float(np.min(np.linalg.norm(origin + t[:, None] * direction - start - s[:, None] * edge, axis=1))))
+    return best
 
 
 def main() -> int:
@@ -87,9 +110,13 @@ def main() -> int:
         d_ours = np.where(ours > 0, frame.hits.distance_m.ravel()[bad] + near, np.inf)
         d_ref = _reference_distances(snapshot, camera, w, h, bad)
         gap = d_ours - d_ref
+        origins, _ = camera.pixel_center_rays(w, h)
         for (a, b), n in Counter(zip(ours.tolist(), theirs.tolist())).most_common(args.pairs):
-            sel = (ours == a) & (theirs == b)
-            print(f"  {n:6d}  {names[a]}  vs  {names[b]}  gap {np.median(gap[sel]):+.4f} m")
+            sel = np.flatnonzero((ours == a) & (theirs == b))
+            edge = [min(_edge_distance(snapshot, a, origins[bad[k]], dirs[bad[k]]),
+                        _edge_distance(snapshot, b, origins[bad[k]], dirs[bad[k]])) for k in sel]
+            print(f"  {n:6d}  {names[a]}  vs  {names[b]}  gap {np.median(gap[sel]):+.4f} m, "
+                  f"edge {np.median(edge):.1e} m")
     print(f"\ntotal disagreeing pixels: {total}")
     return 0
 
