@@ -69,7 +69,7 @@ def church(width: float = 16.0, depth: float = 24.0, foundation_m: float = 1.0) 
     nave_h, tower_w, tower_h = 11.0, 5.0, 22.0
     tx0 = d - tower_w
     structure = [
-        TwinPart.of("Nave", geo.box((-d, -w, -foundation_m), (d - 0.01, w, nave_h)), "Whitewash"),
+        TwinPart.of("Nave", geo.box((-d, -w, -foundation_m), (d, w, nave_h)), "Whitewash"),
         TwinPart.of("NaveRoof", _gable(-d, d, w + 0.3, nave_h, nave_h + 4.0), "RoofTile"),
         TwinPart.of("Tower", geo.box((tx0, -tower_w / 2, -foundation_m), (d + 0.5, tower_w / 2, tower_h)), "Whitewash"),
         TwinPart.of("Spire", _pyramid((d + 0.5 + tx0) / 2, 0.0, tower_h, tower_w / 2 + 0.2, 5.0), "RoofTile"),
@@ -80,7 +80,10 @@ def church(width: float = 16.0, depth: float = 24.0, foundation_m: float = 1.0) 
         parts.doors.append([TwinPart.of("Door", _facade_box(d, y - 0.6, y + 0.6, 0.0, 2.8), "DoorWood")])
     for z0 in (6.0, 14.0):
         parts.windows.append([TwinPart.of("Window", _facade_box(d + 0.5, -0.7, 0.7, z0, z0 + 2.5), "Glass")])
-    for x in np.linspace(-d + 3.0, tx0 - 2.0, 4):
+    # Tall windows along both side walls, 1.4 m wide with at least 1.6 m of wall between them, and 2 m
+    # of wall at each corner: as many as fit, so that no two windows overlap on a short nave.
+    count = max(int((depth - 2.4) // 3.0), 1)
+    for x in np.linspace(-d + 2.7, d - 2.7, count) if count > 1 else [0.0]:
         for y, sign in ((-w, -1), (w, 1)):
             lo, hi = sorted((y, y + sign * 0.06))
             parts.windows.append([TwinPart.of("Window", geo.box((x - 0.7, lo, 4.0), (x + 0.7, hi, 8.5)), "Glass")])

@@ -23,8 +23,12 @@ def stand(length: float = 2.4) -> list[TwinPart]:
             TwinPart.of("Goods", geo.merge(*goods), "Goods")]
 
 
+#: Height of a café table's top surface, metres above the ground.
+TABLE_TOP_M = 0.745
+
+
 def table(radius: float = 0.4) -> list[TwinPart]:
-    return [TwinPart.of("Top", geo.cylinder((0, 0, 0.73), radius, 0.03, sections=16), "PlasticWhite"),
+    return [TwinPart.of("Top", geo.cylinder((0, 0, TABLE_TOP_M - 0.015), radius, 0.03, sections=16), "PlasticWhite"),
             TwinPart.of("Leg", geo.merge(geo.cylinder((0, 0, 0.36), 0.025, 0.72, sections=8),
                                    geo.cylinder((0, 0, 0.01), 0.25, 0.02, sections=12)), "Iron")]
 
@@ -36,8 +40,13 @@ def chair() -> list[TwinPart]:
             TwinPart.of("Legs", geo.merge(*legs), "Iron")]
 
 
-def umbrella(radius: float = 1.2, height: float = 2.3, canvas: str = "CanvasRed") -> list[TwinPart]:
+def umbrella(radius: float = 1.2, height: float = 2.3, canvas: str = "CanvasRed", foot_m: float = 0.0) -> list[TwinPart]:
+    """A parasol whose pole rises from ``foot_m`` above the ground to the canopy's centre, ``height`` + 0.2 m.
+
+    At a table, pass :data:`TABLE_TOP_M`: the pole then stands on the table top instead of running through
+    the table and its leg (the part below the top was hidden anyway, and made the two objects overlap)."""
+    top = height + 0.2
     canopy = geo.cone(radius, 0.45, sections=12)
-    canopy = (canopy[0] + (0, 0, height + 0.2), canopy[1])
-    return [TwinPart.of("Pole", geo.cylinder((0, 0, height / 2 + 0.1), 0.02, height + 0.2, sections=8), "Iron"),
+    canopy = (canopy[0] + (0, 0, top), canopy[1])
+    return [TwinPart.of("Pole", geo.cylinder((0, 0, (foot_m + top) / 2), 0.02, top - foot_m, sections=8), "Iron"),
             TwinPart.of("Canopy", canopy, canvas)]

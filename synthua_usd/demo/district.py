@@ -42,6 +42,9 @@ CROSSWALK_XS = (-30.0, 30.0)
 STREET_CROSSWALK_Y = -29.0
 RAMP_LEN = 1.8   # 15 cm over 1.8 m: 1:12
 RAMP_HALF_W = 1.2
+SLOPE_X = (-45.0, -19.0)     # the grass slope west of the street, rising along y to the largo
+SLOPE_Y0 = -21.0
+STEPS_X = -30.0              # centre line of the flight of steps up the slope, 3 m wide
 
 PAINTS = ["PaintRed", "PaintBlue", "PaintBlack", "PaintWhite", "PaintSilver"]
 
@@ -52,10 +55,25 @@ def street_z(y: float | np.ndarray) -> float | np.ndarray:
     return t * PLAZA_Z
 
 
+def slope_z(y: float) -> float:
+    """Height of the grass slope's surface at ``y``: the kerb's height at its foot, the largo's at its top."""
+    t = (y - SLOPE_Y0) / (PLAZA_Y[0] - SLOPE_Y0)
+    return KERB_H + t * (PLAZA_Z - KERB_H)
+
+
 def _shear(mesh: geo.Mesh) -> geo.Mesh:
-    """Lift a mesh by the street's slope at each vertex's y (planar faces stay planar: the slope is linear)."""
+    """Lift a mesh by the street's slope at each vertex's y. Planar faces stay planar where the mesh lies
+    within one straight stretch of the slope; :func:`_street_box` cuts boxes at the bends."""
     pts, tris = mesh
     return pts + np.column_stack([np.zeros(len(pts)), np.zeros(len(pts)), street_z(pts[:, 1])]), tris
+
+
+def _street_box(min_corner, max_corner) -> geo.Mesh:
+    """A box lifted by the street's slope, cut where the slope starts and ends so that its faces follow the
+    street's bends (a box sheared only at its corners would cut across them, into or above the stones)."""
+    (x0, y0, z0), (x1, y1, z1) = min_corner, max_corner
+    edges = [y0, *(y for y in STREET_Y if y0 < y < y1), y1]
+    return _shear(geo.merge(*[geo.box((x0, a, z0), (x1, b, z1)) for a, b in zip(edges, edges[1:])]))
 
 
 def _ramp_along_x(x_low, x_high, y0, y1, z_low, z_high, z_base) -> geo.Mesh:
@@ -149,8 +167,10 @@ def build_district(seed: int = 0) -> TwinModel:
 
 def _streets(b: _Builder, rng: np.random.Generator) -> None:
     L = HALF_X
-    # Open ground under everything, 2 cm below the road so that no two surfaces are coplanar.
-    b.add("Nature", "Ground", "grass", [TwinPart.of("Surface", geo.box((-L, -50.0, -0.5), (L, 50.0, -0.02)), "Grass")])
+    # Open ground under everything, 2 cm below the road so that no two surfaces are coplanar: for the same
+    # reason it reaches 1 m past the road's ends and further down than any bed or slab (their end and
+    # bottom faces would otherwise lie in its own).
+    b.add("Nature", "Ground", "grass", [TwinPart.of("Surface", geo.box((-L - 1.0, -50.0, -1.0), (L + 1.0, 50.0, -0.02)), "Grass")])
     b.add("Streets", "AsphaltRoad", "road", [TwinPart.of("Surface", geo.box((-L, ROAD_Y[0], -0.3), (L, ROAD_Y[1], 0.0)), "Asphalt")])
     # Road sidewalks, with curb ramps at the crosswalks; the north one stops at the cobbled street.
     b.add("Sidewalks", "RoadSouth", "sidewalk", _sidewalk_x_strip(-L, L, ROAD_Y[0], ROAD_SIDEWALK_S[0], list(CROSSWALK_XS)))
@@ -169,7 +189,7 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
     # The cobbled street: a mortar bed and stones, sloping up to the largo.
     x0, x1 = STREET_X
     y_start = ROAD_Y[1]
-    bed = _shear(geo.box((x0, y_start, -0.5), (x1, STREET_Y[1], 0.0)))
+    bed = _street_box((x0, y_start, -0.5), (x1, STREET_Y[1], 0.0))
     stones = [TwinPart.of(p.name, _shear(p.mesh), p.material)
               for p in _cobbles(rng, x0, x1, y_start, STREET_Y[1], (0.18, 0.14), 0.015, 0.07, ["Cobble0", "Cobble1", "Cobble2"])]
     b.add("Streets", "CobbledStreet", "street_road", [TwinPart.of("Bed", bed, "Mortar")] + stones, surface="cobblestone")
@@ -179,14 +199,14 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
         xa, xb = sorted((kx + sgn * 0.2, kx + sgn * STREET_SIDEWALK_W))
         ka, kb = sorted((kx, kx + sgn * 0.2))
         ra, rb = sorted((kx, kx + sgn * RAMP_LEN))
-        slab = [geo.box((xa, y_start, -0.5), (xb, cy - RAMP_HALF_W, KERB_H)),
-                geo.box((xa, cy + RAMP_HALF_W, -0.5), (xb, STREET_Y[1], KERB_H))]
+        slab = [_street_box((xa, y_start, -0.5), (xb, cy - RAMP_HALF_W, KERB_H)),
+                _street_box((xa, cy + RAMP_HALF_W, -0.5), (xb, STREET_Y[1], KERB_H))]
         back_a, back_b = sorted((kx + sgn * RAMP_LEN, kx + sgn * STREET_SIDEWALK_W))
-        slab.append(geo.box((back_a, cy - RAMP_HALF_W, -0.5), (back_b, cy + RAMP_HALF_W, KERB_H)))
-        kerb = [geo.box((ka, y_start, -0.5), (kb, cy - RAMP_HALF_W, KERB_H)),
-                geo.box((ka, cy + RAMP_HALF_W, -0.5), (kb, STREET_Y[1], KERB_H))]
-        b.add("Sidewalks", side, "sidewalk", [TwinPart.of("Slab", _shear(geo.merge(*slab)), "Concrete"),
-                                              TwinPart.of("Kerb", _shear(geo.merge(*kerb)), "Granite")])
+        slab.append(_street_box((back_a, cy - RAMP_HALF_W, -0.5), (back_b, cy + RAMP_HALF_W, KERB_H)))
+        kerb = [_street_box((ka, y_start, -0.5), (kb, cy - RAMP_HALF_W, KERB_H)),
+                _street_box((ka, cy + RAMP_HALF_W, -0.5), (kb, STREET_Y[1], KERB_H))]
+        b.add("Sidewalks", side, "sidewalk", [TwinPart.of("Slab", geo.merge(*slab), "Concrete"),
+                                              TwinPart.of("Kerb", geo.merge(*kerb), "Granite")])
         low, high = (ra, rb) if sgn > 0 else (rb, ra)
         b.add("CurbRamps", "Ramp", "curb_ramp",
               [TwinPart.of("Surface", _shear(_ramp_along_x(low, high, cy - RAMP_HALF_W, cy + RAMP_HALF_W, 0.075, KERB_H, -0.5)),
@@ -200,31 +220,46 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
           [TwinPart.of("Bed", geo.box((PLAZA_X[0], PLAZA_Y[0], PLAZA_Z - 3.5), (PLAZA_X[1], PLAZA_Y[1], PLAZA_Z)), "Mortar")]
           + [TwinPart.of(p.name, (p.mesh[0] + [0, 0, PLAZA_Z], p.mesh[1]), p.material) for p in pavers])
     # Grass slope west of the street, steps down it, railings along the steps and the slope's top edge.
-    gx0, gx1, gy0 = -45.0, -19.0, -21.0
+    gx0, gx1, gy0 = SLOPE_X[0], SLOPE_X[1], SLOPE_Y0
     slope = geo.ramp(gx0, gx1, gy0, PLAZA_Y[0], KERB_H, PLAZA_Z, -0.5)
     b.add("Nature", "GrassSlope", "grass", [TwinPart.of("Surface", slope, "Grass")])
+    # The flight starts 5 cm in front of the slope's foot: flush, the two front faces would lie in one
+    # plane. Every tread then stands a few millimetres proud of the slope, the top one level with the largo.
     n_steps, rise = 19, (PLAZA_Z - KERB_H) / 19
-    tread = (PLAZA_Y[0] - gy0) / n_steps
-    flight = place(street.steps(3.0, n_steps, rise, tread), (-30.0, gy0, KERB_H), 90.0)
+    foot = gy0 - 0.05
+    tread = (PLAZA_Y[0] - foot) / n_steps
+    flight = place(street.steps(3.0, n_steps, rise, tread), (STEPS_X, foot, KERB_H), 90.0)
     b.add("Steps", "Flight", "sidewalk", flight, surface="steps")
-    for x in (-31.6, -28.4):
+    # Railings stand on the grass (posts planted in the slope), 10 cm short of its edges, the largo and the
+    # houses' back walls, so that no post sticks out over an edge or into a wall.
+    top = PLAZA_Y[0] - 0.1
+    for x in (STEPS_X - 1.6, STEPS_X + 1.6):
         b.add("Railings", "Railing", "railing",
-              street.railing((x, gy0, KERB_H), (x, PLAZA_Y[0], PLAZA_Z), height=1.0))
-    b.add("Railings", "Railing", "railing", street.railing((gx0, PLAZA_Y[0] - 0.1, PLAZA_Z), (-31.8, PLAZA_Y[0] - 0.1, PLAZA_Z)))
-    b.add("Railings", "Railing", "railing", street.railing((-28.2, PLAZA_Y[0] - 0.1, PLAZA_Z), (gx1, PLAZA_Y[0] - 0.1, PLAZA_Z)))
-    # Manhole covers on the road, the cobbles and the largo.
+              street.railing((x, gy0 + 0.1, slope_z(gy0 + 0.1)), (x, top, slope_z(top)), height=1.0))
+    b.add("Railings", "Railing", "railing", street.railing((gx0 + 0.1, top, slope_z(top)), (STEPS_X - 1.8, top, slope_z(top))))
+    b.add("Railings", "Railing", "railing", street.railing((STEPS_X + 1.8, top, slope_z(top)), (gx1 - 0.1, top, slope_z(top))))
+    # Manhole covers on the road, the cobbles and the largo; the one on the cobbles (z None) tilts with the
+    # street, on its highest stones.
     for x, y, z in [(-55.0, -41.0, 0.0), (12.0, -39.5, 0.0), (48.0, -43.0, 0.0), (0.0, -12.0, None), (-20.0, 28.0, PLAZA_Z + PAVER_H)]:
-        z = float(street_z(y)) + 0.07 if z is None else z
-        b.add("Covers", "Manhole", "cover", place(street.manhole_cover(), (x, y, z)))
+        cover = place(street.manhole_cover(), (x, y, 0.07 if z is None else z))
+        if z is None:
+            cover = [TwinPart.of(p.name, _shear(p.mesh), p.material) for p in cover]
+        b.add("Covers", "Manhole", "cover", cover)
 
 
 def _buildings(b: _Builder, rng: np.random.Generator) -> None:
-    def house(folder, at, heading, width, depth, storeys, mural, foundation):
+    def house(folder, at, heading, width, depth, storeys, mural, foundation, ground_z=None):
+        """``ground_z(y)``: height of a sloping sidewalk in front of the house; its doors stand on it."""
         wall = f"Wall{int(rng.integers(len(WALL_COLOURS)))}"
         parts = buildings.row_house(rng, width, depth, storeys, wall, foundation_m=foundation, mural=mural)
         stem = b.add(folder, "House", "building", place(parts.structure, at, heading), storeys=storeys)
         for k, door in enumerate(parts.doors):
-            b.objects.append(_sub(stem, "Door", k, "door", place(door, at, heading)))
+            door = place(door, at, heading)
+            if ground_z is not None:  # lift the door's sill to the sidewalk's highest point under it
+                pts = np.concatenate([p.points for p in door])
+                lift = max(ground_z(y) for y in pts[:, 1]) - pts[:, 2].min()
+                door = [p.moved(p.points + (0.0, 0.0, lift)) for p in door]
+            b.objects.append(_sub(stem, "Door", k, "door", door))
         for k, window in enumerate(parts.windows):
             b.objects.append(_sub(stem, "Window", k, "window", place(window, at, heading)))
         for k, mural_p in enumerate(parts.murals):
@@ -242,7 +277,7 @@ def _buildings(b: _Builder, rng: np.random.Generator) -> None:
             cx = front_x - depth / 2 if heading == 0.0 else front_x + depth / 2
             z = float(street_z(cy)) + KERB_H
             house(f"Buildings/{side}", (cx, cy, z), heading, width, depth, int(rng.integers(2, 4)),
-                  bool(rng.random() < 0.35), foundation=3.5)
+                  bool(rng.random() < 0.35), foundation=3.5, ground_z=lambda y: float(street_z(y)) + KERB_H)
             y += width
     # Along the asphalt road's north side, facing south.
     for x_from, x_to in ((-HALF_X + 1.0, -46.0), (STREET_X[1] + STREET_SIDEWALK_W + 12.0, HALF_X - 1.0)):
@@ -262,8 +297,10 @@ def _buildings(b: _Builder, rng: np.random.Generator) -> None:
                   int(rng.integers(2, 4)), bool(rng.random() < 0.3), foundation=3.5)
             y += width
     # The church at the north end of the largo, facing south.
-    parts = buildings.church(width=14.0, depth=14.0)
-    at, heading = (0.0, PLAZA_Y[1] + 7.5, PLAZA_Z + PAVER_H), -90.0
+    # The nave's front (its side doors) on the largo's north edge, the tower 0.5 m out onto the largo; the
+    # foundation reaches the open ground below the largo's level, as the houses' do.
+    parts = buildings.church(width=14.0, depth=14.0, foundation_m=3.5)
+    at, heading = (0.0, PLAZA_Y[1] + 7.0, PLAZA_Z + PAVER_H), -90.0
     stem = b.add("Buildings", "Church", "building", place(parts.structure, at, heading), name="Igreja da Ordem")
     for k, door in enumerate(parts.doors):
         b.objects.append(_sub(stem, "Door", k, "door", place(door, at, heading)))
@@ -303,7 +340,8 @@ def _furniture(b: _Builder, rng: np.random.Generator) -> None:
     # Signage: street names at the corners, a stop sign where the street meets the road, the bus stop.
     for x in (STREET_X[0] - 1.0, STREET_X[1] + 1.0):
         b.add("Signage", "StreetName", "signage", place(street.sign(kind="street"), (x, ROAD_SIDEWALK_N[0] + 1.0, KERB_H), -90.0))
-    b.add("Signage", "Stop", "signage", place(street.sign(kind="stop"), (STREET_X[1] + 0.8, STREET_Y[0] + 1.5, KERB_H), -90.0))
+    b.add("Signage", "Stop", "signage", place(street.sign(kind="stop"), (STREET_X[1] + 0.8, STREET_Y[0] + 1.5,
+                                                                       float(street_z(STREET_Y[0] + 1.5)) + KERB_H), -90.0))
     b.add("Signage", "BusStop", "signage", place(street.sign(kind="bus"), (38.0, ROAD_Y[1] + 0.7, KERB_H), -90.0))
     b.add("Furniture", "BusShelter", "furniture", place(street.bus_shelter(), (44.0, ROAD_SIDEWALK_N[1] - 1.0, KERB_H), -90.0))
     b.add("Furniture", "BikeRack", "furniture", place(street.bike_rack(), (36.0, PLAZA_Y[0] + 6.0, pz)))
@@ -327,7 +365,7 @@ def _market(b: _Builder, rng: np.random.Generator) -> None:
             off = 0.75 * np.array([np.cos(np.radians(a)), np.sin(np.radians(a))])
             b.add("Market", "Chair", "chair", place(market.chair(), (x + off[0], y + off[1], pz), a))
         if k % 2 == 0:
-            b.add("Market", "Umbrella", "umbrella", place(market.umbrella(canvas=canvases[k % 4]), (x, y, pz)))
+            b.add("Market", "Umbrella", "umbrella", place(market.umbrella(canvas=canvases[k % 4], foot_m=market.TABLE_TOP_M), (x, y, pz)))
 
 
 def _vehicles(b: _Builder, rng: np.random.Generator) -> None:
@@ -342,8 +380,10 @@ def _vehicles(b: _Builder, rng: np.random.Generator) -> None:
     b.add("Vehicles", "Bus", "bus", place(vehicles.bus(), (44.0, ROAD_Y[1] - 1.6, 0.0), 180.0))
     for k in range(3):
         b.add("Vehicles", "Motorcycle", "motorcycle", place(vehicles.motorcycle(), (60.0 + 1.2 * k, lane, 0.0), 60.0))
+    # Parked across the rack (whose hoops stand 0.75 m apart along y), one between each pair of hoops: a
+    # bicycle is 1.8 m long and 0.5 m wide, so side by side they keep 0.25 m apart.
     for k in range(4):
-        b.add("Vehicles", "Bicycle", "bicycle", place(vehicles.bicycle(), (36.0 + 0.3, PLAZA_Y[0] + 4.9 + 0.75 * k, PLAZA_Z + PAVER_H), 90.0))
+        b.add("Vehicles", "Bicycle", "bicycle", place(vehicles.bicycle(), (36.0 + 0.3, PLAZA_Y[0] + 4.9 + 0.75 * k, PLAZA_Z + PAVER_H), 0.0))
 
 
 def _nature(b: _Builder, rng: np.random.Generator) -> None:
@@ -351,16 +391,22 @@ def _nature(b: _Builder, rng: np.random.Generator) -> None:
     for x, y in [(-38.0, 9.0), (-38.0, 30.0), (38.0, 30.0), (-14.0, 30.0), (14.0, 30.0)]:
         b.add("Nature", "GrassBed", "grass", place(nature.grass_bed(4.0, 4.0), (x, y, pz)))
         b.add("Nature", "Tree", "vegetation", place(nature.tree(rng, float(rng.uniform(6.0, 8.0))), (x, y, pz + 0.22)))
-    for x in np.arange(-40.0, -21.0, 9.0):
-        b.add("Nature", "Tree", "vegetation", place(nature.tree(rng, float(rng.uniform(5.0, 7.0))), (x, -14.0, 1.0)))
-    b.add("Nature", "Araucaria", "vegetation", place(nature.araucaria(12.0), (-20.0, -4.0, 2.2)))
+    # On the grass slope: clear of the steps and their railings, crowns (reaching at most 2.7 m from the
+    # trunk along x or y) clear of each other and of the houses' back walls, trunks planted 10 cm deep.
+    for x in (-41.0, -35.5, -23.0):
+        b.add("Nature", "Tree", "vegetation", place(nature.tree(rng, float(rng.uniform(5.0, 7.0))), (x, -14.0, slope_z(-14.0) - 0.1)))
+    b.add("Nature", "Araucaria", "vegetation", place(nature.araucaria(12.0), (-24.0, -4.0, slope_z(-4.0) - 0.1)))
     for k in range(3):
         at = (float(rng.uniform(-20, 20)), float(rng.uniform(16, 22)), pz)
         b.add("Animals", "Dog", "animal", place(nature.dog(float(rng.uniform(0.8, 1.2))), at, float(rng.uniform(0, 360))))
+    # A flock of twelve pigeons, 0.4 m apart at least: a pigeon reaches 0.17 m from its centre, any way it turns.
     cx, cy = float(rng.uniform(-10, 10)), float(rng.uniform(28, 31))
-    for k in range(12):
-        at = (cx + float(rng.normal(0, 1.2)), cy + float(rng.normal(0, 0.8)), pz)
-        b.add("Animals", "Pigeon", "animal", place(nature.pigeon(), at, float(rng.uniform(0, 360))))
+    flock: list[tuple[float, float]] = []
+    while len(flock) < 12:
+        x, y = cx + float(rng.normal(0, 1.2)), cy + float(rng.normal(0, 0.8))
+        if all(np.hypot(x - fx, y - fy) >= 0.4 for fx, fy in flock):
+            flock.append((x, y))
+            b.add("Animals", "Pigeon", "animal", place(nature.pigeon(), (x, y, pz), float(rng.uniform(0, 360))))
 
 
 def _mobility_aids(b: _Builder) -> None:
