@@ -21,3 +21,18 @@ def reference_labels(snapshot, camera, width: int, height: int):
     inst_of = np.array([0] + [m.instance_id for m in snapshot.meshes])
     shape = (height, width)
     return class_of[mesh_index + 1].reshape(shape), inst_of[mesh_index + 1].reshape(shape)
+
+
+def reference_z_depth(snapshot, camera, width: int, height: int):
+    """(H, W) float64 z-depth of the first hit along each pixel-centre ray (0 on a miss), from Embree's hit
+    locations: the hit's offset from the camera centre projected on the optical axis."""
+    from trimesh.ray.ray_pyembree import RayMeshIntersector
+
+    verts, faces, _ = snapshot.world_triangles()
+    mesh = trimesh.Trimesh(verts, faces, process=False, validate=False)
+    origins, dirs = camera.pixel_center_rays(width, height)
+    locations, ray_index, _ = RayMeshIntersector(mesh).intersects_location(origins, dirs, multiple_hits=False)
+    _, _, forward = camera.axes()
+    z = np.zeros(width * height)
+    z[ray_index] = (locations - origins[ray_index]) @ forward
+    return z.reshape(height, width)

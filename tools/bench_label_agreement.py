@@ -2,7 +2,7 @@
 """Benchmark: where the Mitsuba label pass and an independent Embree ray cast disagree, per camera.
 
 Usage: python tools/bench_label_agreement.py [--scenario stages/district/scenario.usda] [--cameras NAME ...]
-                                            [--width 1280 --height 960 --frame 24 --pairs 12]
+                                            [--width 1280 --height 960 --time-code 24 --pairs 12]
 
 Prints, per camera, the number of pixels whose instance id (and class id) differs between the two
 first-hit casts, then the most frequent disagreeing pairs: pixel count, Mitsuba's instance [class], the reference's instance
@@ -69,7 +69,7 @@ def main() -> int:
     parser.add_argument("--cameras", nargs="+", default=None, help="camera prim names (default: every district camera)")
     parser.add_argument("--width", type=int, default=1280)
     parser.add_argument("--height", type=int, default=960)
-    parser.add_argument("--frame", type=float, default=24.0)
+    parser.add_argument("--time-code", "--frame", dest="time_code", type=float, default=24.0)
     parser.add_argument("--pairs", type=int, default=12, help="how many disagreeing pairs to list per camera")
     parser.add_argument("--variant", default=None)
     args = parser.parse_args()
@@ -84,15 +84,15 @@ def main() -> int:
     from synthua_usd.usd.stage_io import open_stage
 
     stage = open_stage(args.scenario)
-    snapshot = StageReader(stage, ClassMap.default()).snapshot(args.frame)
+    snapshot = StageReader(stage, ClassMap.default()).snapshot(args.time_code)
     names = {0: "(none)"} | {i.id: f"{i.prim_path.rsplit('/Twin/', 1)[-1]} [{i.class_name}]" for i in snapshot.instances}
     session = RenderSession(RenderConfig(width=args.width, height=args.height, spp=1, variant=args.variant))
     cameras = args.cameras or [c.name for c in DISTRICT_CAMERAS]
     w, h = args.width, args.height
-    print(f"{args.scenario} at time code {args.frame:g}, {w}x{h}, {snapshot.triangle_count()} triangles")
+    print(f"{args.scenario} at time code {args.time_code:g}, {w}x{h}, {snapshot.triangle_count()} triangles")
     total = 0
     for name in cameras:
-        camera = read_camera(stage, f"/World/Cameras/{name}", args.frame)
+        camera = read_camera(stage, f"/World/Cameras/{name}", args.time_code)
         frame = session.render(snapshot, camera, rgb=False)
         ref_class, ref_inst = reference_labels(snapshot, camera, w, h)
         bad = np.flatnonzero(frame.instance_ids.ravel() != ref_inst.ravel())

@@ -26,7 +26,8 @@ class LabelHits:
     """First hits of the pixel-centre rays. Arrays are (H, W).
 
     ``mesh_index`` int64 indexes the snapshot's meshes (-1 where the ray escapes); ``distance_m`` float32 is
-    the distance along the ray (0 on a miss); ``z_m`` float32 is depth along the camera's optical axis.
+    the distance from the camera centre to the hit along the ray, metres (0 on a miss); ``z_m`` float32 is
+    depth along the camera's optical axis.
     """
 
     mesh_index: np.ndarray = field(repr=False)
@@ -68,9 +69,12 @@ def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCa
     keys = {key: i for i, key in enumerate(shape_ids)}
     sensor = scene.sensors()[0]
     if mi.variant().startswith("scalar"):
-        mesh_index, distance, dirs = _trace_scalar(mi, scene, sensor, keys, width, height)
+        mesh_index, distance, origins, dirs = _trace_scalar(mi, scene, sensor, keys, width, height)
     else:
-        mesh_index, distance, dirs = _trace_jit(mi, scene, sensor, keys, width, height)
+        mesh_index, distance, origins, dirs = _trace_jit(mi, scene, sensor, keys, width, height)
+    # Mitsuba starts each camera ray on the near clipping plane, so hit distances count from there: add the
+    # way from the camera centre to the ray's origin.
+    distance = np.where(mesh_index >= 0, distance + np.linalg.norm(origins - camera.origin, axis=1), 0.0)
     _, _, forward = camera.axes()
     z = (distance * (dirs @ forward)).astype(np.float32)
     shape = (height, width)
@@ -90,8 +94,9 @@ def _trace_jit(mi, scene, sensor, keys, width, height):
     registry = np.asarray(dr.reinterpret_array(mi.UInt32, pi.shape), np.int64)
     distance = np.where(valid, np.asarray(pi.t, np.float64), 0.0)
     dirs = np.stack([np.asarray(ray.d[i], np.float64) for i in range(3)], axis=1)
+    origins = np.stack([np.asarray(ray.o[i], np.float64) for i in range(3)], axis=1)
     if not keys:  # nothing to hit
-        return np.full(len(valid), -1, np.int64), np.zeros(len(valid)), dirs
+        return np.full(len(valid), -1, np.int64), np.zeros(len(valid)), origins, dirs
     # pi.shape holds registry ids, not indices: map them through shapes_dr() beside shapes().
     shape_registry = np.asarray(dr.reinterpret_array(mi.UInt32, scene.shapes_dr()), np.int64)
     shape_mesh = np.array([keys[s.id()] for s in scene.shapes()], np.int64)
@@ -100,7 +105,7 @@ def _trace_jit(mi, scene, sensor, keys, width, height):
     pos_in = np.clip(pos_in, 0, len(order) - 1)
     found = valid & (shape_registry[order][pos_in] == registry)
     mesh_index = np.where(found, shape_mesh[order][pos_in], -1)
-    return mesh_index, np.where(found, distance, 0.0), dirs
+    return mesh_index, np.where(found, distance, 0.0), origins, dirs
 
 
 def _trace_scalar(mi, scene, sensor, keys, width, height):
@@ -108,16 +113,18 @@ def _trace_scalar(mi, scene, sensor, keys, width, height):
     mesh_index = np.full(n, -1, np.int64)
     distance = np.zeros(n, np.float64)
     dirs = np.zeros((n, 3), np.float64)
+    origins = np.zeros((n, 3), np.float64)
     aperture = mi.Point2f(0.5, 0.5)
     for k in range(n):
         y, x = divmod(k, width)
         ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f((x + 0.5) / width, (y + 0.5) / height), aperture)
         dirs[k] = (ray.d[0], ray.d[1], ray.d[2])
+        origins[k] = (ray.o[0], ray.o[1], ray.o[2])
         pi = scene.ray_intersect_preliminary(ray)
         if pi.is_valid():
             mesh_index[k] = keys[pi.shape.id()]
             distance[k] = pi.t
-    return mesh_index, distance, dirs
+    return mesh_index, distance, origins, dirs
 
 
 def label_maps(hits: LabelHits, snapshot: SceneSnapshot) -> tuple[np.ndarray, np.ndarray]:
