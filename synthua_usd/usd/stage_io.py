@@ -25,20 +25,25 @@ def _first_line(exc: Exception) -> str:
     return text
 
 
+def _read(path: Path, what: str, opener):
+    """``opener()`` after the file checks; USD's parse errors become one :class:`StageError` naming ``path``."""
+    _check_file(path)
+    try:
+        result = opener()
+    except Tf.ErrorException as exc:
+        raise StageError(f"{path}: not a readable USD {what}: {echo(_first_line(exc))}") from None
+    except UnicodeDecodeError as exc:
+        raise StageError(f"{path}: not a readable USD {what}: byte 0x{exc.object[exc.start]:02x} is not UTF-8; "
+                         f"expected UTF-8 text or a binary crate file") from None
+    if result is None:
+        raise StageError(f"{path}: not a readable USD {what}")
+    return result
+
+
 def open_layer(path: str | Path) -> Sdf.Layer:
     """Open one layer file (no composition)."""
     path = Path(path)
-    _check_file(path)
-    try:
-        layer = Sdf.Layer.FindOrOpen(str(path))
-    except Tf.ErrorException as exc:
-        raise StageError(f"{path}: not a readable USD layer: {echo(_first_line(exc))}") from None
-    except UnicodeDecodeError as exc:
-        raise StageError(f"{path}: not a readable USD layer: byte 0x{exc.object[exc.start]:02x} is not UTF-8; "
-                         f"expected UTF-8 text or a binary crate file") from None
-    if layer is None:
-        raise StageError(f"{path}: not a readable USD layer")
-    return layer
+    return _read(path, "layer", lambda: Sdf.Layer.FindOrOpen(str(path)))
 
 
 def open_stage(path: str | Path, allow_external_assets: bool = False) -> Usd.Stage:
@@ -50,16 +55,7 @@ def open_stage(path: str | Path, allow_external_assets: bool = False) -> Usd.Sta
     composes lies outside the folder tree of the root layer.
     """
     path = Path(path)
-    _check_file(path)
-    try:
-        stage = Usd.Stage.Open(str(path), Usd.Stage.LoadAll)
-    except Tf.ErrorException as exc:
-        raise StageError(f"{path}: not a readable USD stage: {echo(_first_line(exc))}") from None
-    except UnicodeDecodeError as exc:
-        raise StageError(f"{path}: not a readable USD stage: byte 0x{exc.object[exc.start]:02x} is not UTF-8; "
-                         f"expected UTF-8 text or a binary crate file") from None
-    if stage is None:
-        raise StageError(f"{path}: not a readable USD stage")
+    stage = _read(path, "stage", lambda: Usd.Stage.Open(str(path), Usd.Stage.LoadAll))
     errors = stage.GetCompositionErrors()
     if errors:
         more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
