@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from synthua_usd.agents.crowd import Crowd
 from synthua_usd.cameras import CameraSpec
 from synthua_usd.errors import InputError
 from synthua_usd.outputs import OUTPUT_NAMES, select_outputs
@@ -86,7 +87,7 @@ CLEAR_DAY = Environment()
 class ScenarioSpec:
     """Everything a scenario's layers hold.
 
-    ``crowd`` is an :class:`synthua_usd.agents.crowd.Crowd` or None (no agents layer). ``render_camera``
+    ``crowd`` is None for a scenario without an agents layer. ``render_camera``
     names the camera of ``cameras`` the render settings point at; ``render`` gives the resolution and
     samples per pixel they state; ``outputs`` the render vars (see :mod:`synthua_usd.outputs`).
     """
@@ -96,7 +97,7 @@ class ScenarioSpec:
     twin: TwinModel
     cameras: tuple[CameraSpec, ...]
     render_camera: str
-    crowd: object | None = None
+    crowd: Crowd | None = None
     environment: Environment = CLEAR_DAY
     render: RenderConfig = field(default_factory=RenderConfig)
     outputs: tuple[str, ...] = OUTPUT_NAMES
