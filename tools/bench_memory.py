@@ -12,6 +12,7 @@ runs on the same machine.
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 from pathlib import Path
 
@@ -55,6 +56,7 @@ def main() -> int:
         tc = start + k % int(end - start + 1)
         snapshot = reader.snapshot(tc)
         session.render(snapshot, read_camera(stage, cameras[k % len(cameras)], tc))
+        gc.collect()  # count what is still referenced, not garbage waiting for the collector
         rss.append(rss_kib())
     x = np.arange(args.warm_up, args.renders)
     slope = np.polyfit(x, np.array(rss[args.warm_up:], float), 1)[0]
