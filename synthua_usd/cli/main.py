@@ -18,6 +18,7 @@ import click
 from synthua_usd import __version__
 from synthua_usd.cli.agents_commands import agents
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
+from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.twin_commands import twin
 from synthua_usd.cli.failures import configure_logging, guarded
@@ -270,7 +271,7 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     return EXIT_OK
 
 
-for _group in (twin, agents, survey):
+for _group in (twin, agents, survey, contact_sheet):
     cli.add_command(_group)
 
 
