@@ -96,14 +96,16 @@ class Condition:
         for key, (lo, hi) in ranges.items():
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not lo <= value <= hi:
-                raise InputError(f"condition {self.name}: {key} should be a number in [{lo:g}, {hi:g}], but was {value!r}")
+                raise InputError(f"condition {self.name}: {key} should be a number in [{lo:g}, {hi:g}], "
+                                 f"but was {value!r}")
         v = self.fog_visibility_m
         if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) or v <= 0:
             raise InputError(f"condition {self.name}: fog_visibility_m should be > 0 metres (inf for no fog), "
                              f"but was {v!r}")
         for key in ("street_lights_on", "vehicle_lamps_on"):
             if not isinstance(getattr(self, key), bool):
-                raise InputError(f"condition {self.name}: {key} should be true or false, but was {getattr(self, key)!r}")
+                raise InputError(f"condition {self.name}: {key} should be true or false, "
+                                 f"but was {getattr(self, key)!r}")
 
     @classmethod
     def from_dict(cls, data: dict) -> "Condition":

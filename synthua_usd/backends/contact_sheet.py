@@ -27,7 +27,8 @@ BACKGROUND = (0.12, 0.12, 0.12)
 TEXT = (0.95, 0.95, 0.95)
 
 
-def class_overlay(rgb8: np.ndarray, class_ids: np.ndarray, palette: np.ndarray, alpha: float = OVERLAY_ALPHA) -> np.ndarray:
+def class_overlay(rgb8: np.ndarray, class_ids: np.ndarray, palette: np.ndarray,
+                  alpha: float = OVERLAY_ALPHA) -> np.ndarray:
     """(H, W, 3) uint8: the class colours of ``palette`` (classes, 3) blended over display ``rgb8`` with
     ``alpha``; unlabelled pixels (class 0) keep their RGB."""
     colours = palette[class_ids].astype(np.float64)

@@ -29,8 +29,8 @@ METER_K = 12.5
 ISO = 100.0
 EV100_RANGE = (-4.0, 21.0)
 DELTA_CD_M2 = 1e-4
-RULE = ("log-average luminance of the pixels that see a surface, metered at ISO 100 with K = 12.5 (EV100 = log2(L*100/12.5), clamped to "
-        "[-4, 21]) and placed at key 0.18")
+RULE = ("log-average luminance of the pixels that see a surface, metered at ISO 100 with K = 12.5 "
+        "(EV100 = log2(L*100/12.5), clamped to [-4, 21]) and placed at key 0.18")
 
 
 @dataclass(frozen=True)

@@ -71,7 +71,8 @@ def apply_fog(rgb: np.ndarray, distance_m: np.ndarray, hit: np.ndarray, beta_per
 
 
 def drop_density_per_m3(rate_mm_per_h: float, min_diameter_mm: float = RAIN_MIN_DROP_MM) -> tuple[float, float]:
-    """(drops of diameter ≥ ``min_diameter_mm`` per m³, Λ in 1/mm) of Marshall–Palmer rain at ``rate_mm_per_h``."""
+    """(drops of diameter ≥ ``min_diameter_mm`` per m³, Λ in 1/mm) of Marshall–Palmer rain at
+    ``rate_mm_per_h``."""
     lam = 4.1 * rate_mm_per_h ** -0.21
     return MARSHALL_PALMER_N0 / lam * math.exp(-lam * min_diameter_mm), lam
 

@@ -86,7 +86,8 @@ def make_contact_sheet(request: SheetRequest, show_progress: bool = False) -> Sh
     if not cameras:
         raise StageError(f"{request.stage_path}: has no cameras; expected at least one UsdGeom.Camera")
     if len(cameras) * len(conditions) > MAX_CELLS:
-        raise InputError(f"{len(cameras)} cameras x {len(conditions)} conditions: a sheet holds at most {MAX_CELLS} cells")
+        raise InputError(f"{len(cameras)} cameras x {len(conditions)} conditions: a sheet holds at most "
+                         f"{MAX_CELLS} cells")
     lenses = {path: read_camera(stage, path, time_code) for path in cameras}
     config = RenderConfig(width=request.width, height=request.height, spp=request.spp, seed=request.seed,
                           variant=request.variant)

@@ -285,7 +285,8 @@ class LightMeter:
         cos = np.maximum(np.asarray(cos, np.float64), 0.0)
         return np.array([float(np.mean(np.asarray(weight[i], np.float64) * cos)) for i in range(3)])
 
-    def measure(self, direction: np.ndarray, turbidity: float, albedo: float, up_axis: str) -> tuple[np.ndarray, np.ndarray]:
+    def measure(self, direction: np.ndarray, turbidity: float, albedo: float,
+                up_axis: str) -> tuple[np.ndarray, np.ndarray]:
         key = (tuple(np.round(direction, 9)), turbidity, albedo, up_axis)
         if key not in self._cache:
             base = sky_emitter(self.mi, up_axis, sun_up=True)[SUNSKY]

@@ -127,7 +127,8 @@ def test_wet_ground_is_darker_than_dry(street, class_map):
     road = class_mask(dry, class_map, "road")
     assert luminance(wet.rgb)[road].mean() < 0.8 * luminance(dry.rgb)[road].mean()
     # Only upward faces of ground classes get wet: the road's top, not a house, not the road's underside.
-    up, wet_condition = np.array([0.0, 0.0, 1.0]), dataclasses.replace(street["conditions"]["clear_day"], ground_wetness=1.0)
+    up = np.array([0.0, 0.0, 1.0])
+    wet_condition = dataclasses.replace(street["conditions"]["clear_day"], ground_wetness=1.0)
     road_mesh = next(m for m in street["snapshot"].meshes if m.prim_path == "/World/Road")
     house_mesh = next(m for m in street["snapshot"].meshes if m.prim_path == "/World/House")
     assert np.all(face_weights(road_mesh, "road", up, wet_condition)["face_wet"] == 1.0)
