@@ -40,6 +40,7 @@ stages: setup
 ## render session (first load, per-frame update, labels, RGB) and building the district, imports and agents.
 bench: setup
 	$(BIN)/python tools/bench_render.py
+	$(BIN)/python tools/bench_conditions.py
 	$(BIN)/python tools/bench_label_agreement.py
 	$(BIN)/python tools/bench_memory.py
 	$(BIN)/python tools/bench_twin.py

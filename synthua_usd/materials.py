@@ -50,6 +50,7 @@ PALETTE: dict[str, Material] = {m.key: m for m in [
     Material("PaintBlack", (0.02, 0.02, 0.02), 0.3, metallic=0.3),
     Material("PaintWhite", (0.75, 0.75, 0.75), 0.3, metallic=0.3),
     Material("PaintSilver", (0.45, 0.46, 0.48), 0.3, metallic=0.6), Material("PaintOrange", (0.7, 0.25, 0.02), 0.4),
+    Material("HeadLamp", (0.85, 0.85, 0.82), 0.1), Material("TailLamp", (0.5, 0.02, 0.02), 0.2),
     # Market.
     Material("CanvasWhite", (0.8, 0.8, 0.78), 0.9), Material("CanvasRed", (0.55, 0.06, 0.05), 0.9),
     Material("CanvasBlue", (0.06, 0.15, 0.5), 0.9), Material("CanvasYellow", (0.75, 0.55, 0.05), 0.9),

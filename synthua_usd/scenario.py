@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 from synthua_usd.agents.crowd import Crowd
 from synthua_usd.cameras import CameraSpec
+from synthua_usd.conditions import DEFAULT_CONDITION, SHIPPED, Condition
 from synthua_usd.errors import InputError
 from synthua_usd.outputs import OUTPUT_NAMES, select_outputs
 from synthua_usd.render_config import RenderConfig
@@ -31,6 +32,7 @@ LAYERS: tuple[tuple[str, str], ...] = (
 LAYER_FILE = dict(LAYERS)
 ROOT_FILE = "scenario.usda"
 CAMERAS_ROOT = "/World/Cameras"
+ENVIRONMENT_PATH = "/World/Environment"
 
 
 @dataclass(frozen=True)
@@ -64,23 +66,21 @@ class StageMetadata:
 
 @dataclass(frozen=True)
 class Environment:
-    """Sun and sky: a ``UsdLux.DistantLight`` and a uniform ``UsdLux.DomeLight``.
+    """The environment layer: the conditions a scenario offers (a ``condition`` variant set on
+    ``/World/Environment``, see :mod:`synthua_usd.conditions`) and the one selected by default."""
 
-    The sun shines down its local -Z axis tilted ``sun_tilt_deg`` off vertical about X, then turned
-    ``sun_turn_deg`` about Z. Intensities are UsdLux ``intensity`` values; colours linear Rec.709.
-    """
+    conditions: tuple[Condition, ...] = SHIPPED
+    default: str = DEFAULT_CONDITION
 
-    name: str = "clear_day"
-    sun_intensity: float = 3.0
-    sun_angle_deg: float = 0.53
-    sun_color: tuple[float, float, float] = (1.0, 0.96, 0.9)
-    sun_tilt_deg: float = 40.0
-    sun_turn_deg: float = -35.0
-    sky_intensity: float = 0.6
-    sky_color: tuple[float, float, float] = (0.75, 0.85, 1.0)
+    def __post_init__(self) -> None:
+        names = [c.name for c in self.conditions]
+        if not names or len(set(names)) != len(names):
+            raise InputError(f"environment conditions should have unique names, but were {names}")
+        if self.default not in names:
+            raise InputError(f"default condition '{self.default}' is not one of {names}")
 
 
-CLEAR_DAY = Environment()
+SHIPPED_ENVIRONMENT = Environment()
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,7 +98,7 @@ class ScenarioSpec:
     cameras: tuple[CameraSpec, ...]
     render_camera: str
     crowd: Crowd | None = None
-    environment: Environment = CLEAR_DAY
+    environment: Environment = SHIPPED_ENVIRONMENT
     render: RenderConfig = field(default_factory=RenderConfig)
     outputs: tuple[str, ...] = OUTPUT_NAMES
 

@@ -55,6 +55,7 @@ class MeshItem:
     material_key : str, a key of :attr:`SceneSnapshot.materials`
     instance_id : int, an id of :attr:`SceneSnapshot.instances` (0 for unlabelled geometry)
     class_id : int
+    lamp : str, the gprim's authored ``synthua:lamp`` role ('' when none; see :mod:`synthua_usd.lamps`)
     """
 
     prim_path: str
@@ -63,6 +64,7 @@ class MeshItem:
     material_key: str
     instance_id: int
     class_id: int
+    lamp: str = ""
 
 
 @dataclass(frozen=True)

@@ -62,6 +62,25 @@ def tiny(class_map):
     return read_snapshot(stage, 1.0, class_map), read_camera(stage, "/World/Cam", 1.0)
 
 
+@pytest.fixture(scope="session")
+def lamps_scenario(tmp_path_factory) -> Path:
+    """tests/data/valid/tiny_street_lamps.usda composed under an environment layer that synthua authors with
+    the shipped conditions: a tiny scenario (road, house with a window, lamp post, car with head lamps, a
+    person; camera /World/Cam) for condition tests."""
+    import shutil
+
+    from synthua_usd.scenario import SHIPPED_ENVIRONMENT, StageMetadata
+    from synthua_usd.usd.authoring import save_layer_atomic
+    from synthua_usd.usd.compose import compose_layers
+    from synthua_usd.usd.scenario_layers import build_environment
+
+    folder = tmp_path_factory.mktemp("lamps_scenario")
+    shutil.copy(DATA / "valid" / "tiny_street_lamps.usda", folder / "street.usda")
+    environment = build_environment(StageMetadata(end_time_code=2.0), SHIPPED_ENVIRONMENT)
+    save_layer_atomic(environment.GetRootLayer(), folder / "environment.usda")
+    return compose_layers(folder / "scenario.usda", [folder / "environment.usda", folder / "street.usda"])
+
+
 def activate_variant(name: str):
     """The ``mitsuba`` module with ``name`` active, or skip the test when this machine cannot run it."""
     from synthua_usd.backends.mitsuba import variants

@@ -25,10 +25,11 @@ def write_json_atomic(path: Path, document: dict) -> Path:
     return path
 
 
-def _jobs(output: RenderOutput, out_dir: Path, *, rgb, class_ids, instance_ids, z_depth, palette):
+def _jobs(output: RenderOutput, out_dir: Path, *, rgb, class_ids, instance_ids, z_depth, palette, display_scale):
     """(writer, path, data) for every file of ``output``."""
     if output.var == "rgb":
-        return [(images.write_linear_exr, out_dir / "rgb.exr", rgb), (images.write_display_png, out_dir / "rgb.png", rgb)]
+        return [(images.write_linear_exr, out_dir / "rgb.exr", rgb),
+                (images.write_display_png, out_dir / "rgb.png", rgb * np.float32(display_scale))]
     if output.var == "class_id":
         return [(images.write_id_png, out_dir / "class.png", class_ids),
                 (images.write_color_png, out_dir / "semantic.png", palette[class_ids])]
@@ -40,15 +41,17 @@ def _jobs(output: RenderOutput, out_dir: Path, *, rgb, class_ids, instance_ids, 
 
 
 def write_frame(out_dir: Path, outputs: tuple[RenderOutput, ...], *, rgb: np.ndarray | None, class_ids: np.ndarray,
-                instance_ids: np.ndarray, z_depth: np.ndarray, palette: np.ndarray, frame_doc: dict) -> list[Path]:
-    """Write the files of ``outputs`` and ``frame.json`` into ``out_dir`` (created if needed).
+                instance_ids: np.ndarray, z_depth: np.ndarray, palette: np.ndarray, frame_doc: dict,
+                display_scale: float = 1.0) -> list[Path]:
+    """Write the files of ``outputs`` and ``frame.json`` into ``out_dir`` (created if needed). ``rgb.exr``
+    holds ``rgb`` as rendered; ``rgb.png`` holds it times ``display_scale`` (the frame's exposure).
 
     ``frame_doc`` is validated against ``frame.schema.json`` before anything is written; frame.json is
     written last."""
     validate_document(frame_doc, "frame", FRAME_DOCUMENT)
     out_dir.mkdir(parents=True, exist_ok=True)
     jobs = [job for o in outputs for job in _jobs(o, out_dir, rgb=rgb, class_ids=class_ids, instance_ids=instance_ids,
-                                                   z_depth=z_depth, palette=palette)]
+                                                   z_depth=z_depth, palette=palette, display_scale=display_scale)]
     with ThreadPoolExecutor(max_workers=4) as pool:
         written = [f.result() for f in [pool.submit(fn, path, data) for fn, path, data in jobs]]
     written.append(write_json_atomic(out_dir / FRAME_DOCUMENT, frame_doc))

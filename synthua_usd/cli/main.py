@@ -18,6 +18,7 @@ import click
 from synthua_usd import __version__
 from synthua_usd.cli.agents_commands import agents
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
+from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.twin_commands import twin
 from synthua_usd.cli.failures import configure_logging, guarded
@@ -136,7 +137,7 @@ def compose(out: Path, layers: tuple[Path, ...]) -> int:
 @click.option("--allow-external-assets", is_flag=True,
               help="Accept layers outside the stage's folder tree (refused by default).")
 def inspect(stage: Path, class_map: Path | None, allow_external_assets: bool) -> int:
-    """Print what STAGE holds: layer stack, prims per class, cameras, lights and time range."""
+    """Print what STAGE holds: layer stack, prims per class, cameras, lights, conditions and time range."""
     from synthua_usd.usd.summary import summarize
     from synthua_usd.usd.stage_io import open_stage
 
@@ -224,12 +225,15 @@ def _time_codes(ctx, param, values: tuple[str, ...]) -> tuple[float, ...]:
 @click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed of the RGB pass.")
 @click.option("--variant", help="Mitsuba variant (cuda_ad_rgb, llvm_ad_rgb, scalar_rgb) [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
+@click.option("--condition", help="Weather and light condition, one the stage offers (see `synthua inspect`), e.g. "
+                                  "clear_night; chosen for this render only, no layer is edited [default: the "
+                                  "stage's selection].")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder (created).")
 @click.option("--allow-external-assets", is_flag=True,
               help="Accept layers outside the stage's folder tree (refused by default).")
 def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ...], width: int | None,
            height: int | None, spp: int | None, seed: int, variant: str | None, class_map: Path | None,
-           out_dir: Path, allow_external_assets: bool) -> int:
+           condition: str | None, out_dir: Path, allow_external_assets: bool) -> int:
     """Render SCENARIO from each --camera at each time code into --out.
 
     \b
@@ -237,12 +241,13 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
       synthua render stages/scenario.usda --camera /World/Cameras/CCTV \\
           --camera /World/Cameras/PedestrianEye --time-code 1:48:8 --out out/sweep
     renders 12 frames from one loaded scene (only the camera and what moves are updated between them).
+    --condition day_fog renders them under another of the stage's conditions (labels do not change).
     \b
     Files per frame (the stage's UsdRender vars choose; all when it names none): rgb.exr
     (scene-linear Rec.709) and rgb.png (display sRGB), class.png (8-bit class ids) and semantic.png
     (class colours), instance.png (16-bit instance ids, 0 = none), depth.exr (z-depth in metres,
     0 = no hit), and always frame.json (camera intrinsics/extrinsics, class map, instances with pixel
-    counts). Nothing is written unless every input checks out, and nothing is replaced unless every
+    counts, the condition and the exposure rgb.png was made with). Nothing is written unless every input checks out, and nothing is replaced unless every
     frame rendered.
     """
     from synthua_usd.pipeline.frame import FrameRequest, run_frames
@@ -250,21 +255,23 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     t0 = time.perf_counter()
     run = run_frames(FrameRequest(stage_path=scenario, out_dir=out_dir, camera_paths=cameras, time_codes=time_codes,
                                   width=width, height=height, spp=spp, seed=seed, variant=variant,
-                                  class_map_path=class_map, allow_external_assets=allow_external_assets),
+                                  class_map_path=class_map, allow_external_assets=allow_external_assets,
+                                  condition=condition),
                      show_progress=sys.stderr.isatty())
     for frame in run.frames:
         doc = frame.document
         visible = sum(1 for i in doc["instances"] if i["pixel_count"])
+        condition = f"condition {doc['condition']['name']}, " if doc["condition"] else ""
         click.echo(f"rendered {doc['camera']['prim_path']} at time code {doc['time_code']:g}: "
                    f"{doc['image']['width']}x{doc['image']['height']}, {doc['render']['spp']} spp, "
-                   f"{doc['render']['variant']}, {visible} visible instances -> {frame.out_dir}")
+                   f"{doc['render']['variant']}, {condition}{visible} visible instances -> {frame.out_dir}")
     files = sum(len(f.files) for f in run.frames)
     click.echo(f"wrote {files} files for {len(run.frames)} frames to {out_dir} in {time.perf_counter() - t0:.1f} s "
                f"({run.loads} scene load{'s' if run.loads != 1 else ''})")
     return EXIT_OK
 
 
-for _group in (twin, agents, survey):
+for _group in (twin, agents, survey, contact_sheet):
     cli.add_command(_group)
 
 

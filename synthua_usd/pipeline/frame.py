@@ -29,6 +29,7 @@ from synthua_usd.resources import check_frame_memory
 from synthua_usd.scene import SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.cameras import read_camera
+from synthua_usd.usd.conditions import read_condition
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.render_settings import render_defaults
 from synthua_usd.usd.stage_io import check_time_code, open_stage
@@ -56,6 +57,8 @@ class FrameRequest:
     variant: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
+    #: A condition the stage offers (its ``condition`` variant); None: the stage's own selection.
+    condition: str | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,6 +113,7 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     spp = request.spp if request.spp is not None else defaults.spp if defaults.spp is not None else RenderConfig.spp
     config = RenderConfig(width=request.width or width, height=request.height or height, spp=spp, seed=request.seed,
                           variant=request.variant)
+    condition = read_condition(stage, request.condition)
     reader = StageReader(stage, class_map)
     if not reader.snapshot(time_codes[0]).meshes:
         raise StageError(f"{request.stage_path}: has no renderable geometry (no visible Mesh, Cube, Sphere, Cylinder, "
@@ -124,14 +128,16 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
         for cam_path, tc in bar:
             snapshot = reader.snapshot(tc)
             camera = read_camera(stage, cam_path, tc)
-            rendered = session.render(snapshot, camera, rgb=want_rgb, show_progress=show_progress and single)
+            rendered = session.render(snapshot, camera, rgb=want_rgb, show_progress=show_progress and single,
+                                      condition=condition)
             rel = Path() if single else Path(cam_path.rsplit("/", 1)[-1]) / time_code_folder(tc)
             doc = frame_document(request.stage_path, outputs, time_code=tc, camera=camera, config=config,
                                  snapshot=snapshot, rendered=rendered, class_map=class_map)
             t0 = time.perf_counter()
             written = write_frame(staging / rel, outputs, rgb=rendered.rgb, class_ids=rendered.class_ids,
                                   instance_ids=rendered.instance_ids, z_depth=rendered.hits.z_m,
-                                  palette=class_map.palette(), frame_doc=doc)
+                                  palette=class_map.palette(), frame_doc=doc,
+                                  display_scale=rendered.exposure.scale if rendered.exposure else 1.0)
             log.info("wrote %d files for %s at %g in %.2f s", len(written), cam_path, tc, time.perf_counter() - t0)
             files = [request.out_dir / rel / p.name for p in written]
             run.frames.append(FrameResult(request.out_dir / rel, files, doc, snapshot, camera, rendered))
@@ -180,4 +186,6 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
                       "classes": [c.to_dict() for c in class_map.classes]},
         "class_pixel_counts": {class_map.by_id(i).name: int(n) for i, n in enumerate(class_counts) if n},
         "instances": instances,
+        "condition": rendered.condition.to_dict() if rendered.condition is not None else None,
+        "exposure": rendered.exposure.to_dict() if rendered.exposure is not None else None,
     }

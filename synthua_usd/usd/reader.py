@@ -15,7 +15,8 @@ import numpy as np
 from pxr import Gf, Usd, UsdGeom, UsdLux, UsdShade
 
 from synthua_usd import geometry as geo
-from synthua_usd.errors import StageError, UnsupportedPrimError
+from synthua_usd.errors import StageError, UnsupportedPrimError, echo
+from synthua_usd.lamps import KINDS as LAMP_KINDS
 from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error
@@ -23,6 +24,9 @@ from synthua_usd.usd.semantics import label_sites, renderable_gprims
 from synthua_usd.usd.stage_io import check_time_code, meters_per_unit
 
 log = logging.getLogger(__name__)
+
+#: The gprim attribute naming a lamp role (:mod:`synthua_usd.lamps`).
+LAMP_ATTRIBUTE = "synthua:lamp"
 
 Triangulator = Callable[[Usd.Prim, Usd.TimeCode], geo.Mesh]
 GPRIM_HANDLERS: dict[str, Triangulator] = {}
@@ -177,6 +181,16 @@ def _read_light(prim: Usd.Prim, t: Usd.TimeCode) -> Light:
     raise AssertionError(f"{path}: LIGHT_TYPES lists a type with no reader")
 
 
+def _lamp_role(prim: Usd.Prim) -> str:
+    """The gprim's ``synthua:lamp`` value ('' when unauthored); an unknown role is a :class:`StageError`."""
+    attr = prim.GetAttribute(LAMP_ATTRIBUTE)
+    value = attr.Get() if attr and attr.HasAuthoredValue() else ""
+    if value and value not in LAMP_KINDS:
+        raise StageError(f"{prim.GetPath()}: {LAMP_ATTRIBUTE} is '{echo(value)}'; expected one of "
+                         f"{', '.join(LAMP_KINDS)}")
+    return str(value or "")
+
+
 # --- the snapshot -------------------------------------------------------------------------------------------
 
 def collect_instances(stage: Usd.Stage, class_map: ClassMap) -> dict[str, Instance]:
@@ -275,7 +289,8 @@ class StageReader:
         inst = self.instances.get(sites[0].prim_path) if sites else None
         return MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
                         material_key=_material_for(prim, t, self._materials).key,
-                        instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0)
+                        instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0,
+                        lamp=_lamp_role(prim))
 
     def snapshot(self, time_code: float) -> SceneSnapshot:
         """Everything renderable at ``time_code`` (checked against the stage's time range). Asking for the

@@ -1,4 +1,5 @@
-"""The thin layers of a scenario: cameras (UsdGeom), environment (UsdLux) and render settings (UsdRender)."""
+"""The thin layers of a scenario: cameras (UsdGeom), environment (conditions and UsdLux) and render settings
+(UsdRender)."""
 
 from __future__ import annotations
 
@@ -8,29 +9,28 @@ from synthua_usd import geometry as geo
 from synthua_usd.cameras import CONFORM_EXPAND, CameraSpec
 from synthua_usd.outputs import select_outputs
 from synthua_usd.render_config import RenderConfig
-from synthua_usd.scenario import CAMERAS_ROOT, Environment, StageMetadata
+from synthua_usd.scenario import CAMERAS_ROOT, ENVIRONMENT_PATH, Environment, StageMetadata
 from synthua_usd.usd.authoring import define_xform, new_layer
 from synthua_usd.usd.cameras import author_camera
+from synthua_usd.usd.conditions import SKY, SUN, author_conditions
 
 RENDER_SETTINGS_PATH = "/Render/Settings"
 
 
 def build_environment(meta: StageMetadata, env: Environment) -> Usd.Stage:
-    """The sun as a ``DistantLight`` and the sky as a uniform ``DomeLight`` under ``/World/Environment``."""
-    stage = new_layer(meta, f"Environment '{env.name}': sun and sky (UsdLux).")
+    """``/World/Environment`` with its ``condition`` variant set (:mod:`synthua_usd.usd.conditions`), a
+    ``DistantLight`` sun and a uniform ``DomeLight`` sky that each variant poses for viewers."""
+    stage = new_layer(meta, f"Environment: the conditions {', '.join(c.name for c in env.conditions)} "
+                            f"(variant set 'condition', default '{env.default}'); UsdLux sun and sky.")
     stage.SetDefaultPrim(stage.OverridePrim("/World"))
-    define_xform(stage, "/World/Environment", kind=Kind.Tokens.group)
-    sun = UsdLux.DistantLight.Define(stage, "/World/Environment/Sun")
-    sun.CreateIntensityAttr(env.sun_intensity)
-    sun.CreateAngleAttr(env.sun_angle_deg)
-    sun.CreateColorAttr(Gf.Vec3f(*env.sun_color))
-    # A distant light shines down its local -Z axis: tilt it off vertical, then turn it.
+    define_xform(stage, ENVIRONMENT_PATH, kind=Kind.Tokens.group)
+    sun = UsdLux.DistantLight.Define(stage, f"{ENVIRONMENT_PATH}/{SUN}")
+    sun.CreateAngleAttr(0.53)
     sun_xf = UsdGeom.Xformable(sun.GetPrim())
-    sun_xf.AddRotateZOp().Set(env.sun_turn_deg)
-    sun_xf.AddRotateXOp().Set(env.sun_tilt_deg)
-    sky = UsdLux.DomeLight.Define(stage, "/World/Environment/Sky")
-    sky.CreateIntensityAttr(env.sky_intensity)
-    sky.CreateColorAttr(Gf.Vec3f(*env.sky_color))
+    sun_xf.AddRotateZOp()
+    sun_xf.AddRotateXOp()
+    UsdLux.DomeLight.Define(stage, f"{ENVIRONMENT_PATH}/{SKY}").CreateColorAttr(Gf.Vec3f(0.75, 0.85, 1.0))
+    author_conditions(stage, env.conditions, env.default)
     return stage
 
 

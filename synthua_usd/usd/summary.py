@@ -1,4 +1,4 @@
-"""What a stage holds, for people without usdview: layers, classes, cameras, lights, time range."""
+"""What a stage holds, for people without usdview: layers, classes, cameras, lights, conditions, time range."""
 
 from __future__ import annotations
 
@@ -9,7 +9,9 @@ from dataclasses import dataclass, field
 
 from pxr import Usd, UsdGeom, UsdLux
 
+from synthua_usd.conditions import display_order
 from synthua_usd.taxonomy import ClassMap
+from synthua_usd.usd.conditions import condition_names, selected_condition
 from synthua_usd.usd.prim_checks import lens_unit_mm
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
 from synthua_usd.usd.stage_io import time_range
@@ -31,6 +33,8 @@ class StageSummary:
     unlabelled_gprims: int = 0
     cameras: list[dict] = field(default_factory=list)
     lights: list[dict] = field(default_factory=list)
+    conditions: list[str] = field(default_factory=list)  # shipped order first; see synthua_usd.conditions
+    condition: str | None = None  # the one the stage selects
 
     def format(self) -> str:
         lines = [f"stage      {self.root}",
@@ -49,6 +53,9 @@ class StageSummary:
             f"{c['vertical_aperture_mm']:g} mm  hfov {c['hfov_deg']:.1f} deg" for c in self.cameras) or "(none)"))
         lines.append("lights     " + ("\n           ".join(
             f"{l['path']}  {l['type']}  intensity {l['intensity']:g}" for l in self.lights) or "(none)"))
+        lines.append("conditions " + ("  ".join(f"{c}*" if c == self.condition else c for c in self.conditions)
+                                      + "   (* selected; render --condition NAME picks another)"
+                                      if self.conditions else "(none)"))
         return "\n".join(lines)
 
 
@@ -89,4 +96,5 @@ def summarize(stage: Usd.Stage, class_map: ClassMap) -> StageSummary:
                         default_prim=str(stage.GetDefaultPrim().GetPath()) if stage.GetDefaultPrim() else "",
                         time_codes_per_second=stage.GetTimeCodesPerSecond(), time_range=time_range(stage),
                         prim_count=sum(1 for _ in stage.Traverse()), gprim_count=len(gprims), triangle_estimate=tris,
-                        classes=dict(classes), unlabelled_gprims=unlabelled, cameras=cameras, lights=lights)
+                        classes=dict(classes), unlabelled_gprims=unlabelled, cameras=cameras, lights=lights,
+                        conditions=display_order(condition_names(stage)), condition=selected_condition(stage))

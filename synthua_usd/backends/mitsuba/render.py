@@ -13,7 +13,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
+from synthua_usd.backends.exposure import Exposure
 from synthua_usd.cameras import PinholeCamera
+from synthua_usd.conditions import Condition
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import SceneSnapshot
 
@@ -38,7 +40,8 @@ class LabelHits:
 @dataclass(frozen=True, eq=False)
 class RenderedFrame:
     """All buffers of one frame. ``rgb`` (H, W, 3) float32 scene-linear Rec.709; ``class_ids`` (H, W) uint8;
-    ``instance_ids`` (H, W) uint16; depths as in :class:`LabelHits`."""
+    ``instance_ids`` (H, W) uint16; depths as in :class:`LabelHits`. ``exposure`` is chosen from ``rgb``
+    (None without RGB); ``condition`` is the condition rendered (None: the stage's UsdLux lights)."""
 
     rgb: np.ndarray = field(repr=False)
     class_ids: np.ndarray = field(repr=False)
@@ -46,6 +49,8 @@ class RenderedFrame:
     hits: LabelHits = field(repr=False)
     variant: str
     seconds: dict
+    exposure: Exposure | None = None
+    condition: Condition | None = None
 
 
 def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False) -> np.ndarray:

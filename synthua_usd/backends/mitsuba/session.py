@@ -8,19 +8,31 @@ acceleration structure; the scene, its BSDFs and static meshes stay. A snapshot 
 gprim appeared or disappeared, a mesh changed its topology) or other lights is loaded afresh, and
 ``reloads`` counts it.
 
+Conditions (:mod:`synthua_usd.conditions`): a session loaded with a condition swaps to another in place
+(sun direction, turbidity, sun and sky scales, night sky, lamps and emitter sampling weights through
+``traverse()``; fog, rain and exposure are image-space steps) unless one has the sun up and the other not
+(the environment emitter changes type: ``sunsky`` or a ``constant`` night dome) or they differ in wetness or
+snow cover (those live in the BSDFs and mesh attributes the scene was built with): then the session
+reloads, and counts it in ``reloads``. Labels come
+from the same geometry under every condition.
+
 This is what a dataset worker holds: one session, one scene load, every frame of its share.
 """
 
 from __future__ import annotations
 
 import time
+import zlib
 
 import numpy as np
 
-from synthua_usd.backends.mitsuba import variants
+from synthua_usd.backends import weather
+from synthua_usd.backends.exposure import choose_exposure
+from synthua_usd.backends.mitsuba import variants, weather_scene
 from synthua_usd.backends.mitsuba.render import RenderedFrame, label_maps, render_rgb, trace_pixel_centres
 from synthua_usd.backends.mitsuba.translate import Translation, sensor_to_world, translate
 from synthua_usd.cameras import PinholeCamera
+from synthua_usd.conditions import Condition
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import SceneSnapshot
 
@@ -41,24 +53,42 @@ class RenderSession:
         self._params = None
         self._translation: Translation | None = None
         self._snapshot: SceneSnapshot | None = None
+        self._condition: Condition | None = None
+        self._lighting: weather_scene.Lighting | None = None
+        self._meter: weather_scene.LightMeter | None = None
 
-    def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera) -> None:
-        self._translation = translate(self.mi, snapshot, camera, self.config)
+    def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
+        self._translation = translate(self.mi, snapshot, camera, self.config, condition)
         # optimize=False: Mitsuba would otherwise merge meshes and lose the identity labels depend on.
         self._scene = self.mi.load_dict(self._translation.scene, optimize=False)
         self._params = self.mi.traverse(self._scene)
         self._snapshot = snapshot
+        self._condition = None
+        if condition is not None:
+            self._set_condition(condition)
+            self._params.update()
         self.loads += 1
 
-    def _same_layout(self, snapshot: SceneSnapshot) -> bool:
+    def _set_condition(self, condition: Condition) -> None:
+        """Sky, lamps and sampling weights of the loaded scene to ``condition`` (parameters, no reload)."""
+        if self._meter is None:
+            self._meter = weather_scene.LightMeter(self.mi)
+        self._lighting = weather_scene.apply_condition(self.mi, self._params, self._translation.shape_ids,
+                                                       self._translation.lamps, condition, self._snapshot,
+                                                       self._meter)
+        self._condition = condition
+
+    def _same_layout(self, snapshot: SceneSnapshot, condition: Condition | None = None) -> bool:
         old = self._snapshot
-        return (len(old.meshes) == len(snapshot.meshes) and old.lights == snapshot.lights
+        return (self._translation.condition_key == weather_scene.scene_key(condition)
+                and len(old.meshes) == len(snapshot.meshes) and old.lights == snapshot.lights
                 and all(a is b or (a.prim_path == b.prim_path and a.triangles.shape == b.triangles.shape
                                    and a.material_key == b.material_key)
                         for a, b in zip(old.meshes, snapshot.meshes)))
 
-    def _update(self, snapshot: SceneSnapshot, camera: PinholeCamera) -> int:
-        """Point the sensor at ``camera`` and move what moved; returns how many meshes were updated."""
+    def _update(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> int:
+        """Point the sensor at ``camera``, move what moved and switch to ``condition`` if it is another;
+        returns how many meshes were updated."""
         mi, params = self.mi, self._params
         fov_x, _ = camera.fov_deg(self.config.width, self.config.height)
         params["sensor.to_world"] = sensor_to_world(mi, camera)
@@ -73,37 +103,72 @@ class RenderSession:
             # The parameter's own array type: mi.Float is a plain float on scalar variants.
             params[name] = type(params[name])(np.ascontiguousarray(new.points, np.float32).ravel())
             moved += 1
-        params.update()
         self._snapshot = snapshot
+        if condition is not None and condition != self._condition:
+            self._set_condition(condition)
+        params.update()
         return moved
 
     def render(self, snapshot: SceneSnapshot, camera: PinholeCamera, rgb: bool = True,
-               show_progress: bool = False) -> RenderedFrame:
-        """RGB (unless ``rgb`` is False) and labels of ``snapshot`` seen by ``camera``.
+               show_progress: bool = False, condition: Condition | None = None) -> RenderedFrame:
+        """RGB (unless ``rgb`` is False) and labels of ``snapshot`` seen by ``camera`` under ``condition``
+        (None: the stage's UsdLux lights as they are, no weather).
 
-        ``seconds`` in the result holds ``load`` (first load or reload) or ``update``, then ``labels``
-        and ``rgb``."""
+        ``seconds`` in the result holds ``load`` (first load or reload) or ``update``, then ``labels``,
+        ``rgb`` and ``weather`` (fog, rain and exposure in image space)."""
         seconds = {}
         t0 = time.perf_counter()
         if self._scene is None:
-            self._load(snapshot, camera)
+            self._load(snapshot, camera, condition)
             seconds["load"] = time.perf_counter() - t0
-        elif not self._same_layout(snapshot):
-            self._load(snapshot, camera)
+        elif not self._same_layout(snapshot, condition):
+            self._load(snapshot, camera, condition)
             self.reloads += 1
             seconds["load"] = time.perf_counter() - t0
         else:
-            self._update(snapshot, camera)
+            self._update(snapshot, camera, condition)
             seconds["update"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         w, h = self.config.width, self.config.height
         hits = trace_pixel_centres(self.mi, self._scene, self._translation.shape_ids, camera, w, h)
         class_ids, instance_ids = label_maps(hits, snapshot)
         seconds["labels"] = time.perf_counter() - t0
-        image = None
+        image = exposure = None
         if rgb:
             t0 = time.perf_counter()
+            if condition is not None and self._translation.lamps:
+                self._focus_lamps(hits, camera)
             image = render_rgb(self.mi, self._scene, self.config, show_progress)
             seconds["rgb"] = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            if condition is not None:
+                image = self._weather(image, hits, camera, condition, snapshot)
+            exposure = choose_exposure(image, hits.mesh_index >= 0)
+            seconds["weather"] = time.perf_counter() - t0
         return RenderedFrame(rgb=image, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
-                             variant=self.variant, seconds=seconds)
+                             variant=self.variant, seconds=seconds, exposure=exposure, condition=condition)
+
+    def _focus_lamps(self, hits, camera: PinholeCamera, count: int = 1024) -> None:
+        """Sample lamps in proportion to what they bring to ``count`` surface points this frame sees (an
+        even spread of the label rays' hits)."""
+        h, w = hits.distance_m.shape
+        hit = np.flatnonzero(hits.mesh_index.ravel() >= 0)
+        if len(hit):
+            chosen = hit[np.linspace(0, len(hit) - 1, min(count, len(hit))).astype(np.int64)]
+            origins, directions = camera.pixel_center_rays(w, h)
+            points = origins[chosen] + directions[chosen] * hits.distance_m.ravel()[chosen, None]
+            weather_scene.focus_lamps(self._params, self._translation.shape_ids, self._translation.lamps,
+                                      self._lighting, points)
+            self._params.update()
+
+    def _weather(self, image: np.ndarray, hits, camera: PinholeCamera, condition: Condition,
+                 snapshot: SceneSnapshot) -> np.ndarray:
+        """Fog, then rain streaks in front of it; the rain of a frame is seeded by the session's seed, the
+        camera and the time code."""
+        airlight = self._lighting.airlight
+        image = weather.apply_fog(image, hits.distance_m, hits.mesh_index >= 0, condition.fog_extinction_per_m,
+                                  airlight)
+        rng = np.random.default_rng([self.config.seed, zlib.crc32(camera.path.encode("utf-8")),
+                                     int(round(snapshot.time_code * 1000)) & 0xFFFFFFFF])
+        return weather.rain_streaks(image, hits.z_m, camera, condition.rain_rate_mm_per_h, airlight, rng,
+                                    snapshot.up_axis)

@@ -12,7 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from synthua_usd.backends.mitsuba import weather_scene
+from synthua_usd.backends.mitsuba.weather_scene import LampMesh
 from synthua_usd.cameras import PinholeCamera
+from synthua_usd.conditions import Condition
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import Light, Material, SceneSnapshot
 
@@ -25,6 +28,10 @@ class Translation:
 
     scene: dict
     shape_ids: tuple[str, ...]
+    #: With a condition: the lamp meshes given (dark) area emitters, and what of the condition is built in
+    #: (:func:`weather_scene.scene_key`).
+    lamps: tuple[LampMesh, ...] = ()
+    condition_key: tuple | None = None
 
 
 def shape_id(index: int) -> str:
@@ -72,7 +79,7 @@ def sensor_dict(mi, camera: PinholeCamera, config: RenderConfig, spp: int | None
     }
 
 
-def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter=None):
+def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter=None, face_attributes=None):
     props = mi.Properties()
     props["bsdf"] = bsdf
     if emitter is not None:
@@ -82,12 +89,23 @@ def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter
     params["vertex_positions"] = type(params["vertex_positions"])(np.ascontiguousarray(points, np.float32).ravel())
     params["faces"] = type(params["faces"])(np.ascontiguousarray(triangles, np.uint32).ravel())
     params.update()
+    for name, values in (face_attributes or {}).items():
+        mesh.add_attribute(name, 1, type(params["vertex_positions"])(values))
     return mesh
 
 
-def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: RenderConfig) -> Translation:
-    """The Mitsuba scene for ``snapshot`` seen by ``camera`` (one shape per gprim, flat shading)."""
-    bsdfs = {key: mi.load_dict(bsdf_dict(m)) for key, m in sorted(snapshot.materials.items())}
+def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: RenderConfig,
+              condition: Condition | None = None) -> Translation:
+    """The Mitsuba scene for ``snapshot`` seen by ``camera`` (one shape per gprim, flat shading).
+
+    With a ``condition`` the scene also holds what :mod:`weather_scene` builds (sky emitters, dark area
+    emitters on lamp meshes, weathered BSDFs and their face attributes), and leaves out the environment's
+    own UsdLux sun and sky, which are the condition's approximation for viewers; the caller then sets the
+    condition with :func:`weather_scene.apply_condition`."""
+    face_weights = weather_scene.mesh_face_weights(snapshot, condition)
+    lamps = weather_scene.lamp_meshes(snapshot) if condition is not None else ()
+    lamp_indices = {lamp.index for lamp in lamps}
+    bsdfs: dict = {}
     scene: dict = {"type": "scene",
                    "integrator": {"type": "path", "max_depth": config.max_depth},
                    "sensor": sensor_dict(mi, camera, config)}
@@ -95,11 +113,21 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
     for i, item in enumerate(snapshot.meshes):
         key = shape_id(i)
         material = snapshot.materials[item.material_key]
+        layers = frozenset(face_weights[i])
+        if (material.key, layers) not in bsdfs:
+            bsdfs[(material.key, layers)] = mi.load_dict(
+                weather_scene.surface_bsdf_dict(bsdf_dict(material), material, layers))
         emitter = None
-        if any(material.emissive_color):
+        if i in lamp_indices:
+            emitter = weather_scene.dark_area_emitter(mi)
+        elif any(material.emissive_color):
             emitter = mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": list(material.emissive_color)}})
-        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[item.material_key], emitter)
+        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[(material.key, layers)], emitter,
+                           face_weights[i])
         shape_ids.append(key)
-    for k, light in enumerate(snapshot.lights):
+    for k, light in enumerate(weather_scene.own_lights(snapshot, condition)):
         scene[f"light_{k:03d}"] = emitter_dict(light)
-    return Translation(scene=scene, shape_ids=tuple(shape_ids))
+    if condition is not None:
+        scene.update(weather_scene.sky_emitter(mi, snapshot.up_axis, condition.sun_up))
+    return Translation(scene=scene, shape_ids=tuple(shape_ids), lamps=lamps,
+                       condition_key=weather_scene.scene_key(condition))

@@ -1,0 +1,297 @@
+"""What a condition (:class:`synthua_usd.conditions.Condition`) puts into a Mitsuba scene, and how the loaded
+scene is switched from one condition to another.
+
+Built into the scene when it is loaded with a condition (:mod:`synthua_usd.backends.mitsuba.translate`):
+
+* the sky: Mitsuba's ``sunsky`` emitter (Hosek–Wilkie sky and sun, turbidity, ground albedo) while the sun
+  is up, else a uniform ``constant`` dome for the night sky (Mitsuba allows one environment emitter per
+  scene, and ``sunsky`` is dark with the sun below the horizon);
+* an ``area`` emitter on every lamp mesh (:mod:`synthua_usd.lamps`), dark until a condition turns it on;
+* weathered surfaces, only when the condition has them: a ``blendbsdf`` per material between the dry
+  ``principled`` BSDF and a wet or snowy one, weighted per face by a mesh attribute (``face_wet``,
+  ``face_snow``) that holds the wetness or snow cover of upward-facing faces.
+
+:func:`apply_condition` then sets, through ``traverse()`` parameters and without reloading: the sun's
+direction, turbidity, the sun and sky scales (fog dims the sun, see :mod:`synthua_usd.backends.weather`),
+the night sky's radiance, every lamp's radiance, and the emitters' sampling weights (lumens, so unlit
+lamps are never sampled). Day ↔ night changes the environment emitter's type, and changing wetness or
+snow cover changes the BSDFs and mesh attributes the scene was built with: :func:`scene_key` differs and
+the session reloads.
+
+Wet surfaces (Lekner & Dorf 1988, "Why some things are darker when wet", Applied Optics 27(7)): light
+enters the water film (diffuse reflectance of water r_e ≈ 0.066), and of what the ground (albedo a)
+returns, the share r_i = 1 − (1 − r_e)/n² (n = 1.33) is reflected back down by the film, so the wet
+albedo is a' = (1 − r_e)·a·(1 − r_i)/(1 − a·r_i): darker. The film itself is a smooth clearcoat; the
+ground's roughness halves. Snow: a white (albedo 0.85) rough BSDF.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from synthua_usd.backends.weather import fog_lighting
+from synthua_usd.conditions import SNOW_FREE_CLASSES, SNOW_SLOPE_DEG, WET_GROUND_CLASSES, WET_MAX_SLOPE_DEG, Condition
+from synthua_usd.lamps import KINDS, is_on, lamp_role
+from synthua_usd.photometry import CCT_4000K, CD_PER_M2_PER_UNIT, radiance_rgb
+from synthua_usd.scenario import ENVIRONMENT_PATH
+from synthua_usd.scene import Material, SceneSnapshot
+
+SUNSKY = "sky_sunsky"
+NIGHT_SKY = "sky_night"
+GROUND_ALBEDO = 0.2
+SNOW_ALBEDO = 0.85
+WATER_N = 1.33
+WATER_DIFFUSE_REFLECTANCE = 0.066
+#: Emitters are sampled in proportion to the illuminance (lux) they bring: the sky its horizontal
+#: illuminance, a lamp Φ / (4π d²) at d = REFERENCE_DISTANCE_M until :func:`focus_lamps` measures d for a
+#: camera (never nearer than NEAR_M). The sky keeps a little weight so that a scene with every lamp off
+#: still has an emitter to sample.
+MIN_SKY_WEIGHT = 1e-6
+REFERENCE_DISTANCE_M = 10.0
+NEAR_M = 1.0
+
+
+@dataclass(frozen=True)
+class LampMesh:
+    """A mesh that is a lamp: its index in the snapshot's meshes, role, the labelled instance it belongs to,
+    its area and the area of its instance's meshes of that role (m²), and its centre (3,) world metres."""
+
+    index: int
+    role: str
+    instance_path: str
+    area_m2: float
+    instance_area_m2: float
+    centre: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Lighting:
+    """What :func:`apply_condition` set: the sun and sky scales (fog), ``airlight`` (3,) float64, the linear
+    RGB radiance of fog at infinite distance (renderer units), and the luminous flux of every lit lamp mesh
+    by mesh index."""
+
+    sun_scale: float
+    sky_scale: float
+    airlight: np.ndarray
+    lamp_flux_lm: dict[int, float]
+
+
+def up_vector(up_axis: str) -> np.ndarray:
+    return np.array([0.0, 1.0, 0.0]) if up_axis == "Y" else np.array([0.0, 0.0, 1.0])
+
+
+def _class_names(snapshot: SceneSnapshot) -> dict[int, str]:
+    names = {0: "unlabelled"}
+    names.update({inst.class_id: inst.class_name for inst in snapshot.instances})
+    return names
+
+
+def _instance_paths(snapshot: SceneSnapshot) -> dict[int, str]:
+    return {inst.id: inst.prim_path for inst in snapshot.instances}
+
+
+def _areas(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    a, b, c = (points[triangles[:, i]] for i in range(3))
+    return 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+
+
+def lamp_meshes(snapshot: SceneSnapshot) -> tuple[LampMesh, ...]:
+    """Every lamp mesh of ``snapshot`` (authored ``synthua:lamp`` or a lamp class)."""
+    names, paths = _class_names(snapshot), _instance_paths(snapshot)
+    found = []
+    for i, item in enumerate(snapshot.meshes):
+        role = lamp_role(item.lamp, names.get(item.class_id, ""))
+        if role:
+            found.append((i, role, paths.get(item.instance_id, item.prim_path),
+                          float(_areas(item.points, item.triangles).sum()), tuple(item.points.mean(axis=0))))
+    totals: dict[tuple[str, str], float] = {}
+    for _, role, path, area, _ in found:
+        totals[(path, role)] = totals.get((path, role), 0.0) + area
+    return tuple(LampMesh(i, role, path, area, totals[(path, role)], centre) for i, role, path, area, centre in found)
+
+
+# --- surfaces -------------------------------------------------------------------------------------------
+
+def scene_key(condition: Condition | None) -> tuple | None:
+    """The part of a condition built into the loaded scene, a change of which means a reload: the type of
+    the environment emitter (sun up or not), and wetness and snow cover (BSDFs and mesh attributes)."""
+    if condition is None:
+        return None
+    return (condition.sun_up, condition.ground_wetness, condition.snow_cover)
+
+
+def wet_albedo(albedo: np.ndarray) -> np.ndarray:
+    """Lekner & Dorf's albedo of a surface of ``albedo`` under a water film (see the module docstring)."""
+    a = np.asarray(albedo, np.float64)
+    r_i = 1.0 - (1.0 - WATER_DIFFUSE_REFLECTANCE) / WATER_N ** 2
+    return (1.0 - WATER_DIFFUSE_REFLECTANCE) * a * (1.0 - r_i) / (1.0 - a * r_i)
+
+
+def face_weights(item, class_name: str, up: np.ndarray, condition: Condition) -> dict[str, np.ndarray]:
+    """``face_wet`` and ``face_snow`` (m,) float32 weights of ``item``'s triangles, only those not all zero."""
+    wetness = condition.ground_wetness if class_name in WET_GROUND_CLASSES else 0.0
+    snow = condition.snow_cover if class_name not in SNOW_FREE_CLASSES else 0.0
+    if wetness == 0.0 and snow == 0.0:
+        return {}
+    p, t = item.points, item.triangles
+    normals = np.cross(p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]])
+    cos_up = normals @ up / np.maximum(np.linalg.norm(normals, axis=1), 1e-12)
+    out = {}
+    if wetness:
+        out["face_wet"] = wetness * (cos_up >= math.cos(math.radians(WET_MAX_SLOPE_DEG)))
+    if snow:
+        full, none = (math.cos(math.radians(a)) for a in SNOW_SLOPE_DEG)
+        out["face_snow"] = snow * np.clip((cos_up - none) / (full - none), 0.0, 1.0)
+    return {k: v.astype(np.float32) for k, v in out.items() if np.any(v > 0)}
+
+
+def _wet_dict(dry: dict, material: Material) -> dict:
+    wet = dict(dry)
+    wet["base_color"] = {"type": "rgb", "value": wet_albedo(material.base_color).tolist()}
+    wet["roughness"] = 0.5 * dry["roughness"]
+    wet["clearcoat"] = 1.0
+    wet["clearcoat_gloss"] = 0.9
+    return wet
+
+
+def surface_bsdf_dict(dry: dict, material: Material, layers: frozenset[str]) -> dict:
+    """The BSDF dict of ``material`` with the weathering ``layers`` (``face_wet``, ``face_snow``) over its dry
+    ``principled`` dict ``dry``."""
+    node = dry
+    if "face_wet" in layers:
+        node = {"type": "blendbsdf", "weight": {"type": "mesh_attribute", "name": "face_wet"},
+                "bsdf_0": node, "bsdf_1": _wet_dict(dry, material)}
+    if "face_snow" in layers:
+        node = {"type": "blendbsdf", "weight": {"type": "mesh_attribute", "name": "face_snow"},
+                "bsdf_0": node, "bsdf_1": {"type": "principled", "roughness": 0.7,
+                                           "base_color": {"type": "rgb", "value": [SNOW_ALBEDO] * 3}}}
+    return node
+
+
+def mesh_face_weights(snapshot: SceneSnapshot, condition: Condition | None) -> list[dict[str, np.ndarray]]:
+    """Per mesh of ``snapshot``, its weathering attributes under ``condition`` (empty dicts when dry)."""
+    if condition is None or (condition.ground_wetness, condition.snow_cover) == (0.0, 0.0):
+        return [{} for _ in snapshot.meshes]
+    names, up = _class_names(snapshot), up_vector(snapshot.up_axis)
+    return [face_weights(item, names.get(item.class_id, ""), up, condition) for item in snapshot.meshes]
+
+
+# --- emitters ------------------------------------------------------------------------------------------
+
+def own_lights(snapshot: SceneSnapshot, condition: Condition | None) -> tuple:
+    """The snapshot's UsdLux lights to render: all of them without a condition; with one, all but the
+    environment prim's own sun and sky, which stand in for the condition in viewers."""
+    if condition is None:
+        return snapshot.lights
+    return tuple(light for light in snapshot.lights if not light.prim_path.startswith(ENVIRONMENT_PATH + "/"))
+
+
+def sky_emitter(mi, up_axis: str, sun_up: bool) -> dict:
+    """The environment emitter, dark until :func:`apply_condition`: ``sunsky`` (its frame is Z up; on Y-up
+    stages it is turned so that its zenith is +Y; its ``sun_direction`` is a world direction) or, with the
+    sun down, a ``constant`` night dome."""
+    if not sun_up:
+        return {NIGHT_SKY: {"type": "constant", "radiance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}}
+    to_world = mi.ScalarTransform4f().rotate([1, 0, 0], -90) if up_axis == "Y" else mi.ScalarTransform4f()
+    return {SUNSKY: {"type": "sunsky", "sun_direction": up_vector(up_axis).tolist(), "to_world": to_world,
+                     "sun_scale": 0.0, "sky_scale": 0.0}}
+
+
+def dark_area_emitter(mi):
+    return mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}})
+
+
+def apply_condition(mi, params, shape_ids: tuple[str, ...], lamps: tuple[LampMesh, ...], condition: Condition,
+                    snapshot: SceneSnapshot, meter: "LightMeter") -> Lighting:
+    """Set the sky and lamp parameters of a scene loaded by ``translate(..., condition=...)`` to ``condition``
+    (``params.update()`` is left to the caller)."""
+    if condition.sun_up:
+        direction = condition.sun_direction(snapshot.up_axis)
+        albedo = GROUND_ALBEDO + (SNOW_ALBEDO - GROUND_ALBEDO) * condition.snow_cover
+        e_sun, e_sky = meter.measure(direction, condition.turbidity, albedo, snapshot.up_axis)
+        sun_scale, sky_scale, airlight = fog_lighting(condition, e_sun, e_sky)
+        params[f"{SUNSKY}.sun_direction"] = type(params[f"{SUNSKY}.sun_direction"])(*map(float, direction))
+        params[f"{SUNSKY}.turbidity"] = type(params[f"{SUNSKY}.turbidity"])(float(condition.turbidity))
+        params[f"{SUNSKY}.albedo.value"] = type(params[f"{SUNSKY}.albedo.value"])(float(albedo))
+        params[f"{SUNSKY}.sun_scale"] = float(sun_scale)
+        params[f"{SUNSKY}.sky_scale"] = float(sky_scale)
+        sky_lux = float(np.mean(sun_scale * e_sun + sky_scale * e_sky)) * CD_PER_M2_PER_UNIT
+        params[f"{SUNSKY}.sampling_weight"] = max(sky_lux, MIN_SKY_WEIGHT)
+    else:
+        sun_scale = sky_scale = 0.0
+        airlight = np.asarray(radiance_rgb(condition.night_sky_luminance_cd_m2, CCT_4000K))
+        params[f"{NIGHT_SKY}.radiance.value"] = type(params[f"{NIGHT_SKY}.radiance.value"])(*map(float, airlight))
+        params[f"{NIGHT_SKY}.sampling_weight"] = max(math.pi * condition.night_sky_luminance_cd_m2, MIN_SKY_WEIGHT)
+    flux_lm: dict[int, float] = {}
+    for lamp in lamps:
+        kind = KINDS[lamp.role]
+        on = is_on(kind, condition, lamp.instance_path)
+        luminance = kind.luminance(lamp.instance_area_m2) if on else 0.0
+        key = shape_ids[lamp.index]
+        params[f"{key}.emitter.radiance.value"] = type(params[f"{key}.emitter.radiance.value"])(
+            *radiance_rgb(luminance, kind.color))
+        flux_lm[lamp.index] = math.pi * lamp.area_m2 * luminance
+        params[f"{key}.emitter.sampling_weight"] = flux_lm[lamp.index] / (4.0 * math.pi * REFERENCE_DISTANCE_M ** 2)
+    return Lighting(sun_scale=sun_scale, sky_scale=sky_scale, airlight=np.asarray(airlight, np.float64),
+                    lamp_flux_lm=flux_lm)
+
+
+def focus_lamps(params, shape_ids: tuple[str, ...], lamps: tuple[LampMesh, ...], lighting: Lighting,
+                points: np.ndarray) -> None:
+    """Weight lit lamps for the frame about to be rendered: by the illuminance Φ / (4π d²) each would give,
+    on average, at ``points`` (n, 3) world metres, the surfaces this camera sees (d at least
+    :data:`NEAR_M`). Only the choice of which emitter to sample changes, not the image it converges to
+    (every lit lamp keeps a positive weight); with tens of lamps it is what keeps a night frame from being
+    mostly noise. ``params.update()`` is left to the caller."""
+    if not lamps or len(points) == 0:
+        return
+    centres = np.array([lamp.centre for lamp in lamps])
+    d2 = np.maximum(((points[None, :, :] - centres[:, None, :]) ** 2).sum(axis=2), NEAR_M ** 2)
+    mean_inverse_square = (1.0 / d2).mean(axis=1)
+    for lamp, focus in zip(lamps, mean_inverse_square):
+        flux = lighting.lamp_flux_lm.get(lamp.index, 0.0)
+        params[f"{shape_ids[lamp.index]}.emitter.sampling_weight"] = flux / (4.0 * math.pi) * float(focus)
+
+
+class LightMeter:
+    """Horizontal irradiance (3,) of a ``sunsky``'s sun and of its sky alone, renderer units:
+    E = ∫ L cosθ dω, estimated by sampling directions from the emitter itself (2^16 of them, seeded), so
+    the sun disk is sampled as well as the dome. Results are cached per sky."""
+
+    SAMPLES = 1 << 16
+
+    def __init__(self, mi) -> None:
+        self.mi = mi
+        self._cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+
+    def _irradiance(self, emitter: dict, up: np.ndarray) -> np.ndarray:
+        mi = self.mi
+        sky = mi.load_dict({"type": "scene", "sky": emitter}).emitters()[0]
+        origin = mi.Interaction3f()
+        origin.p = mi.Point3f(0.0, 0.0, 0.0)
+        if mi.variant().startswith("scalar"):  # one direction per call: a golden-ratio lattice of 4096
+            n, total = 4096, np.zeros(3)
+            for k in range(n):
+                ds, weight = sky.sample_direction(origin, mi.Point2f((k + 0.5) / n, (k * 0.6180339887498949) % 1.0))
+                total += np.array([weight[0], weight[1], weight[2]]) * max(float(np.dot(ds.d, up)), 0.0)
+            return total / n
+        sampler = mi.load_dict({"type": "independent"})
+        sampler.seed(0, self.SAMPLES)
+        ds, weight = sky.sample_direction(origin, sampler.next_2d())
+        cos = mi.Float(0.0) + ds.d[0] * float(up[0]) + ds.d[1] * float(up[1]) + ds.d[2] * float(up[2])
+        cos = np.maximum(np.asarray(cos, np.float64), 0.0)
+        return np.array([float(np.mean(np.asarray(weight[i], np.float64) * cos)) for i in range(3)])
+
+    def measure(self, direction: np.ndarray, turbidity: float, albedo: float,
+                up_axis: str) -> tuple[np.ndarray, np.ndarray]:
+        key = (tuple(np.round(direction, 9)), turbidity, albedo, up_axis)
+        if key not in self._cache:
+            base = sky_emitter(self.mi, up_axis, sun_up=True)[SUNSKY]
+            base.update(sun_direction=[float(x) for x in direction], turbidity=float(turbidity), albedo=float(albedo))
+            up = up_vector(up_axis)
+            self._cache[key] = (self._irradiance(dict(base, sun_scale=1.0, sky_scale=0.0), up),
+                                self._irradiance(dict(base, sun_scale=0.0, sky_scale=1.0), up))
+        return self._cache[key]
