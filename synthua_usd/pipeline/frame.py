@@ -151,7 +151,7 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
         entry = inst.to_dict()
         entry["pixel_count"] = int(inst_counts[inst.id])
         instances.append(entry)
-    return {
+    document = {
         "$schema": "frame.schema.json",
         "generator": f"synthua-usd {__version__}",
         "stage": str(stage_path),
@@ -181,3 +181,6 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
         "class_pixel_counts": {class_map.by_id(i).name: int(n) for i, n in enumerate(class_counts) if n},
         "instances": instances,
     }
+    if camera.distortion is not None:  # K is the ideal pinhole's; pixels went through this lens model
+        document["camera"]["distortion"] = camera.distortion.to_dict()
+    return document

@@ -18,6 +18,7 @@ import time
 import numpy as np
 
 from synthua_usd.backends.mitsuba import variants
+from synthua_usd.backends.mitsuba.lens import distorted_sensor
 from synthua_usd.backends.mitsuba.render import RenderedFrame, label_maps, render_rgb, trace_pixel_centres
 from synthua_usd.backends.mitsuba.translate import Translation, sensor_to_world, translate
 from synthua_usd.cameras import PinholeCamera
@@ -103,7 +104,9 @@ class RenderSession:
         image = None
         if rgb:
             t0 = time.perf_counter()
-            image = render_rgb(self.mi, self._scene, self.config, show_progress)
+            # Mitsuba's perspective sensor cannot distort: a lens with distortion renders through its own sensor.
+            sensor = distorted_sensor(self.mi, camera, self.config) if camera.distortion is not None else None
+            image = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor)
             seconds["rgb"] = time.perf_counter() - t0
         return RenderedFrame(rgb=image, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
                              variant=self.variant, seconds=seconds)
