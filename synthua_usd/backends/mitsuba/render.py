@@ -64,17 +64,19 @@ def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sen
     return (total / config.spp).astype(np.float32)
 
 
-def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCamera, width: int, height: int) -> LabelHits:
+def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCamera, width: int, height: int,
+                        camera_rays: bool = False) -> LabelHits:
     """One primary ray through each pixel centre; first hit per pixel. ``shape_ids`` are the Mitsuba ids of the
     snapshot's meshes, in order.
 
     An ideal pinhole asks the scene's sensor for its rays at ((x + 0.5) / W, (y + 0.5) / H). A camera with lens
-    distortion gets rays computed from the plain-data camera (:meth:`PinholeCamera.pixel_center_rays`, the
-    Brown–Conrady model inverted per pixel centre), started on the near clipping plane as Mitsuba's
-    perspective sensor starts its own, and traced the same way."""
+    distortion (or any camera, with ``camera_rays``: then the scene's sensor need not point at it) gets rays
+    computed from the plain-data camera (:meth:`PinholeCamera.pixel_center_rays`, the Brown–Conrady model
+    inverted per pixel centre), started on the near clipping plane as Mitsuba's perspective sensor starts its
+    own, and traced the same way."""
     keys = {key: i for i, key in enumerate(shape_ids)}
     scalar = mi.variant().startswith("scalar")
-    if camera.distortion is None:
+    if camera.distortion is None and not camera_rays:
         sensor = scene.sensors()[0]
         rays = _sensor_rays_scalar(mi, sensor, width, height) if scalar else _sensor_rays_jit(mi, sensor, width, height)
     else:

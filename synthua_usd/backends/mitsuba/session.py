@@ -78,6 +78,20 @@ class RenderSession:
         self._snapshot = snapshot
         return moved
 
+    def quick_labels(self, snapshot: SceneSnapshot, camera: PinholeCamera) -> np.ndarray:
+        """(H, W) uint16 instance ids of ``camera``'s pixel-centre rays computed from its lens values, without
+        pointing the scene's sensor at it (a sensor change costs a full parameter update): the cheap pass for
+        many throw-away views of one snapshot, such as scoring camera placements. Ids agree with
+        :meth:`render`'s up to float32 rounding of the ray directions; dataset labels come from :meth:`render`."""
+        if self._scene is None or not self._same_layout(snapshot):
+            self._load(snapshot, camera)
+            self.reloads += self.loads > 1
+        elif snapshot is not self._snapshot:
+            self._update(snapshot, camera)
+        hits = trace_pixel_centres(self.mi, self._scene, self._translation.shape_ids, camera, self.config.width,
+                                   self.config.height, camera_rays=True)
+        return label_maps(hits, snapshot)[1]
+
     def render(self, snapshot: SceneSnapshot, camera: PinholeCamera, rgb: bool = True,
                show_progress: bool = False) -> RenderedFrame:
         """RGB (unless ``rgb`` is False) and labels of ``snapshot`` seen by ``camera``.
