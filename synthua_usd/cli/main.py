@@ -168,12 +168,16 @@ def create_street(out_dir: Path) -> int:
 @click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Layout and crowd seed.")
 def create_district(out_dir: Path, seed: int) -> int:
     """Write the Largo da Ordem demo district as a full scenario into OUT_DIR: twin, semantics, a populated
-    agents layer, cameras (CCTV, pedestrian and wheelchair eye level, UAV), environment, render settings
-    and scenario.usda."""
-    from synthua_usd.demo.district import district_scenario
-    from synthua_usd.usd.scenario_writer import write_scenario
+    agents layer, cameras (CCTV, pedestrian and wheelchair eye level, UAV), camera rigs aimed at the crowd's
+    mobility-aid users (rigs.usda, with rigs.report.json: see `synthua cameras author`), environment,
+    render settings (through the first aimed CCTV) and scenario.usda."""
+    from synthua_usd.cli.cameras_commands import format_table
+    from synthua_usd.demo import district
+    from synthua_usd.pipeline.aimed_scenario import write_scenario_with_rigs
 
-    for path in write_scenario(district_scenario(seed), out_dir):
+    paths, rigs = write_scenario_with_rigs(district.district_scenario(seed), district.district_aimed_rigs(), out_dir)
+    click.echo(format_table(rigs.report))
+    for path in paths:
         click.echo(f"wrote {path}")
     return EXIT_OK
 
