@@ -55,7 +55,9 @@ DEFAULT_REPORT_TIME_CODES = 7
 EXTRA_TARGETS = 2
 #: Riders tried per riding rig and target (the nearest ones that have the target ahead).
 MAX_RIDERS = 16
-#: Candidates per target counted at more than the first scoring time code.
+#: Candidates per target kept by the line-of-sight test for label passes, and counted at more than the first
+#: scoring time code.
+PREFILTER_KEEP = 6
 SCORE_KEEP = 3
 
 
@@ -135,6 +137,7 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
         found = usd_targets.find_targets(stage, spec.aim, reader.instances, tracks, report_tcs, source)
         groups += _candidates(k, spec, found[:spec.count + EXTRA_TARGETS], terrain, tracks, all_tcs, report_tcs, fps,
                               request, source)
+    _prefilter(groups, terrain, report_tcs[len(report_tcs) // 2])
     _score(groups, reader, request, report_tcs, show_progress)
     chosen = _choose(groups, request.rigs, names)
     evaluated = _evaluate(chosen, reader, request, report_tcs, tracks, show_progress)
@@ -290,6 +293,33 @@ def _ahead(riders: list, target, time_code: float) -> list:
 
 def _count(ids: np.ndarray, wanted) -> int:
     return int(np.isin(ids, list(wanted)).sum())
+
+
+def _prefilter(groups: list[_Group], terrain: Terrain, time_code: float) -> None:
+    """Keep the PREFILTER_KEEP candidates of each target with the clearest sight of it (Embree rays from the
+    camera to its box's centre and eight points half-way to its corners, against the static twin; agents do
+    not block here, the label passes see them), ties broken by the larger image of the target (focal length
+    over distance). Only these are scored by label passes."""
+    for g in groups:
+        if g.target is None or len(g.candidates) <= PREFILTER_KEEP:
+            continue
+        lo, hi = g.target.boxes[time_code]
+        centre = (lo + hi) / 2
+        points = np.array([centre] + [centre + 0.5 * (np.array([x, y, z]) - centre)
+                                      for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        eyes = np.array([c.camera_to_world(time_code)[:3, 3] for c in g.candidates])
+        origins = np.repeat(eyes, len(points), axis=0)
+        ends = np.tile(points, (len(eyes), 1))
+        dirs = ends - origins
+        dist = np.linalg.norm(dirs, axis=1)
+        locations, ray_idx, _ = terrain.mesh.ray.intersects_location(origins, dirs / dist[:, None],
+                                                                     multiple_hits=False)
+        blocked = np.zeros(len(origins), bool)
+        blocked[ray_idx] = np.linalg.norm(locations - origins[ray_idx], axis=1) < dist[ray_idx] - 0.3
+        clear = (~blocked).reshape(len(eyes), len(points)).sum(axis=1)
+        size = np.array([c.focal_length_mm for c in g.candidates]) / np.linalg.norm(eyes - centre, axis=1)
+        keep = np.lexsort((-size, -clear))[:PREFILTER_KEEP]
+        g.candidates = [g.candidates[i] for i in sorted(keep)]
 
 
 def _score(groups: list[_Group], reader: StageReader, request: RigRequest, report_tcs: list[float],
