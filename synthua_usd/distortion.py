@@ -75,17 +75,18 @@ class BrownConrady:
 
     # --- the model --------------------------------------------------------------------------------------
 
-    def distort(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Undistorted → distorted normalised coordinates; arrays of any (same) shape, float64."""
-        x, y = np.asarray(x, np.float64), np.asarray(y, np.float64)
+    def distort(self, x, y):
+        """Undistorted → distorted normalised coordinates. Plain arithmetic, so ``x``, ``y`` may be numbers,
+        numpy arrays (float64 here) or the renderer's own arrays (the distorting sensor runs it in Dr.Jit)."""
         r2 = x * x + y * y
         radial = 1.0 + r2 * (self.k1 + r2 * (self.k2 + r2 * self.k3))
         xd = x * radial + 2.0 * self.p1 * x * y + self.p2 * (r2 + 2.0 * x * x)
         yd = y * radial + self.p1 * (r2 + 2.0 * y * y) + 2.0 * self.p2 * x * y
         return xd, yd
 
-    def jacobian(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, ...]:
-        """The forward map's partial derivatives (dxd/dx, dxd/dy, dyd/dx, dyd/dy) at (x, y)."""
+    def jacobian(self, x, y) -> tuple:
+        """The forward map's partial derivatives (dxd/dx, dxd/dy, dyd/dx, dyd/dy) at (x, y) (any array type,
+        as :meth:`distort`)."""
         r2 = x * x + y * y
         radial = 1.0 + r2 * (self.k1 + r2 * (self.k2 + r2 * self.k3))
         dradial = self.k1 + r2 * (2.0 * self.k2 + 3.0 * self.k3 * r2)  # d radial / d r2

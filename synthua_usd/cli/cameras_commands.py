@@ -76,7 +76,7 @@ def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_ta
     Examples:
       synthua cameras author stages/district/scenario.usda --out rigs.usda --min-target-px 2000 \\
           --rig cctv:aim=electric_wheelchair,count=2 --rig dashcam --rig uav_oblique:height_m=30 \\
-          --rig wheelchair_eye:ride=auto,aim=crossing --rig pedestrian_eye:k1=-0.2,k2=0.05
+          --rig pedestrian_eye:ride=auto,aim=crossing --rig wheelchair_eye:k1=-0.2,k2=0.05
       synthua compose with-rigs.usda rigs.usda stages/district/scenario.usda
     Distortion (k1, k2, k3, p1, p2; OpenCV's convention) is stored on the camera as synthua:distortion:*
     attributes and applied to RGB and labels alike by `synthua render`.

@@ -42,25 +42,15 @@ def distorted_sensor(mi, camera: PinholeCamera, config: RenderConfig, spp: int |
     near, far = float(camera.clip_near_m), float(camera.clip_far_m)
     basis = [[float(v) for v in axis] for axis in (right, up, forward)]
 
-    def forward_map(x, y):
-        r2 = x * x + y * y
-        radial = 1.0 + r2 * (dist.k1 + r2 * (dist.k2 + r2 * dist.k3))
-        return (x * radial + 2.0 * dist.p1 * x * y + dist.p2 * (r2 + 2.0 * x * x),
-                y * radial + dist.p1 * (r2 + 2.0 * y * y) + 2.0 * dist.p2 * x * y)
-
     def undistort(xd, yd):
+        """Newton on the library's own forward model and Jacobian, in Dr.Jit arithmetic."""
         x, y = xd, yd
         for _ in range(NEWTON_STEPS):
-            r2 = x * x + y * y
-            radial = 1.0 + r2 * (dist.k1 + r2 * (dist.k2 + r2 * dist.k3))
-            dradial = dist.k1 + r2 * (2.0 * dist.k2 + 3.0 * dist.k3 * r2)
-            a = radial + 2.0 * x * x * dradial + 2.0 * dist.p1 * y + 6.0 * dist.p2 * x
-            b = 2.0 * x * y * dradial + 2.0 * dist.p1 * x + 2.0 * dist.p2 * y
-            d = radial + 2.0 * y * y * dradial + 6.0 * dist.p1 * y + 2.0 * dist.p2 * x
-            fx_, fy_ = forward_map(x, y)
+            a, b, c, d = dist.jacobian(x, y)
+            fx_, fy_ = dist.distort(x, y)
             rx, ry = fx_ - xd, fy_ - yd
-            inv_det = dr.rcp(a * d - b * b)
-            x, y = x - (d * rx - b * ry) * inv_det, y - (a * ry - b * rx) * inv_det
+            inv_det = dr.rcp(a * d - b * c)
+            x, y = x - (d * rx - b * ry) * inv_det, y - (a * ry - c * rx) * inv_det
         return x, y
 
     class DistortedPerspective(mi.Sensor):
