@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import trimesh
+from scipy import ndimage
 
 from synthua_usd import geometry as geo
 from synthua_usd import roads
@@ -116,13 +117,24 @@ class Terrain:
         return float(locations[0, 2]) if len(locations) else math.nan
 
     def cells(self, surfaces: tuple[str, ...], facade: bool = False) -> np.ndarray:
-        """(n, 3) centres of grid cells on ``surfaces`` (or, with ``facade``, beside a building)."""
+        """(n, 3) centres of grid cells on ``surfaces``; with ``facade``, only those next to (8-neighbours
+        of) a cell whose first surface seen from above is a building's."""
         g = self.grid
+        mask = np.isin(g.surface, surfaces) & g.walkable
         if facade:
-            ij = g.cells_beside("building")
-        else:
-            ij = list(zip(*np.nonzero(np.isin(g.surface, surfaces) & g.walkable)))
-        return np.array([g.centre(i, j) for i, j in ij], np.float64).reshape(-1, 3)
+            mask &= ndimage.binary_dilation(self._covered_by("building"), np.ones((3, 3), bool))
+        return np.array([g.centre(i, j) for i, j in zip(*np.nonzero(mask))], np.float64).reshape(-1, 3)
+
+    def _covered_by(self, class_name: str) -> np.ndarray:
+        """(ny, nx) bool: the first surface a ray straight down through the cell's centre meets is ``class_name``."""
+        g = self.grid
+        ny, nx_ = g.z.shape
+        gx, gy = np.meshgrid(g.x0 + (np.arange(nx_) + 0.5) * g.cell_m, g.y0 + (np.arange(ny) + 0.5) * g.cell_m)
+        top = self.vertices[:, 2].max() + 10.0
+        origins = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, top)])
+        tri = self.mesh.ray.intersects_first(origins, np.tile([0.0, 0.0, -1.0], (len(origins), 1)))
+        covered = (tri >= 0) & (self.face_class[np.maximum(tri, 0)] == class_name)
+        return covered.reshape(ny, nx_)
 
 
 def fit_focal(pose: np.ndarray, corners: np.ndarray, spec: RigSpec, width: int, height: int) -> float:
@@ -209,7 +221,7 @@ def fixed_candidates(spec: RigSpec, terrain: Terrain, anchor: np.ndarray, corner
             mounts += [("pole on " + terrain.grid.surface[terrain.grid.cell_of(*p[:2])], p)
                        for p in _ring(terrain.cells(POLE_SURFACES), anchor, d_lo, d_hi)]
         if spec.mount in ("any", "facade"):
-            mounts += [("façade", p) for p in _ring(terrain.cells((), facade=True), anchor, d_lo, d_hi)]
+            mounts += [("façade", p) for p in _ring(terrain.cells(MOUNT_CLASSES, facade=True), anchor, d_lo, d_hi)]
     else:  # standing at eye level
         d_lo, d_hi = 3.0, spec.distance_m or DEFAULT_DISTANCE_M[spec.type]
         mounts = [("standing on " + terrain.grid.surface[terrain.grid.cell_of(*p[:2])], p)

@@ -31,7 +31,8 @@ from synthua_usd.agents.walkable import WALKABLE
 from synthua_usd.atomic import atomic_path
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.errors import InputError, StageError, echo
-from synthua_usd.placement import Placement, Terrain, dashcam_candidates, fixed_candidates, riding_placement
+from synthua_usd.placement import (DEFAULT_DISTANCE_M, Placement, Terrain, dashcam_candidates, fixed_candidates,
+                                   riding_placement)
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.resources import check_frame_memory
 from synthua_usd.rigs import RigSpec
@@ -249,9 +250,10 @@ def _candidates(k: int, spec: RigSpec, found: list, terrain: Terrain, tracks: li
         return [_Group(k, None, placements[:1])]
     groups = [_Group(k, t, fixed_candidates(spec, terrain, t.anchor(), t.corners(), w, h)) for t in found]
     if not any(g.candidates for g in groups):
-        raise InputError(f"{source}: found no place for a {spec.type} around its targets (mount {spec.mount}, "
-                         f"within {spec.distance_m or 'the default'} m); expected sidewalks, squares or façades nearby "
-                         f"(or a larger distance_m)")
+        reach = spec.distance_m or DEFAULT_DISTANCE_M.get(spec.type)
+        raise InputError(f"{source}: found no place for a {spec.type} around its targets (mount {spec.mount}"
+                         + (f", within {reach:g} m" if reach else "") + "); expected sidewalks, squares or façades "
+                         "nearby (or a larger distance_m)")
     return [g for g in groups if g.candidates]
 
 
