@@ -10,7 +10,7 @@ the frame without leaving it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -228,9 +228,6 @@ class RigSpec:
                 raise InputError(f"{source}: {echo(key)} is given twice; expected each key once")
             data[key] = _convert(source, key, value, types.get(key, "str"))
         return cls.from_dict(data, source)
-
-    def with_name(self, name: str) -> "RigSpec":
-        return replace(self, name=name)
 
 
 @dataclass(frozen=True)

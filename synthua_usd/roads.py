@@ -13,7 +13,6 @@ only where it stays on cells with room for the car.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import networkx as nx
@@ -129,9 +128,3 @@ def drive(route: np.ndarray, start_m: float, distances_m: np.ndarray, look_m: fl
     grade = np.arctan2(delta[:, 2], np.maximum(np.linalg.norm(delta[:, :2], axis=1), 1e-9))
     return pos, heading, grade
 
-
-def describe(net: RoadNetwork) -> str:
-    cells = int(net.grid.walkable.sum())
-    return (f"{cells} road cells of {net.grid.cell_m:g} m ({cells * net.grid.cell_m ** 2:.0f} m²), "
-            f"{net.graph.number_of_nodes()} with room for a car; widest clearance {net.clearance_m.max():.1f} m"
-            if math.isfinite(net.clearance_m.max()) else "no road")

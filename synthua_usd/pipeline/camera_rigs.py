@@ -19,18 +19,17 @@ import json
 import logging
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from pxr import UsdGeom
-from tqdm import tqdm
 
 from synthua_usd import __version__
 from synthua_usd.agents.walkable import WALKABLE
 from synthua_usd.atomic import atomic_path
-from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.errors import InputError, StageError, echo
+from synthua_usd.pipeline.target_pixels import CandidateGroup, evaluate, prefilter, score
 from synthua_usd.placement import (DEFAULT_DISTANCE_M, Placement, Terrain, dashcam_candidates, fixed_candidates,
                                    riding_placement)
 from synthua_usd.render_config import RenderConfig
@@ -56,10 +55,6 @@ DEFAULT_REPORT_TIME_CODES = 7
 EXTRA_TARGETS = 2
 #: Riders tried per riding rig and target (the nearest ones that have the target ahead).
 MAX_RIDERS = 16
-#: Candidates per target kept by the line-of-sight test for label passes, and counted at more than the first
-#: scoring time code.
-PREFILTER_KEEP = 6
-SCORE_KEEP = 3
 
 
 @dataclass(frozen=True)
@@ -84,24 +79,11 @@ class RigRequest:
         return self.out_path.with_name(self.out_path.stem + ".report.json")
 
 
-@dataclass(eq=False)
-class _Group:
-    """Candidates of one rig for one target (None: a rig that aims at nothing)."""
-
-    rig: int
-    target: usd_targets.Target | None
-    candidates: list[Placement]
-    scores: list[float] = field(default_factory=list)
-
-    def best(self) -> tuple[Placement, float]:
-        if not self.scores:
-            return self.candidates[0], math.nan
-        k = int(np.argmax(self.scores))
-        return self.candidates[k], self.scores[k]
-
-
 @dataclass(frozen=True, eq=False)
 class RigsResult:
+    """What :func:`author_rigs` wrote: the report (as written), both paths, and how many cameras were written
+    and rejected."""
+
     report: dict
     layer_path: Path
     report_path: Path
@@ -138,10 +120,11 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
         found = usd_targets.find_targets(stage, spec.aim, reader.instances, tracks, report_tcs, source)
         groups += _candidates(k, spec, found[:spec.count + EXTRA_TARGETS], terrain, tracks, all_tcs, report_tcs, fps,
                               request, source)
-    _prefilter(groups, terrain, report_tcs[len(report_tcs) // 2])
-    _score(groups, reader, request, report_tcs, show_progress)
+    config = RenderConfig(width=request.width, height=request.height, spp=1, variant=request.variant)
+    prefilter(groups, terrain, report_tcs[len(report_tcs) // 2])
+    score(groups, reader, request.rigs, config, report_tcs, show_progress)
     chosen = _choose(groups, request.rigs, names)
-    evaluated = _evaluate(chosen, reader, request, report_tcs, tracks, show_progress)
+    evaluated = evaluate(chosen, reader, config, report_tcs, tracks, show_progress)
     rows, placed = [], []
     for (rig, target), frames in evaluated:
         entry = _camera_entry(rig, target, frames, request.min_target_px, terrain, report_tcs)
@@ -225,17 +208,18 @@ def _names(rigs: tuple[RigSpec, ...], taken: set[str]) -> list[list[str]]:
 
 
 def _candidates(k: int, spec: RigSpec, found: list, terrain: Terrain, tracks: list, all_tcs: list[float],
-                report_tcs: list[float], fps: float, request: RigRequest, source: str) -> list[_Group]:
+                report_tcs: list[float], fps: float, request: RigRequest, source: str) -> list[CandidateGroup]:
     w, h = request.width, request.height
     if spec.type == "dashcam":
         drives = dashcam_candidates(spec, terrain, all_tcs, fps, aimed=bool(found))
-        return [_Group(k, t, drives) for t in found] or [_Group(k, None, drives)]
+        return [CandidateGroup(k, t, drives) for t in found] or [CandidateGroup(k, None, drives)]
     if spec.ride is not None:
         riders = _riders(spec, tracks, source)
         if not found:
-            return [_Group(k, None, [riding_placement(spec, riders[0], all_tcs)])]
+            return [CandidateGroup(k, None, [riding_placement(spec, riders[0], all_tcs)])]
         mid = report_tcs[len(report_tcs) // 2]
-        groups = [_Group(k, t, [riding_placement(spec, r, all_tcs) for r in _ahead(riders, t, mid)]) for t in found]
+        groups = [CandidateGroup(k, t, [riding_placement(spec, r, all_tcs) for r in _ahead(riders, t, mid)])
+                  for t in found]
         if not any(g.candidates for g in groups):
             raise InputError(f"{source}: the only agents to ride with are its targets; expected another "
                              f"{'wheelchair user' if spec.type == 'wheelchair_eye' else 'agent on foot'} to ride with")
@@ -247,8 +231,8 @@ def _candidates(k: int, spec: RigSpec, found: list, terrain: Terrain, tracks: li
         if not placements:
             raise InputError(f"{source}: found no place to stand near the centre of the walkable area; expected "
                              f"sidewalks or squares (or give aim=...)")
-        return [_Group(k, None, placements[:1])]
-    groups = [_Group(k, t, fixed_candidates(spec, terrain, t.anchor(), t.corners(), w, h)) for t in found]
+        return [CandidateGroup(k, None, placements[:1])]
+    groups = [CandidateGroup(k, t, fixed_candidates(spec, terrain, t.anchor(), t.corners(), w, h)) for t in found]
     if not any(g.candidates for g in groups):
         reach = spec.distance_m or DEFAULT_DISTANCE_M.get(spec.type)
         raise InputError(f"{source}: found no place for a {spec.type} around its targets (mount {spec.mount}"
@@ -293,67 +277,7 @@ def _ahead(riders: list, target, time_code: float) -> list:
     return ahead or [s[3] for s in scored[:4]]
 
 
-def _count(ids: np.ndarray, wanted) -> int:
-    return int(np.isin(ids, list(wanted)).sum())
-
-
-def _prefilter(groups: list[_Group], terrain: Terrain, time_code: float) -> None:
-    """Keep the PREFILTER_KEEP candidates of each target with the clearest sight of it (Embree rays from the
-    camera to its box's centre and eight points half-way to its corners, against the static twin; agents do
-    not block here, the label passes see them), ties broken by the larger image of the target (focal length
-    over distance). Only these are scored by label passes."""
-    for g in groups:
-        if g.target is None or len(g.candidates) <= PREFILTER_KEEP:
-            continue
-        lo, hi = g.target.boxes[time_code]
-        centre = (lo + hi) / 2
-        points = np.array([centre] + [centre + 0.5 * (np.array([x, y, z]) - centre)
-                                      for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-        eyes = np.array([c.camera_to_world(time_code)[:3, 3] for c in g.candidates])
-        origins = np.repeat(eyes, len(points), axis=0)
-        ends = np.tile(points, (len(eyes), 1))
-        dirs = ends - origins
-        dist = np.linalg.norm(dirs, axis=1)
-        locations, ray_idx, _ = terrain.mesh.ray.intersects_location(origins, dirs / dist[:, None],
-                                                                     multiple_hits=False)
-        blocked = np.zeros(len(origins), bool)
-        blocked[ray_idx] = np.linalg.norm(locations - origins[ray_idx], axis=1) < dist[ray_idx] - 0.3
-        clear = (~blocked).reshape(len(eyes), len(points)).sum(axis=1)
-        size = np.array([c.focal_length_mm for c in g.candidates]) / np.linalg.norm(eyes - centre, axis=1)
-        keep = np.lexsort((-size, -clear))[:PREFILTER_KEEP]
-        g.candidates = [g.candidates[i] for i in sorted(keep)]
-
-
-def _score(groups: list[_Group], reader: StageReader, request: RigRequest, report_tcs: list[float],
-           show_progress: bool) -> None:
-    """Each aimed candidate's score: the fewest visible target pixels over three report time codes (middle,
-    first, last), counted at a quarter of the image size (at least 160 wide) and scaled to the full size. All
-    candidates are counted at the middle time code; only the best SCORE_KEEP of each target at the others."""
-    aimed = [g for g in groups if g.target is not None and len(g.candidates) > 1]
-    if not aimed:
-        return
-    sw = max(min(request.width, 160), request.width // 4)
-    sh = max(1, round(sw * request.height / request.width))
-    scale = request.width * request.height / (sw * sh)
-    session = RenderSession(RenderConfig(width=sw, height=sh, spp=1, variant=request.variant))
-    order = list(dict.fromkeys([report_tcs[len(report_tcs) // 2], report_tcs[0], report_tcs[-1]]))
-    counts = {id(g): np.full((len(g.candidates), len(order)), np.inf) for g in aimed}
-    for j, tc in enumerate(tqdm(order, desc="placing", unit="time code", disable=not show_progress, leave=False)):
-        snap = reader.snapshot(tc)
-        for g in aimed:
-            spec, c = request.rigs[g.rig], counts[id(g)]
-            todo = range(len(g.candidates)) if j == 0 else np.argsort(-c.min(axis=1), kind="stable")[:SCORE_KEEP]
-            for i in todo:
-                ids = session.quick_labels(snap, g.candidates[i].camera(spec, "/candidate", tc))
-                c[i, j] = _count(ids, g.target.instance_ids) * scale
-    for g in aimed:
-        c = counts[id(g)]
-        seen = np.where(np.isfinite(c), c, 0.0)
-        # Candidates not counted at every time code rank below those that were; ties broken by the mean.
-        g.scores = list(np.where(np.isfinite(c).all(axis=1), c.min(axis=1), -1.0) + 1e-3 * seen.mean(axis=1))
-
-
-def _choose(groups: list[_Group], rigs: tuple[RigSpec, ...], names: list[list[str]]) -> list[tuple]:
+def _choose(groups: list[CandidateGroup], rigs: tuple[RigSpec, ...], names: list[list[str]]) -> list[tuple]:
     """Per rig, its ``count`` best targets (by their best candidate's score) with their best candidates, as
     (PlacedRig, Target or None) pairs."""
     out = []
@@ -366,38 +290,6 @@ def _choose(groups: list[_Group], rigs: tuple[RigSpec, ...], names: list[list[st
             log.warning("rig %d (%s): only %d target(s) to aim at; camera %s not placed", k + 1, spec.type,
                         len(ranked), name)
     return out
-
-
-def _evaluate(chosen: list, reader: StageReader, request: RigRequest, report_tcs: list[float], tracks: list,
-              show_progress: bool) -> list:
-    """Per chosen rig, a list of per-time-code dicts: target pixels visible and alone, the target's pixels
-    per instance, and every aid user's visible pixels."""
-    config = RenderConfig(width=request.width, height=request.height, spp=1, variant=request.variant)
-    session = RenderSession(config)
-    alone = {target.prim_path: RenderSession(config) for _, target in chosen if target is not None}
-    users = {a.prim_path: a.instance_ids for a in tracks if a.device}
-    paths = {i.id: i.prim_path for i in reader.instances.values()}
-    frames = {id(rig): [] for rig, _ in chosen}
-    for tc in tqdm(report_tcs, desc="reporting", unit="time code", disable=not show_progress, leave=False):
-        snap = reader.snapshot(tc)
-        for rig, target in chosen:
-            camera = rig.placement.camera(rig.spec, rig.prim_path, tc)
-            ids = session.render(snap, camera, rgb=False).instance_ids
-            counts = np.bincount(ids.ravel(), minlength=len(paths) + 1)
-            entry = {"time_code": tc, "camera_to_world": camera.camera_to_world.tolist(),
-                     "aid_users_px": {p: int(counts[list(i)].sum()) for p, i in users.items() if counts[list(i)].sum()}}
-            if target is not None:
-                only = SceneSnapshot(tc, snap.up_axis, tuple(m for m in snap.meshes if m.instance_id in
-                                                             target.instance_ids), snap.materials, snap.lights,
-                                     snap.instances)
-                alone_px = _count(alone[target.prim_path].render(only, camera, rgb=False).instance_ids,
-                                  target.instance_ids)
-                visible = int(counts[list(target.instance_ids)].sum())
-                entry.update(target_px=visible, alone_px=alone_px,
-                             occluded_fraction=None if alone_px == 0 else round(1.0 - visible / alone_px, 4),
-                             parts_px={paths[i]: int(counts[i]) for i in target.instance_ids})
-            frames[id(rig)].append(entry)
-    return [((rig, target), frames[id(rig)]) for rig, target in chosen]
 
 
 def _camera_entry(rig: PlacedRig, target, frames: list[dict], min_px: int, terrain: Terrain,

@@ -89,6 +89,9 @@ def test_zero_distortion_is_bit_identical_to_the_pinhole(street, session):
     near_zero = session.render(snap, dataclasses.replace(pinhole, distortion=BrownConrady(k1=1e-15)), rgb=False)
     assert np.array_equal(near_zero.instance_ids, plain.instance_ids)
     assert np.abs(near_zero.hits.z_m - plain.hits.z_m).max() < 2e-3
+    # quick_labels (camera placement's pass) takes that path without pointing the sensor: same ids here
+    assert np.array_equal(session.quick_labels(snap, cameras["PedestrianEye"]),
+                          session.render(snap, cameras["PedestrianEye"], rgb=False).instance_ids)
 
 
 def test_the_rgb_sensor_shoots_the_label_rays(variant, tiny):
