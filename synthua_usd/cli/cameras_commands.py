@@ -66,7 +66,7 @@ def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_ta
       pedestrian_eye  about 1.6 m; wheelchair_eye: about 1.2 m; standing still, or ride=auto / ride=AGENT
                       to ride with an agent (a walking one, a wheelchair user) over the animation
     \b
-    Aims: aid_user (agents whose person uses a mobility aid, largest first), a device class
+    Aims: aid_user (agents whose person uses a mobility aid, wheelchair users first), a device class
     (electric_wheelchair, walker, ...), crossing, curb_ramp, none, or a prim path. Each candidate place is
     scored by the target's visible pixels in the exact label pass (one ray per pixel centre); the best is
     kept and the target's focal length fitted (unless focal_length_mm is given). The report gives, per
