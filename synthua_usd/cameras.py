@@ -7,6 +7,9 @@ Frames and conventions
 * Pixel (0, 0) is the top-left pixel; pixel centres are at integer + 0.5; image y grows downward.
 * Intrinsics ``K`` follow OpenCV: x right, y down, z forward; ``cx = W/2``, ``cy = H/2`` (no lens shift).
 * Lens values are in millimetres here. USD authors them in tenths of a scene unit; the USD reader converts.
+* An optional Brown–Conrady ``distortion`` (:mod:`synthua_usd.distortion`, OpenCV's convention) acts on
+  normalised image coordinates: ``K`` stays the ideal pinhole's, and a pixel centre's ray goes through the
+  undistorted point that the lens maps onto it.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from synthua_usd.distortion import BrownConrady
 from synthua_usd.errors import InputError
 
 #: USD's default ``aspectRatioConformPolicy``: when the image and aperture aspects differ, the aperture
@@ -37,6 +41,8 @@ class PinholeCamera:
         Clipping range, metres.
     camera_to_world : (4, 4) float64
         Rigid transform, column-vector convention, metres.
+    distortion : BrownConrady or None
+        Lens distortion; None (and all-zero coefficients, which are stored as None) is the ideal pinhole.
     """
 
     path: str
@@ -46,6 +52,7 @@ class PinholeCamera:
     clip_near_m: float
     clip_far_m: float
     camera_to_world: np.ndarray = field(repr=False)
+    distortion: BrownConrady | None = None
 
     def __post_init__(self) -> None:
         for name in ("focal_length_mm", "horizontal_aperture_mm", "vertical_aperture_mm"):
@@ -59,6 +66,8 @@ class PinholeCamera:
         if m.shape != (4, 4) or not np.all(np.isfinite(m)):
             raise InputError(f"camera {self.path}: camera_to_world should be a finite 4x4 matrix")
         object.__setattr__(self, "camera_to_world", m)
+        if self.distortion is not None and self.distortion.is_zero:
+            object.__setattr__(self, "distortion", None)  # zero distortion is the pinhole, exactly
 
     # --- image formation -------------------------------------------------------------------------
 
@@ -109,16 +118,42 @@ class PinholeCamera:
         """Rays through every pixel centre, row-major from the top-left pixel.
 
         Returns ``origins`` (H*W, 3) float64 and unit ``directions`` (H*W, 3) float64, world space.
-        Computed from the lens values alone, independently of any renderer.
+        Computed from the lens values alone, independently of any renderer. With ``distortion``, each pixel
+        centre's distorted normalised coordinates are inverted (:meth:`BrownConrady.undistort`) first.
         """
         k = self.intrinsics(width, height)
         xs = (np.arange(width) + 0.5 - k[0, 2]) / k[0, 0]
         ys = (np.arange(height) + 0.5 - k[1, 2]) / k[1, 1]
         gx, gy = np.meshgrid(xs, ys)
+        if self.distortion is not None:
+            gx, gy = self.distortion.undistort(gx, gy, where=f"camera {self.path}")
         right, up, forward = self.axes()
         d = gx.reshape(-1, 1) * right - gy.reshape(-1, 1) * up + forward
         d /= np.linalg.norm(d, axis=1, keepdims=True)
         return np.broadcast_to(self.origin, d.shape).copy(), d
+
+
+    def project(self, points: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """Pixel coordinates (n, 2) float64 (pixel centres at +0.5, distortion applied) and OpenCV depth
+        ``z`` (n,) float64 metres of world ``points`` (n, 3); points with z <= 0 are behind the camera and
+        get NaN coordinates."""
+        ext = self.world_to_camera_opencv()
+        pc = np.asarray(points, np.float64) @ ext[:3, :3].T + ext[:3, 3]
+        z = pc[:, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x, y = np.where(z > 0, pc[:, 0] / z, np.nan), np.where(z > 0, pc[:, 1] / z, np.nan)
+        if self.distortion is not None:
+            x, y = self.distortion.distort(x, y)
+        k = self.intrinsics(width, height)
+        return np.column_stack([k[0, 0] * x + k[0, 2], k[1, 1] * y + k[1, 2]]), z
+
+    def check_distortion(self, width: int, height: int) -> None:
+        """Refuse a distortion that cannot be inverted over a W×H image (its pixel centres and corners)."""
+        if self.distortion is None:
+            return
+        k = self.intrinsics(width, height)
+        half_w, half_h = width / 2.0 / k[0, 0], height / 2.0 / k[1, 1]
+        self.distortion.check_field(half_w, half_h, where=f"camera {self.path}")
 
 
 def _check_size(width: int, height: int) -> None:

@@ -8,12 +8,16 @@ import trimesh
 
 
 def reference_labels(snapshot, camera, width: int, height: int):
-    """(class_ids, instance_ids, hit_distance) as (H, W) arrays from first hits of pixel-centre rays."""
+    """(class_ids, instance_ids) as (H, W) arrays from first hits of pixel-centre rays."""
+    return labels_of_rays(snapshot, *camera.pixel_center_rays(width, height), width, height)
+
+
+def labels_of_rays(snapshot, origins, dirs, width: int, height: int):
+    """(class_ids, instance_ids) as (H, W) arrays from first hits of the rays (H*W, 3), row-major."""
     from trimesh.ray.ray_pyembree import RayMeshIntersector
 
     verts, faces, owner = snapshot.world_triangles()
     mesh = trimesh.Trimesh(verts, faces, process=False, validate=False)
-    origins, dirs = camera.pixel_center_rays(width, height)
     tri = RayMeshIntersector(mesh).intersects_first(origins, dirs)
     hit = tri >= 0
     mesh_index = np.where(hit, owner[np.maximum(tri, 0)], -1)

@@ -64,3 +64,27 @@ def test_image_up_is_world_up():
 def test_bad_values_are_refused_with_the_value(field, value, text):
     with pytest.raises(InputError, match=text.replace("(", r"\(")):
         camera(**{field: value})
+
+
+def test_distorted_pixel_rays_project_back_onto_their_pixel_centres():
+    from synthua_usd.distortion import BrownConrady
+
+    cam = camera(camera_to_world=look_at((3, -7, 4), (0, 1, 0.5)),
+                 distortion=BrownConrady(k1=-0.25, k2=0.05, p1=0.001, p2=-0.002))
+    w, h = 64, 48
+    origins, dirs = cam.pixel_center_rays(w, h)
+    uv, z = cam.project(origins + 5.0 * dirs, w, h)
+    ys, xs = np.mgrid[0:h, 0:w]
+    assert np.all(z > 0)
+    assert np.abs(uv[:, 0] - (xs.ravel() + 0.5)).max() < 1e-8 and np.abs(uv[:, 1] - (ys.ravel() + 0.5)).max() < 1e-8
+    # and the lens does bend them: the corner ray leaves the pinhole's corner by pixels, not rounding
+    _, plain = camera(camera_to_world=cam.camera_to_world).pixel_center_rays(w, h)
+    assert np.degrees(np.arccos(np.clip(dirs[0] @ plain[0], -1, 1))) > 2.0
+
+
+def test_zero_distortion_is_the_pinhole():
+    from synthua_usd.distortion import BrownConrady
+
+    zero = camera(distortion=BrownConrady())
+    assert zero.distortion is None
+    assert zero.pixel_center_rays(8, 6)[1].tobytes() == camera().pixel_center_rays(8, 6)[1].tobytes()

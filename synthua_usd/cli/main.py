@@ -8,7 +8,6 @@ malformed file, unknown camera, time code out of range, bad option, an output th
 from __future__ import annotations
 
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -17,7 +16,9 @@ import click
 
 from synthua_usd import __version__
 from synthua_usd.cli.agents_commands import agents
+from synthua_usd.cli.cameras_commands import cameras
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
+from synthua_usd.cli.common import parse_time_codes as _time_codes
 from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.twin_commands import twin
@@ -168,47 +169,21 @@ def create_street(out_dir: Path) -> int:
 @click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Layout and crowd seed.")
 def create_district(out_dir: Path, seed: int) -> int:
     """Write the Largo da Ordem demo district as a full scenario into OUT_DIR: twin, semantics, a populated
-    agents layer, cameras (CCTV, pedestrian and wheelchair eye level, UAV), environment, render settings
-    and scenario.usda."""
-    from synthua_usd.demo.district import district_scenario
-    from synthua_usd.usd.scenario_writer import write_scenario
+    agents layer, cameras (CCTV, pedestrian and wheelchair eye level, UAV), camera rigs aimed at the crowd's
+    mobility-aid users (rigs.usda, with rigs.report.json: see `synthua cameras author`), environment,
+    render settings (through the first aimed CCTV) and scenario.usda."""
+    from synthua_usd.cli.cameras_commands import format_table
+    from synthua_usd.demo import district
+    from synthua_usd.pipeline.aimed_scenario import write_scenario_with_rigs
 
-    for path in write_scenario(district_scenario(seed), out_dir):
+    paths, rigs = write_scenario_with_rigs(district.district_scenario(seed), district.district_aimed_rigs(), out_dir)
+    click.echo(format_table(rigs.report))
+    for path in paths:
         click.echo(f"wrote {path}")
     return EXIT_OK
 
 
 # --- render --------------------------------------------------------------------------------------------------
-
-def _time_codes(ctx, param, values: tuple[str, ...]) -> tuple[float, ...]:
-    """``--time-code 24 --time-code 1:48:8 --frame 1,12``: single time codes, comma lists, and START:END[:STEP]
-    ranges with END included when the steps reach it."""
-    out: list[float] = []
-    for value in values:
-        for item in value.split(","):
-            item = item.strip()
-            try:
-                if ":" in item:
-                    parts = [float(x) for x in item.split(":")]
-                    if len(parts) not in (2, 3):
-                        raise ValueError
-                    start, end, step = parts[0], parts[1], parts[2] if len(parts) == 3 else 1.0
-                    if not (all(map(math.isfinite, parts)) and step > 0 and end >= start):
-                        raise ValueError
-                    count = int(math.floor((end - start) / step + 1e-9)) + 1
-                    if count > 100_000:
-                        raise click.BadParameter(f"{item!r} holds {count} time codes; at most 100000", ctx, param)
-                    out += [start + k * step for k in range(count)]
-                else:
-                    number = float(item)
-                    if not math.isfinite(number):
-                        raise ValueError
-                    out.append(number)
-            except ValueError:
-                raise click.BadParameter(f"{item!r} is not a time code, a comma list or START:END[:STEP] with "
-                                         f"finite numbers, STEP > 0 and END >= START", ctx, param) from None
-    return tuple(dict.fromkeys(out))
-
 
 @cli.command()
 @click.argument("scenario", type=click.Path(path_type=Path))
@@ -271,7 +246,7 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     return EXIT_OK
 
 
-for _group in (twin, agents, survey, contact_sheet):
+for _group in (twin, agents, cameras, survey, contact_sheet):
     cli.add_command(_group)
 
 

@@ -22,6 +22,7 @@ from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
 from synthua_usd.assets import buildings, devices, market, nature, place, street, vehicles
 from synthua_usd.cameras import CameraSpec
 from synthua_usd.materials import WALL_COLOURS, subset
+from synthua_usd.rigs import AimedRigs, RigSpec
 from synthua_usd.scenario import ScenarioSpec, StageMetadata
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart
@@ -447,6 +448,30 @@ DISTRICT_CAMERAS = (
     CameraSpec("UAV_Oblique", (-60.0, -70.0, 55.0), (0.0, 0.0, 0.0), 24.0, 36.0, 24.0,
                "UAV, oblique 45 degrees over the district."),
 )
+
+
+#: Cameras aimed at the crowd's mobility-aid users, placed in the written district by the machinery of
+#: `synthua cameras author` (rigs.usda, with rigs.report.json beside it): two CCTVs on the two first-ranked aid
+#: users (wheelchair users first), a pedestrian's and a seated wheelchair user's eye level, two UAV views, and a
+#: dashcam driving the road. Each aimed camera must show its target with DISTRICT_MIN_TARGET_PX visible
+#: pixels at 1280x960 at every DISTRICT_RIG_TIME_CODES, or it is reported and left out.
+DISTRICT_RIGS = (
+    RigSpec("cctv", name="CCTV_AidUser", aim="aid_user", count=2),
+    RigSpec("pedestrian_eye", name="PedestrianEye_AidUser", aim="aid_user"),
+    RigSpec("wheelchair_eye", name="WheelchairEye_AidUser", aim="aid_user"),
+    RigSpec("uav_oblique", name="UAVOblique_AidUser", aim="aid_user", height_m=30.0),
+    RigSpec("uav_nadir", name="UAVNadir_AidUser", aim="aid_user", height_m=30.0),
+    RigSpec("dashcam", name="Dashcam_Road", aim="none"),
+)
+DISTRICT_MIN_TARGET_PX = 2000
+DISTRICT_RIG_TIME_CODES = (1.0, 12.0, 24.0, 36.0, 48.0)
+#: The render settings' camera when it is placed (else CCTV_Largo stays).
+DISTRICT_RENDER_RIG = "CCTV_AidUser_1"
+
+
+def district_aimed_rigs() -> AimedRigs:
+    """The district's aimed rigs, placed when the district is written (``synthua create district``)."""
+    return AimedRigs(DISTRICT_RIGS, DISTRICT_MIN_TARGET_PX, DISTRICT_RIG_TIME_CODES, DISTRICT_RENDER_RIG)
 
 
 def district_crowd(model: TwinModel, seed: int = 0, class_map: ClassMap | None = None) -> Crowd:

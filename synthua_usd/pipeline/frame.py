@@ -157,7 +157,7 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
         entry = inst.to_dict()
         entry["pixel_count"] = int(inst_counts[inst.id])
         instances.append(entry)
-    return {
+    document = {
         "$schema": "frame.schema.json",
         "generator": f"synthua-usd {__version__}",
         "stage": str(stage_path),
@@ -189,3 +189,6 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
         "condition": rendered.condition.to_dict() if rendered.condition is not None else None,
         "exposure": rendered.exposure.to_dict() if rendered.exposure is not None else None,
     }
+    if camera.distortion is not None:  # K is the ideal pinhole's; pixels went through this lens model
+        document["camera"]["distortion"] = camera.distortion.to_dict()
+    return document

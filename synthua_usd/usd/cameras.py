@@ -2,22 +2,31 @@
 
 USD measures focalLength and the apertures in tenths of a scene unit (so millimetres on a centimetre
 stage, and 1/100 of the millimetre value on a metre stage). Everything outside this module uses mm.
+
+Lens distortion is stored on the camera prim as custom attributes (not an applied schema: a schema would
+need a plugin every reader must load, while custom attributes open anywhere): ``synthua:distortion:model
+= "brown_conrady"`` and the doubles ``synthua:distortion:k1``, ``k2``, ``k3``, ``p1``, ``p2`` (OpenCV's
+convention, see :mod:`synthua_usd.distortion`).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from pxr import Gf, Usd, UsdGeom
+from pxr import Gf, Sdf, Usd, UsdGeom
 
 from synthua_usd.cameras import PinholeCamera
+from synthua_usd.distortion import COEFFICIENTS, MODEL, BrownConrady
 from synthua_usd.errors import StageError
-from synthua_usd.usd.prim_checks import camera_findings, lens_unit_mm, raise_first_error
+from synthua_usd.usd.prim_checks import DISTORTION_PREFIX, camera_findings, lens_unit_mm, raise_first_error, read_distortion
 
 
 def author_camera(stage: Usd.Stage, path: str, camera_to_world: np.ndarray, *, focal_length_mm: float,
                   horizontal_aperture_mm: float, vertical_aperture_mm: float, clip_near_m: float,
-                  clip_far_m: float, meters_per_unit: float, doc: str = "") -> UsdGeom.Camera:
-    """Define a perspective camera. ``camera_to_world`` (4, 4), column-vector convention, metres."""
+                  clip_far_m: float, meters_per_unit: float, doc: str = "",
+                  time_samples: dict[float, np.ndarray] | None = None,
+                  distortion: BrownConrady | None = None) -> UsdGeom.Camera:
+    """Define a perspective camera. ``camera_to_world`` (4, 4), column-vector convention, metres; with
+    ``time_samples`` ({time code: (4, 4)}) the transform is time-sampled instead (a moving camera)."""
     unit = lens_unit_mm(meters_per_unit)
     cam = UsdGeom.Camera.Define(stage, path)
     cam.CreateProjectionAttr(UsdGeom.Tokens.perspective)
@@ -25,11 +34,33 @@ def author_camera(stage: Usd.Stage, path: str, camera_to_world: np.ndarray, *, f
     cam.CreateHorizontalApertureAttr(horizontal_aperture_mm / unit)
     cam.CreateVerticalApertureAttr(vertical_aperture_mm / unit)
     cam.CreateClippingRangeAttr(Gf.Vec2f(clip_near_m / meters_per_unit, clip_far_m / meters_per_unit))
-    # Gf matrices are row-vector (translation in the last row): the transpose of ours.
-    cam.AddTransformOp().Set(Gf.Matrix4d(np.asarray(camera_to_world, float).T.tolist()))
+    op = cam.AddTransformOp()
+    if time_samples:
+        for t, m in sorted(time_samples.items()):
+            op.Set(_gf_matrix(m, meters_per_unit), Usd.TimeCode(t))
+    else:
+        op.Set(_gf_matrix(camera_to_world, meters_per_unit))
+    if distortion is not None and not distortion.is_zero:
+        author_distortion(cam.GetPrim(), distortion)
     if doc:
         cam.GetPrim().SetDocumentation(doc)
     return cam
+
+
+def _gf_matrix(camera_to_world: np.ndarray, meters_per_unit: float) -> Gf.Matrix4d:
+    """Our (4, 4) metres matrix as USD's: Gf matrices are row-vector (translation in the last row), the
+    transpose of ours, and translations are in scene units."""
+    m = np.array(camera_to_world, float)
+    m[:3, 3] /= meters_per_unit
+    return Gf.Matrix4d(m.T.tolist())
+
+
+def author_distortion(prim: Usd.Prim, distortion: BrownConrady) -> None:
+    """Store ``distortion`` on a camera prim as ``synthua:distortion:*`` custom attributes."""
+    prim.CreateAttribute(DISTORTION_PREFIX + "model", Sdf.ValueTypeNames.Token, custom=True).Set(MODEL)
+    for name in COEFFICIENTS:
+        prim.CreateAttribute(DISTORTION_PREFIX + name, Sdf.ValueTypeNames.Double, custom=True).Set(
+            getattr(distortion, name))
 
 
 def camera_paths(stage: Usd.Stage) -> list[str]:
@@ -53,6 +84,7 @@ def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
     t = Usd.TimeCode(time_code)
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
     raise_first_error(camera_findings(prim, t, mpu))
+    _, distortion = read_distortion(prim, t)
     unit = lens_unit_mm(mpu)
     near, far = cam.GetClippingRangeAttr().Get(t)
     m = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(t), float).T
@@ -60,4 +92,5 @@ def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
     return PinholeCamera(path=path, focal_length_mm=float(cam.GetFocalLengthAttr().Get(t)) * unit,
                          horizontal_aperture_mm=float(cam.GetHorizontalApertureAttr().Get(t)) * unit,
                          vertical_aperture_mm=float(cam.GetVerticalApertureAttr().Get(t)) * unit,
-                         clip_near_m=float(near) * mpu, clip_far_m=float(far) * mpu, camera_to_world=m)
+                         clip_near_m=float(near) * mpu, clip_far_m=float(far) * mpu, camera_to_world=m,
+                         distortion=distortion)

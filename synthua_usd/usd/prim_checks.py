@@ -12,13 +12,17 @@ import math
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from synthua_usd.errors import StageError
+from synthua_usd.distortion import COEFFICIENTS, MODEL, BrownConrady
+from synthua_usd.errors import InputError, StageError
 from synthua_usd.findings import Finding, Severity
 from synthua_usd.taxonomy import ClassMap
 
 #: Plausible physical lens values; outside them the authored numbers are probably in the wrong unit.
 FOCAL_RANGE_MM = (1.0, 2000.0)
 APERTURE_RANGE_MM = (1.0, 100.0)
+#: Lens distortion lives on the camera prim as custom attributes: ``synthua:distortion:model`` (token,
+#: ``brown_conrady``) and one double per coefficient (``synthua:distortion:k1`` ... ``:p2``).
+DISTORTION_PREFIX = "synthua:distortion:"
 
 
 def lens_unit_mm(meters_per_unit: float) -> float:
@@ -99,4 +103,38 @@ def camera_findings(prim: Usd.Prim, t: Usd.TimeCode, meters_per_unit: float, rul
     if not np.all(np.isfinite(m)) or abs(np.linalg.det(m[:3, :3])) < 1e-12:
         out.append(Finding(rule, path, "transform is not finite and invertible (a zero scale?); expected a rigid "
                                        "placement"))
+    distortion_found, distortion = read_distortion(prim, t, rule)
+    out += distortion_found
+    focal, h_ap, v_ap = (prim.GetAttribute(a).Get(t) for a in ("focalLength", "horizontalAperture", "verticalAperture"))
+    if distortion is not None and all(v is not None and math.isfinite(v) and v > 0 for v in (focal, h_ap, v_ap)):
+        try:  # over the authored filmback; a render checks its own (conformed) image again
+            distortion.check_field(h_ap / 2 / focal, v_ap / 2 / focal, where="distortion")
+        except InputError as exc:
+            out.append(Finding(rule, path, str(exc)))
     return out
+
+
+def read_distortion(prim: Usd.Prim, t: Usd.TimeCode, rule: str = "camera-lens") -> tuple[list[Finding], BrownConrady | None]:
+    """Findings for the camera's ``synthua:distortion:*`` attributes and, when they hold none, the
+    distortion they author (None when the prim has none)."""
+    path = str(prim.GetPath())
+    attrs = [a for a in prim.GetAttributes() if a.GetName().startswith(DISTORTION_PREFIX)]
+    if not attrs:
+        return [], None
+    values, out = {}, []
+    for attr in attrs:
+        name = attr.GetName()[len(DISTORTION_PREFIX):]
+        value = attr.Get(t)
+        if name == "model":
+            if value != MODEL:
+                out.append(Finding(rule, path, f"{attr.GetName()} is {value!r}; expected '{MODEL}'"))
+        elif name not in COEFFICIENTS:
+            out.append(Finding(rule, path, f"{attr.GetName()} is not a distortion coefficient; expected "
+                                           f"{', '.join(DISTORTION_PREFIX + c for c in COEFFICIENTS)}"))
+        elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            out.append(Finding(rule, path, f"{attr.GetName()} is {value!r}; expected a finite number"))
+        else:
+            values[name] = float(value)
+    if out:
+        return out, None
+    return [], BrownConrady(**values)

@@ -2,9 +2,12 @@
 
 import filecmp
 
+from pxr import Sdf
+
 from conftest import STAGES
 from synthua_usd.demo import district
 from synthua_usd.demo.street import street_scenario
+from synthua_usd.rigs import RigSpec
 from synthua_usd.scenario import ROOT_FILE
 
 
@@ -17,10 +20,18 @@ def test_create_street_writes_the_committed_stages(run_cli, tmp_path):
         assert filecmp.cmp(tmp_path / name, STAGES / name, shallow=False), name
 
 
-def test_create_district_passes_the_seed(run_cli, tmp_path, monkeypatch):
-    # The command's wiring only (the district itself is tested in tests/demo): a cheap scenario stands in.
+def test_create_district_passes_the_seed_and_aims_its_rigs(run_cli, tmp_path, monkeypatch):
+    # The command's wiring only (the district itself is tested in tests/demo): a cheap scenario and one cheap
+    # rig stand in.
     seeds = []
     monkeypatch.setattr(district, "district_scenario", lambda seed: seeds.append(seed) or street_scenario())
+    monkeypatch.setattr(district, "DISTRICT_RIGS", (RigSpec("uav_nadir", name="Above", aim="crossing"),))
+    monkeypatch.setattr(district, "DISTRICT_RIG_TIME_CODES", (1.0,))
+    monkeypatch.setattr(district, "DISTRICT_RENDER_RIG", "Above")
     code, out, _ = run_cli("create", "district", tmp_path / "d", "--seed", "3")
     assert code == 0 and seeds == [3]
     assert (tmp_path / "d" / ROOT_FILE).exists() and f"wrote {tmp_path / 'd' / ROOT_FILE}" in out
+    assert "Above" in out and (tmp_path / "d" / "rigs.report.json").exists()
+    root = Sdf.Layer.FindOrOpen(str(tmp_path / "d" / ROOT_FILE))
+    assert "rigs.usda" in root.subLayerPaths
+    assert "</World/Cameras/Above>" in (tmp_path / "d" / "render.usda").read_text()

@@ -1,6 +1,8 @@
 """The Largo da Ordem demo district: completeness, determinism, and labels checked against Embree."""
 
 import filecmp
+import json
+import shutil
 
 import numpy as np
 import pytest
@@ -10,7 +12,8 @@ from pxr import Usd, UsdGeom
 from conftest import DISTRICT, MOBILITY_AIDS
 from reference_raycast import reference_labels
 from synthua_usd.demo import district
-from synthua_usd.demo.district import CROSSWALK_XS, ROAD_Y, build_district, district_scenario
+from synthua_usd.demo.district import CROSSWALK_XS, ROAD_Y, build_district, district_aimed_rigs, district_scenario
+from synthua_usd.pipeline.aimed_scenario import RIGS_FILE, join_rigs
 from synthua_usd.pipeline.frame import FrameRequest, run_frames
 from synthua_usd.usd.scenario_writer import write_scenario
 from synthua_usd.usd.stage_checks import validate_stage
@@ -71,9 +74,17 @@ def test_curb_ramp_at_both_ends_of_every_road_crosswalk(seed0):
 
 @pytest.mark.slow
 def test_committed_district_is_seed_0_and_deterministic(scenario0, tmp_path):
+    # Everything but the rigs' placement (about a minute of label passes; tests/pipeline checks placing, and
+    # test_aimed_views checks the committed rigs' numbers): the scenario's own layers, then the committed
+    # rigs joined in as `synthua create district` joins them.
     written = write_scenario(scenario0, tmp_path)
-    assert sorted(p.name for p in written) == sorted(p.name for p in DISTRICT.iterdir())
-    for path in written:
+    for name in (RIGS_FILE, "rigs.report.json"):
+        shutil.copy(DISTRICT / name, tmp_path / name)
+    names = join_rigs(scenario0, tmp_path, district_aimed_rigs(),
+                      json.loads((DISTRICT / "rigs.report.json").read_text()))
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in DISTRICT.iterdir())
+    assert set(names) == {p.name for p in written} - {"scenario.usda"} | {RIGS_FILE}
+    for path in tmp_path.iterdir():
         assert filecmp.cmp(path, DISTRICT / path.name, shallow=False), \
             f"stages/district/{path.name} differs from seed 0: run `synthua create district stages/district`"
 

@@ -117,3 +117,29 @@ def test_unknown_render_vars_are_ignored_with_a_warning(tmp_path, caplog):
         run_frames(FrameRequest(stage_path=stage_path, out_dir=tmp_path / "out"))
     assert "render vars ['normals'] are not outputs synthua writes" in caplog.text
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(file_names(select_outputs(["class_id"])))
+
+
+def test_a_distorted_camera_renders_with_its_lens_in_frame_json(tmp_path):
+    """Distortion authored on the camera prim (synthua:distortion:*) reaches the labels, the RGB and frame.json."""
+    from pxr import Usd
+
+    from synthua_usd.distortion import BrownConrady
+    from synthua_usd.schemas import validate_document
+    from synthua_usd.usd.cameras import author_distortion
+
+    stage_path = tmp_path / "tiny.usda"
+    shutil.copy(DATA / "valid" / "tiny_scene.usda", stage_path)
+    stage = Usd.Stage.Open(str(stage_path))
+    lens = BrownConrady(k1=-0.3, k2=0.08, p2=0.002)
+    author_distortion(stage.GetPrimAtPath("/World/Cam"), lens)
+    stage.GetRootLayer().Save()
+    runs = {}
+    for name, path in (("lens", stage_path), ("pinhole", DATA / "valid" / "tiny_scene.usda")):
+        runs[name] = run_frames(FrameRequest(stage_path=path, out_dir=tmp_path / name, camera_paths=("/World/Cam",),
+                                             width=48, height=32, spp=4)).frames[0]
+    doc = json.loads((tmp_path / "lens" / FRAME_DOCUMENT).read_text())
+    validate_document(doc, "frame", "frame.json")
+    assert doc["camera"]["distortion"] == lens.to_dict()
+    assert "distortion" not in runs["pinhole"].document["camera"]
+    lensed, plain = runs["lens"].rendered, runs["pinhole"].rendered
+    assert (lensed.instance_ids != plain.instance_ids).any() and not np.array_equal(lensed.rgb, plain.rgb)

@@ -53,30 +53,43 @@ class RenderedFrame:
     condition: Condition | None = None
 
 
-def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False) -> np.ndarray:
-    """(H, W, 3) float32 linear RGB: the mean of passes of at most SPP_PER_PASS samples each."""
+def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sensor=None) -> np.ndarray:
+    """(H, W, 3) float32 linear RGB: the mean of passes of at most SPP_PER_PASS samples each; ``sensor`` (e.g. a
+    :func:`synthua_usd.backends.mitsuba.lens.distorted_sensor`) replaces the scene's own."""
     passes = math.ceil(config.spp / SPP_PER_PASS)
     total = np.zeros((config.height, config.width, 3), np.float64)
     done = 0
     with tqdm(total=config.spp, unit="spp", desc="rgb", disable=not show_progress, leave=False) as bar:
         for k in range(passes):
             spp = min(SPP_PER_PASS, config.spp - done)
-            image = mi.render(scene, spp=spp, seed=config.seed * 100_003 + k)
+            image = mi.render(scene, spp=spp, seed=config.seed * 100_003 + k, sensor=0 if sensor is None else sensor)
             total += np.asarray(image, np.float64)[..., :3] * spp
             done += spp
             bar.update(spp)
     return (total / config.spp).astype(np.float32)
 
 
-def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCamera, width: int, height: int) -> LabelHits:
-    """One primary ray through each pixel centre of the scene's sensor; first hit per pixel. ``shape_ids``
-    are the Mitsuba ids of the snapshot's meshes, in order."""
+def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCamera, width: int, height: int,
+                        camera_rays: bool = False) -> LabelHits:
+    """One primary ray through each pixel centre; first hit per pixel. ``shape_ids`` are the Mitsuba ids of the
+    snapshot's meshes, in order.
+
+    An ideal pinhole asks the scene's sensor for its rays at ((x + 0.5) / W, (y + 0.5) / H). A camera with lens
+    distortion (or any camera, with ``camera_rays``: then the scene's sensor need not point at it) gets rays
+    computed from the plain-data camera (:meth:`PinholeCamera.pixel_center_rays`, the Brown–Conrady model
+    inverted per pixel centre), started on the near clipping plane as Mitsuba's perspective sensor starts its
+    own, and traced the same way."""
     keys = {key: i for i, key in enumerate(shape_ids)}
-    sensor = scene.sensors()[0]
-    if mi.variant().startswith("scalar"):
-        mesh_index, distance, origins, dirs = _trace_scalar(mi, scene, sensor, keys, width, height)
+    scalar = mi.variant().startswith("scalar")
+    if camera.distortion is None and not camera_rays:
+        sensor = scene.sensors()[0]
+        rays = _sensor_rays_scalar(mi, sensor, width, height) if scalar else _sensor_rays_jit(mi, sensor, width, height)
     else:
-        mesh_index, distance, origins, dirs = _trace_jit(mi, scene, sensor, keys, width, height)
+        rays = _camera_rays(mi, camera, width, height, scalar)
+    if scalar:
+        mesh_index, distance, origins, dirs = _trace_scalar(mi, scene, keys, rays, width * height)
+    else:
+        mesh_index, distance, origins, dirs = _trace_jit(mi, scene, keys, rays)
     # Mitsuba starts each camera ray on the near clipping plane, so hit distances count from there: add the
     # way from the camera centre to the ray's origin.
     distance = np.where(mesh_index >= 0, distance + np.linalg.norm(origins - camera.origin, axis=1), 0.0)
@@ -86,7 +99,7 @@ def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCa
     return LabelHits(mesh_index.reshape(shape), distance.astype(np.float32).reshape(shape), z.reshape(shape))
 
 
-def _trace_jit(mi, scene, sensor, keys, width, height):
+def _sensor_rays_jit(mi, sensor, width, height):
     import drjit as dr
 
     idx = dr.arange(mi.UInt32, width * height)
@@ -94,6 +107,37 @@ def _trace_jit(mi, scene, sensor, keys, width, height):
     y = mi.Float(idx // width)
     pos = mi.Point2f((x + 0.5) / width, (y + 0.5) / height)
     ray, _ = sensor.sample_ray(0.0, 0.5, pos, mi.Point2f(0.5, 0.5))
+    return ray
+
+
+def _sensor_rays_scalar(mi, sensor, width, height):
+    aperture = mi.Point2f(0.5, 0.5)
+    for k in range(width * height):
+        y, x = divmod(k, width)
+        ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f((x + 0.5) / width, (y + 0.5) / height), aperture)
+        yield ray
+
+
+def _camera_rays(mi, camera: PinholeCamera, width: int, height: int, scalar: bool):
+    """Rays through the pixel centres of ``camera`` (distortion included) from its near clipping plane to its
+    far one, like Mitsuba's perspective sensor: origin ``c + d near / (d . forward)``, maxt ``(far - near) /
+    (d . forward)``."""
+    centre, dirs = camera.pixel_center_rays(width, height)
+    _, _, forward = camera.axes()
+    cos = dirs @ forward
+    origins = centre + dirs * (camera.clip_near_m / cos)[:, None]
+    maxt = (camera.clip_far_m - camera.clip_near_m) / cos
+    if scalar:
+        return (mi.Ray3f(mi.Point3f(*map(float, o)), mi.Vector3f(*map(float, d)), float(t), 0.0, [])
+                for o, d, t in zip(origins, dirs, maxt))
+    o = mi.Point3f(*(mi.Float(np.ascontiguousarray(origins[:, i], np.float32)) for i in range(3)))
+    d = mi.Vector3f(*(mi.Float(np.ascontiguousarray(dirs[:, i], np.float32)) for i in range(3)))
+    return mi.Ray3f(o, d, mi.Float(maxt.astype(np.float32)), mi.Float(0.0), [])
+
+
+def _trace_jit(mi, scene, keys, ray):
+    import drjit as dr
+
     pi = scene.ray_intersect_preliminary(ray, coherent=True)
     valid = np.asarray(pi.is_valid(), bool)
     registry = np.asarray(dr.reinterpret_array(mi.UInt32, pi.shape), np.int64)
@@ -113,16 +157,12 @@ def _trace_jit(mi, scene, sensor, keys, width, height):
     return mesh_index, np.where(found, distance, 0.0), origins, dirs
 
 
-def _trace_scalar(mi, scene, sensor, keys, width, height):
-    n = width * height
+def _trace_scalar(mi, scene, keys, rays, n):
     mesh_index = np.full(n, -1, np.int64)
     distance = np.zeros(n, np.float64)
     dirs = np.zeros((n, 3), np.float64)
     origins = np.zeros((n, 3), np.float64)
-    aperture = mi.Point2f(0.5, 0.5)
-    for k in range(n):
-        y, x = divmod(k, width)
-        ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f((x + 0.5) / width, (y + 0.5) / height), aperture)
+    for k, ray in enumerate(rays):
         dirs[k] = (ray.d[0], ray.d[1], ray.d[2])
         origins[k] = (ray.o[0], ray.o[1], ray.o[2])
         pi = scene.ray_intersect_preliminary(ray)

@@ -29,6 +29,7 @@ import numpy as np
 from synthua_usd.backends import weather
 from synthua_usd.backends.exposure import choose_exposure
 from synthua_usd.backends.mitsuba import variants, weather_scene
+from synthua_usd.backends.mitsuba.lens import distorted_sensor
 from synthua_usd.backends.mitsuba.render import RenderedFrame, label_maps, render_rgb, trace_pixel_centres
 from synthua_usd.backends.mitsuba.translate import Translation, sensor_to_world, translate
 from synthua_usd.cameras import PinholeCamera
@@ -109,6 +110,20 @@ class RenderSession:
         params.update()
         return moved
 
+    def quick_labels(self, snapshot: SceneSnapshot, camera: PinholeCamera) -> np.ndarray:
+        """(H, W) uint16 instance ids of ``camera``'s pixel-centre rays computed from its lens values, without
+        pointing the scene's sensor at it (a sensor change costs a full parameter update): the cheap pass for
+        many throw-away views of one snapshot, such as scoring camera placements. Ids agree with
+        :meth:`render`'s up to float32 rounding of the ray directions; dataset labels come from :meth:`render`."""
+        if self._scene is None or not self._same_layout(snapshot):
+            self._load(snapshot, camera)
+            self.reloads += self.loads > 1
+        elif snapshot is not self._snapshot:
+            self._update(snapshot, camera)
+        hits = trace_pixel_centres(self.mi, self._scene, self._translation.shape_ids, camera, self.config.width,
+                                   self.config.height, camera_rays=True)
+        return label_maps(hits, snapshot)[1]
+
     def render(self, snapshot: SceneSnapshot, camera: PinholeCamera, rgb: bool = True,
                show_progress: bool = False, condition: Condition | None = None) -> RenderedFrame:
         """RGB (unless ``rgb`` is False) and labels of ``snapshot`` seen by ``camera`` under ``condition``
@@ -138,7 +153,9 @@ class RenderSession:
             t0 = time.perf_counter()
             if condition is not None and self._translation.lamps:
                 self._focus_lamps(hits, camera)
-            image = render_rgb(self.mi, self._scene, self.config, show_progress)
+            # Mitsuba's perspective sensor cannot distort: a lens with distortion renders through its own sensor.
+            sensor = distorted_sensor(self.mi, camera, self.config) if camera.distortion is not None else None
+            image = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor)
             seconds["rgb"] = time.perf_counter() - t0
             t0 = time.perf_counter()
             if condition is not None:
