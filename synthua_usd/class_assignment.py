@@ -37,8 +37,8 @@ def compile_pattern(pattern: str, where: str):
     except (re2.error, UnicodeError, ValueError, TypeError) as exc:
         reason = exc.args[0] if exc.args and not isinstance(exc, UnicodeError) else "text that is not UTF-8"
         reason = reason.decode("utf-8", "replace") if isinstance(reason, bytes) else str(reason)
-        raise InputError(f"{where}: '{echo(pattern)}' is not an RE2 pattern ({echo(reason)}); expected a regular "
-                         f"expression without backreferences or lookaround (RE2 syntax, linear time)") from None
+        raise InputError(f"{where} '{echo(pattern)}' is not a valid regular expression for RE2 ({echo(reason)}); "
+                         f"expected one without backreferences or lookaround (RE2 syntax, linear time)") from None
 
 
 @dataclass(frozen=True)

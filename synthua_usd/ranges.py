@@ -12,6 +12,7 @@ option and the library check can never disagree.
 from __future__ import annotations
 
 import math
+import numbers
 import re
 from dataclasses import dataclass
 
@@ -60,10 +61,10 @@ def _show(value) -> str:
         return "null"
     if isinstance(value, bool):
         return f"{str(value).lower()} (a boolean)"
-    if isinstance(value, float):
-        return f"{value:g}"
-    if isinstance(value, int):
-        return echo(value)
+    if isinstance(value, numbers.Integral):
+        return echo(int(value))
+    if isinstance(value, numbers.Real):
+        return f"{float(value):g}"
     if isinstance(value, str):
         return f"'{echo(value)}'"
     return {list: "an array", dict: "an object"}.get(type(value), type(value).__name__)
@@ -79,7 +80,7 @@ def number_field(value, where: str, allowed: Range, text: bool = False) -> float
     JSON numbers are accepted; booleans never (``true`` is no height); numeric strings only when ``text``
     (GeoJSON properties from OpenStreetMap carry ``"height": "12.5"``). Anything else, or a value outside
     ``allowed``, raises :class:`InputError` naming ``where`` and the range."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, str)) or (isinstance(value, str) and not text):
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, str)) or (isinstance(value, str) and not text):
         raise InputError(f"{where}: {_show(value)}; expected {allowed}")
     if isinstance(value, str) and not _DECIMAL.match(value.strip()):
         raise InputError(f"{where}: {_show(value)} is not a number; expected {allowed}")

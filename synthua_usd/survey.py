@@ -59,8 +59,8 @@ def check_flight_input(values: dict, name: Callable[[str], str] = _field) -> Non
     if given and len(given) < len(GSD_FIELDS):
         missing = [name(f) for f in GSD_FIELDS if f not in given]
         raise InputError(f"{', '.join(missing)}: missing while {' and '.join(name(f) for f in given)} "
-                         f"{'is' if len(given) == 1 else 'are'} given; expected {', '.join(name(f) for f in GSD_FIELDS)} "
-                         f"together (for the GSD), or none of them")
+                         f"{'is' if len(given) == 1 else 'are'} given; expected {', '.join(name(f) for f in GSD_FIELDS)} to "
+                         f"go together (for the GSD), or none of them")
 
 
 @dataclass(frozen=True)
