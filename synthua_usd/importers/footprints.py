@@ -18,8 +18,8 @@ import trimesh
 
 from synthua_usd.errors import InputError, echo
 from synthua_usd.importers.crs import local_tmerc, lonlat_to, require_projected_metres
-from synthua_usd.importers.limits import (COORDINATE, HEIGHT, LEVELS, MAX_EXTENT_M, MIN_FOOTPRINT_AREA_M2, MIN_HEIGHT,
-                                          STOREY_HEIGHT)
+from synthua_usd.importers.limits import (COORDINATE, HEIGHT, LEVELS, MAX_EXTENT_M, MIN_BLOCK_HEIGHT_M,
+                                          MIN_FOOTPRINT_AREA_M2, MIN_HEIGHT, STOREY_HEIGHT)
 from synthua_usd.input_files import shown
 from synthua_usd.materials import class_material, subset
 from synthua_usd.ranges import number_field
@@ -90,9 +90,9 @@ def _height(props: dict, where: str, storey_height_m: float) -> tuple[float, flo
                 break
         else:
             raise InputError(f"{where}: no height; expected a 'height' (m) or 'levels' property")
-    if not top > base:
+    if not top - base >= MIN_BLOCK_HEIGHT_M:
         raise InputError(f"{where}: properties.min_height {base:g} m is not below the height {top:g} m; expected "
-                         f"min_height < height")
+                         f"min_height at least {MIN_BLOCK_HEIGHT_M:g} m below the height")
     return base, top
 
 

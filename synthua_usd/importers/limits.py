@@ -29,8 +29,10 @@ COORDINATE = Range(-1e8, 1e8, "m")
 #: Largest horizontal or vertical extent of one import; the twin is stored in 32-bit floats around a local
 #: origin, which at 1,000 km still resolves 6 cm.
 MAX_EXTENT_M = 1_000_000.0
-#: Building heights above ground (the tallest building is 828 m).
-HEIGHT = Range(0, 1000, "m", low_open=True)
+#: Building heights above ground (the tallest building is 828 m), and the least a block may rise above its
+#: min_height: 10 cm (an extrusion thinner than that is a digitising slip, and trimesh cannot extrude ~0).
+HEIGHT = Range(0.1, 1000, "m")
+MIN_BLOCK_HEIGHT_M = 0.1
 MIN_HEIGHT = Range(0, 1000, "m")
 LEVELS = Range(0, 300, low_open=True)
 #: Smallest footprint area: 10 cm x 10 cm; below it a polygon is a digitising slip, not a building.

@@ -14,8 +14,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from hostile import assert_refused
-from importers.hostile_corpus import (CITYJSON, CLASSMAP, GCP_MODEL, GEOJSON, OBJ, MTL, doc, run_inprocess,
-                                      write)
+from importers.hostile_corpus import (CITYJSON, CLASSMAP, GCP_MODEL, GCP_SURVEYED, GEOJSON, MTL, OBJ, RULES, doc,
+                                      run_inprocess, write)
 
 PROPERTY = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 DOCUMENT = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -58,9 +58,7 @@ def test_flight_plan_any_values(capsys, values):
 @PROPERTY
 @given(value=number_text)
 def test_gcp_threshold_any_value(capsys, value):
-    from conftest import DATA
-
-    result = run_inprocess(capsys, "survey", "gcp", DATA / "valid" / "gcp_surveyed.csv", GCP_MODEL,
+    result = run_inprocess(capsys, "survey", "gcp", GCP_SURVEYED, GCP_MODEL,
                            "--threshold-m", value)
     message = _check(result, (0, 1))
     if message is not None:
@@ -76,7 +74,7 @@ TWIN_OPTIONS = {"--scale": ("mesh", 1e-3, 1e3), "--max-deviation-m": ("pointclou
 def test_twin_import_option_any_value(capsys, tmp_path, option, value):
     """A nonsense value names the option; a plainly sensible one gets past it (to the absent input)."""
     kind, low, high = TWIN_OPTIONS[option]
-    rules = ["--rules", str(Path(__file__).parents[1] / "data" / "valid" / "mesh_rules.json")] if kind == "mesh" else []
+    rules = ["--rules", RULES] if kind == "mesh" else []
     result = run_inprocess(capsys, "twin", "import", kind, tmp_path / "absent.input", *rules, option, repr(value),
                            "--out", tmp_path / "out")
     message = assert_refused(result)
