@@ -70,6 +70,10 @@ def _show(value) -> str:
     return {list: "an array", dict: "an object"}.get(type(value), type(value).__name__)
 
 
+#: Projected coordinates (metres) of any input (CityJSON, GeoJSON with a CRS, meshes, point clouds, GCPs):
+#: UTM northings reach 1e7, so 1e8 leaves room and keeps squares and sums far from overflow.
+COORDINATE = Range(-1e8, 1e8, "m")
+
 #: A decimal number as text: no NaN, infinity, hexadecimal or underscores.
 _DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\Z")
 

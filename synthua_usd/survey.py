@@ -19,8 +19,7 @@ import numpy as np
 
 from synthua_usd.errors import InputError, echo
 from synthua_usd.input_files import MAX_DOCUMENT_BYTES, read_input_text, shown
-from synthua_usd.ranges import Range, number_field
-
+from synthua_usd.ranges import COORDINATE, Range, number_field
 
 #: Stated range of every flight-plan parameter (the CLI builds its options from these).
 LIMITS = {
@@ -37,10 +36,8 @@ LIMITS = {
 GSD_FIELDS = ("sensor_width_mm", "focal_length_mm", "image_width_px")
 #: Most images a plan may have: far above any survey a person flies (the paper's 1.5 km² took 286).
 MAX_IMAGES = 1_000_000
-#: Accepted RMSE of a GCP report, and the magnitude of any GCP coordinate (projected metres; UTM
-#: northings reach 1e7).
+#: Accepted RMSE of a GCP report. GCP coordinates are projected metres within ranges.COORDINATE.
 THRESHOLD = Range(0, 1_000, "m")
-COORDINATE = Range(-1e8, 1e8, "m")
 
 
 def _field(name: str) -> str:

@@ -19,10 +19,10 @@ from tqdm import tqdm
 from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.errors import InputError, echo
 from synthua_usd.importers.crs import require_projected_metres
-from synthua_usd.importers.limits import COORDINATE, MAX_EXTENT_M, TRANSFORM_SCALE
+from synthua_usd.importers.limits import MAX_EXTENT_M, TRANSFORM_SCALE
 from synthua_usd.input_files import shown
 from synthua_usd.materials import class_material, subset
-from synthua_usd.ranges import number_field
+from synthua_usd.ranges import COORDINATE, number_field
 from synthua_usd.schemas import read_json, type_name
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 

@@ -18,11 +18,11 @@ import trimesh
 
 from synthua_usd.errors import InputError, echo
 from synthua_usd.importers.crs import local_tmerc, lonlat_to, require_projected_metres
-from synthua_usd.importers.limits import (COORDINATE, HEIGHT, LEVELS, MAX_EXTENT_M, MIN_BLOCK_HEIGHT_M,
-                                          MIN_FOOTPRINT_AREA_M2, MIN_HEIGHT, STOREY_HEIGHT)
+from synthua_usd.importers.limits import (HEIGHT, LEVELS, MAX_EXTENT_M, MIN_BLOCK_HEIGHT_M, MIN_FOOTPRINT_AREA_M2,
+                                          MIN_HEIGHT, STOREY_HEIGHT)
 from synthua_usd.input_files import shown
 from synthua_usd.materials import class_material, subset
-from synthua_usd.ranges import number_field
+from synthua_usd.ranges import COORDINATE, number_field
 from synthua_usd.schemas import read_json, type_name
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 

@@ -23,9 +23,6 @@ STOREY_HEIGHT = Range(1, 20, "m")
 
 # --- numbers read from files ---------------------------------------------------------------------------------
 
-#: Projected coordinates (metres) of any input: UTM northings reach 1e7, so 1e8 leaves room and keeps
-#: squares and sums far from overflow.
-COORDINATE = Range(-1e8, 1e8, "m")
 #: Largest horizontal or vertical extent of one import; the twin is stored in 32-bit floats around a local
 #: origin, which at 1,000 km still resolves 6 cm.
 MAX_EXTENT_M = 1_000_000.0

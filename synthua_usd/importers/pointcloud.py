@@ -28,10 +28,11 @@ from tqdm import tqdm
 
 from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.errors import InputError, echo
-from synthua_usd.importers.limits import (COORDINATE, MAX_DEVIATION, MAX_EXTENT_M, MAX_POINTCLOUD_BYTES, MAX_POINTS,
+from synthua_usd.importers.limits import (MAX_DEVIATION, MAX_EXTENT_M, MAX_POINTCLOUD_BYTES, MAX_POINTS,
                                           PLANE_THRESHOLD)
 from synthua_usd.input_files import check_input_file, shown
 from synthua_usd.materials import class_material, subset
+from synthua_usd.ranges import COORDINATE
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart
 
 log = logging.getLogger(__name__)

@@ -6,8 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from importers.hostile_corpus import (GCP_MODEL, GCP_SURVEYED, GEOJSON, RULES, earlier_import, mesh_input,  # noqa: F401
-                                      refuse, workdir, write)
+from importers.hostile_corpus import GCP_MODEL, GCP_SURVEYED, GEOJSON, RULES, mesh_input, write
 
 FLIGHT = {"--altitude-m": "150", "--fov-deg": "84", "--area-width-m": "1225", "--area-length-m": "1225"}
 GSD = {"--sensor-width-mm": "13.2", "--focal-length-mm": "10.26", "--image-width-px": "5472"}

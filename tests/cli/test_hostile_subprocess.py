@@ -10,8 +10,7 @@ import shutil
 import pytest
 
 from hostile import assert_refused, tree_state
-from importers.hostile_corpus import (CITYJSON, CLASSMAP, GCP_MODEL, GEOJSON, doc, earlier_import, mesh_input,  # noqa: F401
-                                      run_limited, write)
+from importers.hostile_corpus import CITYJSON, CLASSMAP, GCP_MODEL, GEOJSON, doc, mesh_input, run_limited, write
 
 #: A hang check fails long before the suite's own time limit.
 HANG_S = 30

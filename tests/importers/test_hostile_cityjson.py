@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from importers.hostile_corpus import CITYJSON, doc, earlier_import, refuse, workdir, write  # noqa: F401
+from importers.hostile_corpus import CITYJSON, doc, write
 
 
 def _set(d: dict, path: tuple, value) -> dict:

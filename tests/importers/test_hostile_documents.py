@@ -8,8 +8,7 @@ import os
 
 import pytest
 
-from importers.hostile_corpus import (CITYJSON, CLASSMAP, GEOJSON, RULES, doc, earlier_import, mesh_input,  # noqa: F401
-                                      refuse, workdir, write)
+from importers.hostile_corpus import CITYJSON, CLASSMAP, GEOJSON, RULES, doc, mesh_input, write
 
 BIG = "9" * 5000
 

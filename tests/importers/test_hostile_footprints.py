@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from importers.hostile_corpus import GEOJSON, doc, earlier_import, refuse, workdir, write  # noqa: F401
+from importers.hostile_corpus import GEOJSON, doc, write
 
 SQUARE = [[-49.2712, -25.4270], [-49.2710, -25.4270], [-49.2710, -25.4268], [-49.2712, -25.4268], [-49.2712, -25.4270]]
 BOWTIE = [[-49.2712, -25.4270], [-49.2710, -25.4268], [-49.2710, -25.4270], [-49.2712, -25.4268], [-49.2712, -25.4270]]

@@ -9,7 +9,7 @@ import struct
 import numpy as np
 import pytest
 
-from importers.hostile_corpus import RULES, earlier_import, refuse, workdir, write  # noqa: F401
+from importers.hostile_corpus import RULES, write
 
 OBJ_CASES = {
     "empty": ("", ("triangles",)),
