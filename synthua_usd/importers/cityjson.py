@@ -291,7 +291,7 @@ def import_cityjson(path: str | Path, rules: AssignmentRules | None = None, lod:
         fallback += lod is not None and str(geom.get("lod")) != str(lod)
         gw = f"{ow}.geometry[{k}]"
         gtype = geom.get("type")
-        if gtype not in BOUNDARY_DEPTH:
+        if not isinstance(gtype, str) or gtype not in BOUNDARY_DEPTH:
             raise InputError(f"{gw}: geometry type '{echo(gtype)}' is not supported; expected MultiSurface, "
                              f"CompositeSurface, Solid, MultiSolid or CompositeSolid")
         try:

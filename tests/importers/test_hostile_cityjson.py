@@ -51,6 +51,7 @@ CASES = {
     "geometry-object": (lambda d: _set(d, ("CityObjects", "house-1", "geometry"), {"type": "Solid"}),
                         ("house-1", "geometry")),
     "geometry-entry-number": (lambda d: _set(d, HOUSE, 7), ("house-1", "geometry[0]")),
+    "geometry-type-list": (lambda d: _set(d, HOUSE + ("type",), []), ("house-1", "geometry type")),
     "geometry-type-point": (lambda d: _set(d, HOUSE + ("type",), "MultiPoint"), ("house-1", "MultiPoint")),
     "boundary-negative": (lambda d: _set(d, HOUSE + ("boundaries", 0, 0, 0, 0), -1), ("house-1", "-1")),
     "boundary-past-end": (lambda d: _set(d, HOUSE + ("boundaries", 0, 0, 0, 0), 10_000), ("house-1", "10000")),
