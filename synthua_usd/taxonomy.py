@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.errors import InputError
+from synthua_usd.input_files import shown
 from synthua_usd.schemas import bundled_path, read_json, validate_document
 
 @dataclass(frozen=True)
@@ -44,7 +45,7 @@ class ClassMap:
     @classmethod
     def load(cls, path: str | Path) -> "ClassMap":
         """Read, schema-check and rule-check a class map file; unusable maps raise :class:`InputError`."""
-        return cls.from_document(read_json(path), source=str(path))
+        return cls.from_document(read_json(path, "a class map (schemas/classmap.schema.json)"), source=str(path))
 
     @classmethod
     def from_document(cls, document: dict, source: str = "(in memory)") -> "ClassMap":
@@ -56,7 +57,7 @@ class ClassMap:
         errors = [f for f in check_classmap_rules(document) if f.severity is Severity.ERROR]
         if errors:
             more = f" (and {len(errors) - 1} more; run `synthua validate classes {source}`)" if len(errors) > 1 else ""
-            raise InputError(f"{source}: {errors[0].where}: {errors[0].message}{more}")
+            raise InputError(f"{shown(source)}: {errors[0].where}: {errors[0].message}{more}")
         classes = tuple(
             SemanticClass(id=c["id"], name=c["name"], display_name=c["display_name"], color=tuple(c["color"]),
                           group=c["group"], isthing=c["isthing"], aliases=tuple(c["aliases"]))

@@ -60,11 +60,15 @@ class TwinPart:
 
     def __post_init__(self) -> None:
         if self.points.ndim != 2 or self.points.shape[1] != 3:
-            raise InputError(f"part {self.name}: points should be (n, 3), but were {self.points.shape}")
+            raise InputError(f"part {self.name}: points of shape {self.points.shape}; expected (n, 3)")
         if not np.all(np.isfinite(self.points)):
-            raise InputError(f"part {self.name}: points contain NaN or infinite coordinates")
+            raise InputError(f"part {self.name}: points contain NaN or infinite coordinates; expected finite metres")
+        if self.triangles.ndim != 2 or self.triangles.shape[1] != 3:
+            raise InputError(f"part {self.name}: triangles of shape {self.triangles.shape}; expected (m, 3) vertex "
+                             f"indices")
         if len(self.triangles) and (self.triangles.min() < 0 or self.triangles.max() >= len(self.points)):
-            raise InputError(f"part {self.name}: triangle indices reach outside its {len(self.points)} points")
+            raise InputError(f"part {self.name}: triangle indices reach outside its {len(self.points)} points; "
+                             f"expected indices in [0, {len(self.points) - 1}]")
 
 
 @dataclass(frozen=True, eq=False)

@@ -8,6 +8,9 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK
+from synthua_usd.cli.options import InRange
+from synthua_usd.errors import echo
+from synthua_usd.survey import LIMITS, THRESHOLD
 
 # --- survey -----------------------------------------------------------------------------------------------
 
@@ -16,28 +19,42 @@ def survey() -> None:
     """Photogrammetry helpers: UAV flight plans and ground-control-point accuracy."""
 
 
+def option_name(field: str) -> str:
+    """The option a flight-plan field comes from, as the user typed it: altitude_m -> --altitude-m."""
+    return "--" + field.replace("_", "-")
+
+
 @survey.command("flight-plan")
-@click.option("--altitude-m", type=float, required=True, help="Flight height above ground, h (m).")
-@click.option("--fov-deg", type=float, required=True, help="Camera field of view across the footprint, theta.")
-@click.option("--frontal-overlap", type=float, default=0.7, show_default=True, help="Fraction along a line.")
-@click.option("--lateral-overlap", type=float, default=0.8, show_default=True, help="Fraction between lines.")
-@click.option("--area-width-m", type=float, required=True, help="Area extent across flight lines (m).")
-@click.option("--area-length-m", type=float, required=True, help="Area extent along flight lines (m).")
-@click.option("--sensor-width-mm", type=float, help="For GSD: sensor width (mm).")
-@click.option("--focal-length-mm", type=float, help="For GSD: focal length (mm).")
-@click.option("--image-width-px", type=int, help="For GSD: image width (pixels).")
+@click.option("--altitude-m", type=InRange(LIMITS["altitude_m"]), required=True,
+              help="Flight height above ground, h (m).")
+@click.option("--fov-deg", type=InRange(LIMITS["fov_deg"]), required=True,
+              help="Camera field of view across the footprint, theta (degrees).")
+@click.option("--frontal-overlap", type=InRange(LIMITS["frontal_overlap"]), default=0.7, show_default=True,
+              help="Fraction along a line.")
+@click.option("--lateral-overlap", type=InRange(LIMITS["lateral_overlap"]), default=0.8, show_default=True,
+              help="Fraction between lines.")
+@click.option("--area-width-m", type=InRange(LIMITS["area_width_m"]), required=True,
+              help="Area extent across flight lines (m).")
+@click.option("--area-length-m", type=InRange(LIMITS["area_length_m"]), required=True,
+              help="Area extent along flight lines (m).")
+@click.option("--sensor-width-mm", type=InRange(LIMITS["sensor_width_mm"]), help="For GSD: sensor width (mm).")
+@click.option("--focal-length-mm", type=InRange(LIMITS["focal_length_mm"]), help="For GSD: focal length (mm).")
+@click.option("--image-width-px", type=InRange(LIMITS["image_width_px"]), help="For GSD: image width (pixels).")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 def survey_flight_plan(as_json: bool, **kwargs) -> int:
     """Footprint W = 2 h tan(theta/2), spacing D = (1 - overlap) W, image count, and GSD.
+
+    Plans of more than 1,000,000 images are refused.
 
     \b
     The paper's survey: synthua survey flight-plan --altitude-m 150 --fov-deg 84 \\
         --area-width-m 1225 --area-length-m 1225 --sensor-width-mm 13.2 --focal-length-mm 10.26 \\
         --image-width-px 5472
     """
-    from synthua_usd.survey import FlightPlanInput, plan_flight
+    from synthua_usd.survey import FlightPlanInput, check_flight_input, plan_flight
 
-    plan = plan_flight(FlightPlanInput(**kwargs))
+    check_flight_input(kwargs, option_name)  # the GSD options go together: named as typed
+    plan = plan_flight(FlightPlanInput(**kwargs), option_name)
     if as_json:
         click.echo(json.dumps(plan.to_dict(), indent=2))
     else:
@@ -55,7 +72,7 @@ def survey_flight_plan(as_json: bool, **kwargs) -> int:
 @survey.command("gcp")
 @click.argument("surveyed", type=click.Path(path_type=Path))
 @click.argument("model", type=click.Path(path_type=Path))
-@click.option("--threshold-m", type=float, default=0.05, show_default=True, help="Accepted RMSE (m).")
+@click.option("--threshold-m", type=InRange(THRESHOLD), default=0.05, show_default=True, help="Accepted RMSE (m).")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 def survey_gcp(surveyed: Path, model: Path, threshold_m: float, as_json: bool) -> int:
     """Per-point 3-D error and RMSE = sqrt(mean(dX^2 + dY^2 + dZ^2)) between SURVEYED and MODEL GCPs.
@@ -71,7 +88,7 @@ def survey_gcp(surveyed: Path, model: Path, threshold_m: float, as_json: bool) -
     else:
         click.echo(f"{'id':>10} {'dX m':>9} {'dY m':>9} {'dZ m':>9} {'error m':>9}")
         for i, d, e in zip(report.ids, report.delta_m, report.errors_m):
-            click.echo(f"{i:>10} {d[0]:9.4f} {d[1]:9.4f} {d[2]:9.4f} {e:9.4f}")
+            click.echo(f"{echo(i):>10} {d[0]:9.4f} {d[1]:9.4f} {d[2]:9.4f} {e:9.4f}")
         x, y, z = report.rmse_xyz_m
         click.echo(f"RMSE {report.rmse_m:.4f} m (X {x:.4f}, Y {y:.4f}, Z {z:.4f}); threshold {threshold_m:g} m: "
                    f"{'pass' if report.passed else 'FAIL'}")

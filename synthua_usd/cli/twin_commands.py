@@ -9,12 +9,36 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK, load_class_map
+from synthua_usd.cli.options import InRange
+from synthua_usd.errors import echo
+from synthua_usd.importers import limits as importer_limits
 
 # --- twin -------------------------------------------------------------------------------------------------
 
 @click.group()
 def twin() -> None:
     """Build twin layers: the procedural demo district, or imports of real city data."""
+
+
+#: Options that belong to one kind of import (or to a few): given for another kind they are refused, not
+#: silently ignored.
+KIND_OPTIONS = {
+    "rules": ("mesh", "cityjson", "pointcloud"),
+    "up_axis": ("mesh",), "scale": ("mesh",),
+    "lod": ("cityjson",),
+    "max_deviation_m": ("pointcloud",), "plane_threshold_m": ("pointcloud",),
+    "storey_height_m": ("footprints",),
+}
+
+
+def _refuse_foreign_options(ctx: click.Context, kind: str) -> None:
+    from click.core import ParameterSource
+
+    for name, kinds in KIND_OPTIONS.items():
+        if kind not in kinds and ctx.get_parameter_source(name) is ParameterSource.COMMANDLINE:
+            option = "--" + name.replace("_", "-")
+            raise click.UsageError(f"{option}: given for a {kind} import; expected only with "
+                                   f"{' or '.join(kinds)} imports", ctx)
 
 
 @twin.command("import")
@@ -24,20 +48,23 @@ def twin() -> None:
               help="Folder for twin.usdc, semantics.usda, cameras/environment/render layers, scenario.usda "
                    "and import_report.json.")
 @click.option("--rules", type=click.Path(path_type=Path),
-              help="Semantic rules JSON (schemas/semantic_rules.schema.json): (field, regex) -> class. "
-                   "Required for meshes; optional overrides for the others.")
+              help="Semantic rules JSON (schemas/semantic_rules.schema.json): (field, RE2 regex) -> class. "
+                   "Required for meshes; optional overrides for cityjson and pointcloud.")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--up-axis", type=click.Choice(["Y", "Z"]), help="mesh: the file's up axis [default: Y for glTF, Z otherwise].")
-@click.option("--scale", type=float, default=1.0, show_default=True, help="mesh: file units to metres.")
-@click.option("--lod", help="cityjson: level of detail to import [default: the highest each object has].")
-@click.option("--max-deviation-m", type=float, default=0.005, show_default=True,
+@click.option("--scale", type=InRange(importer_limits.SCALE), default=1.0, show_default=True,
+              help="mesh: file units to metres.")
+@click.option("--lod", help="cityjson: level of detail to import, one the file has [default: the highest each object "
+                            "has].")
+@click.option("--max-deviation-m", type=InRange(importer_limits.MAX_DEVIATION), default=0.005, show_default=True,
               help="pointcloud: largest Hausdorff distance simplification may introduce (metres).")
-@click.option("--plane-threshold-m", type=float, default=0.02, show_default=True,
+@click.option("--plane-threshold-m", type=InRange(importer_limits.PLANE_THRESHOLD), default=0.02, show_default=True,
               help="pointcloud: RANSAC inlier distance (metres).")
-@click.option("--storey-height-m", type=float, default=3.0, show_default=True,
+@click.option("--storey-height-m", type=InRange(importer_limits.STOREY_HEIGHT), default=3.0, show_default=True,
               help="footprints: metres per level when a footprint gives levels, not height.")
-def twin_import(kind: str, input_path: Path, out_dir: Path, rules: Path | None, class_map: Path | None,
-                up_axis: str | None, scale: float, lod: str | None, max_deviation_m: float,
+@click.pass_context
+def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, rules: Path | None,
+                class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, max_deviation_m: float,
                 plane_threshold_m: float, storey_height_m: float) -> int:
     """Import real city data of KIND from INPUT as labelled twin layers plus a renderable scenario.
 
@@ -49,22 +76,25 @@ def twin_import(kind: str, input_path: Path, out_dir: Path, rules: Path | None, 
     footprints GeoJSON polygons with 'height' or 'levels' -> extruded LoD1 buildings
 
     Geometry no rule matches is labelled 'unlabelled' (class 0) and listed in import_report.json.
+    Options of one kind (--lod, --scale, ...) are refused for the others. Nothing in --out changes
+    unless the whole import is written.
     """
     from synthua_usd.class_assignment import AssignmentRules
-    from synthua_usd.errors import InputError
     from synthua_usd.importers import importers
-    from synthua_usd.pipeline.twin_import import write_import
 
+    _refuse_foreign_options(ctx, kind)
+    if kind == "mesh" and rules is None:
+        raise click.UsageError("--rules: missing; mesh import needs --rules FILE (meshes carry no classes of their "
+                               "own; see schemas/semantic_rules.schema.json)", ctx)
     cmap = load_class_map(class_map)
     loaded_rules = AssignmentRules.load(rules, cmap) if rules else None
-    if kind == "mesh" and loaded_rules is None:
-        raise InputError("mesh import needs --rules FILE: meshes carry no classes of their own "
-                         "(see schemas/semantic_rules.schema.json)")
     t0 = time.perf_counter()
     model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod,
                               max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
                               storey_height_m=storey_height_m, show_progress=sys.stderr.isatty())
     seconds = time.perf_counter() - t0
+    from synthua_usd.pipeline.twin_import import write_import  # USD and the writers: only once the input is good
+
     report = {"kind": kind, "input": str(input_path), "seconds": round(seconds, 3), "objects": len(model.objects),
               "triangles": model.triangle_count(), "classes": model.label_counts(), "crs": model.crs,
               "origin_offset_m": list(model.origin_offset_m), **model.report}
@@ -78,7 +108,7 @@ def twin_import(kind: str, input_path: Path, out_dir: Path, rules: Path | None, 
                        f"{seg['residual_max_m'] * 1000:.1f} mm / rms {seg['residual_rms_m'] * 1000:.1f} mm")
     unmatched = model.report.get("unmatched") or model.report.get("unlabelled_types")
     if unmatched:
-        click.echo(f"  labelled 'unlabelled' (no rule matched): {unmatched}")
+        click.echo(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
     click.echo(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "
                f"--out OUT")
     return EXIT_OK

@@ -6,11 +6,12 @@ files. :func:`importers` maps the kind names of ``synthua twin import KIND`` to 
 
 from __future__ import annotations
 
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
-from synthua_usd.twin import TwinModel
+if TYPE_CHECKING:  # the twin module pulls in trimesh; the CLI imports this package at start-up
+    from synthua_usd.twin import TwinModel
 
-Importer = Callable[..., TwinModel]
+Importer = Callable[..., "TwinModel"]
 
 
 def importers() -> dict[str, Importer]:

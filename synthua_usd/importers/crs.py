@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthua_usd.errors import InputError
+from synthua_usd.errors import InputError, echo
 
 
 def require_projected_metres(crs_text: str, source: str):
@@ -15,14 +15,15 @@ def require_projected_metres(crs_text: str, source: str):
     try:
         crs = CRS.from_user_input(_normalise(crs_text))
     except CRSError as exc:
-        raise InputError(f"{source}: unknown CRS '{crs_text}' ({exc})") from None
+        raise InputError(f"{source}: unknown CRS '{echo(crs_text)}' ({echo(exc)}); expected an EPSG code or CRS URL of "
+                         f"a projected CRS in metres") from None
     horizontal = crs.sub_crs_list[0] if crs.is_compound else crs
     if not horizontal.is_projected:
-        raise InputError(f"{source}: CRS '{crs_text}' is geographic (degrees); expected a projected CRS in metres "
+        raise InputError(f"{source}: CRS '{echo(crs_text)}' is geographic (degrees); expected a projected CRS in metres "
                          f"(reproject the file first)")
     units = {a.unit_name for a in horizontal.axis_info}
     if units - {"metre", "meter"}:
-        raise InputError(f"{source}: CRS '{crs_text}' uses units {sorted(units)}; expected metres")
+        raise InputError(f"{source}: CRS '{echo(crs_text)}' uses units {sorted(units)}; expected metres")
     return crs
 
 

@@ -1,9 +1,12 @@
 """Building footprints (GeoJSON polygons with a height or a number of levels) → LoD1 extruded blocks.
 
 Heights: ``height`` (metres above ground) or ``levels`` / ``building:levels`` × ``storey_height_m``;
-optional ``min_height``. Coordinates are WGS84 lon/lat (RFC 7946) and are projected to a local transverse
-Mercator, or, when the file names a projected CRS in a legacy ``crs`` member, used as metres. Each
-building is one ``building`` instance with ``Walls`` and ``Roof`` parts.
+optional ``min_height``; all within the ranges of :mod:`synthua_usd.importers.limits`. Coordinates are
+WGS84 lon/lat (RFC 7946) and are projected to a local transverse Mercator, or, when the file names a
+projected CRS in a legacy ``crs`` member, used as metres. A footprint must be a valid polygon (no
+self-intersections, holes inside their shell) of at least 0.01 m²: invalid footprints are refused with
+the reason and place, never silently repaired. Each building is one ``building`` instance with ``Walls``
+and ``Roof`` parts, in the palette's materials.
 """
 
 from __future__ import annotations
@@ -13,79 +16,109 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from synthua_usd.errors import InputError
+from synthua_usd.errors import InputError, echo
 from synthua_usd.importers.crs import local_tmerc, lonlat_to, require_projected_metres
-from synthua_usd.scene import Material
+from synthua_usd.importers.limits import (HEIGHT, LEVELS, MAX_EXTENT_M, MIN_BLOCK_HEIGHT_M, MIN_FOOTPRINT_AREA_M2,
+                                          MIN_HEIGHT, STOREY_HEIGHT)
+from synthua_usd.input_files import shown
+from synthua_usd.materials import class_material, subset
+from synthua_usd.ranges import COORDINATE, number_field
+from synthua_usd.schemas import read_json, type_name
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 
-MATERIALS = {"Wall": Material("Wall", (0.55, 0.5, 0.45), 0.9), "Roof": Material("Roof", (0.3, 0.12, 0.08), 0.8)}
 HEIGHT_KEYS = ("height",)
 LEVEL_KEYS = ("levels", "building:levels")
+#: Palette keys of the two parts of every block.
+WALL_MATERIAL = class_material("building").key
+ROOF_MATERIAL = class_material("roof").key
 
 
-def _rings(geometry: dict, where: str) -> list[list[np.ndarray]]:
+def _position(value, where: str) -> tuple[float, float]:
+    if not isinstance(value, list) or len(value) < 2:
+        found = f"{len(value)} numbers" if isinstance(value, list) else type_name(value)
+        raise InputError(f"{where}: a position of {found}; expected [x, y] (or [x, y, z]) numbers")
+    return (number_field(value[0], where + "[0]", COORDINATE), number_field(value[1], where + "[1]", COORDINATE))
+
+
+def _rings(geometry, where: str) -> list[list[np.ndarray]]:
+    """Polygons as lists of (n, 2) float64 rings (shell first), checked for structure and finite numbers."""
     kind = geometry.get("type") if isinstance(geometry, dict) else None
     if kind == "Polygon":
-        polygons = [geometry.get("coordinates")]
+        polygons, base = [geometry.get("coordinates")], f"{where}: geometry.coordinates"
     elif kind == "MultiPolygon":
-        polygons = geometry.get("coordinates")
+        polygons, base = geometry.get("coordinates"), f"{where}: geometry.coordinates"
     else:
-        raise InputError(f"{where}: geometry type '{kind}' is not a footprint; expected Polygon or MultiPolygon")
+        found = echo(kind) if isinstance(kind, str) else (type_name(geometry) if not isinstance(geometry, dict)
+                                                          else "None")
+        raise InputError(f"{where}: geometry type '{found}' is not a footprint; expected Polygon or MultiPolygon")
+    if not isinstance(polygons, list):
+        raise InputError(f"{base}: {type_name(polygons)}; expected an array of {'polygons' if kind == 'MultiPolygon' else 'rings'}")
     out = []
-    for poly in polygons or []:
-        try:
-            rings = [np.asarray(ring, float)[:, :2] for ring in poly]
-        except (ValueError, IndexError, TypeError):
-            raise InputError(f"{where}: polygon coordinates should be lists of [x, y] pairs") from None
-        if not rings or len(rings[0]) < 4:
-            raise InputError(f"{where}: polygon has {len(rings[0]) if rings else 0} vertices; a closed ring needs at "
-                             f"least 4")
-        for ring in rings:
-            if not np.all(np.isfinite(ring)):
-                raise InputError(f"{where}: polygon has NaN or infinite coordinates")
+    for p, poly in enumerate(polygons):
+        pw = base if kind == "Polygon" else f"{base}[{p}]"
+        if not isinstance(poly, list) or not poly:
+            raise InputError(f"{pw}: {type_name(poly) if poly != [] else 'no rings'}; expected an array of rings, "
+                             f"the shell first")
+        rings = []
+        for r, ring in enumerate(poly):
+            if not isinstance(ring, list):
+                raise InputError(f"{pw}[{r}]: {type_name(ring)}; expected a ring: an array of [x, y] positions")
+            rings.append(np.array([_position(v, f"{pw}[{r}][{i}]") for i, v in enumerate(ring)], float).reshape(-1, 2))
+        if len(rings[0]) < 4:
+            raise InputError(f"{where}: polygon has {len(rings[0])} vertices; a closed ring needs at least 4")
         out.append(rings)
     if not out:
-        raise InputError(f"{where}: empty geometry")
+        raise InputError(f"{where}: empty geometry; expected at least one polygon")
     return out
 
 
 def _height(props: dict, where: str, storey_height_m: float) -> tuple[float, float]:
-    base = float(props.get("min_height", 0.0) or 0.0)
+    """(base, top) metres above ground of one footprint, checked against the stated ranges."""
+    base = 0.0
+    if props.get("min_height") not in (None, ""):
+        base = number_field(props["min_height"], f"{where}: properties.min_height", MIN_HEIGHT, text=True)
     for key in HEIGHT_KEYS:
         if props.get(key) not in (None, ""):
-            value = _number(props[key], f"{where}: property '{key}'")
+            top = number_field(props[key], f"{where}: properties.{key}", HEIGHT, text=True)
             break
     else:
         for key in LEVEL_KEYS:
             if props.get(key) not in (None, ""):
-                value = _number(props[key], f"{where}: property '{key}'") * storey_height_m
+                levels = number_field(props[key], f"{where}: properties.{key}", LEVELS, text=True)
+                top = HEIGHT.check(levels * storey_height_m, f"{where}: properties.{key} x storey height "
+                                                             f"{storey_height_m:g} m")
                 break
         else:
             raise InputError(f"{where}: no height; expected a 'height' (m) or 'levels' property")
-    if not value > base:
-        raise InputError(f"{where}: height {value:g} m should be above min_height {base:g} m")
-    return base, value
+    if not top - base >= MIN_BLOCK_HEIGHT_M:
+        raise InputError(f"{where}: properties.min_height {base:g} m is not below the height {top:g} m; expected "
+                         f"min_height at least {MIN_BLOCK_HEIGHT_M:g} m below the height")
+    return base, top
 
 
-def _number(value, where: str) -> float:
-    try:
-        out = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{where} should be a number, but was {value!r}") from None
-    if not np.isfinite(out):
-        raise InputError(f"{where} should be finite, but was {value!r}")
-    return out
-
-
-def _extrude(rings: list[np.ndarray], base: float, top: float):
+def _footprint(rings: list[np.ndarray], where: str):
+    """The shapely polygon of projected rings (metres), refused unless valid and of some area."""
     from shapely.geometry import Polygon
+    from shapely.validation import explain_validity
 
-    poly = Polygon(rings[0], rings[1:]).buffer(0)  # buffer(0) repairs self-touching rings
-    if poly.is_empty or poly.area <= 0:
-        return None
-    polys = list(poly.geoms) if poly.geom_type == "MultiPolygon" else [poly]
-    meshes = [trimesh.creation.extrude_polygon(p, height=top - base) for p in polys]
-    mesh = trimesh.util.concatenate(meshes)
+    try:
+        poly = Polygon(rings[0], rings[1:])
+    except (ValueError, TypeError) as exc:
+        raise InputError(f"{where}: not a polygon ({echo(exc)}); expected closed rings of at least 4 positions") from None
+    if not poly.is_valid:
+        reason = explain_validity(poly)
+        kind = "self-intersects" if "Self-intersection" in reason else "is not a valid polygon"
+        raise InputError(f"{where}: the footprint {kind} ({echo(reason)} in projected metres; signed area "
+                         f"{poly.area:.3g} m²); expected a simple ring with holes inside it (fix the geometry, e.g. "
+                         f"QGIS 'Fix geometries')")
+    if poly.area < MIN_FOOTPRINT_AREA_M2:
+        raise InputError(f"{where}: area {poly.area:.3g} m²; expected a footprint of at least "
+                         f"{MIN_FOOTPRINT_AREA_M2:g} m² (a degenerate or zero-area ring)")
+    return poly
+
+
+def _extrude(poly, base: float, top: float):
+    mesh = trimesh.creation.extrude_polygon(poly, height=top - base)
     mesh.apply_translation((0, 0, base))
     normals = mesh.face_normals
     roof = normals[:, 2] > 0.5
@@ -96,54 +129,79 @@ def _extrude(rings: list[np.ndarray], base: float, top: float):
 def _part(name: str, mesh: trimesh.Trimesh, mask: np.ndarray, surface: str) -> TwinPart:
     sub = mesh.submesh([np.flatnonzero(mask)], append=True)
     return TwinPart(name, np.asarray(sub.vertices, float), np.asarray(sub.faces, np.int64),
-                    "Roof" if surface == "roof" else "Wall", {"surface": surface})
+                    ROOF_MATERIAL if surface == "roof" else WALL_MATERIAL, {"surface": surface})
+
+
+def _crs_member(doc: dict, where: str) -> str | None:
+    crs = doc.get("crs")
+    if crs is None:
+        return None
+    name = crs.get("properties", {}).get("name") if isinstance(crs, dict) and isinstance(crs.get("properties"),
+                                                                                           dict) else None
+    if not isinstance(name, str) or not name:
+        raise InputError(f"{where}: crs: {type_name(crs) if not isinstance(crs, dict) else 'no properties.name text'}; "
+                         f"expected {{\"type\": \"name\", \"properties\": {{\"name\": \"EPSG:...\"}}}} or no crs member "
+                         f"(lon/lat)")
+    return name
 
 
 def import_footprints(path: str | Path, storey_height_m: float = 3.0, **_ignored) -> TwinModel:
     """Extrude every footprint polygon of a GeoJSON FeatureCollection into a labelled building."""
-    from synthua_usd.schemas import read_json
-
     path = Path(path)
-    doc = read_json(path)
+    where = shown(path)
+    STOREY_HEIGHT.check(storey_height_m, "storey_height_m")
+    doc = read_json(path, "a GeoJSON FeatureCollection")
     if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection":
-        raise InputError(f"{path}: expected a GeoJSON FeatureCollection, found "
-                         f"{doc.get('type') if isinstance(doc, dict) else type(doc).__name__}")
-    features = doc.get("features") or []
+        found = (f"\"type\": {echo(doc.get('type'))}" if isinstance(doc, dict) else type_name(doc))
+        raise InputError(f"{where}: {found}; expected a GeoJSON object with \"type\": \"FeatureCollection\"")
+    features = doc.get("features")
+    if features is not None and not isinstance(features, list):
+        raise InputError(f"{where}: features: {type_name(features)}; expected an array of features")
     if not features:
-        raise InputError(f"{path}: the FeatureCollection has no features")
+        raise InputError(f"{where}: the FeatureCollection has no features")
     parsed = []
     for i, feat in enumerate(features):
-        props = (feat or {}).get("properties") or {}
-        where = f"{path}: features[{i}]" + (f" ({props['name']})" if props.get("name") else "")
-        parsed.append((i, props, _rings((feat or {}).get("geometry"), where), _height(props, where, storey_height_m)))
-    all_xy = np.concatenate([r for _, _, polys, _ in parsed for rings in polys for r in rings])
-    crs_member = ((doc.get("crs") or {}).get("properties") or {}).get("name")
+        if not isinstance(feat, dict):
+            raise InputError(f"{where}: features[{i}]: {type_name(feat)}; expected a Feature object")
+        props = feat.get("properties") or {}
+        if not isinstance(props, dict):
+            raise InputError(f"{where}: features[{i}].properties: {type_name(props)}; expected an object or null")
+        label = props.get("name")
+        fw = f"{where}: features[{i}]" + (f" ({echo(label)})" if isinstance(label, str) and label else "")
+        parsed.append((i, props, fw, _rings(feat.get("geometry"), fw), _height(props, fw, storey_height_m)))
+    all_xy = np.concatenate([r for *_, polys, _ in parsed for rings in polys for r in rings])
+    crs_member = _crs_member(doc, where)
     if crs_member:
-        crs = require_projected_metres(crs_member, str(path))
-        origin = all_xy.mean(axis=0)
+        crs = require_projected_metres(crs_member, where)
+        origin = (all_xy.min(axis=0) + all_xy.max(axis=0)) / 2
         crs_text = crs.to_string()
         project = lambda xy: xy - origin
     else:
         if np.abs(all_xy[:, 0]).max() > 180 or np.abs(all_xy[:, 1]).max() > 90:
-            raise InputError(f"{path}: coordinates exceed lon/lat ranges but the file names no CRS; add a 'crs' "
+            raise InputError(f"{where}: coordinates exceed lon/lat ranges but the file names no CRS; add a 'crs' "
                              f"member for projected coordinates")
         crs_text = local_tmerc(all_xy)
         origin = np.zeros(2)
         project = lambda xy: lonlat_to(crs_text, xy)
+    projected = [[[project(r) for r in rings] for rings in polys] for *_, polys, _ in parsed]
+    flat = np.concatenate([r for polys in projected for rings in polys for r in rings])
+    if not np.all(np.isfinite(flat)):
+        raise InputError(f"{where}: coordinates cannot be projected to metres (non-finite results); expected lon/lat "
+                         f"degrees or a projected CRS")
+    extent = float((flat.max(axis=0) - flat.min(axis=0)).max())
+    if extent > MAX_EXTENT_M:
+        raise InputError(f"{where}: footprints span {extent:.3g} m; expected at most {MAX_EXTENT_M:g} m (split the file)")
     objects = []
-    for i, props, polys, (base, top) in parsed:
+    for (i, props, fw, polys, (base, top)), rings_m in zip(parsed, projected):
         name = prim_name(props.get("name") or props.get("id") or f"Building_{i:04d}", "Building")
         parts = []
-        for k, rings in enumerate(polys):
-            made = _extrude([project(r) for r in rings], base, top)
-            if made is None:
-                raise InputError(f"{path}: features[{i}]: polygon {k} has no area")
-            mesh, roof, wall = made
+        for k, rings in enumerate(rings_m):
+            pw = f"{fw}: polygon {k}" if len(rings_m) > 1 else fw
+            mesh, roof, wall = _extrude(_footprint(rings, pw), base, top)
             suffix = f"_{k}" if len(polys) > 1 else ""
             parts += [_part(f"Walls{suffix}", mesh, wall, "wall"), _part(f"Roof{suffix}", mesh, roof, "roof")]
         objects.append(TwinObject(f"Buildings/{name}", "building", tuple(parts),
                                   {"source_feature": i, "height_m": top, "min_height_m": base}))
-    return TwinModel(objects=tuple(unique_paths(objects)), materials=dict(MATERIALS), source=str(path),
-                     origin_offset_m=(float(origin[0]), float(origin[1]), 0.0), crs=crs_text,
+    return TwinModel(objects=tuple(unique_paths(objects)), materials=subset([WALL_MATERIAL, ROOF_MATERIAL]),
+                     source=str(path), origin_offset_m=(float(origin[0]), float(origin[1]), 0.0), crs=crs_text,
                      report={"buildings": len(objects)})
-

@@ -8,15 +8,19 @@ geometry no rule matches gets the rules' default class (``unlabelled``) and is l
 from __future__ import annotations
 
 import logging
+import warnings
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
-from synthua_usd.errors import InputError
-from synthua_usd.scene import Material
 from synthua_usd.class_assignment import AssignmentRules
+from synthua_usd.errors import InputError, echo
+from synthua_usd.importers.limits import MAX_MESH_BYTES, MAX_TRIANGLES, SCALE
+from synthua_usd.input_files import check_input_file, shown
+from synthua_usd.scene import Material
+from synthua_usd.ranges import COORDINATE
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 
 log = logging.getLogger(__name__)
@@ -28,9 +32,19 @@ _Y_TO_Z = trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0])
 
 
 def _srgb8_to_linear(rgb8) -> tuple[float, float, float]:
-    c = np.asarray(rgb8[:3], float) / 255.0
+    # Colours come from the file: anything but 0..255 (NaN included) is clipped into it.
+    c = np.clip(np.nan_to_num(np.asarray(rgb8[:3], float), nan=0.0), 0.0, 255.0) / 255.0
     lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
     return tuple(float(v) for v in lin)
+
+
+def _unit(value, default: float) -> float:
+    """A factor of the file's material in [0, 1] (``default`` when absent or not a number)."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return default
+    return float(np.clip(number, 0.0, 1.0)) if np.isfinite(number) else default
 
 
 def _material(geom: trimesh.Trimesh, fallback: str) -> tuple[str, Material]:
@@ -40,8 +54,8 @@ def _material(geom: trimesh.Trimesh, fallback: str) -> tuple[str, Material]:
         name = getattr(mat, "name", None) or fallback
         if hasattr(mat, "baseColorFactor") and mat.baseColorFactor is not None:
             color = _srgb8_to_linear(np.asarray(mat.baseColorFactor))
-            rough = float(mat.roughnessFactor) if getattr(mat, "roughnessFactor", None) is not None else 0.8
-            metal = float(mat.metallicFactor) if getattr(mat, "metallicFactor", None) is not None else 0.0
+            rough = _unit(getattr(mat, "roughnessFactor", None), 0.8)
+            metal = _unit(getattr(mat, "metallicFactor", None), 0.0)
             return name, Material(name, color, rough, metal)
         if hasattr(mat, "diffuse") and mat.diffuse is not None:
             return name, Material(name, _srgb8_to_linear(np.asarray(mat.diffuse)), 0.8)
@@ -59,39 +73,54 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
     file units to metres.
     """
     path = Path(path)
+    where = shown(path)
     kind = SUFFIXES.get(path.suffix.lower())
     if kind is None:
-        raise InputError(f"{path}: unsupported mesh format '{path.suffix}'; expected one of {', '.join(SUFFIXES)}")
-    if not path.is_file():
-        raise InputError(f"{path}: file not found")
-    if not (np.isfinite(scale) and scale > 0):
-        raise InputError(f"scale should be > 0, but was {scale}")
+        raise InputError(f"{where}: unsupported mesh format '{echo(path.suffix)}'; expected one of {', '.join(SUFFIXES)}")
+    SCALE.check(scale, "scale")
     up = (up_axis or DEFAULT_UP.get(kind, "Z")).upper()
     if up not in ("Y", "Z"):
-        raise InputError(f"up axis should be Y or Z, but was {up_axis!r}")
+        raise InputError(f"up_axis: {echo(repr(up_axis))}; expected Y or Z")
+    check_input_file(path, MAX_MESH_BYTES, f"a {kind.upper()} mesh")
     try:
-        scene = trimesh.load(str(path), force="scene", split_objects=True, split_groups=False)
-    except Exception as exc:  # trimesh raises many types for malformed files
-        raise InputError(f"{path}: cannot read as {kind.upper()}: {exc}") from None
+        with warnings.catch_warnings():  # numpy's overflow warnings on absurd coordinates: refused below
+            warnings.simplefilter("ignore", RuntimeWarning)
+            scene = trimesh.load(str(path), force="scene", split_objects=True, split_groups=False)
+    except Exception as exc:  # trimesh raises many types for malformed files (MemoryError included)
+        raise InputError(f"{where}: cannot read as {kind.upper()}: {echo(exc) or type(exc).__name__}; expected a "
+                         f"valid {kind.upper()} file") from None
     # Object name -> class -> parts, in file order.
     grouped: dict[str, dict[str, list[TwinPart]]] = defaultdict(lambda: defaultdict(list))
     materials: dict[str, Material] = {}
     unmatched: list[str] = []
     matched_by: dict[str, int] = defaultdict(int)
     nodes = list(scene.graph.nodes_geometry)
-    if not nodes:
-        raise InputError(f"{path}: no geometry")
-    for node in nodes:
-        transform, geom_name = scene.graph[node]
+    meshes = [(node, *scene.graph[node]) for node in nodes]
+    meshes = [(node, transform, name) for node, transform, name in meshes
+              if isinstance(scene.geometry.get(name), trimesh.Trimesh) and len(scene.geometry[name].faces)]
+    if not meshes:
+        points = sum(len(getattr(g, "vertices", ())) for g in scene.geometry.values())
+        raise InputError(f"{where}: no geometry with triangles ({len(nodes)} geometries, {points} vertices, no face "
+                         f"of 3 or more vertices); expected a mesh with faces")
+    triangles = sum(len(scene.geometry[name].faces) for _, _, name in meshes)
+    if triangles > MAX_TRIANGLES:
+        raise InputError(f"{where}: {triangles} triangles; expected at most {MAX_TRIANGLES} (simplify or tile the mesh)")
+    for node, transform, geom_name in meshes:
         geom = scene.geometry[geom_name]
-        if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
-            continue
-        points = trimesh.transform_points(np.asarray(geom.vertices, float), transform)
+        faces = np.asarray(geom.faces, np.int64)
+        if faces.min() < 0 or faces.max() >= len(geom.vertices):
+            raise InputError(f"{where}: object '{echo(node)}': a face refers to vertex {int(faces.max()) + 1} of "
+                             f"{len(geom.vertices)}; expected indices of existing vertices")
+        with np.errstate(over="ignore", invalid="ignore"):
+            points = trimesh.transform_points(np.asarray(geom.vertices, float), transform)
+            if up == "Y":
+                points = trimesh.transform_points(points, _Y_TO_Z)
+            points *= scale
         if not np.all(np.isfinite(points)):
-            raise InputError(f"{path}: object '{node}' has NaN or infinite coordinates")
-        if up == "Y":
-            points = trimesh.transform_points(points, _Y_TO_Z)
-        points *= scale
+            raise InputError(f"{where}: object '{echo(node)}' has NaN or infinite coordinates; expected finite numbers")
+        if np.abs(points).max() > COORDINATE.high:
+            raise InputError(f"{where}: object '{echo(node)}' has coordinates up to {np.abs(points).max():.3g} m "
+                             f"(after scale {scale:g}); expected coordinates within ±{COORDINATE.high:g} m")
         mat_name, material = _material(geom, "default")
         materials.setdefault(mat_name, material)
         obj = _object_name(node, geom_name, mat_name, kind, path)
@@ -101,7 +130,7 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
             unmatched.append(geom_name)
         else:
             matched_by[f"rules[{rule}]"] += 1
-        grouped[obj][label].append(TwinPart(prim_name(mat_name, "Mesh"), points, np.asarray(geom.faces, np.int64),
+        grouped[obj][label].append(TwinPart(prim_name(mat_name, "Mesh"), points, faces,
                                             mat_name, {"source_group": geom_name, "source_material": mat_name}))
     objects = []
     for obj, by_class in grouped.items():
@@ -109,10 +138,10 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
             path_ = prim_name(obj) if len(by_class) == 1 else f"{prim_name(obj)}/{prim_name(label)}"
             objects.append(TwinObject(path_, label, tuple(_unique_part_names(parts)), {"source_object": obj}))
     if unmatched:
-        log.warning("%s: %d of %d meshes matched no rule and are labelled '%s': %s", path, len(unmatched),
-                    len(nodes), rules.default, ", ".join(unmatched[:5]) + (" ..." if len(unmatched) > 5 else ""))
+        log.warning("%s: %d of %d meshes matched no rule and are labelled '%s': %s", where, len(unmatched),
+                    len(meshes), rules.default, echo(", ".join(unmatched[:5]) + (" ..." if len(unmatched) > 5 else "")))
     model = TwinModel(objects=tuple(unique_paths(objects)), materials=materials, source=str(path),
-                      report={"meshes": len(nodes), "unmatched": unmatched, "matched_by": dict(matched_by),
+                      report={"meshes": len(meshes), "unmatched": unmatched, "matched_by": dict(matched_by),
                               "rules": rules.source})
     return model
 

@@ -17,16 +17,22 @@
 
 from __future__ import annotations
 
+import contextlib
 import logging
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 from tqdm import tqdm
 
-from synthua_usd.errors import InputError
-from synthua_usd.scene import Material
 from synthua_usd.class_assignment import AssignmentRules
+from synthua_usd.errors import InputError, echo
+from synthua_usd.importers.limits import (MAX_DEVIATION, MAX_EXTENT_M, MAX_POINTCLOUD_BYTES, MAX_POINTS,
+                                          PLANE_THRESHOLD)
+from synthua_usd.input_files import check_input_file, shown
+from synthua_usd.materials import class_material, subset
+from synthua_usd.ranges import COORDINATE
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart
 
 log = logging.getLogger(__name__)
@@ -40,9 +46,8 @@ LAS_CLASSES = {2: "road", 3: "vegetation", 4: "vegetation", 5: "vegetation", 6: 
 LAS_NAMES = {0: "never_classified", 1: "unclassified", 2: "ground", 3: "low_vegetation", 4: "medium_vegetation",
              5: "high_vegetation", 6: "building", 7: "noise", 9: "water", 11: "road_surface", 17: "bridge_deck"}
 PLANE_CLASSES = {"ground": "road", "roof": "building", "facade": "building"}
-
-MATERIALS = {"road": Material("road", (0.07, 0.07, 0.075), 0.9), "vegetation": Material("vegetation", (0.08, 0.2, 0.05), 0.8),
-             "building": Material("building", (0.5, 0.45, 0.4), 0.9), "other": Material("other", (0.3, 0.3, 0.3), 0.8)}
+#: Largest point data a LAS/LAZ header may announce (points x record length), decompressed in memory.
+MAX_POINT_DATA_BYTES = 2 * 2**30
 
 
 @dataclass(frozen=True)
@@ -61,34 +66,77 @@ class Segment:
         return self.points - np.outer(self.points @ normal + d, normal)
 
 
+@contextlib.contextmanager
+def _quiet(logger: str) -> Iterator[None]:
+    """Silence a library's own error log while we read (we report the failure ourselves, in one line)."""
+    log_ = logging.getLogger(logger)
+    level = log_.level
+    log_.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        log_.setLevel(level)
+
+
+def _check_las_header(header, size: int, where: str) -> None:
+    """Refuse a LAS/LAZ header whose point count, record size, scales or offsets cannot be true of this file
+    (before any point is read, so that a lying header cannot make us allocate what it claims)."""
+    count, record = int(header.point_count), int(header.point_format.size)
+    if count > MAX_POINTS:
+        raise InputError(f"{where}: the header announces {count} points; expected at most {MAX_POINTS} (thin or tile "
+                         f"the cloud)")
+    if count * record > MAX_POINT_DATA_BYTES:
+        raise InputError(f"{where}: the header announces {count} points of {record} bytes ({count * record} bytes); "
+                         f"expected at most {MAX_POINT_DATA_BYTES} bytes of point data")
+    if not header.are_points_compressed and int(header.offset_to_point_data) + count * record > size:
+        held = max(size - int(header.offset_to_point_data), 0) // max(record, 1)
+        raise InputError(f"{where}: the header announces {count} points but the file holds {held}; expected a "
+                         f"complete LAS file")
+    scales, offsets = np.asarray(header.scales, float), np.asarray(header.offsets, float)
+    if not (np.all(np.isfinite(scales)) and np.all(scales > 0) and np.all(scales <= 1e3)):
+        raise InputError(f"{where}: header scale factors {echo(scales.tolist())}; expected numbers in (0, 1000]")
+    if not np.all(np.abs(offsets) <= COORDINATE.high):  # NaN fails too
+        raise InputError(f"{where}: header offsets {echo(offsets.tolist())}; expected numbers within "
+                         f"±{COORDINATE.high:g} m")
+
+
 def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None]:
     """(n, 3) float64 coordinates, (n,) uint8 LAS classification or None, CRS text or None."""
+    where = shown(path)
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
-        raise InputError(f"{path}: unsupported point cloud format '{path.suffix}'; expected {', '.join(SUFFIXES)}")
-    if not path.is_file():
-        raise InputError(f"{path}: file not found")
+        raise InputError(f"{where}: unsupported point cloud format '{echo(path.suffix)}'; expected {', '.join(SUFFIXES)}")
+    size = check_input_file(path, MAX_POINTCLOUD_BYTES, f"a {suffix[1:].upper()} point cloud")
     if suffix == ".ply":
         import trimesh
 
         try:
             cloud = trimesh.load(str(path))
-        except Exception as exc:
-            raise InputError(f"{path}: cannot read as PLY: {exc}") from None
-        return np.asarray(cloud.vertices, float), None, None
+        except Exception as exc:  # malformed files raise many types (MemoryError included)
+            raise InputError(f"{where}: cannot read as PLY: {echo(exc) or type(exc).__name__}") from None
+        vertices = np.asarray(getattr(cloud, "vertices", np.zeros((0, 3))), float).reshape(-1, 3)
+        if len(vertices) > MAX_POINTS:
+            raise InputError(f"{where}: {len(vertices)} points; expected at most {MAX_POINTS}")
+        return vertices, None, None
     import laspy
 
     try:
-        las = laspy.read(str(path))
-    except laspy.errors.LaspyException as exc:
-        raise InputError(f"{path}: cannot read as LAS/LAZ: {exc}") from None
-    except Exception as exc:  # corrupt headers raise plain ValueError/struct errors
-        raise InputError(f"{path}: cannot read as LAS/LAZ: {exc}") from None
+        with _quiet("laspy"), laspy.open(str(path)) as reader:
+            _check_las_header(reader.header, size, where)
+            las = reader.read()
+    except InputError:
+        raise
+    except Exception as exc:  # corrupt headers and bodies raise LaspyException, ValueError, struct and lazrs errors
+        raise InputError(f"{where}: cannot read as LAS/LAZ: {echo(exc) or type(exc).__name__}") from None
+    if len(las.points) != las.header.point_count:
+        raise InputError(f"{where}: {len(las.points)} of the {las.header.point_count} points the header announces "
+                         f"could be read; expected a complete file")
     xyz = np.column_stack([np.asarray(las.x, float), np.asarray(las.y, float), np.asarray(las.z, float)])
     classes = np.asarray(las.classification, np.uint8)
     try:
-        crs = las.header.parse_crs()
-    except Exception:
+        with _quiet("laspy"):
+            crs = las.header.parse_crs()
+    except Exception:  # a CRS record laspy cannot parse leaves the CRS unknown, as a file without one
         crs = None
     return xyz, (classes if np.any(classes > 1) else None), (crs.to_string() if crs is not None else None)
 
@@ -220,15 +268,22 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
                       show_progress: bool = False, **_ignored) -> TwinModel:
     """Segment, reconstruct and simplify a point cloud; the report holds the measured deviations."""
     path = Path(path)
-    if not (np.isfinite(max_deviation_m) and max_deviation_m > 0):
-        raise InputError(f"max_deviation_m should be > 0, but was {max_deviation_m}")
+    where = shown(path)
+    MAX_DEVIATION.check(max_deviation_m, "max_deviation_m")
+    PLANE_THRESHOLD.check(plane_threshold_m, "plane_threshold_m")
     xyz, classes, crs = read_points(path)
     if len(xyz) == 0:
-        raise InputError(f"{path}: the point cloud has no points")
+        raise InputError(f"{where}: the point cloud has no points; expected at least 3")
     if not np.all(np.isfinite(xyz)):
-        raise InputError(f"{path}: {int((~np.isfinite(xyz)).any(axis=1).sum())} points have NaN or infinite "
-                         f"coordinates")
+        raise InputError(f"{where}: {int((~np.isfinite(xyz)).any(axis=1).sum())} points have NaN or infinite "
+                         f"coordinates; expected finite coordinates")
+    if np.abs(xyz).max() > COORDINATE.high:
+        raise InputError(f"{where}: coordinates up to {np.abs(xyz).max():.3g} m; expected coordinates within "
+                         f"±{COORDINATE.high:g} m")
     lo, hi = xyz.min(axis=0), xyz.max(axis=0)
+    if (hi - lo).max() > MAX_EXTENT_M:
+        raise InputError(f"{where}: points span {(hi - lo).max():.3g} m; expected at most {MAX_EXTENT_M:g} m (tile the "
+                         f"cloud)")
     origin = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]])
     local = xyz - origin
     rng = np.random.default_rng(seed)
@@ -258,11 +313,11 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
         surface = seg.surface_points()
         tris = triangulate_height_field(surface)
         if len(tris) == 0:
-            log.warning("%s: segment %s (%d points) could not be triangulated; skipped", path, seg.name, len(seg.points))
+            log.warning("%s: segment %s (%d points) could not be triangulated; skipped", where, seg.name, len(seg.points))
             report["segments"].append({"name": seg.name, "points": int(len(seg.points)), "skipped": True})
             continue
         simple = simplify_within(surface, tris, seg.points, max_deviation_m)
-        material = seg.label if seg.label in MATERIALS else "other"
+        material = class_material(seg.label).key
         objects.append(TwinObject(seg.name, seg.label, (TwinPart("Surface", simple.points, simple.triangles, material),),
                                   {"segment_source": seg.source, "simplification_deviation_m": simple.deviation_m,
                                    "residual_max_m": simple.residual_max_m}))
@@ -272,8 +327,10 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
                                    "residual_max_m": simple.residual_max_m, "residual_mean_m": simple.residual_mean_m,
                                    "residual_rms_m": simple.residual_rms_m})
     if not objects:
-        raise InputError(f"{path}: no surface could be reconstructed from {len(xyz)} points")
-    return TwinModel(objects=tuple(objects), materials=dict(MATERIALS), source=str(path),
+        raise InputError(f"{where}: no surface could be reconstructed from {len(xyz)} points; expected points that "
+                         f"sample surfaces (at least 3 not on one line)")
+    return TwinModel(objects=tuple(objects), materials=subset(p.material for o in objects for p in o.parts),
+                     source=str(path),
                      origin_offset_m=tuple(float(v) for v in origin), crs=crs, report=report)
 
 

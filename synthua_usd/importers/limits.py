@@ -1,0 +1,49 @@
+"""The stated limits of the importers: ranges of their parameters and of the numbers and sizes they read.
+
+Kept apart from the importer modules so that the command line can build its options from them without
+loading trimesh, laspy or pymeshlab. Each limit says why it is where it is.
+"""
+
+from __future__ import annotations
+
+from synthua_usd.input_files import MiB
+from synthua_usd.ranges import Range
+
+# --- parameters --------------------------------------------------------------------------------------------
+
+#: mesh: file units to metres (micrometres to kilometres, with room on both sides).
+SCALE = Range(1e-6, 1e6)
+#: pointcloud: largest Hausdorff distance simplification may introduce; 10 µm is below any scanner's noise.
+MAX_DEVIATION = Range(1e-5, 10, "m")
+#: pointcloud: RANSAC inlier distance; below 0.1 mm no plane of a real scan has inliers, above 10 m
+#: everything is one plane.
+PLANE_THRESHOLD = Range(1e-4, 10, "m")
+#: footprints: metres per level when a footprint gives levels.
+STOREY_HEIGHT = Range(1, 20, "m")
+
+# --- numbers read from files ---------------------------------------------------------------------------------
+
+#: Largest horizontal or vertical extent of one import; the twin is stored in 32-bit floats around a local
+#: origin, which at 1,000 km still resolves 6 cm.
+MAX_EXTENT_M = 1_000_000.0
+#: Building heights above ground (the tallest building is 828 m), and the least a block may rise above its
+#: min_height: 10 cm (an extrusion thinner than that is a digitising slip, and trimesh cannot extrude ~0).
+HEIGHT = Range(0.1, 1000, "m")
+MIN_BLOCK_HEIGHT_M = 0.1
+MIN_HEIGHT = Range(0, 1000, "m")
+LEVELS = Range(0, 300, low_open=True)
+#: Smallest footprint area: 10 cm x 10 cm; below it a polygon is a digitising slip, not a building.
+MIN_FOOTPRINT_AREA_M2 = 0.01
+#: CityJSON transform: scale of the integer vertices (metres per unit) and translation.
+TRANSFORM_SCALE = Range(0, 1000, low_open=True)
+
+# --- sizes ---------------------------------------------------------------------------------------------------
+
+#: Mesh files: parsing takes several times the file's size in memory.
+MAX_MESH_BYTES = 512 * MiB
+#: Point cloud files (LAS/LAZ/PLY).
+MAX_POINTCLOUD_BYTES = 2048 * MiB
+#: Points of one cloud: RANSAC, Delaunay and MeshLab's simplification work on all of them in memory.
+MAX_POINTS = 20_000_000
+#: Triangles of one mesh import.
+MAX_TRIANGLES = 20_000_000
