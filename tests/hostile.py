@@ -73,6 +73,8 @@ def tree_state(root: Path) -> dict[str, tuple]:
                 out[rel] = ("link", os.readlink(path))
             elif path.is_dir():
                 out[rel] = ("dir",)
+            elif not path.is_file():  # a FIFO, socket or device: its kind, never its content (reading blocks)
+                out[rel] = ("special", path.stat().st_mode)
             else:
                 out[rel] = ("file", hashlib.sha256(path.read_bytes()).hexdigest(), path.stat().st_mode & 0o777)
     return out

@@ -35,9 +35,9 @@ def test_gsd_by_hand():
 
 
 @pytest.mark.parametrize("kwargs,text", [
-    (dict(altitude_m=0), "altitude_m should be > 0"),
-    (dict(fov_deg=180), "fov_deg should be in (0, 180)"),
-    (dict(frontal_overlap=1.0), "frontal_overlap should be a fraction in [0, 1)"),
+    (dict(altitude_m=0), "altitude_m: 0; expected a number in [1, 20000] m"),
+    (dict(fov_deg=180), "fov_deg: 180; expected a number in [1, 170] deg"),
+    (dict(frontal_overlap=1.0), "frontal_overlap: 1; expected a number in [0, 0.95]"),
     (dict(sensor_width_mm=13.2), "go together"),
 ])
 def test_bad_flight_inputs(kwargs, text):
@@ -72,7 +72,7 @@ def test_flight_plan_cli(run_cli):
 
 @pytest.mark.parametrize("name,text", [
     ("gcp_missing_z.csv", "missing columns ['z']"),
-    ("gcp_not_number.csv", "line 2: x, y, z should be numbers"),
+    ("gcp_not_number.csv", "line 2: y: 'two' is not a number; expected a number in"),
 ])
 def test_bad_gcp_files(name, text):
     with pytest.raises(InputError, match=text.replace("[", r"\[").replace("]", r"\]")):

@@ -39,7 +39,12 @@ class OneLineFormatter(logging.Formatter):
     """``synthua: warning: message`` with the message kept on one line."""
 
     def format(self, record: logging.LogRecord) -> str:
-        return f"synthua: {record.levelname.lower()}: {one_line(record.getMessage())}"
+        # Only synthua says "error": it prints its one error line itself. What other libraries log at error
+        # level is, for the user, a warning before synthua's own verdict.
+        level = record.levelname.lower()
+        if level in ("error", "critical") and not record.name.startswith("synthua"):
+            level = "warning"
+        return f"synthua: {level}: {one_line(record.getMessage())}"
 
 
 def configure_logging(verbose: int) -> None:

@@ -26,7 +26,7 @@ def test_validate_classes_unusable_input_exit_2_one_line(run_cli, tmp_path):
     missing = tmp_path / "nope.json"
     code, out, err = run_cli("validate", "classes", missing)
     assert code == 2 and out == ""
-    assert err.strip() == f"synthua: error: {missing}: file not found"
+    assert err.strip() == f"synthua: error: {missing}: file not found; expected a JSON document"
     code, _, err = run_cli("validate", "classes", DATA / "invalid" / "not_json.json")
     assert code == 2 and len(err.strip().splitlines()) == 1 and "not valid JSON" in err
 

@@ -50,8 +50,8 @@ def test_rules_override_the_type_table(class_map):
     ("cityjson_v1_0", "CityJSON version 1.0 is not supported; expected one of 1.1, 2.0"),
     ("cityjson_no_crs", "metadata.referenceSystem is missing"),
     ("cityjson_geographic_crs", "is geographic (degrees); expected a projected CRS in metres"),
-    ("cityjson_nan_vertex", "vertices contain NaN"),
-    ("cityjson_bad_boundary", "CityObjects['road-1']: malformed geometry boundaries"),
+    ("cityjson_nan_vertex", "NaN is not JSON; expected finite numbers"),
+    ("cityjson_bad_boundary", "CityObjects['road-1'].geometry[0].boundaries[0][0][2]: vertex index 999"),
 ])
 def test_broken_cityjson(name, text):
     path = DATA / "invalid" / f"{name}.city.json"

@@ -24,7 +24,7 @@ def test_extrudes_heights_and_levels():
 @pytest.mark.parametrize("name,text", [
     ("footprint_point", "features[1] (Casa): geometry type 'Point' is not a footprint; expected Polygon or MultiPolygon"),
     ("footprint_no_height", "features[1] (Casa): no height; expected a 'height' (m) or 'levels' property"),
-    ("footprint_nan", "features[0] (Igreja): polygon has NaN or infinite coordinates"),
+    ("footprint_nan", "NaN is not JSON; expected finite numbers (NaN and Infinity are not allowed)"),
     ("footprint_empty", "the FeatureCollection has no features"),
 ])
 def test_broken_footprints(name, text):
