@@ -18,7 +18,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
-from synthua_usd.errors import InputError
+from synthua_usd.errors import OutputError
 
 
 @contextmanager
@@ -48,14 +48,14 @@ def output_set(out_dir: str | Path) -> Iterator[Path]:
     """
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"{out_dir}: output folder is a file; expected a folder or a path that does not exist")
+        raise OutputError(f"{out_dir}: output folder is a file; expected a folder or a path that does not exist")
     parent = out_dir.parent
     try:
         parent.mkdir(parents=True, exist_ok=True)
         staging = parent / f".{out_dir.name[:64]}.partial-{secrets.token_hex(4)}"
         staging.mkdir()
     except FileExistsError:
-        raise InputError(f"{out_dir}: a parent of the output folder is a file; expected folders") from None
+        raise OutputError(f"{out_dir}: a parent of the output folder is a file; expected folders") from None
     try:
         yield staging
         _move_into_place(staging, out_dir)
@@ -72,11 +72,11 @@ def _move_into_place(staging: Path, out_dir: Path) -> None:
     for src in files:
         target = out_dir / src.relative_to(staging)
         if target.is_dir() and not target.is_symlink():
-            raise InputError(f"{target}: is a folder where the output file goes; move it away and run again")
+            raise OutputError(f"{target}: is a folder where the output file goes; move it away and run again")
         for ancestor in target.relative_to(out_dir).parents:
             folder = out_dir / ancestor
             if folder.exists() and not folder.is_dir():
-                raise InputError(f"{folder}: is a file where an output folder goes; move it away and run again")
+                raise OutputError(f"{folder}: is a file where an output folder goes; move it away and run again")
     for src in files:
         target = out_dir / src.relative_to(staging)
         target.parent.mkdir(parents=True, exist_ok=True)

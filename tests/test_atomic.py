@@ -3,7 +3,7 @@
 import pytest
 
 from synthua_usd.atomic import output_set
-from synthua_usd.errors import InputError
+from synthua_usd.errors import OutputError
 
 
 def folder(path, **files):
@@ -31,7 +31,7 @@ def test_files_are_replaced_and_others_kept(tmp_path):
 
 @pytest.mark.parametrize("staged,error,text", [
     ({"f.txt": "new"}, RuntimeError, "boom"),  # the command fails after staging
-    ({"f.txt": "new", "CCTV/frame.json": "{}"}, InputError, "is a file where an output folder goes"),
+    ({"f.txt": "new", "CCTV/frame.json": "{}"}, OutputError, "is a file where an output folder goes"),
 ])
 def test_a_failure_leaves_the_folder_as_it_was(tmp_path, staged, error, text):
     out = folder(tmp_path / "out", **{"f.txt": "old", "CCTV": "a file"})

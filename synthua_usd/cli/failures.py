@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import faulthandler
 import logging
 import os
 import re
@@ -76,7 +77,7 @@ def describe(exc: BaseException) -> tuple[str, int]:
         return str(exc), EXIT_INPUT
     if isinstance(exc, OSError):
         where = exc.filename if exc.filename is not None else "output"
-        found = exc.strerror or type(exc).__name__
+        found = exc.strerror or str(exc) or type(exc).__name__
         expected = _OS_EXPECTED.get(exc.errno, "a usable path")
         return f"{echo(where)}: {found.lower()}; expected {expected}", EXIT_INPUT
     if isinstance(exc, RecursionError):
@@ -131,6 +132,10 @@ def guarded(fn: Callable[[], int], debug: bool) -> int:
         return status
 
 
+#: How much of the native diagnostics is read back and how many lines are printed.
+NATIVE_LIMIT = 64 * 1024
+NATIVE_LINES = 20
+
 _DIAGNOSTIC = re.compile(r"^(?:Warning|Error|Coding Error|Fatal Error|Status):?\s*(?:in \S+ at line \d+ of \S+ -- )?")
 _STAGE_SUFFIX = re.compile(r"\s*\(instantiating stage on stage @[^@]*@ <0x[0-9a-f]+>\)$")
 
@@ -149,27 +154,38 @@ def native_stderr_as_warnings(keep_on_failure: bool = True) -> Iterator[None]:
         return
     sys.stderr.flush()
     saved = os.dup(2)
+    original = sys.stderr
+    replacement = None
+    failed = True
     with tempfile.TemporaryFile() as sink:
-        os.dup2(sink.fileno(), 2)
-        original = sys.stderr
-        sys.stderr = os.fdopen(os.dup(saved), "w", buffering=1, encoding=original.encoding or "utf-8",
-                               errors="backslashreplace")
-        _rebind_log_handlers(original, sys.stderr)
-        failed = True
         try:
+            os.dup2(sink.fileno(), 2)
+            replacement = os.fdopen(os.dup(saved), "w", buffering=1, encoding=original.encoding or "utf-8",
+                                    errors="backslashreplace")
+            sys.stderr = replacement
+            _rebind_log_handlers(original, replacement)
+            # A native crash (segfault, abort) still reaches the terminal, not the captured file.
+            faulthandler.enable(replacement)
             yield
             failed = False
         finally:
-            sys.stderr.flush()
+            if replacement is not None:
+                replacement.flush()
             os.dup2(saved, 2)
             os.close(saved)
-            replacement, sys.stderr = sys.stderr, original
-            _rebind_log_handlers(replacement, original)
-            replacement.close()
-            sink.seek(0)
+            sys.stderr = original
+            if replacement is not None:
+                faulthandler.disable()
+                _rebind_log_handlers(replacement, original)
+                replacement.close()
             if keep_on_failure or not failed:
-                for line in _diagnostics(sink.read().decode("utf-8", "backslashreplace")):
+                size = sink.seek(0, os.SEEK_END)
+                sink.seek(0)
+                lines = _diagnostics(sink.read(NATIVE_LIMIT).decode("utf-8", "backslashreplace"))
+                for line in lines[:NATIVE_LINES]:
                     log.warning("usd: %s", line)
+                if len(lines) > NATIVE_LINES or size > NATIVE_LIMIT:
+                    log.warning("usd: ... and more diagnostics (%d bytes in all, the first %d lines shown)", size, NATIVE_LINES)
 
 
 def _rebind_log_handlers(old, new) -> None:

@@ -22,7 +22,7 @@ from synthua_usd.backends.frame_files import write_frame
 from synthua_usd.backends.mitsuba.render import RenderedFrame
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.cameras import CONFORM_EXPAND, PinholeCamera
-from synthua_usd.errors import InputError, StageError
+from synthua_usd.errors import InputError, StageError, echo
 from synthua_usd.outputs import OUTPUT_NAMES, RenderOutput, select_outputs
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.resources import check_frame_memory
@@ -57,20 +57,24 @@ class FrameRequest:
     variant: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
+    #: Keep every frame's buffers in the result (tests); by default only a single frame's are kept, so a
+    #: long sweep holds documents and paths, not images, in memory.
+    keep_buffers: bool | None = None
     #: A condition the stage offers (its ``condition`` variant); None: the stage's own selection.
     condition: str | None = None
 
 
 @dataclass(frozen=True, eq=False)
 class FrameResult:
-    """One rendered frame: where it went, its ``frame.json`` document and its buffers."""
+    """One rendered frame: where it went, its ``frame.json`` document, and (see
+    :attr:`FrameRequest.keep_buffers`) its snapshot and buffers, else None."""
 
     out_dir: Path
     files: list[Path]
     document: dict
-    snapshot: SceneSnapshot
+    snapshot: SceneSnapshot | None
     camera: PinholeCamera
-    rendered: RenderedFrame
+    rendered: RenderedFrame | None
 
 
 @dataclass(eq=False)
@@ -109,6 +113,12 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
                          f"codes); one render call holds at most {MAX_FRAMES}")
     for cam in camera_paths:  # every camera is checked before anything renders
         read_camera(stage, cam, time_codes[0])
+    folders: dict[str, str] = {}
+    for cam in dict.fromkeys(camera_paths):  # frame folders are named by the camera's prim name
+        other = folders.setdefault(cam.rsplit("/", 1)[-1], cam)
+        if other != cam and len(frames) > 1:
+            raise InputError(f"--camera {echo(other)} and {echo(cam)}: both would write frames into "
+                             f"'{cam.rsplit('/', 1)[-1]}/'; expected cameras with different prim names")
     width, height = defaults.resolution or (RenderConfig.width, RenderConfig.height)
     spp = request.spp if request.spp is not None else defaults.spp if defaults.spp is not None else RenderConfig.spp
     config = RenderConfig(width=request.width or width, height=request.height or height, spp=spp, seed=request.seed,
@@ -140,7 +150,9 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
                                   display_scale=rendered.exposure.scale if rendered.exposure else 1.0)
             log.info("wrote %d files for %s at %g in %.2f s", len(written), cam_path, tc, time.perf_counter() - t0)
             files = [request.out_dir / rel / p.name for p in written]
-            run.frames.append(FrameResult(request.out_dir / rel, files, doc, snapshot, camera, rendered))
+            keep = request.keep_buffers if request.keep_buffers is not None else single
+            run.frames.append(FrameResult(request.out_dir / rel, files, doc, snapshot if keep else None, camera,
+                                          rendered if keep else None))
     run.loads, run.reloads = session.loads, session.reloads
     return run
 

@@ -42,7 +42,7 @@ def seed1():
 @pytest.fixture(scope="module")
 def views(tmp_path_factory):
     """The shipped district rendered from four cameras at time code 24, from one scene load."""
-    run = run_frames(FrameRequest(stage_path=DISTRICT / "scenario.usda", out_dir=tmp_path_factory.mktemp("district"),
+    run = run_frames(FrameRequest(stage_path=DISTRICT / "scenario.usda", keep_buffers=True, out_dir=tmp_path_factory.mktemp("district"),
                                   camera_paths=tuple(f"/World/Cameras/{c}" for c in VIEWS), time_codes=(24,),
                                   width=W, height=H, spp=1))
     assert run.loads == 1

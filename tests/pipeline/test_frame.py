@@ -29,7 +29,7 @@ def out(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def run(out):
-    return run_frames(FrameRequest(stage_path=SCENARIO, out_dir=out, camera_paths=CAMERAS, time_codes=(24,),
+    return run_frames(FrameRequest(stage_path=SCENARIO, out_dir=out, camera_paths=CAMERAS, time_codes=(24,), keep_buffers=True,
                                    width=W, height=H, spp=1))
 
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from synthua_usd.backends.mitsuba.translate import film_dict, sampler_dict
 from synthua_usd.cameras import PinholeCamera
 from synthua_usd.render_config import RenderConfig
 
@@ -75,9 +76,8 @@ def distorted_sensor(mi, camera: PinholeCamera, config: RenderConfig, spp: int |
             return f"DistortedPerspective[{camera.path}, {dist}]"
 
     props = mi.Properties()
-    props["film"] = mi.load_dict({"type": "hdrfilm", "width": width, "height": height, "pixel_format": "rgb",
-                                  "rfilter": {"type": config.pixel_filter}})
-    props["sampler"] = mi.load_dict({"type": "independent", "sample_count": spp or config.spp, "seed": config.seed})
+    props["film"] = mi.load_dict(film_dict(config, width, height))
+    props["sampler"] = mi.load_dict(sampler_dict(config, spp))
     return DistortedPerspective(props)
 
 

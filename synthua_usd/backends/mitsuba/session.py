@@ -83,8 +83,9 @@ class RenderSession:
         old = self._snapshot
         return (self._translation.condition_key == weather_scene.scene_key(condition)
                 and len(old.meshes) == len(snapshot.meshes) and old.lights == snapshot.lights
-                and all(a is b or (a.prim_path == b.prim_path and a.triangles.shape == b.triangles.shape
-                                   and a.material_key == b.material_key)
+                and all(a is b or (a.prim_path == b.prim_path and a.material_key == b.material_key
+                                   and a.points.shape == b.points.shape
+                                   and (a.triangles is b.triangles or np.array_equal(a.triangles, b.triangles)))
                         for a, b in zip(old.meshes, snapshot.meshes)))
 
     def _update(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> int:
@@ -112,9 +113,10 @@ class RenderSession:
 
     def quick_labels(self, snapshot: SceneSnapshot, camera: PinholeCamera) -> np.ndarray:
         """(H, W) uint16 instance ids of ``camera``'s pixel-centre rays computed from its lens values, without
-        pointing the scene's sensor at it (a sensor change costs a full parameter update): the cheap pass for
-        many throw-away views of one snapshot, such as scoring camera placements. Ids agree with
-        :meth:`render`'s up to float32 rounding of the ray directions; dataset labels come from :meth:`render`."""
+        pointing the scene's sensor at it: the cheap pass for many throw-away views of one snapshot, such as
+        scoring camera placements (a new snapshot is still loaded or updated first, and the session's
+        condition is not kept: use a session of its own). Ids agree with :meth:`render`'s up to float32
+        rounding of the ray directions; dataset labels come from :meth:`render`."""
         if self._scene is None or not self._same_layout(snapshot):
             self._load(snapshot, camera)
             self.reloads += self.loads > 1

@@ -73,10 +73,20 @@ def sensor_dict(mi, camera: PinholeCamera, config: RenderConfig, spp: int | None
         "near_clip": camera.clip_near_m,
         "far_clip": camera.clip_far_m,
         "to_world": sensor_to_world(mi, camera),
-        "film": {"type": "hdrfilm", "width": config.width, "height": config.height, "pixel_format": "rgb",
-                 "rfilter": {"type": config.pixel_filter}},
-        "sampler": {"type": "independent", "sample_count": spp or config.spp, "seed": config.seed},
+        "film": film_dict(config),
+        "sampler": sampler_dict(config, spp),
     }
+
+
+def film_dict(config: RenderConfig, width: int | None = None, height: int | None = None) -> dict:
+    """The RGB film of every sensor (``width``/``height`` override the config's size)."""
+    return {"type": "hdrfilm", "width": width or config.width, "height": height or config.height,
+            "pixel_format": "rgb", "rfilter": {"type": config.pixel_filter}}
+
+
+def sampler_dict(config: RenderConfig, spp: int | None = None) -> dict:
+    """The sampler of every sensor: independent samples seeded by the config."""
+    return {"type": "independent", "sample_count": spp or config.spp, "seed": config.seed}
 
 
 def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter=None, face_attributes=None):
