@@ -1,5 +1,7 @@
 """Exception types. Every message names the file, prim or field, what was found and what was expected."""
 
+import re
+
 
 class SynthuaError(Exception):
     """Base class of the errors this package raises on purpose."""
@@ -33,9 +35,17 @@ class OutputError(SynthuaError):
 ECHO_LIMIT = 120
 
 
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+
+
+def escape_controls(text: str) -> str:
+    """``text`` with newlines and other control characters escaped (``\\n``, ``\\x1b``); other characters,
+    accented letters included, kept as they are."""
+    return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), str(text))
+
+
 def echo(value, limit: int = ECHO_LIMIT) -> str:
-    """``value`` as it may appear inside a one-line message: control characters and newlines escaped
-    (``repr`` style, without the quotes), cut to ``limit`` characters."""
-    text = str(value)
-    out = text.encode("unicode_escape").decode("ascii", "backslashreplace") if not text.isprintable() else text
+    """``value`` as it may appear inside a one-line message: control characters escaped, cut to ``limit``
+    characters."""
+    out = escape_controls(value)
     return out if len(out) <= limit else out[:limit - 3] + "..."

@@ -11,7 +11,7 @@ import os
 import stat
 from pathlib import Path
 
-from synthua_usd.errors import InputError
+from synthua_usd.errors import InputError, escape_controls
 
 MiB = 2**20
 #: JSON documents (class maps, rules, CityJSON, GeoJSON) and CSV tables: far above any class map or rules
@@ -28,9 +28,7 @@ PATH_SHOWN = 200
 
 def shown(path: str | Path) -> str:
     """``path`` as a message shows it: control characters escaped, a very long path cut in the middle."""
-    text = str(path)
-    if not text.isprintable():
-        text = text.encode("unicode_escape").decode("ascii", "backslashreplace")
+    text = escape_controls(path)
     return text if len(text) <= PATH_SHOWN else f"{text[:60]}...{text[-(PATH_SHOWN - 63):]}"
 
 

@@ -22,18 +22,15 @@ from typing import Callable, Iterator
 
 import click
 
-from synthua_usd.errors import SynthuaError, echo
+from synthua_usd.errors import SynthuaError, echo, escape_controls
 
 EXIT_OK, EXIT_FINDINGS, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
 
 log = logging.getLogger("synthua")
 
-_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
-
-
 def one_line(text: str) -> str:
     """``text`` with newlines and other control characters escaped, so a message stays one line."""
-    return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), str(text).strip())
+    return escape_controls(str(text).strip())
 
 
 class OneLineFormatter(logging.Formatter):
