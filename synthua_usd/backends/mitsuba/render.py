@@ -53,16 +53,19 @@ class RenderedFrame:
     condition: Condition | None = None
 
 
-def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sensor=None) -> np.ndarray:
+def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sensor=None,
+               seed: int | None = None) -> np.ndarray:
     """(H, W, 3) float32 linear RGB: the mean of passes of at most SPP_PER_PASS samples each; ``sensor`` (e.g. a
-    :func:`synthua_usd.backends.mitsuba.lens.distorted_sensor`) replaces the scene's own."""
+    :func:`synthua_usd.backends.mitsuba.lens.distorted_sensor`) replaces the scene's own; ``seed`` replaces
+    ``config.seed``."""
+    seed = config.seed if seed is None else seed
     passes = math.ceil(config.spp / SPP_PER_PASS)
     total = np.zeros((config.height, config.width, 3), np.float64)
     done = 0
     with tqdm(total=config.spp, unit="spp", desc="rgb", disable=not show_progress, leave=False) as bar:
         for k in range(passes):
             spp = min(SPP_PER_PASS, config.spp - done)
-            image = mi.render(scene, spp=spp, seed=config.seed * 100_003 + k, sensor=0 if sensor is None else sensor)
+            image = mi.render(scene, spp=spp, seed=seed * 100_003 + k, sensor=0 if sensor is None else sensor)
             total += np.asarray(image, np.float64)[..., :3] * spp
             done += spp
             bar.update(spp)

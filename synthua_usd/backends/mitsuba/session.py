@@ -127,9 +127,11 @@ class RenderSession:
         return label_maps(hits, snapshot)[1]
 
     def render(self, snapshot: SceneSnapshot, camera: PinholeCamera, rgb: bool = True,
-               show_progress: bool = False, condition: Condition | None = None) -> RenderedFrame:
+               show_progress: bool = False, condition: Condition | None = None,
+               seed: int | None = None) -> RenderedFrame:
         """RGB (unless ``rgb`` is False) and labels of ``snapshot`` seen by ``camera`` under ``condition``
-        (None: the stage's UsdLux lights as they are, no weather).
+        (None: the stage's UsdLux lights as they are, no weather); ``seed`` (default: the config's) seeds the
+        sampler and the rain.
 
         ``seconds`` in the result holds ``load`` (first load or reload) or ``update``, then ``labels``,
         ``rgb`` and ``weather`` (fog, rain and exposure in image space)."""
@@ -157,11 +159,12 @@ class RenderSession:
                 self._focus_lamps(hits, camera)
             # Mitsuba's perspective sensor cannot distort: a lens with distortion renders through its own sensor.
             sensor = distorted_sensor(self.mi, camera, self.config) if camera.distortion is not None else None
-            image = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor)
+            image = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor, seed=seed)
             seconds["rgb"] = time.perf_counter() - t0
             t0 = time.perf_counter()
             if condition is not None:
-                image = self._weather(image, hits, camera, condition, snapshot)
+                image = self._weather(image, hits, camera, condition, snapshot,
+                                      self.config.seed if seed is None else seed)
             exposure = choose_exposure(image, hits.mesh_index >= 0)
             seconds["weather"] = time.perf_counter() - t0
         return RenderedFrame(rgb=image, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
@@ -181,13 +184,13 @@ class RenderSession:
             self._params.update()
 
     def _weather(self, image: np.ndarray, hits, camera: PinholeCamera, condition: Condition,
-                 snapshot: SceneSnapshot) -> np.ndarray:
+                 snapshot: SceneSnapshot, seed: int) -> np.ndarray:
         """Fog, then rain streaks in front of it; the rain of a frame is seeded by the session's seed, the
         camera and the time code."""
         airlight = self._lighting.airlight
         image = weather.apply_fog(image, hits.distance_m, hits.mesh_index >= 0, condition.fog_extinction_per_m,
                                   airlight)
-        rng = np.random.default_rng([self.config.seed, zlib.crc32(camera.path.encode("utf-8")),
+        rng = np.random.default_rng([seed, zlib.crc32(camera.path.encode("utf-8")),
                                      int(round(snapshot.time_code * 1000)) & 0xFFFFFFFF])
         return weather.rain_streaks(image, hits.z_m, camera, condition.rain_rate_mm_per_h, airlight, rng,
                                     snapshot.up_axis)
