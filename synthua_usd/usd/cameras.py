@@ -94,3 +94,11 @@ def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
                          vertical_aperture_mm=float(cam.GetVerticalApertureAttr().Get(t)) * unit,
                          clip_near_m=float(near) * mpu, clip_far_m=float(far) * mpu, camera_to_world=m,
                          distortion=distortion)
+
+
+def camera_rig_type(stage: Usd.Stage, path: str) -> str | None:
+    """The rig type a camera was placed as (``synthua:rig:type``, see :mod:`synthua_usd.usd.rig_layer`), or
+    None for a camera authored by hand."""
+    attr = stage.GetPrimAtPath(path).GetAttribute("synthua:rig:type")
+    value = attr.Get() if attr and attr.HasAuthoredValue() else None
+    return str(value) if value else None
