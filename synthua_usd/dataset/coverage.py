@@ -113,9 +113,11 @@ def coverage(records: Sequence[dict], config: GenerationConfig, targets: dict | 
         if shortfall:
             shortfalls.append(shortfall)
 
-    rejected = f" ({verdicts['rejected']} rejected by QA)" if verdicts["rejected"] else ""
     entry, short = _quota("images", None, config.images, len(kept), pool.get("candidates"), "")
-    add((entry, short and short + rejected))
+    if short and verdicts["rejected"]:
+        short = f"images: asked {config.images}, got {len(kept)} ({verdicts['rejected']} rejected by QA" + (
+            f"; the pool had {pool['candidates']})" if "candidates" in pool else ")")
+    add((entry, short))
     if targets.get("aid_users") is not None:
         occl = "" if quota_aid.max_occlusion is None else f", occluded at most {quota_aid.max_occlusion:g}"
         add(_quota("aid_users", None, targets["aid_users"], qualifying, pool.get("aid_users"),
