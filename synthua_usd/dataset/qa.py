@@ -51,7 +51,8 @@ class AidUser:
 
 def aid_users(instances: Sequence[dict]) -> list[AidUser]:
     """The aid users among a record's ``instances`` (dicts with ``class_name``, ``prim_path``, ``area``,
-    optional ``amodal_area``, ``occlusion`` and ``relations``), in instance order."""
+    optional ``amodal_area``, ``occlusion`` and ``relations``), in instance order. A device out of view
+    takes its type from the person's ``relations.uses_class``."""
     by_prim = {inst.get("prim_path"): inst for inst in instances}
     out = []
     for person in instances:
@@ -64,7 +65,8 @@ def aid_users(instances: Sequence[dict]) -> list[AidUser]:
         if device is not None and "amodal_area" in person and "amodal_area" in device:
             amodal = int(person["amodal_area"]) + int(device["amodal_area"])
             occlusion = 1.0 - visible / amodal if amodal > 0 else None
-        out.append(AidUser(person.get("prim_path", ""), uses, device["class_name"] if device else UNKNOWN_AID,
+        aid_type = device["class_name"] if device else (person.get("relations") or {}).get("uses_class", UNKNOWN_AID)
+        out.append(AidUser(person.get("prim_path", ""), uses, aid_type,
                            int(person["area"]), int(device["area"]) if device else 0,
                            None if occlusion is None else float(occlusion)))
     return out
