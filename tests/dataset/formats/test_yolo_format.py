@@ -43,7 +43,7 @@ def test_outlines_are_one_per_8_connected_part_and_fill_the_mask_without_holes()
 
 
 def test_supervision_loads_the_layout_with_the_same_boxes(tmp_path, class_map):
-    sv = pytest.importorskip("supervision")
+    import supervision as sv
     layout = Layout(tmp_path)
     index = class_index(class_map)
     records = [record(1, "train", class_map)[0], record(2, "train", class_map, flip=True)[0]]
