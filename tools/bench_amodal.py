@@ -64,7 +64,8 @@ def main() -> None:
         amodal_px = sum(len(v) for v in masks.values())
         print(f"amodal {name}: {len(ids)} instances, {triangles} triangles; cold {cold:.3f} s, warm {warm:.3f} s "
               f"({warm / label_s:.2f}x label pass); visible {visible_px} px, amodal {amodal_px} px; "
-              f"layers reached {session._amodal.layers}, capped rays {session._amodal.capped_rays}")
+              f"{len(session._amodal.apart)} scenes, layers reached {session._amodal.layers}, "
+              f"capped rays {session._amodal.capped_rays}")
 
 
 def _timed(fn) -> float:

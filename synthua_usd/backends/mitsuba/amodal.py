@@ -1,28 +1,31 @@
 """Amodal (unoccluded) masks: the pixels whose pixel-centre ray meets an instance at any depth.
 
 The label pass keeps the first hit of each pixel-centre ray; an amodal mask needs every hit. An
-:class:`AmodalScene` is a second Mitsuba scene holding only the meshes of the instances asked for (so
-nothing else can stand in front of them) and a sensor set up exactly as the label pass's, so that its rays
-are the label pass's rays bit for bit (:func:`render.pixel_centre_rays`; a distorted camera's rays come from
-the plain-data camera, as in the label pass). Each ray is traced, then started again just past its hit, until
+:class:`AmodalScene` is a second Mitsuba scene (a few, see below) holding only the meshes of the instances
+asked for (so nothing else can stand in front of them) and a sensor set up exactly as the label pass's, so
+that its rays are the label pass's rays bit for bit (:func:`render.pixel_centre_rays`; a distorted camera's
+rays come from the plain-data camera, as in the label pass). Each ray is traced, then started again just past its hit, until
 it escapes or reaches the far clipping plane ("all hits along each pixel ray"); every (pixel, instance) pair
 met on the way goes into the masks.
 
 Continuing past a hit moves the ray's origin along its own, unchanged direction to the hit plus
-``STEP_PER_M * (1 + |origin|_inf + distance)`` metres (a bound on ``|hit|_inf``) (a few float32 ulps of the coordinates: enough that the surface just
-hit is not found again at t = 0, though a grazing ray may meet it again, which only repeats a pair). The
-origin is accumulated in float64 from the first origin and rounded to float32 each layer, so it drifts at
-most half an ulp off the original ray. A surface of *another* instance closer than that step behind a hit
-can be stepped over; it matters only if that instance has no other surface on the ray (closed meshes have
-two), so in practice never.
+``STEP_PER_M * (1 + |origin|_inf + distance)`` metres (a bound on 16 float32 ulps of the hit's largest
+coordinate: enough that the surface just hit is not found again at t = 0, though a grazing ray may meet it
+again, which only repeats a pair). The origin is accumulated in float64 from the first origin and rounded
+to float32 each layer, so it drifts at most half an ulp off the original ray.
+
+A surface of *another* instance closer than that step behind a hit could be stepped over, and real scenes
+are full of them (a mural on a wall, a door in it, row houses sharing a wall: coplanar faces): so the
+instances are split into several scenes, none holding two instances whose world boxes touch
+(:func:`apart_sets`), and every ray is traced through each. What can still be stepped over is another
+surface of the same instance, which does not change its mask.
 
 A ray still hitting after ``MAX_LAYERS`` hits is stopped there: its pixel keeps the instances found so
 far, and the number of such rays is logged as a warning and kept in :attr:`AmodalScene.capped_rays`.
 
-Because the first layer is the label pass's ray against a subset of the label pass's meshes, every visible
-pixel of a requested instance (``instance_ids == i`` of :meth:`RenderSession.render`) is in its amodal set,
-except where two instances' surfaces coincide at the same depth (then which one is "first" is Embree's
-choice, in both passes).
+Because the first hit in each scene is that of the label pass's ray against a subset of the label pass's
+meshes, with no two touching instances together, every visible pixel of a requested instance
+(``instance_ids == i`` of :meth:`RenderSession.render`) is in its amodal set.
 """
 
 from __future__ import annotations
@@ -46,6 +49,9 @@ log = logging.getLogger(__name__)
 MAX_LAYERS = 1024
 #: The step past a hit, metres per metre of the hit's largest coordinate (2^-18: 16 float32 ulps).
 STEP_PER_M = 2.0 ** -18
+#: World boxes closer than this (metres) touch; well above the step past a hit (about a millimetre at the
+#: few hundred metres of a district).
+TOUCH_M = 0.05
 
 
 @dataclass(eq=False)
@@ -60,8 +66,10 @@ class AmodalScene:
     instance_ids: frozenset[int]
     snapshot: SceneSnapshot = field(repr=False)
     mesh_indices: tuple[int, ...]
-    scene: object = field(repr=False)
-    params: object = field(repr=False)
+    #: Instance ids per scene: instances whose boxes touch are never in one scene.
+    apart: tuple[frozenset[int], ...]
+    scenes: tuple = field(repr=False)
+    params: tuple = field(repr=False)
     capped_rays: int = 0
     layers: int = 0
 
@@ -69,21 +77,29 @@ class AmodalScene:
     def build(cls, mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: RenderConfig,
               instance_ids: Iterable[int]) -> "AmodalScene":
         """Load the meshes of ``instance_ids`` (ids of ``snapshot.instances``; an unknown id raises
-        :class:`InputError`) with a sensor for ``camera`` at ``config``'s size."""
+        :class:`InputError`), split into scenes of instances apart (:func:`apart_sets`); the first scene
+        has a sensor for ``camera`` at ``config``'s size."""
         ids = checked_ids(snapshot, instance_ids)
         indices = _mesh_indices(snapshot, ids)
+        apart = apart_sets(snapshot, ids)
         bsdf = mi.load_dict({"type": "diffuse"})  # never shaded: one BSDF for every mesh
-        scene = {"type": "scene", "sensor": sensor_dict(mi, camera, config, spp=1)}
-        for i in indices:
-            item = snapshot.meshes[i]
-            scene[shape_id(i)] = _mesh(mi, shape_id(i), item.points, item.triangles, bsdf)
-        # optimize=False keeps one shape per gprim, as in the label pass's scene.
-        loaded = mi.load_dict(scene, optimize=False)
-        return cls(mi, ids, snapshot, indices, loaded, mi.traverse(loaded))
+        scenes = []
+        for k, members in enumerate(apart or (frozenset(),)):
+            scene = {"type": "scene"}
+            if k == 0:
+                scene["sensor"] = sensor_dict(mi, camera, config, spp=1)
+            for i in indices:
+                item = snapshot.meshes[i]
+                if item.instance_id in members:
+                    scene[shape_id(i)] = _mesh(mi, shape_id(i), item.points, item.triangles, bsdf)
+            # optimize=False keeps one shape per gprim, as in the label pass's scene.
+            scenes.append(mi.load_dict(scene, optimize=False))
+        return cls(mi, ids, snapshot, indices, apart, tuple(scenes), tuple(mi.traverse(s) for s in scenes))
 
     def holds(self, snapshot: SceneSnapshot, instance_ids: Iterable[int]) -> bool:
-        """Whether :meth:`update` can bring this scene to ``snapshot``: the same instances, and their meshes
-        the same gprims with the same triangles (only vertex positions may differ)."""
+        """Whether :meth:`update` can bring this scene to ``snapshot``: the same instances, their meshes the
+        same gprims with the same triangles (only vertex positions may differ), and instances that share a
+        scene still apart."""
         ids = frozenset(int(i) for i in instance_ids)
         if ids != self.instance_ids or snapshot is self.snapshot:
             return ids == self.instance_ids
@@ -95,25 +111,30 @@ class AmodalScene:
             if a is not b and (a.prim_path != b.prim_path or a.points.shape != b.points.shape
                                or not (a.triangles is b.triangles or np.array_equal(a.triangles, b.triangles))):
                 return False
-        return True
+        boxes = _boxes(snapshot, ids)
+        return all(not _touch(boxes[a], boxes[b]) for members in self.apart for a in members for b in members if a < b)
 
     def update(self, snapshot: SceneSnapshot, camera: PinholeCamera, config: RenderConfig) -> int:
         """Point the sensor at ``camera`` and move the meshes that moved in ``snapshot`` (which :meth:`holds`);
         returns how many meshes moved."""
-        params = self.params
-        params["sensor.to_world"] = sensor_to_world(self.mi, camera)
-        params["sensor.x_fov"] = camera.fov_deg(config.width, config.height)[0]
-        params["sensor.near_clip"] = camera.clip_near_m
-        params["sensor.far_clip"] = camera.clip_far_m
-        moved = 0
+        first = self.params[0]
+        first["sensor.to_world"] = sensor_to_world(self.mi, camera)
+        first["sensor.x_fov"] = camera.fov_deg(config.width, config.height)[0]
+        first["sensor.near_clip"] = camera.clip_near_m
+        first["sensor.far_clip"] = camera.clip_far_m
+        moved, changed = 0, {0}
+        scene_of = {inst: k for k, members in enumerate(self.apart) for inst in members}
         for i in self.mesh_indices:
             old, new = self.snapshot.meshes[i], snapshot.meshes[i]
             if old is new or old.points is new.points:
                 continue
-            name = f"{shape_id(i)}.vertex_positions"
+            k = scene_of[new.instance_id]
+            params, name = self.params[k], f"{shape_id(i)}.vertex_positions"
             params[name] = type(params[name])(np.ascontiguousarray(new.points, np.float32).ravel())
+            changed.add(k)
             moved += 1
-        params.update()
+        for k in changed:
+            self.params[k].update()
         self.snapshot = snapshot
         return moved
 
@@ -125,14 +146,21 @@ class AmodalScene:
         instance_of = {shape_id(i): self.snapshot.meshes[i].instance_id for i in self.mesh_indices}
         order = np.array(sorted(self.instance_ids), np.int64)
         slot_of = {int(v): k for k, v in enumerate(order)}
-        rays = pixel_centre_rays(mi, self.scene, camera, width, height)
-        if not self.mesh_indices:
-            pixels, slots, capped, layers = np.zeros(0, np.int64), np.zeros(0, np.int64), 0, 0
-        elif mi.variant().startswith("scalar"):
-            shape_slot = {key: slot_of[inst] for key, inst in instance_of.items()}
-            pixels, slots, capped, layers = _all_hits_scalar(mi, self.scene, rays, shape_slot)
-        else:
-            pixels, slots, capped, layers = _all_hits_jit(mi, self.scene, rays, instance_of, slot_of)
+        rays = pixel_centre_rays(mi, self.scenes[0], camera, width, height)
+        scalar = mi.variant().startswith("scalar")
+        if scalar:
+            rays = list(rays)
+        pixels, slots, capped, layers = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)], 0, 0
+        for members, scene in zip(self.apart, self.scenes):
+            if scalar:
+                shape_slot = {key: slot_of[inst] for key, inst in instance_of.items() if inst in members}
+                found = _all_hits_scalar(mi, scene, rays, shape_slot)
+            else:
+                found = _all_hits_jit(mi, scene, rays, instance_of, slot_of)
+            pixels.append(found[0])
+            slots.append(found[1])
+            capped, layers = capped + found[2], max(layers, found[3])
+        pixels, slots = np.concatenate(pixels), np.concatenate(slots)
         self.capped_rays, self.layers = capped, layers
         if capped:
             log.warning("amodal: %d of %d pixel rays still hit after %d layers; their pixels keep the instances "
@@ -152,6 +180,40 @@ def checked_ids(snapshot: SceneSnapshot, instance_ids: Iterable[int]) -> frozens
         raise InputError(f"amodal masks: instance id(s) {unknown[:10]} not in the snapshot at time code "
                          f"{snapshot.time_code}; expected ids of its {len(snapshot.instances)} instances")
     return ids
+
+
+def apart_sets(snapshot: SceneSnapshot, ids: frozenset[int]) -> tuple[frozenset[int], ...]:
+    """``ids`` split so that no two instances in one set have touching world boxes (within ``TOUCH_M``):
+    greedy colouring of the touch graph, instances in ascending id order. Instances with surfaces on top of
+    each other (a mural on a wall, two row houses sharing a wall, a rider on a seat) then never share a
+    scene, where a ray stepping past one surface could step over the other."""
+    boxes = _boxes(snapshot, ids)
+    sets: list[set[int]] = []
+    for inst in sorted(boxes):
+        for members in sets:
+            if not any(_touch(boxes[inst], boxes[other]) for other in members):
+                members.add(inst)
+                break
+        else:
+            sets.append({inst})
+    return tuple(frozenset(m) for m in sets)
+
+
+def _boxes(snapshot: SceneSnapshot, ids: frozenset[int]) -> dict[int, np.ndarray]:
+    """Instance id → (2, 3) float64 world box (min, max) of its meshes' points; instances without meshes are
+    left out."""
+    boxes: dict[int, np.ndarray] = {}
+    for m in snapshot.meshes:
+        if m.instance_id in ids and len(m.points):
+            box = np.stack([m.points.min(axis=0), m.points.max(axis=0)])
+            old = boxes.get(m.instance_id)
+            boxes[m.instance_id] = box if old is None else np.stack([np.minimum(old[0], box[0]),
+                                                                     np.maximum(old[1], box[1])])
+    return boxes
+
+
+def _touch(a: np.ndarray, b: np.ndarray) -> bool:
+    return bool(np.all(a[0] <= b[1] + TOUCH_M) and np.all(b[0] <= a[1] + TOUCH_M))
 
 
 def _mesh_indices(snapshot: SceneSnapshot, ids: frozenset[int]) -> tuple[int, ...]:
