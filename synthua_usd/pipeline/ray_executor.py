@@ -14,11 +14,13 @@ Ray is imported here only, when asked for: it is an optional dependency (``pip i
 from __future__ import annotations
 
 import logging
+import re
 from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from synthua_usd.errors import echo
+from synthua_usd import __version__
+from synthua_usd.errors import InputError, echo
 from synthua_usd.pipeline.executors import (ExecutorConfig, ItemResult, RunSummary, WorkerError, WorkerLostError,
                                             call_work, failure, lost_message, peak_rss_mib, raise_failure, worker_name)
 
@@ -26,6 +28,9 @@ log = logging.getLogger(__name__)
 
 #: Calls sent ahead to one actor.
 IN_FLIGHT = 2
+
+#: Colour codes Ray puts in its error messages.
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 
 class ShardActor:
@@ -97,9 +102,14 @@ def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Ca
             feed(actor)
 
     def lost(actor: _Actor, exc: Exception) -> None:
-        how = f"was lost ({type(exc).__name__}: {echo(str(exc).strip().splitlines()[0] if str(exc).strip() else '')})"
-        name = actor.name or "(starting)"
+        lines = [line for line in _ANSI.sub("", str(exc)).splitlines() if line.strip()]
         ray.kill(actor.handle, no_restart=True)
+        if getattr(exc, "actor_init_failed", False):  # Ray could not even build the actor: a setup problem
+            raise InputError(f"--executor ray: a worker could not start on the cluster ({echo(lines[-1])}); expected "
+                             f"synthua-usd {__version__} and the job's modules importable on every Ray node (the same "
+                             f"install at the same path)") from exc
+        how = f"was lost ({type(exc).__name__}: {echo(lines[0] if lines else '')})"
+        name = actor.name or "(starting)"
         if actor.shard is None:
             raise WorkerLostError(lost_message(f"Ray actor {name}, building its state", how, 1, actor.peak)) from exc
         attempts[actor.shard] += 1
