@@ -29,6 +29,9 @@ log = logging.getLogger(__name__)
 #: Calls sent ahead to one actor.
 IN_FLIGHT = 2
 
+#: Seconds one ``ray.wait`` blocks: between two waits Python sees KeyboardInterrupt.
+WAIT_S = 0.5
+
 #: Colour codes Ray puts in its error messages.
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
@@ -128,7 +131,9 @@ def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Ca
                      for a in actors if a.ready_ref is not None or a.in_flight}
             if not heads:  # every actor idle and the queue empty: cannot happen while the loop runs
                 raise WorkerError("ray executor: no actor is working but shards remain (a bug)")
-            done, _ = ray.wait(list(heads), num_returns=1)
+            done = []
+            while not done:  # a wait without a timeout blocks in Ray's C++ code, deaf to Ctrl-C
+                done, _ = ray.wait(list(heads), num_returns=1, timeout=WAIT_S)
             actor = heads[done[0]]
             try:
                 envelope = ray.get(done[0])
