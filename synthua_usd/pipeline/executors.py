@@ -242,12 +242,14 @@ def _class(module: str, qualname: str):
     return None
 
 
-def lost_message(where: str, how: str, attempts: int, peak: float | None) -> str:
-    """The one line of :class:`WorkerLostError`."""
+def lost_message(where: str, how: str, attempts: int, peak: float | None, exit_status: int | None = None) -> str:
+    """The one line of :class:`WorkerLostError`; ``exit_status`` > 0: the worker exited by itself (its own
+    error output says why), else it was killed or lost."""
     memory = f"; its peak memory was {peak:.0f} MiB" if peak is not None else ""
     tries = f" on {attempts} workers in turn" if attempts > 1 else ""
-    return (f"{where}: the worker {how}{tries}{memory}; expected it to finish (a crash in native code or the "
-            f"system running out of memory: try fewer --workers or a smaller image)")
+    why = ("the worker's error output above says why" if exit_status is not None and exit_status > 0 else
+           "a crash in native code, or the system out of memory: try fewer --workers or a smaller image")
+    return f"{where}: the worker {how}{tries}{memory}; expected it to finish ({why})"
 
 
 # ---- local: a pool of spawned processes -------------------------------------------------------------------
@@ -376,12 +378,12 @@ class _LocalPool:
                else f"exited with status {code}" if code is not None else "stopped answering")
         name = slot.name or f"pid {slot.process.pid}"
         if slot.status != "busy":
-            raise WorkerLostError(lost_message(f"worker {name}, building its state", how, 1, slot.peak))
+            raise WorkerLostError(lost_message(f"worker {name}, building its state", how, 1, slot.peak, code))
         self.attempts[slot.shard] += 1
         self.summary.workers_lost += 1
         where = f"worker {name}, item {slot.next_index} of shard {slot.shard}"
         if self.attempts[slot.shard] > self.retries:
-            raise WorkerLostError(lost_message(where, how, self.attempts[slot.shard], slot.peak))
+            raise WorkerLostError(lost_message(where, how, self.attempts[slot.shard], slot.peak, code))
         log.warning("%s: the worker %s; continuing the shard on a fresh worker", where, how)
         self.queue.appendleft((slot.shard, slot.next_index))
         slot.conn.close()

@@ -44,6 +44,8 @@ def make_state(seed: int, fail: str | None = None, meet: tuple[str, int] | None 
         raise InputError("scenario.usda: no camera; expected one")
     if fail == "die":
         os.kill(os.getpid(), signal.SIGKILL)
+    if fail == "exit":
+        os._exit(3)
     table = np.random.default_rng(seed).integers(0, 2**63, 64, dtype=np.int64).tobytes()
     return {"table": table, "token": os.urandom(8).hex()}
 
@@ -156,7 +158,7 @@ def test_empty_shards_start_no_worker():
      "/World/cam: not a Camera; expected a Camera prim"),
     (("output", "out/images: not writable; expected a writable folder"), OutputError,
      "out/images: not writable; expected a writable folder"),
-])
+], ids=["StageError", "OutputError"])
 def test_errors_reach_the_parent_with_their_type_and_message(item, cls, message):
     shards = [[0, 1, item, 3], list(range(4, 9))]
     with pytest.raises(cls) as info:
@@ -202,9 +204,13 @@ def test_a_worker_killed_more_often_than_the_retries_allow_is_a_clear_error():
     assert not [p for p in __import__("multiprocessing").active_children() if p.name == "synthua-worker"]
 
 
-def test_a_worker_dying_while_building_its_state_is_a_clear_error():
-    with pytest.raises(WorkerLostError, match="building its state: the worker was killed by SIGKILL"):
-        run(SHARDS, ExecutorConfig("local"), init=functools.partial(make_state, SEED, "die"))
+@pytest.mark.parametrize("fail, message", [
+    ("die", r"building its state: the worker was killed by SIGKILL; expected it to finish \(a crash in native code"),
+    ("exit", r"building its state: the worker exited with status 3; expected it to finish \(the worker's error output"),
+], ids=["killed", "exited"])
+def test_a_worker_dying_while_building_its_state_is_a_clear_error(fail, message):
+    with pytest.raises(WorkerLostError, match=message):
+        run(SHARDS, ExecutorConfig("local"), init=functools.partial(make_state, SEED, fail))
 
 
 def test_functions_that_cannot_reach_a_worker_are_refused_up_front():
