@@ -21,9 +21,10 @@ Guarantees:
   parent: :class:`~synthua_usd.errors.SynthuaError` subclasses (``InputError``, ``StageError``,
   ``OutputError``...), ``OSError`` and ``MemoryError`` as the same type with the same message; anything
   else as :class:`WorkerError`, whose ``__cause__`` carries the worker's traceback;
-- a worker that dies (native crash, out-of-memory kill, a lost Ray node) is replaced by a fresh one, with a
-  fresh state, that continues its shard at the first item not delivered; after ``retries`` such losses
-  of one shard the run stops with :class:`WorkerLostError`;
+- a worker that dies (native crash, out-of-memory kill, a lost Ray node) takes its state with it: its
+  shard continues at the first item not delivered on another worker, an idle one (state built, nothing left
+  to do) or else a new one with a fresh state; after ``retries`` such losses of one shard the run stops with
+  :class:`WorkerLostError`;
 - on any exit, KeyboardInterrupt included, every worker is ended before :func:`run_shards` returns.
 
 Which worker runs which shard, and what a worker's state did before, varies from run to run: a caller
@@ -95,7 +96,7 @@ class ExecutorConfig:
 
     ``kind`` is one of :data:`EXECUTORS`; ``workers`` the number of worker processes (Ray actors);
     ``address`` a Ray cluster (``HOST:6379`` or ``auto``; ray only, None: a Ray instance on this machine);
-    ``retries`` how many times one shard may lose its worker and continue on a fresh one;
+    ``retries`` how many times one shard may lose its worker and continue on another;
     ``cpus_per_worker`` the CPUs Ray reserves for each actor (ray only: a render session uses many threads,
     so on a cluster of large nodes give each actor a node's share); ``ray_runtime_env`` Ray's
     ``runtime_env`` for the job (e.g. ``{"working_dir": "."}`` to ship the scenario files; ray only).
@@ -299,7 +300,8 @@ class _Slot:
 
     process: Any
     conn: Any
-    #: "starting" (building its state), "busy" (running ``shard``) or "stopped" (told to exit).
+    #: "starting" (building its state), "busy" (running ``shard``), "idle" (waiting for a shard that a lost
+    #: worker may leave) or "stopped" (exited, or told to).
     status: str = "starting"
     name: str = ""
     peak: float | None = None
@@ -366,10 +368,8 @@ class _LocalPool:
             shard, start = self.queue.popleft()
             slot.status, slot.shard, slot.next_index, slot.end_index = "busy", shard, start, len(self.shards[shard])
             slot.conn.send(self.shards[shard][start:])
-        else:  # nothing left to give it: it exits, and its end of file is not a loss
-            slot.status, slot.shard = "stopped", None
-            with contextlib.suppress(OSError):
-                slot.conn.send(None)
+        else:  # kept until the end: a shard a lost worker leaves goes to a worker whose state is built
+            slot.status, slot.shard = "idle", None
 
     def _lost(self, slot: _Slot) -> None:
         slot.process.join(STOP_GRACE_S)
@@ -377,22 +377,34 @@ class _LocalPool:
         how = (f"was killed by {signal.Signals(-code).name}" if code is not None and code < 0
                else f"exited with status {code}" if code is not None else "stopped answering")
         name = slot.name or f"pid {slot.process.pid}"
-        if slot.status != "busy":
+        slot.conn.close()
+        status, slot.status = slot.status, "stopped"
+        if status == "idle":  # nothing was lost with it
+            log.warning("worker %s, idle: the worker %s", name, how)
+            return
+        if status == "starting":
             raise WorkerLostError(lost_message(f"worker {name}, building its state", how, 1, slot.peak, code))
         self.attempts[slot.shard] += 1
         self.summary.workers_lost += 1
         where = f"worker {name}, item {slot.next_index} of shard {slot.shard}"
         if self.attempts[slot.shard] > self.retries:
             raise WorkerLostError(lost_message(where, how, self.attempts[slot.shard], slot.peak, code))
-        log.warning("%s: the worker %s; continuing the shard on a fresh worker", where, how)
+        log.warning("%s: the worker %s; continuing the shard on another worker", where, how)
         self.queue.appendleft((slot.shard, slot.next_index))
-        slot.conn.close()
-        self.slots[self.slots.index(slot)] = self._start()
+        idle = next((s for s in self.slots if s.status == "idle"), None)
+        if idle is not None:
+            self._dispatch(idle)
+        else:
+            self.slots.append(self._start())
 
     def _stop_all(self) -> None:
-        """End every worker: those told to stop get :data:`STOP_GRACE_S` s, then SIGTERM, then SIGKILL."""
+        """End every worker: idle ones are told to stop and get :data:`STOP_GRACE_S` s, then SIGTERM, then
+        SIGKILL; busy or starting ones (interrupted, or another failed) are terminated at once."""
         for slot in self.slots:
-            if slot.status != "stopped":  # interrupted or failed mid-item or mid-load: no point waiting for it
+            if slot.status == "idle":
+                with contextlib.suppress(OSError):
+                    slot.conn.send(None)
+            elif slot.status != "stopped":
                 slot.process.terminate()
         deadline = time.monotonic() + STOP_GRACE_S
         for slot in self.slots:

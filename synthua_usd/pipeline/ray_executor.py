@@ -6,7 +6,7 @@ actor are in flight at a time: the actor starts the next while the parent fetche
 do not pile up in Ray's object store when the parent is slower than the workers. Actor methods return the
 same plain envelopes as the local pool's workers (:func:`~synthua_usd.pipeline.executors.call_work`), so
 errors reach the parent the same way; a Ray error on a call means the actor (its process or its node) is
-gone, and the shard continues on a fresh actor.
+gone, and the shard continues on another actor (an idle one, else a new one).
 
 Ray is imported here only, when asked for: it is an optional dependency (``pip install 'synthua-usd[ray]'``).
 """
@@ -120,9 +120,14 @@ def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Ca
         where = f"Ray actor {name}, item {actor.next_index} of shard {actor.shard}"
         if attempts[actor.shard] > config.retries:
             raise WorkerLostError(lost_message(where, how, attempts[actor.shard], actor.peak)) from exc
-        log.warning("%s: the actor %s; continuing the shard on a fresh actor", where, how)
+        log.warning("%s: the actor %s; continuing the shard on another actor", where, how)
         queue.appendleft((actor.shard, actor.next_index))
-        actors[actors.index(actor)] = start()
+        actors.remove(actor)
+        idle = next((a for a in actors if a.ready_ref is None and a.shard is None), None)
+        if idle is not None:  # an actor whose state is built and that has nothing to do takes it
+            dispatch(idle)
+        else:
+            actors.append(start())
 
     try:
         actors.extend(start() for _ in range(min(config.workers, len(queue))))

@@ -186,6 +186,7 @@ def test_an_error_building_the_state_reaches_the_parent():
 
 
 def test_a_killed_worker_is_replaced_and_its_shard_continues_on_a_fresh_state(tmp_path):
+    # One worker: no idle one to take the shard over, so a new one starts.
     shards = [[0, 1, ("die_once", str(tmp_path / "died")), 3, 4], [5, 6]]
     got, order, summary = run(shards, ExecutorConfig("local", workers=1))
     check_run(got, order, shards)
@@ -193,6 +194,16 @@ def test_a_killed_worker_is_replaced_and_its_shard_continues_on_a_fresh_state(tm
     tokens = [got[(0, i)][1] for i in range(5)]
     assert tokens[0] == tokens[1] != tokens[2] == tokens[3]  # items from 2 on ran on a new state
     assert len(worker_pids(order)) == 2 and all(gone(pid, 0.5) for pid in worker_pids(order))
+
+
+def test_the_shard_of_a_killed_worker_goes_to_an_idle_worker_before_a_new_one(tmp_path):
+    (tmp_path / "meet").mkdir()
+    init = functools.partial(make_state, SEED, meet=(str(tmp_path / "meet"), 2))
+    shards = [[*range(10), ("die_once", str(tmp_path / "died")), 11], [20]]  # shard 1 ends long before item 10
+    got, order, summary = run(shards, ExecutorConfig("local", workers=2), init=init)
+    check_run(got, order, shards)
+    assert summary.workers_lost == 1 and len(worker_pids(order)) == 2  # no third worker started
+    assert got[(0, 10)][1] == got[(1, 0)][1] != got[(0, 0)][1]  # the idle worker's state took the rest
 
 
 def test_a_worker_killed_more_often_than_the_retries_allow_is_a_clear_error():
