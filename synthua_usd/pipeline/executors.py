@@ -1,0 +1,418 @@
+"""Run shards of work on worker processes that each build an expensive state once: the scale-out of a job.
+
+A *shard* is a sequence of items that one worker processes in order. A worker builds its state once with
+``init()`` (a render session: one scene load) and then runs ``work(state, item)`` for every item of every
+shard it is given; each result goes back to the parent, as soon as it is ready, through
+``on_result(ItemResult)``. The parent writes dataset-level files from those results.
+
+Two executors run the same protocol:
+
+- ``local``: a pool of worker processes started with the ``spawn`` method (a fresh interpreter: Mitsuba,
+  Dr.Jit and usd-core are imported inside the worker, never inherited from a parent that loaded them).
+  One worker still runs in its own process, so a crash of native code ends that worker, not the command.
+- ``ray``: one Ray actor per worker on a Ray cluster (``address``) or on a Ray instance started here.
+
+Guarantees:
+
+- an item's result is delivered exactly once; a shard's results arrive in the shard's order (shards run
+  side by side, so results of different shards interleave: each :class:`ItemResult` names its shard
+  and index, and the caller orders by them);
+- an error raised by ``init`` or ``work`` stops the run (the other workers are ended) and is raised in the
+  parent: :class:`~synthua_usd.errors.SynthuaError` subclasses (``InputError``, ``StageError``,
+  ``OutputError``...), ``OSError`` and ``MemoryError`` as the same type with the same message; anything
+  else as :class:`WorkerError`, whose ``__cause__`` carries the worker's traceback;
+- a worker that dies (native crash, out-of-memory kill, a lost Ray node) takes its state with it: its
+  shard continues at the first item not delivered on another worker, an idle one (state built, nothing left
+  to do) or else a new one with a fresh state; after ``retries`` such losses of one shard the run stops with
+  :class:`WorkerLostError`;
+- on any exit, KeyboardInterrupt included, every worker is ended before :func:`run_shards` returns.
+
+Which worker runs which shard, and what a worker's state did before, varies from run to run: a caller
+wanting identical output makes each result depend on its item only (a render session's frame depends on
+its snapshot, camera and condition, not on the frames before it).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import importlib
+import importlib.util
+import logging
+import multiprocessing
+import os
+import pickle
+import signal
+import socket
+import sys
+import time
+import traceback
+from collections import deque
+from dataclasses import dataclass, field
+from multiprocessing.connection import wait
+from typing import Any, Callable, Generic, Sequence, TypeVar
+
+from synthua_usd.errors import InputError, SynthuaError, echo
+
+log = logging.getLogger(__name__)
+
+T = TypeVar("T")
+S = TypeVar("S")
+R = TypeVar("R")
+
+#: The executors :func:`run_shards` knows.
+EXECUTORS = ("local", "ray")
+
+#: Seconds a stopped worker gets to exit before it is terminated, then killed.
+STOP_GRACE_S = 5.0
+
+#: The install line given when Ray is asked for and missing.
+RAY_INSTALL = "pip install 'synthua-usd[ray]'"
+
+
+class WorkerError(RuntimeError):
+    """An unexpected exception in a worker (a bug); ``__cause__`` holds the worker's traceback as text."""
+
+
+class WorkerLostError(SynthuaError):
+    """A worker process ended without an answer (a crash in native code, an out-of-memory kill, a lost
+    node) more often than the retries allow."""
+
+
+class RemoteTraceback(Exception):
+    """The traceback of an exception raised in a worker, chained as the ``__cause__`` of the parent's."""
+
+    def __init__(self, text: str) -> None:
+        super().__init__(text)
+        self.text = text
+
+    def __str__(self) -> str:
+        return self.text
+
+
+@dataclass(frozen=True)
+class ExecutorConfig:
+    """Where and how wide shards run.
+
+    ``kind`` is one of :data:`EXECUTORS`; ``workers`` the number of worker processes (Ray actors);
+    ``address`` a Ray cluster (``HOST:6379`` or ``auto``; ray only, None: a Ray instance on this machine);
+    ``retries`` how many times one shard may lose its worker and continue on another;
+    ``cpus_per_worker`` the CPUs Ray reserves for each actor (ray only: a render session uses many threads,
+    so on a cluster of large nodes give each actor a node's share); ``ray_runtime_env`` Ray's
+    ``runtime_env`` for the job (e.g. ``{"working_dir": "."}`` to ship the scenario files; ray only).
+    """
+
+    kind: str = "local"
+    workers: int = 1
+    address: str | None = None
+    retries: int = 1
+    cpus_per_worker: float = 1.0
+    ray_runtime_env: dict | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in EXECUTORS:
+            raise InputError(f"--executor: {echo(self.kind)!r} is not an executor; expected one of {', '.join(EXECUTORS)}")
+        if not isinstance(self.workers, int) or isinstance(self.workers, bool) or self.workers < 1:
+            raise InputError(f"--workers: {echo(self.workers)}; expected a whole number >= 1")
+        if self.kind != "ray" and (self.address is not None or self.ray_runtime_env is not None):
+            raise InputError(f"--address: {echo(self.address)} given with --executor {self.kind}; "
+                             f"expected --executor ray (a Ray cluster) or no --address")
+        if self.kind == "ray" and importlib.util.find_spec("ray") is None:
+            raise InputError(f"--executor ray: the ray package is not installed; expected it installed "
+                             f"(run: {RAY_INSTALL})")
+        if not isinstance(self.retries, int) or self.retries < 0:
+            raise InputError(f"retries: {echo(self.retries)}; expected a whole number >= 0")
+        if not self.cpus_per_worker > 0:
+            raise InputError(f"cpus_per_worker: {echo(self.cpus_per_worker)}; expected a number > 0")
+
+
+@dataclass(frozen=True)
+class ItemResult(Generic[R]):
+    """What ``work`` returned for item ``index`` of shard ``shard``, with the worker that computed it
+    (``host:pid``), the worker's peak resident memory so far (MiB) and the seconds ``work`` took."""
+
+    shard: int
+    index: int
+    value: R
+    worker: str
+    peak_rss_mib: float
+    seconds: float
+
+
+@dataclass
+class RunSummary:
+    """Counts of a finished run: items delivered, shards, workers lost and replaced, wall time (s), and
+    the peak resident memory (MiB) of each worker (``host:pid``), its state included."""
+
+    items: int = 0
+    shards: int = 0
+    workers_lost: int = 0
+    seconds: float = 0.0
+    peak_rss_mib: dict[str, float] = field(default_factory=dict)
+
+
+def peak_rss_mib() -> float:
+    """Peak resident set size of this process so far, MiB (``getrusage``: KiB on Linux, bytes on macOS)."""
+    import resource
+
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / (1024 * 1024) if sys.platform == "darwin" else peak / 1024
+
+
+def worker_name() -> str:
+    """``host:pid`` of this process: how results and memory reports name a worker."""
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def run_shards(shards: Sequence[Sequence[T]], init: Callable[[], S], work: Callable[[S, T], R],
+               on_result: Callable[[ItemResult[R]], None], config: ExecutorConfig = ExecutorConfig()) -> RunSummary:
+    """Run every item of every shard (see the module's docstring for the guarantees).
+
+    ``init`` and ``work`` must be picklable: top-level functions, bound with :func:`functools.partial`.
+    ``on_result`` runs in the calling thread, between reads from the workers: keep it short (hand heavy
+    writing to a thread) or the workers wait on it. Progress: count the calls to ``on_result``.
+    """
+    shards = [list(s) for s in shards]
+    for name, fn in (("init", init), ("work", work)):
+        try:
+            pickle.dumps(fn)
+        except Exception as exc:  # noqa: BLE001 - any pickling failure means the same thing
+            raise TypeError(f"run_shards: {name}={fn!r} cannot be sent to a worker ({exc}); expected a "
+                            f"top-level function, bound with functools.partial") from exc
+    summary = RunSummary(shards=len(shards))
+    t0 = time.perf_counter()
+    if any(shards):
+        if config.kind == "local":
+            _LocalPool(shards, init, work, on_result, config, summary).run()
+        else:
+            from synthua_usd.pipeline.ray_executor import run_on_ray
+
+            run_on_ray(shards, init, work, on_result, config, summary)
+    summary.seconds = time.perf_counter() - t0
+    return summary
+
+
+# ---- what a worker does, under either executor ------------------------------------------------------------
+
+def call_work(work: Callable, state: Any, item: Any) -> tuple:
+    """``("ok", value, peak_rss_mib, seconds)`` or the :func:`failure` of ``work(state, item)``."""
+    t0 = time.perf_counter()
+    try:
+        value = work(state, item)
+    except BaseException as exc:  # noqa: BLE001 - reported to the parent, which decides
+        return failure(exc)
+    return ("ok", value, peak_rss_mib(), time.perf_counter() - t0)
+
+
+def failure(exc: BaseException) -> tuple:
+    """``("error", kind, module, qualname, message, errno, filename, traceback text)`` of ``exc``: plain
+    data the parent turns back into an exception (:func:`raise_failure`), whatever the class pickles to."""
+    cls = type(exc)
+    kind = "expected" if isinstance(exc, (SynthuaError, MemoryError)) else "os" if isinstance(exc, OSError) else "other"
+    message = exc.strerror if kind == "os" and exc.strerror else str(exc)
+    return ("error", kind, cls.__module__, cls.__qualname__, message, getattr(exc, "errno", None),
+            getattr(exc, "filename", None), "".join(traceback.format_exception(exc)))
+
+
+def raise_failure(envelope: tuple, where: str) -> None:
+    """Raise in the parent the exception a worker reported as ``envelope`` (see :func:`failure`)."""
+    _, kind, module, qualname, message, errno_, filename, tb = envelope
+    log.debug("%s failed:\n%s", where, tb)
+    cause = RemoteTraceback(tb)
+    if kind == "os":
+        raise OSError(errno_, message, filename) from cause  # OSError(errno, ...) picks the subclass by errno
+    if kind == "expected":
+        cls = _class(module, qualname)
+        if isinstance(cls, type) and issubclass(cls, (SynthuaError, MemoryError)):
+            try:
+                exc = cls(message)
+            except Exception:  # noqa: BLE001 - a subclass with another signature: keep the message
+                exc = SynthuaError(message)
+            raise exc from cause
+        raise SynthuaError(message) from cause
+    first = message.splitlines()[0] if message else ""
+    raise WorkerError(f"{where}: {qualname}: {echo(first)}") from cause
+
+
+def _class(module: str, qualname: str):
+    with contextlib.suppress(Exception):
+        obj = importlib.import_module(module)
+        for part in qualname.split("."):
+            obj = getattr(obj, part)
+        return obj
+    return None
+
+
+def lost_message(where: str, how: str, attempts: int, peak: float | None, exit_status: int | None = None) -> str:
+    """The one line of :class:`WorkerLostError`; ``exit_status`` > 0: the worker exited by itself (its own
+    error output says why), else it was killed or lost."""
+    memory = f"; its peak memory was {peak:.0f} MiB" if peak is not None else ""
+    tries = f" on {attempts} workers in turn" if attempts > 1 else ""
+    why = ("the worker's error output above says why" if exit_status is not None and exit_status > 0 else
+           "a crash in native code, or the system out of memory: try fewer --workers or a smaller image")
+    return f"{where}: the worker {how}{tries}{memory}; expected it to finish ({why})"
+
+
+# ---- local: a pool of spawned processes -------------------------------------------------------------------
+
+def _local_worker(conn, init: Callable, work: Callable) -> None:
+    """A local worker's life: build the state, then run the shards the parent sends until it sends None."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole process group: the parent decides
+    _end_with_parent()
+    try:
+        state = init()
+    except BaseException as exc:  # noqa: BLE001 - reported to the parent
+        conn.send(failure(exc))
+        return
+    conn.send(("ready", worker_name(), peak_rss_mib()))
+    while True:
+        try:
+            task = conn.recv()
+        except EOFError:  # the parent is gone
+            return
+        if task is None:
+            return
+        for item in task:
+            envelope = call_work(work, state, item)
+            try:
+                conn.send(envelope)
+            except OSError:  # the parent is gone
+                return
+            except Exception as exc:  # noqa: BLE001 - the value cannot be pickled: say so (nothing was sent)
+                envelope = failure(exc)
+                conn.send(envelope)
+            if envelope[0] == "error":
+                return
+
+
+def _end_with_parent() -> None:
+    """Ask Linux to end this process when its parent dies (no orphans if the parent is killed -9)."""
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(Exception):
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # 1: PR_SET_PDEATHSIG
+            if os.getppid() == 1:  # the parent died before the request took effect
+                os._exit(1)
+
+
+@dataclass(eq=False)
+class _Slot:
+    """One worker process of the pool and the shard it runs."""
+
+    process: Any
+    conn: Any
+    #: "starting" (building its state), "busy" (running ``shard``), "idle" (waiting for a shard that a lost
+    #: worker may leave) or "stopped" (exited, or told to).
+    status: str = "starting"
+    name: str = ""
+    peak: float | None = None
+    shard: int | None = None
+    next_index: int = 0
+    end_index: int = 0
+
+
+class _LocalPool:
+    def __init__(self, shards, init, work, on_result, config: ExecutorConfig, summary: RunSummary) -> None:
+        self.shards, self.init, self.work, self.on_result = shards, init, work, on_result
+        self.summary = summary
+        self.retries = config.retries
+        self.count = min(config.workers, sum(1 for s in shards if s))
+        self.context = multiprocessing.get_context("spawn")
+        self.queue = deque((i, 0) for i, s in enumerate(shards) if s)  # (shard, first item not yet delivered)
+        self.attempts = {i: 0 for i in range(len(shards))}
+        self.slots: list[_Slot] = []
+
+    def run(self) -> None:
+        try:
+            for _ in range(self.count):
+                self.slots.append(self._start())
+            while any(s.status == "busy" for s in self.slots) or self.queue:
+                for conn in wait([s.conn for s in self.slots if s.status != "stopped"]):
+                    slot = next(s for s in self.slots if s.conn is conn)
+                    try:
+                        message = conn.recv()
+                    except (EOFError, OSError):
+                        self._lost(slot)
+                        continue
+                    self._handle(slot, message)
+        finally:
+            self._stop_all()
+
+    def _start(self) -> _Slot:
+        parent_end, child_end = self.context.Pipe()
+        process = self.context.Process(target=_local_worker, args=(child_end, self.init, self.work),
+                                       name="synthua-worker", daemon=True)
+        process.start()
+        child_end.close()  # the worker holds the only other end: its death reads as end of file here
+        return _Slot(process, parent_end)
+
+    def _handle(self, slot: _Slot, message: tuple) -> None:
+        if message[0] == "error":
+            where = f"worker {slot.name or slot.process.pid}" + (
+                f", item {slot.next_index} of shard {slot.shard}" if slot.status == "busy" else ", building its state")
+            raise_failure(message, where)
+        if message[0] == "ready":
+            slot.name, slot.peak = message[1], message[2]
+            self.summary.peak_rss_mib[slot.name] = slot.peak
+        else:
+            _, value, slot.peak, seconds = message
+            self.summary.peak_rss_mib[slot.name] = slot.peak
+            self.on_result(ItemResult(slot.shard, slot.next_index, value, slot.name, slot.peak, seconds))
+            self.summary.items += 1
+            slot.next_index += 1
+            if slot.next_index < slot.end_index:
+                return
+        self._dispatch(slot)
+
+    def _dispatch(self, slot: _Slot) -> None:
+        if self.queue:
+            shard, start = self.queue.popleft()
+            slot.status, slot.shard, slot.next_index, slot.end_index = "busy", shard, start, len(self.shards[shard])
+            slot.conn.send(self.shards[shard][start:])
+        else:  # kept until the end: a shard a lost worker leaves goes to a worker whose state is built
+            slot.status, slot.shard = "idle", None
+
+    def _lost(self, slot: _Slot) -> None:
+        slot.process.join(STOP_GRACE_S)
+        code = slot.process.exitcode
+        how = (f"was killed by {signal.Signals(-code).name}" if code is not None and code < 0
+               else f"exited with status {code}" if code is not None else "stopped answering")
+        name = slot.name or f"pid {slot.process.pid}"
+        slot.conn.close()
+        status, slot.status = slot.status, "stopped"
+        if status == "idle":  # nothing was lost with it
+            log.warning("worker %s, idle: the worker %s", name, how)
+            return
+        if status == "starting":
+            raise WorkerLostError(lost_message(f"worker {name}, building its state", how, 1, slot.peak, code))
+        self.attempts[slot.shard] += 1
+        self.summary.workers_lost += 1
+        where = f"worker {name}, item {slot.next_index} of shard {slot.shard}"
+        if self.attempts[slot.shard] > self.retries:
+            raise WorkerLostError(lost_message(where, how, self.attempts[slot.shard], slot.peak, code))
+        log.warning("%s: the worker %s; continuing the shard on another worker", where, how)
+        self.queue.appendleft((slot.shard, slot.next_index))
+        idle = next((s for s in self.slots if s.status == "idle"), None)
+        if idle is not None:
+            self._dispatch(idle)
+        else:
+            self.slots.append(self._start())
+
+    def _stop_all(self) -> None:
+        """End every worker: idle ones are told to stop and get :data:`STOP_GRACE_S` s, then SIGTERM, then
+        SIGKILL; busy or starting ones (interrupted, or another failed) are terminated at once."""
+        for slot in self.slots:
+            if slot.status == "idle":
+                with contextlib.suppress(OSError):
+                    slot.conn.send(None)
+            elif slot.status != "stopped":
+                slot.process.terminate()
+        deadline = time.monotonic() + STOP_GRACE_S
+        for slot in self.slots:
+            slot.process.join(max(0.0, deadline - time.monotonic()))
+            if slot.process.is_alive():
+                slot.process.terminate()
+                slot.process.join(1.0)
+            if slot.process.is_alive():
+                slot.process.kill()
+                slot.process.join()
+            slot.conn.close()
