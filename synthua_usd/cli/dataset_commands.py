@@ -52,8 +52,9 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
                            show_progress=sys.stderr.isatty())
     s = summary
     busy = sum(s.seconds.values()) or 1.0
-    click.echo(f"dataset {s.out_dir}: {s.planned} images ({s.rendered} rendered now, {s.resumed} from an earlier "
-               f"run), {s.rejected} rejected and {s.flagged} flagged by QA (rejected.csv)")
+    click.echo(f"dataset {s.out_dir}: {s.planned - s.rejected} images ({s.flagged} flagged by QA) and {s.rejected} "
+               f"rejected by QA, replaced where the pool allowed (rejected.csv); {s.rendered} rendered now, "
+               f"{s.resumed} found from an earlier run")
     if s.rendered:
         shares = ", ".join(f"{k} {100 * v / busy:.0f} %" for k, v in s.seconds.items())
         peak = max(s.peak_rss_mib.values()) if s.peak_rss_mib else 0.0

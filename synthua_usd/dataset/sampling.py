@@ -240,16 +240,31 @@ def plan(pool: Sequence[Candidate], scores, config: GenerationConfig) -> list[Pl
     targets = quota_targets(pool, config)
     rank = np.empty(len(pool), dtype=np.int64)
     rank[np.random.default_rng(config.sampling_seed).permutation(len(pool))] = np.arange(len(pool))
+    groups = _groups(pool, qualifying, rank, range(len(pool)))
+
+    chosen = _pick(groups, rank, targets["images"], dict(targets["per_condition"]), dict(targets["per_rig_type"]),
+                   targets["aid_users"] or 0)
+    chosen.sort()
+    splits = split_of([pool[i].camera_path for i in chosen], config.split)
+    return [PlannedImage(k, splits[pool[i].camera_path], **asdict(pool[i]), aid_user=qualifying[i])
+            for k, i in enumerate(chosen, start=1)]
+
+
+def _groups(pool: Sequence[Candidate], qualifying: list[bool], rank: np.ndarray, indices) -> dict[tuple, deque]:
+    """Indices of ``pool`` grouped by (condition, rig type, qualifying aid user), each group in rank order."""
     groups: dict[tuple, deque] = {}
-    for index in sorted(range(len(pool)), key=lambda i: rank[i]):
+    for index in sorted(indices, key=lambda i: rank[i]):
         c = pool[index]
         groups.setdefault((c.condition_key, c.rig_key, qualifying[index]), deque()).append(index)
+    return groups
 
-    need_condition = dict(targets["per_condition"])
-    need_rig = dict(targets["per_rig_type"])
-    need_aid = targets["aid_users"] or 0
+
+def _pick(groups: dict[tuple, deque], rank: np.ndarray, count: int, need_condition: dict, need_rig: dict,
+          need_aid: int) -> list[int]:
+    """Take ``count`` candidates from ``groups``: each pick from the group that helps the most quotas still
+    short (ties: the group whose next candidate ranks first)."""
     chosen: list[int] = []
-    for _ in range(targets["images"]):
+    for _ in range(count):
         best, best_key = None, None
         for key, queue in groups.items():
             if not queue:
@@ -259,17 +274,43 @@ def plan(pool: Sequence[Candidate], scores, config: GenerationConfig) -> list[Pl
             order = (-gain, rank[queue[0]])
             if best_key is None or order < best_key:
                 best, best_key = key, order
-        index = groups[best].popleft()
-        chosen.append(index)
+        if best is None:
+            break
+        chosen.append(groups[best].popleft())
         condition, rig, aid = best
         need_condition[condition] = need_condition.get(condition, 0) - 1
         need_rig[rig] = need_rig.get(rig, 0) - 1
         need_aid -= int(aid)
+    return chosen
 
-    chosen.sort()
-    splits = split_of([pool[i].camera_path for i in chosen], config.split)
-    return [PlannedImage(k, splits[pool[i].camera_path], **asdict(pool[i]), aid_user=qualifying[i])
-            for k, i in enumerate(chosen, start=1)]
+
+def replacements(pool: Sequence[Candidate], scores, config: GenerationConfig, planned: Sequence[PlannedImage],
+                 rejected: set[int]) -> list[PlannedImage]:
+    """Images to render in place of the ``rejected`` ids of ``planned``, chosen like :func:`plan` from the
+    candidates not planned yet, counting what the kept images already give the quotas. Only cameras of
+    the plan are used, so each replacement inherits its camera's split; ids continue after the plan's."""
+    pool = list(pool)
+    qualifying = _qualifying(pool, scores, config)
+    targets = quota_targets(pool, config)
+    rank = np.empty(len(pool), dtype=np.int64)
+    rank[np.random.default_rng(config.sampling_seed).permutation(len(pool))] = np.arange(len(pool))
+    key = lambda c: (c.camera_path, float(c.time_code), c.condition, c.seed)  # noqa: E731
+    taken = {key(p) for p in planned}
+    split_of_camera = {p.camera_path: p.split for p in planned}
+    kept = [p for p in planned if p.id not in rejected]
+    need_condition = dict(targets["per_condition"])
+    need_rig = dict(targets["per_rig_type"])
+    need_aid = targets["aid_users"] or 0
+    for p in kept:
+        need_condition[condition_key(p.condition)] = need_condition.get(condition_key(p.condition), 0) - 1
+        need_rig[p.rig_type or NO_RIG] = need_rig.get(p.rig_type or NO_RIG, 0) - 1
+        need_aid -= int(p.aid_user)
+    free = [i for i, c in enumerate(pool) if key(c) not in taken and c.camera_path in split_of_camera]
+    chosen = sorted(_pick(_groups(pool, qualifying, rank, free), rank, targets["images"] - len(kept), need_condition,
+                          need_rig, need_aid))
+    first = max((p.id for p in planned), default=0) + 1
+    return [PlannedImage(first + k, split_of_camera[pool[i].camera_path], **asdict(pool[i]), aid_user=qualifying[i])
+            for k, i in enumerate(chosen)]
 
 
 def _stable_hash(seed: int, key: str) -> str:

@@ -49,6 +49,8 @@ log = logging.getLogger(__name__)
 #: Images a worker renders before its shard ends and a fresh worker takes the next one (bounded so that
 #: work spreads over workers and a failure costs little).
 SHARD_IMAGES = 16
+#: Rounds of replacing images QA rejected (each round replaces the rejections of the one before).
+REPLACEMENT_ROUNDS = 3
 
 
 @dataclass(frozen=True)
@@ -155,7 +157,6 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     """Plan (or find the plan of an earlier run), render what is missing, assemble the dataset files."""
     from tqdm import tqdm
 
-    from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
 
     started = time.perf_counter()
     config = GenerationConfig.load(request.config_path)
@@ -178,6 +179,7 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
                           f"resume: pick another --out or remove it")
     if existing is not None:
         plan = [sampling.PlannedImage(**p) for p in existing["plan"]]
+        scores = [_score_from_dict(s) for s in existing["scores"]]
     else:
         scores = score_views(stage, pool, render, class_map, show_progress)
         plan = sampling.plan(pool, scores, config)
@@ -185,8 +187,9 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
                          "layer_stack": stack, "render": asdict(render),
                          "cameras": [list(c) for c in cameras], "quota_targets": sampling.quota_targets(pool, config),
                          "pool": sampling.pool_summary(pool, scores, config),
-                         "plan": [p.to_dict() for p in plan]})
-    summary = GenerateSummary(out_dir=out, planned=len(plan))
+                         "scores": [asdict(s) for s in scores], "plan": [p.to_dict() for p in plan]})
+    summary = GenerateSummary(out_dir=out)
+    _remove_partial_files(out)
     done = _complete_records(layout, plan)
     todo = [p for p in plan if p.id not in done]
     summary.resumed = len(done)
@@ -210,18 +213,20 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
 
     # A worker writes an image while it renders the next, so a worker lost mid-shard can take an image
     # whose render the executor counts as delivered: rounds repeat until every planned image has a record.
-    while todo:
-        ordered = sorted(todo, key=lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id))
-        shards = [ordered[i:i + SHARD_IMAGES] + [FLUSH] for i in range(0, len(ordered), SHARD_IMAGES)]
-        executor = ExecutorConfig(kind=request.executor, workers=min(config_workers, len(shards)),
-                                  address=request.address)
-        run_shards(shards, functools.partial(init_worker, job), work, collect, executor)
-        missing = [p for p in todo if p.id not in done]
-        if len(missing) == len(todo):
-            raise OutputError(f"{out}: {len(missing)} images were rendered but none was written; expected "
-                              f"their records in {out / 'records'}")
-        todo = missing
+    # Images QA rejects are replaced by others of the pool (their quotas counted), for a few rounds.
+    for _ in range(REPLACEMENT_ROUNDS + 1):
+        _render_all(todo, done, job, request, config_workers, collect, out)
+        rejected = {p.id for p in plan if done[p.id]["qa"]["verdict"] == "rejected"}
+        todo = sampling.replacements(pool, scores, config, plan, rejected) if rejected else []
+        if not todo:
+            break
+        plan += todo
+        job_document["plan"] = [p.to_dict() for p in plan]
+        _write_job(out, job_document)
+        bar.total += len(todo)
+        bar.refresh()
     bar.close()
+    summary.planned = len(plan)
     records = [done[p.id] for p in plan]
     assemble(layout, records, class_map, config, job_document)
     summary.rejected = sum(r["qa"]["verdict"] == "rejected" for r in records)
@@ -251,6 +256,28 @@ def worker_job_from_document(document: dict, out_dir: Path, allow_external_asset
                      onehot=config.outputs.onehot, amodal_groups=tuple(config.amodal_groups), qa_thresholds=config.qa,
                      city=cityscapes_city(config.name), camera_index={p: i for i, (p, _, _) in enumerate(cameras)},
                      layer_stack=document["layer_stack"]["digest"], yolo_classes=yolo.class_index(class_map))
+
+
+def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, workers: int, collect, out: Path) -> None:
+    """Render every planned image of ``todo`` on the executor, in shards; rounds repeat for images a lost
+    worker took with it."""
+    from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
+
+    while todo:
+        ordered = sorted(todo, key=lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id))
+        shards = [ordered[i:i + SHARD_IMAGES] + [FLUSH] for i in range(0, len(ordered), SHARD_IMAGES)]
+        executor = ExecutorConfig(kind=request.executor, workers=min(workers, len(shards)), address=request.address)
+        run_shards(shards, functools.partial(init_worker, job), work, collect, executor)
+        missing = [p for p in todo if p.id not in done]
+        if len(missing) == len(todo):
+            raise OutputError(f"{out}: {len(missing)} images were rendered but none was written; expected "
+                              f"their records in {out / 'records'}")
+        todo = missing
+
+
+def _score_from_dict(document: dict) -> sampling.ViewScore:
+    return sampling.ViewScore(camera_path=document["camera_path"], time_code=document["time_code"],
+                              aid_users=tuple(sampling.AidUserView(**a) for a in document["aid_users"]))
 
 
 def default_workers() -> int:
@@ -284,6 +311,14 @@ def _write_json(path: Path, document) -> Path:
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(document, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     return path
+
+
+def _remove_partial_files(out: Path) -> None:
+    """Delete what a killed run left half-written: the temporary files of atomic writes (dot files; the
+    dataset's own files never start with a dot, see :mod:`synthua_usd.dataset.layout`)."""
+    for path in sorted(out.rglob(".*")):
+        if path.is_file() or path.is_symlink():
+            path.unlink()
 
 
 def _complete_records(layout: Layout, plan) -> dict[int, dict]:

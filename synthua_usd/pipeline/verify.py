@@ -68,9 +68,11 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         result.add(f"image {missing}: planned in generate.json but not in the manifest (run generate again to "
                    f"finish it)")
     entries = [e for img in manifest.get("images", []) for e in img["files"]] + manifest.get("dataset_files", [])
+    damaged = set()
     for entry in tqdm(entries, desc="checksums", unit="file", disable=not show_progress):
         result.files += 1
-        _check_file(layout, entry, result)
+        if not _check_file(layout, entry, result):
+            damaged.add(entry["path"])
     records = []
     for img in manifest.get("images", []):
         try:
@@ -99,22 +101,24 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
             for ann in document.get("annotations", []):
                 panoptic_by_image[ann["image_id"]] = ann
     for record in tqdm(records, desc="consistency", unit="image", disable=not show_progress):
-        if record["qa"]["verdict"] == "rejected":
-            continue
+        if record["qa"]["verdict"] == "rejected" or damaged & set(record["files"].values()):
+            continue  # a damaged file is reported already; its image is not read
         try:
             _check_image(layout, record, coco_by_image.get(record["id"], []), panoptic_by_image.get(record["id"]),
                          result)
-        except (OSError, ValueError, KeyError) as exc:
-            result.add(f"image {record['id']} ({record['name']}): cannot be checked: {echo(exc)}")
+        except Exception as exc:  # noqa: BLE001 - whatever a broken file raises, it is a problem of the dataset
+            result.add(f"image {record['id']} ({record['name']}): cannot be checked: {type(exc).__name__}: "
+                       f"{echo(exc)}")
     return result
 
 
-def _check_file(layout: Layout, entry: dict, result: Verification) -> None:
+def _check_file(layout: Layout, entry: dict, result: Verification) -> bool:
+    """Whether the file of a manifest entry is there with its size and SHA-256 (else a problem is added)."""
     try:
         path = layout.path(entry["path"])
     except OutputError as exc:
         result.add(f"manifest: {exc}")
-        return
+        return False
     if not path.is_file():
         result.add(f"{entry['path']}: missing")
     elif path.stat().st_size != entry["bytes"]:
@@ -122,6 +126,9 @@ def _check_file(layout: Layout, entry: dict, result: Verification) -> None:
                    f"or replaced)")
     elif sha256_file(path) != entry["sha256"]:
         result.add(f"{entry['path']}: SHA-256 differs from the manifest's (altered)")
+    else:
+        return True
+    return False
 
 
 def _read(layout: Layout, relative: str) -> np.ndarray:
