@@ -241,8 +241,11 @@ def test_verify_checks_annotations_against_masks(damaged):
 # --- resampling ---------------------------------------------------------------------------------------------
 
 def test_resampled_dataset_has_no_invented_labels(generated, tmp_path):
+    """Written at half size (with the optional EXR and one-hot outputs): labels copy source pixels, so no
+    (class, instance) pair appears that the full-size labels lack."""
     config = json.loads(TINY_CONFIG.read_text())
     config["resample"] = {"width": 32, "height": 24}
+    config["outputs"] = {"rgb_exr": True, "depth": True, "onehot": True}
     path = tmp_path / "half.json"
     path.write_text(json.dumps(config))
     out = tmp_path / "half"
@@ -264,6 +267,12 @@ def test_resampled_dataset_has_no_invented_labels(generated, tmp_path):
         assert pairs <= set(zip(big_class.ravel().tolist(), big_inst.ravel().tolist()))
         rgb = read_image(out / r["files"]["rgb_png"])[0]
         assert rgb.shape == (24, 32, 3)
+        if r["qa"]["verdict"] == "rejected":
+            continue  # a rejected image keeps only what shows why
+        assert read_image(out / r["files"]["rgb_exr"])[0].shape == (24, 32, 3)
+        onehot = np.load(out / r["files"]["onehot"])["onehot"]
+        assert onehot.dtype == bool and onehot.shape[1:] == (24, 32)
+        assert np.array_equal(np.argmax(onehot, axis=0), small_class) and (onehot.sum(axis=0) == 1).all()
     assert compared >= 5
 
 
