@@ -253,7 +253,8 @@ import sys
 sys.path.insert(0, {here!r})
 from test_executors import INIT, toy_work
 from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
-run_shards([[("sleep", {folder!r})], [("sleep", {folder!r})]], INIT, toy_work, print, ExecutorConfig("local", workers=2))
+shards = [[("sleep", {folder!r})], [("sleep", {folder!r})]]
+run_shards(shards, INIT, toy_work, print, ExecutorConfig("local", workers=2))
 """
 
 
@@ -290,7 +291,7 @@ def ray_instance():
     import ray
 
     # Ray's workers import the toy from this folder, as cluster nodes import synthua from the same install.
-    ray.init(num_cpus=2, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False,
+    ray.init(address="local", num_cpus=2, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False,
              runtime_env={"env_vars": {"PYTHONPATH": os.pathsep.join([str(HERE), *sys.path])}})
     yield ray
     ray.shutdown()
@@ -326,7 +327,8 @@ def test_ray_replaces_a_killed_actor_or_reports_it(ray_instance, tmp_path):
     # Item 2 is sent once item 0 is in: item 0 comes from the first state and item 2 from another. (Which item
     # the retry starts at depends on what was in flight: Ray may lose item 1's answer with the actor.)
     assert summary.workers_lost == 1 and got[(0, 0)][1] != got[(0, 2)][1]
-    with pytest.raises(WorkerLostError, match=r"item 1 of shard 0: the worker was lost \(.*\) on 2 workers in turn"):
+    with pytest.raises(WorkerLostError, match=r"item 1 of shard 0: the worker was lost \(.*\) on 2 workers in "
+                                              r"turn"):
         run([[0, ("die", None)]], ExecutorConfig("ray", retries=1))
 
 
