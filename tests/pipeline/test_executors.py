@@ -10,6 +10,7 @@ from __future__ import annotations
 import errno
 import functools
 import hashlib
+import multiprocessing
 import os
 import signal
 import subprocess
@@ -166,6 +167,19 @@ def test_errors_reach_the_parent_with_their_type_and_message(item, cls, message)
     assert type(info.value) is cls and str(info.value) == message
 
 
+def test_an_error_in_the_parents_on_result_ends_the_workers():
+    seen = []
+
+    def on_result(r):
+        seen.append(r)
+        raise OutputError("out/annotations: disk full; expected free space")
+
+    with pytest.raises(OutputError, match="^out/annotations: disk full"):
+        run_shards(SHARDS, INIT, toy_work, on_result, ExecutorConfig("local", workers=2))
+    assert len(seen) == 1 and gone(int(seen[0].worker.rsplit(":", 1)[1]), 0.5)
+    assert not [p for p in multiprocessing.active_children() if p.name == "synthua-worker"]
+
+
 def test_os_errors_keep_errno_and_file():
     with pytest.raises(OSError) as info:
         run([[("os", "out/x.png")]], ExecutorConfig("local"))
@@ -212,7 +226,7 @@ def test_a_worker_killed_more_often_than_the_retries_allow_is_a_clear_error():
     message = str(info.value)
     assert "item 1 of shard 0" in message and "SIGKILL" in message and "on 2 workers in turn" in message
     assert "\n" not in message
-    assert not [p for p in __import__("multiprocessing").active_children() if p.name == "synthua-worker"]
+    assert not [p for p in multiprocessing.active_children() if p.name == "synthua-worker"]
 
 
 @pytest.mark.parametrize("fail, message", [
