@@ -175,3 +175,5 @@ class CameraSpec:
     doc: str
     clip_near_m: float = 0.05
     clip_far_m: float = 1000.0
+    #: The kind of rig it stands for (a name of :data:`synthua_usd.rigs.RIG_TYPES`), or None.
+    rig_type: str | None = None

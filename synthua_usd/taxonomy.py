@@ -64,6 +64,11 @@ class ClassMap:
             for c in sorted(document["classes"], key=lambda c: c["id"]))
         return cls(taxonomy=document["taxonomy"], classes=classes, source=source)
 
+    def document(self) -> dict:
+        """The class map as a document of ``schemas/classmap.schema.json`` (what :meth:`from_document` reads)."""
+        return {"$schema": "classmap.schema.json", "taxonomy": self.taxonomy,
+                "classes": [c.to_dict() for c in self.classes]}
+
     def resolve(self, label: str) -> SemanticClass | None:
         """The class whose name is ``label``, or whose alias matches it case-insensitively; else None."""
         return self._index().get(label) or self._index().get(label.casefold())

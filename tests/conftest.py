@@ -110,3 +110,22 @@ def third_party(*parts: str) -> Path:
     if not path.exists():
         pytest.skip(f"{path} is absent: third-party test data lives in ../shared beside the repository (CI has it)")
     return path
+
+
+#: A generation config for tests: the demo street, 6 images of 64x48 at 2 spp over two conditions.
+TINY_CONFIG = DATA / "configs" / "tiny.json"
+
+
+def generate_dataset(out: Path, config: Path = TINY_CONFIG, scenario: Path = SCENARIO, **options):
+    """Run ``synthua generate`` in-process (workers in their own processes) and return its summary."""
+    from synthua_usd.pipeline.generate import GenerateRequest, generate
+
+    return generate(GenerateRequest(scenario=scenario, config_path=config, out_dir=out, **options))
+
+
+@pytest.fixture(scope="session")
+def generated(tmp_path_factory) -> Path:
+    """A dataset of the demo street made with tests/data/configs/tiny.json (do not modify it: copy it)."""
+    out = tmp_path_factory.mktemp("generated") / "dataset"
+    generate_dataset(out)
+    return out

@@ -58,6 +58,10 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ constraints.txt -nt
   echo "setup: installing synthua-usd and its dependencies into $VENV"
   "$VENV/bin/python" -m pip install -q --upgrade pip
   "$VENV/bin/python" -m pip install -q -c constraints.txt -e '.[test]'
+  # panopticapi (the COCO panoptic reader of the tests): its PyPI wheel, panopticapi-lite, is the
+  # cocodataset/panopticapi code but declares numpy<2, which the rest of the stack cannot meet; its code runs
+  # on NumPy 2, and what it needs (numpy, pillow) comes with the test extra.
+  "$VENV/bin/python" -m pip install -q -c constraints.txt --no-deps panopticapi-lite
   touch "$stamp"
 fi
 "$VENV/bin/synthua" --version

@@ -31,6 +31,9 @@ def _write(path: Path, pixels: np.ndarray, fmt: str, attributes: dict[str, str] 
     spec = oiio.ImageSpec(w, h, c, fmt)
     if channel_names:
         spec.channelnames = tuple(channel_names)
+    # No capture date: OpenEXR would store the wall clock, and a file must depend on its pixels and
+    # attributes only (a dataset rerun is byte-identical; provenance lives in the dataset's manifest).
+    spec.attribute("DateTime", "")
     for key, value in (attributes or {}).items():
         spec.attribute(key, value)
     with atomic_path(path) as tmp:

@@ -19,6 +19,7 @@ from synthua_usd.cli.agents_commands import agents
 from synthua_usd.cli.cameras_commands import cameras
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
 from synthua_usd.cli.common import parse_time_codes as _time_codes
+from synthua_usd.cli.dataset_commands import generate, replay, verify
 from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.twin_commands import twin
@@ -246,7 +247,7 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     return EXIT_OK
 
 
-for _group in (twin, agents, cameras, survey, contact_sheet):
+for _group in (twin, agents, cameras, survey, contact_sheet, generate, verify, replay):
     cli.add_command(_group)
 
 

@@ -438,15 +438,16 @@ META = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=24.
 
 DISTRICT_CAMERAS = (
     CameraSpec("CCTV_Largo", (-30.0, 6.0, PLAZA_Z + 6.0), (0.0, 20.0, PLAZA_Z), 2.8, 4.8, 3.6,
-               "CCTV on a largo lamp post, 6 m up, over the market."),
+               "CCTV on a largo lamp post, 6 m up, over the market.", rig_type="cctv"),
     CameraSpec("CCTV_Street", (6.5, -34.0, 6.0), (0.0, -10.0, 1.0), 2.8, 4.8, 3.6,
-               "CCTV at the foot of the cobbled street, looking up the slope."),
+               "CCTV at the foot of the cobbled street, looking up the slope.", rig_type="cctv"),
     CameraSpec("PedestrianEye_Street", (-6.5, -30.0, float(street_z(-30.0)) + 0.15 + 1.6), (-2.0, 0.0, PLAZA_Z + 1.0),
-               24.0, 36.0, 24.0, "Pedestrian eye level (1.6 m) on the cobbled street's west sidewalk, looking uphill."),
+               24.0, 36.0, 24.0, "Pedestrian eye level (1.6 m) on the cobbled street's west sidewalk, looking uphill.",
+               rig_type="pedestrian_eye"),
     CameraSpec("WheelchairEye_Largo", (-12.0, 7.0, PLAZA_Z + 1.24), (10.0, 25.0, PLAZA_Z + 1.0), 24.0, 36.0, 24.0,
-               "Seated wheelchair user's eye level (1.2 m) in the largo."),
+               "Seated wheelchair user's eye level (1.2 m) in the largo.", rig_type="wheelchair_eye"),
     CameraSpec("UAV_Oblique", (-60.0, -70.0, 55.0), (0.0, 0.0, 0.0), 24.0, 36.0, 24.0,
-               "UAV, oblique 45 degrees over the district."),
+               "UAV, oblique 45 degrees over the district.", rig_type="uav_oblique"),
 )
 
 

@@ -38,13 +38,16 @@ RAMP_LENGTH = 1.8  # 15 cm over 1.8 m: 1:12, the usual maximum running slope for
 CAMERAS = (
     # 1/3" CCTV sensor (4.8 x 3.6 mm) behind a 2.8 mm lens: ~81 degree horizontal view from 6 m up.
     CameraSpec("CCTV", (-10.0, -6.2, 5.5), (2.0, 2.5, 0.0), 2.8, 4.8, 3.6,
-              "Wall-mounted CCTV camera on building B, 6 m above the sidewalk.", clip_far_m=500.0),
+              "Wall-mounted CCTV camera on building B, 6 m above the sidewalk.", clip_far_m=500.0,
+              rig_type="cctv"),
     # Full-frame 36 x 24 mm with a 24 mm lens, held at 1.6 m eye height.
     CameraSpec("PedestrianEye", (-11.0, -4.6, 1.6), (4.0, 1.5, 1.0), 24.0, 36.0, 24.0,
-              "Pedestrian eye level (1.6 m) on the south sidewalk, looking down the street.", clip_far_m=500.0),
+              "Pedestrian eye level (1.6 m) on the south sidewalk, looking down the street.", clip_far_m=500.0,
+              rig_type="pedestrian_eye"),
     # Same lens at the eye height of a seated wheelchair user (1.2 m).
     CameraSpec("WheelchairEye", (8.0, 5.6, 1.2), (-2.0, 4.5, 0.7), 24.0, 36.0, 24.0,
-              "Eye level of a seated wheelchair user (1.2 m) on the north sidewalk, looking west.", clip_far_m=500.0),
+              "Eye level of a seated wheelchair user (1.2 m) on the north sidewalk, looking west.",
+              clip_far_m=500.0, rig_type="wheelchair_eye"),
 )
 
 

@@ -24,9 +24,10 @@ def author_camera(stage: Usd.Stage, path: str, camera_to_world: np.ndarray, *, f
                   horizontal_aperture_mm: float, vertical_aperture_mm: float, clip_near_m: float,
                   clip_far_m: float, meters_per_unit: float, doc: str = "",
                   time_samples: dict[float, np.ndarray] | None = None,
-                  distortion: BrownConrady | None = None) -> UsdGeom.Camera:
+                  distortion: BrownConrady | None = None, rig_type: str | None = None) -> UsdGeom.Camera:
     """Define a perspective camera. ``camera_to_world`` (4, 4), column-vector convention, metres; with
-    ``time_samples`` ({time code: (4, 4)}) the transform is time-sampled instead (a moving camera)."""
+    ``time_samples`` ({time code: (4, 4)}) the transform is time-sampled instead (a moving camera);
+    ``rig_type`` is authored as ``synthua:rig:type``."""
     unit = lens_unit_mm(meters_per_unit)
     cam = UsdGeom.Camera.Define(stage, path)
     cam.CreateProjectionAttr(UsdGeom.Tokens.perspective)
@@ -42,6 +43,8 @@ def author_camera(stage: Usd.Stage, path: str, camera_to_world: np.ndarray, *, f
         op.Set(_gf_matrix(camera_to_world, meters_per_unit))
     if distortion is not None and not distortion.is_zero:
         author_distortion(cam.GetPrim(), distortion)
+    if rig_type:
+        cam.GetPrim().CreateAttribute(RIG_TYPE_ATTRIBUTE, Sdf.ValueTypeNames.Token, custom=True).Set(rig_type)
     if doc:
         cam.GetPrim().SetDocumentation(doc)
     return cam
@@ -94,3 +97,15 @@ def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
                          vertical_aperture_mm=float(cam.GetVerticalApertureAttr().Get(t)) * unit,
                          clip_near_m=float(near) * mpu, clip_far_m=float(far) * mpu, camera_to_world=m,
                          distortion=distortion)
+
+
+#: The rig type a camera stands for (cctv, dashcam, uav_nadir, ...: :data:`synthua_usd.rigs.RIG_TYPES`).
+RIG_TYPE_ATTRIBUTE = "synthua:rig:type"
+
+
+def camera_rig_type(stage: Usd.Stage, path: str) -> str | None:
+    """The rig type a camera was placed as (``synthua:rig:type``, see :mod:`synthua_usd.usd.rig_layer`), or
+    None for a camera authored by hand."""
+    attr = stage.GetPrimAtPath(path).GetAttribute(RIG_TYPE_ATTRIBUTE)
+    value = attr.Get() if attr and attr.HasAuthoredValue() else None
+    return str(value) if value else None

@@ -48,9 +48,8 @@ def build_rig_layer(meta: StageMetadata, rigs: list[PlacedRig], doc: str) -> Usd
         cam = author_camera(stage, rig.prim_path, place.pose, focal_length_mm=place.focal_length_mm,
                             horizontal_aperture_mm=h_ap, vertical_aperture_mm=v_ap, clip_near_m=near, clip_far_m=far,
                             meters_per_unit=meta.meters_per_unit, doc=f"{spec.type}: {place.where}.",
-                            time_samples=place.track, distortion=spec.distortion)
+                            time_samples=place.track, distortion=spec.distortion, rig_type=spec.type)
         prim = cam.GetPrim()
-        prim.CreateAttribute("synthua:rig:type", Sdf.ValueTypeNames.Token, custom=True).Set(spec.type)
         prim.CreateAttribute("synthua:rig:height_m", Sdf.ValueTypeNames.Double, custom=True).Set(spec.height_m)
         if rig.target_path:
             prim.CreateRelationship("synthua:rig:target", custom=True).SetTargets([Sdf.Path(rig.target_path)])

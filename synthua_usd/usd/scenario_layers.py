@@ -69,5 +69,6 @@ def build_camera_layer(meta: StageMetadata, cameras: tuple[CameraSpec, ...], doc
         author_camera(stage, f"{CAMERAS_ROOT}/{cam.name}", geo.look_at(cam.eye, cam.target),
                       focal_length_mm=cam.focal_length_mm, horizontal_aperture_mm=cam.horizontal_aperture_mm,
                       vertical_aperture_mm=cam.vertical_aperture_mm, clip_near_m=cam.clip_near_m,
-                      clip_far_m=cam.clip_far_m, meters_per_unit=meta.meters_per_unit, doc=cam.doc)
+                      clip_far_m=cam.clip_far_m, meters_per_unit=meta.meters_per_unit, doc=cam.doc,
+                      rig_type=cam.rig_type)
     return stage

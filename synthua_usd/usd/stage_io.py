@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdGeom
@@ -127,3 +128,21 @@ def check_time_code(stage: Usd.Stage, time_code: float) -> None:
 
 def meters_per_unit(stage: Usd.Stage) -> float:
     return float(UsdGeom.GetStageMetersPerUnit(stage))
+
+
+def layer_stack_digest(stage: Usd.Stage) -> dict:
+    """The composed stage's provenance: SHA-256 of each layer file it uses (sublayers, references, payloads;
+    anonymous layers such as the session layer left out), by path relative to the root layer's folder, and
+    one SHA-256 over them all (``digest``): two stages with the same digest compose the same bytes."""
+    import hashlib
+
+    root = Path(stage.GetRootLayer().realPath).resolve().parent
+    layers = {}
+    for layer in stage.GetUsedLayers():
+        if layer.anonymous or not layer.realPath:
+            continue
+        real = Path(layer.realPath).resolve()
+        name = os.path.relpath(real, root).replace(os.sep, "/")
+        layers[name] = hashlib.sha256(real.read_bytes()).hexdigest()
+    total = hashlib.sha256("".join(f"{k}\0{v}\n" for k, v in sorted(layers.items())).encode("utf-8")).hexdigest()
+    return {"digest": total, "layers": dict(sorted(layers.items()))}

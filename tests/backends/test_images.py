@@ -62,3 +62,21 @@ def test_failed_write_leaves_no_file(tmp_path, monkeypatch):
         images.write_linear_exr(target, np.zeros((2, 2, 3), np.float32))
     assert target.read_bytes() == b"previous"
     assert [p.name for p in tmp_path.iterdir()] == ["rgb.exr"]
+
+
+def test_exr_files_depend_only_on_their_pixels(tmp_path, monkeypatch):
+    """No capture date in EXR headers: the same pixels written at two moments give the same bytes."""
+    import time as _time
+
+    from synthua_usd.backends import images as _images
+
+    pixels = np.random.default_rng(0).random((6, 8, 3)).astype(np.float32)
+    _images.write_linear_exr(tmp_path / "a.exr", pixels)
+    _images.write_depth_exr(tmp_path / "a_z.exr", pixels[..., 0], "z")
+    real = _time.time
+    monkeypatch.setattr(_time, "time", lambda: real() + 86400.0)
+    _time.sleep(1.05)
+    _images.write_linear_exr(tmp_path / "b.exr", pixels)
+    _images.write_depth_exr(tmp_path / "b_z.exr", pixels[..., 0], "z")
+    assert (tmp_path / "a.exr").read_bytes() == (tmp_path / "b.exr").read_bytes()
+    assert (tmp_path / "a_z.exr").read_bytes() == (tmp_path / "b_z.exr").read_bytes()

@@ -53,16 +53,19 @@ class RenderedFrame:
     condition: Condition | None = None
 
 
-def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sensor=None) -> np.ndarray:
+def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sensor=None,
+               seed: int | None = None) -> np.ndarray:
     """(H, W, 3) float32 linear RGB: the mean of passes of at most SPP_PER_PASS samples each; ``sensor`` (e.g. a
-    :func:`synthua_usd.backends.mitsuba.lens.distorted_sensor`) replaces the scene's own."""
+    :func:`synthua_usd.backends.mitsuba.lens.distorted_sensor`) replaces the scene's own; ``seed`` replaces
+    ``config.seed``."""
+    seed = config.seed if seed is None else seed
     passes = math.ceil(config.spp / SPP_PER_PASS)
     total = np.zeros((config.height, config.width, 3), np.float64)
     done = 0
     with tqdm(total=config.spp, unit="spp", desc="rgb", disable=not show_progress, leave=False) as bar:
         for k in range(passes):
             spp = min(SPP_PER_PASS, config.spp - done)
-            image = mi.render(scene, spp=spp, seed=config.seed * 100_003 + k, sensor=0 if sensor is None else sensor)
+            image = mi.render(scene, spp=spp, seed=seed * 100_003 + k, sensor=0 if sensor is None else sensor)
             total += np.asarray(image, np.float64)[..., :3] * spp
             done += spp
             bar.update(spp)
@@ -81,11 +84,7 @@ def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCa
     own, and traced the same way."""
     keys = {key: i for i, key in enumerate(shape_ids)}
     scalar = mi.variant().startswith("scalar")
-    if camera.distortion is None and not camera_rays:
-        sensor = scene.sensors()[0]
-        rays = _sensor_rays_scalar(mi, sensor, width, height) if scalar else _sensor_rays_jit(mi, sensor, width, height)
-    else:
-        rays = _camera_rays(mi, camera, width, height, scalar)
+    rays = pixel_centre_rays(mi, scene, camera, width, height, camera_rays)
     if scalar:
         mesh_index, distance, origins, dirs = _trace_scalar(mi, scene, keys, rays, width * height)
     else:
@@ -97,6 +96,18 @@ def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCa
     z = (distance * (dirs @ forward)).astype(np.float32)
     shape = (height, width)
     return LabelHits(mesh_index.reshape(shape), distance.astype(np.float32).reshape(shape), z.reshape(shape))
+
+
+def pixel_centre_rays(mi, scene, camera: PinholeCamera, width: int, height: int, camera_rays: bool = False):
+    """The rays :func:`trace_pixel_centres` traces, row-major from the top-left pixel: from the scene's sensor for
+    an ideal pinhole, else (or with ``camera_rays``) from the plain-data camera. One ``mi.Ray3f`` of H*W lanes on
+    JIT variants; an iterator of H*W scalar rays on scalar ones."""
+    if camera.distortion is None and not camera_rays:
+        sensor = scene.sensors()[0]
+        if mi.variant().startswith("scalar"):
+            return _sensor_rays_scalar(mi, sensor, width, height)
+        return _sensor_rays_jit(mi, sensor, width, height)
+    return _camera_rays(mi, camera, width, height, mi.variant().startswith("scalar"))
 
 
 def _sensor_rays_jit(mi, sensor, width, height):

@@ -23,12 +23,14 @@ from __future__ import annotations
 
 import time
 import zlib
+from typing import Iterable
 
 import numpy as np
 
 from synthua_usd.backends import weather
 from synthua_usd.backends.exposure import choose_exposure
 from synthua_usd.backends.mitsuba import variants, weather_scene
+from synthua_usd.backends.mitsuba.amodal import AmodalScene, checked_ids
 from synthua_usd.backends.mitsuba.lens import distorted_sensor
 from synthua_usd.backends.mitsuba.render import RenderedFrame, label_maps, render_rgb, trace_pixel_centres
 from synthua_usd.backends.mitsuba.translate import Translation, sensor_to_world, translate
@@ -57,6 +59,7 @@ class RenderSession:
         self._condition: Condition | None = None
         self._lighting: weather_scene.Lighting | None = None
         self._meter: weather_scene.LightMeter | None = None
+        self._amodal: AmodalScene | None = None
 
     def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
         self._translation = translate(self.mi, snapshot, camera, self.config, condition)
@@ -127,9 +130,11 @@ class RenderSession:
         return label_maps(hits, snapshot)[1]
 
     def render(self, snapshot: SceneSnapshot, camera: PinholeCamera, rgb: bool = True,
-               show_progress: bool = False, condition: Condition | None = None) -> RenderedFrame:
+               show_progress: bool = False, condition: Condition | None = None,
+               seed: int | None = None) -> RenderedFrame:
         """RGB (unless ``rgb`` is False) and labels of ``snapshot`` seen by ``camera`` under ``condition``
-        (None: the stage's UsdLux lights as they are, no weather).
+        (None: the stage's UsdLux lights as they are, no weather); ``seed`` (default: the config's) seeds the
+        sampler and the rain.
 
         ``seconds`` in the result holds ``load`` (first load or reload) or ``update``, then ``labels``,
         ``rgb`` and ``weather`` (fog, rain and exposure in image space)."""
@@ -157,15 +162,33 @@ class RenderSession:
                 self._focus_lamps(hits, camera)
             # Mitsuba's perspective sensor cannot distort: a lens with distortion renders through its own sensor.
             sensor = distorted_sensor(self.mi, camera, self.config) if camera.distortion is not None else None
-            image = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor)
+            image = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor, seed=seed)
             seconds["rgb"] = time.perf_counter() - t0
             t0 = time.perf_counter()
             if condition is not None:
-                image = self._weather(image, hits, camera, condition, snapshot)
+                image = self._weather(image, hits, camera, condition, snapshot,
+                                      self.config.seed if seed is None else seed)
             exposure = choose_exposure(image, hits.mesh_index >= 0)
             seconds["weather"] = time.perf_counter() - t0
         return RenderedFrame(rgb=image, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
                              variant=self.variant, seconds=seconds, exposure=exposure, condition=condition)
+
+    def amodal(self, snapshot: SceneSnapshot, camera: PinholeCamera, instance_ids: Iterable[int]) -> dict[int, np.ndarray]:
+        """Amodal masks of ``instance_ids`` (ids of ``snapshot.instances``) seen by ``camera``: each id → (k,)
+        int64 sorted flat pixel indices (``y * width + x`` at the session's size) whose pixel-centre ray, the
+        label pass's own, meets the instance at any depth (:mod:`synthua_usd.backends.mitsuba.amodal`).
+
+        The instances' meshes live in a second scene of their own, kept for the next call with the same ids
+        and the same gprims (then only the sensor and moved vertices are updated), loaded afresh otherwise.
+        It is independent of the scene :meth:`render` holds and of its condition."""
+        ids = checked_ids(snapshot, instance_ids)
+        if self._amodal is not None and self._amodal.holds(snapshot, ids):
+            self._amodal.update(snapshot, camera, self.config)
+        else:
+            self._amodal = None  # let the old scene go before the new one is built
+            self._amodal = AmodalScene.build(self.mi, snapshot, camera, self.config, ids)
+        w, h = self.config.width, self.config.height
+        return self._amodal.trace(camera, w, h)
 
     def _focus_lamps(self, hits, camera: PinholeCamera, count: int = 1024) -> None:
         """Sample lamps in proportion to what they bring to ``count`` surface points this frame sees (an
@@ -181,13 +204,13 @@ class RenderSession:
             self._params.update()
 
     def _weather(self, image: np.ndarray, hits, camera: PinholeCamera, condition: Condition,
-                 snapshot: SceneSnapshot) -> np.ndarray:
+                 snapshot: SceneSnapshot, seed: int) -> np.ndarray:
         """Fog, then rain streaks in front of it; the rain of a frame is seeded by the session's seed, the
         camera and the time code."""
         airlight = self._lighting.airlight
         image = weather.apply_fog(image, hits.distance_m, hits.mesh_index >= 0, condition.fog_extinction_per_m,
                                   airlight)
-        rng = np.random.default_rng([self.config.seed, zlib.crc32(camera.path.encode("utf-8")),
+        rng = np.random.default_rng([seed, zlib.crc32(camera.path.encode("utf-8")),
                                      int(round(snapshot.time_code * 1000)) & 0xFFFFFFFF])
         return weather.rain_streaks(image, hits.z_m, camera, condition.rain_rate_mm_per_h, airlight, rng,
                                     snapshot.up_axis)

@@ -85,8 +85,9 @@ def film_dict(config: RenderConfig, width: int | None = None, height: int | None
 
 
 def sampler_dict(config: RenderConfig, spp: int | None = None) -> dict:
-    """The sampler of every sensor: independent samples seeded by the config."""
-    return {"type": "independent", "sample_count": spp or config.spp, "seed": config.seed}
+    """The sampler of every sensor: independent samples. Its base seed stays 0: Mitsuba adds it to the seed
+    each ``mi.render`` call passes, and the render seed (:func:`render.render_rgb`) must be the only one."""
+    return {"type": "independent", "sample_count": spp or config.spp, "seed": 0}
 
 
 def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter=None, face_attributes=None):

@@ -1,0 +1,88 @@
+"""Cityscapes ``gtFine`` images: ``*_gtFine_labelIds.png``, ``*_gtFine_instanceIds.png``, ``*_gtFine_color.png``.
+
+The label ids are **synthua's class ids** (the class map's taxonomy), not Cityscapes' 34 ids: the classes
+differ (mobility aids, furniture, ...). cityscapesScripts reads the files once its label table is replaced
+by :func:`cityscapes_labels` (its tools import ``labels``, ``id2label``, ``name2label``, ``category2labels``
+from ``cityscapesscripts.helpers.labels``; patch those, as the tests do).
+
+``instanceIds`` follows Cityscapes: a pixel of a thing class that belongs to an instance is
+``class * 1000 + k`` with ``k = 0, 1, ...`` numbering that class's instances in the image in instance-id
+order; any other pixel (stuff, void, thing without instance) is its class id. A class with more than 1000
+instances in one image, or an encoded id above 65535 (class ids >= 66), cannot be written in this scheme and
+raises :class:`OutputError` instead of wrapping into another class's ids.
+
+File names come from :class:`synthua_usd.dataset.layout.CityscapesName`: ``{city}_{seq:06d}_{frame:06d}``,
+the three underscore-separated fields ``getCsFileInfo`` expects.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from synthua_usd.dataset.annotations import pixel_groups
+from synthua_usd.errors import InputError, OutputError
+from synthua_usd.scene import Instance
+from synthua_usd.taxonomy import ClassMap
+
+#: Instances of one class that ``class * 1000 + k`` can number in one image.
+MAX_INSTANCES_PER_CLASS = 1000
+
+
+def cityscapes_arrays(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequence[Instance],
+                      class_map: ClassMap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The three gtFine images of one frame.
+
+    Parameters
+    ----------
+    class_ids : (H, W) uint8 class ids
+    instance_ids : (H, W) uint16 instance ids (0 none)
+    instances : the scene's instances (their ``class_id`` is their class)
+    class_map : thing/stuff and colours of the classes
+
+    Returns
+    -------
+    label_ids : (H, W) uint8, the class ids as they are
+    cs_instance_ids : (H, W) uint16, ``class * 1000 + k`` on thing instances, the class id elsewhere
+    color : (H, W, 3) uint8 sRGB class colours
+    """
+    if class_ids.ndim != 2 or class_ids.dtype != np.uint8 or instance_ids.shape != class_ids.shape:
+        raise InputError(f"label maps: {class_ids.dtype}{class_ids.shape} and {instance_ids.dtype}{instance_ids.shape}; "
+                         f"expected (H, W) uint8 and uint16 of the same shape")
+    thing = {c.id for c in class_map.classes if c.isthing}
+    by_id = {inst.id: inst for inst in instances}
+    out = class_ids.astype(np.uint16)
+    counters: dict[int, int] = {}
+    for inst_id, idx in sorted(pixel_groups(instance_ids).items()):
+        if inst_id == 0:
+            continue
+        inst = by_id.get(inst_id)
+        if inst is None:
+            raise InputError(f"instance map: id {inst_id} has no instance; expected one of the scene's "
+                             f"{len(by_id)} instances")
+        if inst.class_id not in thing:
+            continue
+        k = counters.get(inst.class_id, 0)
+        counters[inst.class_id] = k + 1
+        if k >= MAX_INSTANCES_PER_CLASS or inst.class_id * 1000 + k > np.iinfo(np.uint16).max:
+            raise OutputError(f"Cityscapes instanceIds: instance {inst_id} is number {k} of class {inst.class_id} "
+                              f"in this image; class*1000+k must stay below {MAX_INSTANCES_PER_CLASS} per class "
+                              f"and within 16 bits")
+        flat = out.reshape(-1)
+        flat[idx[class_ids.reshape(-1)[idx] == inst.class_id]] = inst.class_id * 1000 + k
+    return class_ids.copy(), out, class_map.palette()[class_ids]
+
+
+def cityscapes_labels(class_map: ClassMap) -> list[dict]:
+    """The label table for cityscapesScripts, one dict per class with the fields of its ``Label`` namedtuple
+    (``name, id, trainId, category, categoryId, hasInstances, ignoreInEval, color``): ``trainId`` = id,
+    ``category`` = the class's group, ``categoryId`` = the group's rank of first appearance, class 0 ignored
+    in evaluation. Build ``Label(**entry)`` from each to patch cityscapesScripts."""
+    groups: dict[str, int] = {}
+    out = []
+    for c in class_map.classes:
+        category_id = groups.setdefault(c.group, len(groups))
+        out.append({"name": c.name, "id": c.id, "trainId": c.id, "category": c.group, "categoryId": category_id,
+                    "hasInstances": bool(c.isthing), "ignoreInEval": c.id == 0, "color": tuple(c.color)})
+    return out

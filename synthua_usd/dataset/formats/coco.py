@@ -1,0 +1,85 @@
+"""COCO instances (``annotations/instances_{split}.json``) from the per-image records.
+
+pycocotools reads it as it is: RLE masks, ``bbox`` as floats ``[x, y, w, h]`` (pixel-edge box), ``area`` in
+pixels, ``iscrowd`` 0. Only thing classes are annotated (COCO's instances task has no stuff); stuff is in
+the panoptic and Cityscapes formats. Extra fields per annotation, which COCO readers ignore:
+``amodal_segmentation``, ``amodal_bbox``, ``amodal_area``, ``occlusion``, ``truncation``, ``prim_path``,
+``instance_id`` (the pixel value in the image's instance map) and ``relations`` (``{"uses": prim path,
+"uses_annotation_id": id}``; the id only when the used device or person is annotated in the same image).
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+from synthua_usd.dataset.formats.records import image_entry, is_rejected, ordered
+from synthua_usd.errors import InputError
+from synthua_usd.taxonomy import ClassMap
+
+
+def categories(class_map: ClassMap) -> list[dict]:
+    """COCO ``categories``: every thing class with id >= 1; ``supercategory`` is the class's group."""
+    return [{"id": c.id, "name": c.name, "supercategory": c.group} for c in class_map.classes
+            if c.isthing and c.id >= 1]
+
+
+def annotation_ids(records: Iterable[dict], class_map: ClassMap) -> dict[tuple[int, int], int]:
+    """(image id, instance id) -> annotation id, unique across the whole dataset (all splits): 1, 2, ... in
+    image-id order, then in each record's instance order. Rejected images take no ids."""
+    things = {c.id for c in class_map.classes if c.isthing and c.id >= 1}
+    out: dict[tuple[int, int], int] = {}
+    for record in ordered(records):
+        if is_rejected(record):
+            continue
+        for inst in record["instances"]:
+            if inst["category_id"] in things:
+                out[(record["id"], inst["id"])] = len(out) + 1
+    return out
+
+
+def coco_instances(records: Iterable[dict], class_map: ClassMap, split: str) -> dict:
+    """The COCO instances document of ``split``.
+
+    Parameters
+    ----------
+    records : every record of the dataset (all splits: annotation ids are unique across them)
+    class_map : the dataset's classes
+    split : ``train``, ``val`` or ``test``
+
+    Returns
+    -------
+    dict with ``info``, ``licenses``, ``images`` (``file_name`` = ``{name}.png``, relative to
+    ``images/{split}/``), ``annotations`` and ``categories``; JSON-serialisable.
+    """
+    records = ordered(records)
+    known = {c.id for c in class_map.classes}
+    ids = annotation_ids(records, class_map)
+    images, annotations = [], []
+    for record in records:
+        if record["split"] != split or is_rejected(record):
+            continue
+        images.append(image_entry(record))
+        by_path = {inst["prim_path"]: ids.get((record["id"], inst["id"])) for inst in record["instances"]}
+        for inst in record["instances"]:
+            if inst["category_id"] not in known:
+                raise InputError(f"record {record['name']!r}: instance {inst['id']} has class id "
+                                 f"{inst['category_id']}; expected a class of {class_map.source}")
+            ann_id = ids.get((record["id"], inst["id"]))
+            if ann_id is None:
+                continue
+            relations = dict(inst.get("relations") or {})
+            used = by_path.get(relations.get("uses"))
+            if used is not None:
+                relations["uses_annotation_id"] = used
+            annotations.append({
+                "id": ann_id, "image_id": int(record["id"]), "category_id": int(inst["category_id"]),
+                "segmentation": inst["segmentation"], "area": int(inst["area"]),
+                "bbox": [float(v) for v in inst["bbox"]], "iscrowd": 0,
+                "amodal_segmentation": inst["amodal_segmentation"], "amodal_area": int(inst["amodal_area"]),
+                "amodal_bbox": [float(v) for v in inst["amodal_bbox"]],
+                "occlusion": float(inst["occlusion"]), "truncation": float(inst["truncation"]),
+                "prim_path": inst["prim_path"], "instance_id": int(inst["id"]), "relations": relations,
+            })
+    return {"info": {"description": f"synthua-usd synthetic street scenes, {split} split",
+                     "version": "1.0"},
+            "licenses": [], "images": images, "annotations": annotations, "categories": categories(class_map)}

@@ -1,0 +1,35 @@
+"""Which records a dataset-level format holds: one rule for every format."""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+from synthua_usd.errors import InputError
+
+
+def is_rejected(record: dict) -> bool:
+    """True when QA rejected the image: it is listed in the metadata table and ``rejected.csv``, never in an
+    annotation format."""
+    return (record.get("qa") or {}).get("verdict") == "rejected"
+
+
+def ordered(records: Iterable[dict]) -> list[dict]:
+    """All records sorted by image id (formats are then the same whatever order workers finished in);
+    duplicate ids raise :class:`InputError`."""
+    out = sorted(records, key=lambda r: r["id"])
+    for a, b in zip(out, out[1:]):
+        if a["id"] == b["id"]:
+            raise InputError(f"records {a['name']!r} and {b['name']!r}: both have image id {a['id']}; "
+                             f"expected unique image ids")
+    return out
+
+
+def in_split(records: Iterable[dict], split: str) -> list[dict]:
+    """The accepted or flagged records of ``split``, by image id."""
+    return [r for r in ordered(records) if r["split"] == split and not is_rejected(r)]
+
+
+def image_entry(record: dict) -> dict:
+    """A COCO ``images`` entry: ``file_name`` relative to ``images/{split}/``."""
+    return {"id": int(record["id"]), "file_name": f"{record['name']}.png",
+            "width": int(record["width"]), "height": int(record["height"])}

@@ -1,0 +1,113 @@
+"""The metadata table (``metadata.csv`` and ``metadata.parquet``): one row per image, rejected ones included.
+
+Columns, in this order:
+
+* ``image_id, name, split, width, height, camera_path, camera_name, rig_type, fx, fy, cx, cy`` (pixels),
+  ``focal_length_mm, horizontal_aperture_mm, vertical_aperture_mm``;
+* ``camera_to_world_RC`` and ``world_to_camera_opencv_RC`` for row R and column C of the two 4x4 matrices
+  (world metres; the second is the OpenCV extrinsic: x right, y down, z forward);
+* ``time_code, seed, condition`` (its name) and ``condition.KEY`` for each parameter of any record's
+  condition (a list or dict parameter is JSON text);
+* ``instances.CLASS`` and ``pixels.CLASS`` for every class of the class map (instances: the record's
+  instance entries of that class; pixels: its class pixel counts);
+* ``qa_verdict``, ``qa_reasons`` (joined by ``"; "``) and ``qa.MEASURE`` for each QA measure.
+
+A value a record does not have is empty in the CSV and null in Parquet.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Iterable
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from synthua_usd.atomic import atomic_path
+from synthua_usd.dataset.formats.records import ordered
+from synthua_usd.errors import OutputError
+from synthua_usd.taxonomy import ClassMap
+
+
+def _matrix(prefix: str, matrix) -> dict:
+    if matrix is None:
+        return {f"{prefix}_{r}{c}": None for r in range(4) for c in range(4)}
+    return {f"{prefix}_{r}{c}": float(matrix[r][c]) for r in range(4) for c in range(4)}
+
+
+def _scalar(value):
+    if isinstance(value, (list, tuple, dict)):
+        return json.dumps(value, sort_keys=True)
+    return value
+
+
+def metadata_rows(records: Iterable[dict], class_map: ClassMap) -> list[dict]:
+    """One dict per record, by image id, every dict with the same keys in the same order (see module)."""
+    records = ordered(records)
+    condition_keys = sorted({k for r in records for k in (r.get("condition") or {}) if k != "name"})
+    measure_keys = sorted({k for r in records for k in ((r.get("qa") or {}).get("measures") or {})})
+    rows = []
+    for r in records:
+        cam = r.get("camera") or {}
+        K = cam.get("K")
+        cond = r.get("condition") or {}
+        qa = r.get("qa") or {}
+        row = {"image_id": int(r["id"]), "name": r["name"], "split": r["split"],
+               "width": int(r["width"]), "height": int(r["height"]),
+               "camera_path": cam.get("prim_path"), "camera_name": cam.get("name"), "rig_type": cam.get("rig_type"),
+               "fx": None if K is None else float(K[0][0]), "fy": None if K is None else float(K[1][1]),
+               "cx": None if K is None else float(K[0][2]), "cy": None if K is None else float(K[1][2]),
+               "focal_length_mm": cam.get("focal_length_mm"),
+               "horizontal_aperture_mm": cam.get("horizontal_aperture_mm"),
+               "vertical_aperture_mm": cam.get("vertical_aperture_mm")}
+        row |= _matrix("camera_to_world", cam.get("camera_to_world"))
+        row |= _matrix("world_to_camera_opencv", cam.get("world_to_camera_opencv"))
+        row |= {"time_code": float(r["time_code"]), "seed": int(r["seed"]), "condition": cond.get("name")}
+        row |= {f"condition.{k}": _scalar(cond.get(k)) for k in condition_keys}
+        counts = {c.name: 0 for c in class_map.classes}
+        for inst in r.get("instances", ()):
+            counts[class_map.by_id(inst["category_id"]).name] += 1
+        pixels = r.get("class_pixel_counts") or {}
+        row |= {f"instances.{c.name}": counts[c.name] for c in class_map.classes}
+        row |= {f"pixels.{c.name}": int(pixels.get(c.name, 0)) for c in class_map.classes}
+        row |= {"qa_verdict": qa.get("verdict"), "qa_reasons": "; ".join(qa.get("reasons") or ())}
+        row |= {f"qa.{k}": (qa.get("measures") or {}).get(k) for k in measure_keys}
+        rows.append(row)
+    return rows
+
+
+def write_tables(rows: list[dict], csv_path: str | Path, parquet_path: str | Path) -> None:
+    """Write ``rows`` (same keys in each) as CSV (``csv`` module, ``\\n`` line ends, empty for None) and as
+    Parquet (pyarrow, types inferred per column), each atomically."""
+    columns = list(rows[0]) if rows else []
+    for i, row in enumerate(rows):
+        if list(row) != columns:
+            raise OutputError(f"metadata row {i}: columns {list(row)[:3]}...; expected the columns of row 0")
+    with atomic_path(csv_path) as tmp:
+        with open(tmp, "w", newline="", encoding="utf-8") as f:
+            writer = csv.writer(f, lineterminator="\n")
+            writer.writerow(columns)
+            for row in rows:
+                writer.writerow(["" if row[c] is None else _csv_text(row[c]) for c in columns])
+    table = pa.table({c: _column([row[c] for row in rows]) for c in columns})
+    with atomic_path(parquet_path) as tmp:
+        pq.write_table(table, tmp)
+
+
+def _csv_text(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def _column(values: list) -> pa.Array:
+    """A Parquet column of inferred type; a column mixing text and numbers (a condition parameter that is a
+    number in one record and a word in another) is written as text, as in the CSV."""
+    try:
+        return pa.array(values)
+    except (pa.ArrowInvalid, pa.ArrowTypeError):
+        return pa.array([None if v is None else _csv_text(v) for v in values], pa.string())

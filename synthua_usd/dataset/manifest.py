@@ -1,0 +1,45 @@
+"""Provenance of a dataset: file checksums and the manifest document.
+
+The manifest (``manifest.json``) is written last by ``synthua generate``. It records the software that
+made the dataset (synthua, usd-core, mitsuba and the Mitsuba variant), the generation config, the hash of
+the composed layer stack, and per image its seed, its name and every file with its SHA-256 and size; then
+the dataset-level files (COCO, panoptic, tables...) the same way. It holds no times or dates: two runs
+with the same config and seed on the same variant write the same manifest, byte for byte.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+#: Bytes read at a time when hashing files.
+_CHUNK = 1 << 20
+
+
+def sha256_file(path: str | Path) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(_CHUNK), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def file_entry(root: Path, relative: str) -> dict:
+    """``{"path", "sha256", "bytes"}`` of the file ``root / relative``."""
+    path = Path(root) / relative
+    return {"path": relative, "sha256": sha256_file(path), "bytes": path.stat().st_size}
+
+
+def manifest_document(*, provenance: dict, images: list[dict], dataset_files: list[dict]) -> dict:
+    """The manifest: ``provenance`` (software versions, variant, config and its hash, layer stack digest),
+    one entry per image (``id``, ``name``, ``split``, ``seed``, ``layer_stack``, ``files``: a list of file
+    entries) and the dataset-level files."""
+    return {"$schema": "manifest", "provenance": provenance, "images": images, "dataset_files": dataset_files}
+
+
+def document_digest(document) -> str:
+    """SHA-256 of a JSON-able value in canonical form (sorted keys, no spaces)."""
+    import json
+
+    text = json.dumps(document, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()

@@ -1,0 +1,320 @@
+"""One dataset worker: a render session and the files of each image it renders.
+
+A worker is made once per shard of a ``synthua generate`` run (:func:`init_worker`: open the stage, one
+:class:`RenderSession`, one scene load) and then renders its images in order (:func:`work`). Per image it
+renders RGB and exact labels, traces amodal masks, measures truncation, annotates every visible instance,
+runs the QA checks, and writes the image's files. Writing runs on a background thread while the next image
+renders; the image's record (``records/{name}.json``) is written after all its files, so a record on disk
+means a complete image and a run killed at any moment resumes from the records it finds.
+
+Every file is written atomically (a temporary sibling renamed into place), and every path is made by
+:mod:`synthua_usd.dataset.layout` from safe names, so nothing outside the dataset folder is ever touched.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from synthua_usd.atomic import atomic_path
+from synthua_usd.backends import images
+from synthua_usd.dataset import annotations, qa, resample
+from synthua_usd.dataset.formats import cityscapes, onehot, previews, yolo
+from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
+from synthua_usd.dataset.manifest import file_entry
+from synthua_usd.outputs import DEPTH_DEFINITION
+from synthua_usd.render_config import RenderConfig
+from synthua_usd.taxonomy import ClassMap
+
+#: The item that ends a shard: the worker finishes its pending write and returns that record.
+FLUSH = "flush"
+
+
+@dataclass(frozen=True)
+class WorkerJob:
+    """Everything a worker needs, as plain picklable data (sent to worker processes and Ray actors)."""
+
+    scenario: str
+    out_dir: str
+    render: RenderConfig
+    class_map_document: dict
+    allow_external_assets: bool = False
+    #: Written size when smaller than the render size (resampled), else None.
+    output_size: tuple[int, int] | None = None
+    rgb_exr: bool = False
+    depth: bool = True
+    onehot: bool = False
+    amodal_groups: tuple[str, ...] = ()
+    qa_thresholds: object = None
+    city: str = "synthua"
+    camera_index: dict = field(default_factory=dict)
+    layer_stack: str = ""
+    #: Class id -> YOLO class index (:func:`synthua_usd.dataset.formats.yolo.class_index`).
+    yolo_classes: dict = field(default_factory=dict)
+
+
+@dataclass
+class WorkerState:
+    job: WorkerJob
+    stage: object
+    reader: object
+    session: object
+    class_map: ClassMap
+    conditions: dict = field(default_factory=dict)
+    writer: ThreadPoolExecutor = field(default_factory=lambda: ThreadPoolExecutor(max_workers=1))
+    encoders: ThreadPoolExecutor = field(default_factory=lambda: ThreadPoolExecutor(max_workers=4))
+    pending: Future | None = None
+    seconds: dict = field(default_factory=lambda: {"render": 0.0, "annotate": 0.0, "write": 0.0})
+
+    def condition(self, name: str | None):
+        from synthua_usd.usd.conditions import read_condition
+
+        if name not in self.conditions:
+            self.conditions[name] = read_condition(self.stage, name)
+        return self.conditions[name]
+
+
+def init_worker(job: WorkerJob) -> WorkerState:
+    """Open the scenario and make the render session (the scene itself loads with the first image)."""
+    from synthua_usd.backends.mitsuba.session import RenderSession
+    from synthua_usd.usd.reader import StageReader
+    from synthua_usd.usd.stage_io import open_stage
+
+    class_map = ClassMap.from_document(job.class_map_document, source="class_map.json")
+    stage = open_stage(job.scenario, job.allow_external_assets)
+    return WorkerState(job=job, stage=stage, reader=StageReader(stage, class_map), session=RenderSession(job.render),
+                       class_map=class_map)
+
+
+def work(state: WorkerState, item) -> list[dict]:
+    """Render ``item`` (a planned image) and start writing it; returns the results of images whose files
+    are now complete: ``{"record": ..., "seconds": ..., "peak_rss_mib": ...}`` (the previous image's, or
+    the last one's for :data:`FLUSH`)."""
+    done = []
+    if item == FLUSH:
+        if state.pending is not None:
+            done.append(state.pending.result())
+            state.pending = None
+        return done
+    image = render_image(state, item)
+    if state.pending is not None:
+        done.append(state.pending.result())
+    state.pending = state.writer.submit(write_image, state, image)
+    return done
+
+
+@dataclass(eq=False)
+class ImageBuffers:
+    """One rendered and annotated image, ready to write."""
+
+    record: dict
+    arrays: dict = field(repr=False)
+    rejected: bool
+    seconds: dict
+
+
+def render_image(state: WorkerState, planned) -> ImageBuffers:
+    """Render, trace amodal masks, annotate and check one planned image (nothing is written here)."""
+    from synthua_usd.projection import truncation
+    from synthua_usd.usd.cameras import read_camera
+
+    job, class_map = state.job, state.class_map
+    t0 = time.perf_counter()
+    snapshot = state.reader.snapshot(planned.time_code)
+    camera = read_camera(state.stage, planned.camera_path, planned.time_code)
+    condition = state.condition(planned.condition)
+    rendered = state.session.render(snapshot, camera, rgb=True, condition=condition, seed=planned.seed)
+    width, height = job.render.width, job.render.height
+    visible = [int(i) for i in np.unique(rendered.instance_ids) if i]
+    group_of = {c.id: c.group for c in class_map.classes}
+    by_id = {inst.id: inst for inst in snapshot.instances}
+    wanted = [i for i in visible if by_id[i].class_name in job.amodal_groups
+              or group_of.get(by_id[i].class_id) in job.amodal_groups]
+    amodal = state.session.amodal(snapshot, camera, wanted) if wanted else {}
+    seconds = {"render": time.perf_counter() - t0}
+
+    t0 = time.perf_counter()
+    meshes_of: dict[int, list] = {}
+    for mesh in snapshot.meshes:
+        if mesh.instance_id in by_id:
+            meshes_of.setdefault(mesh.instance_id, []).append(mesh)
+    truncations = {}
+    for i in visible:
+        meshes = meshes_of.get(i, [])
+        points, triangles, _ = snapshot.world_triangles(meshes)
+        truncations[i] = truncation(points, triangles, camera, width, height)
+    rgb, class_ids, instance_ids, depth = (rendered.rgb, rendered.class_ids, rendered.instance_ids,
+                                           rendered.hits.z_m)
+    if job.output_size is not None:
+        # Images by a filter; labels, depth and amodal sets all copy one source pixel per output pixel (the
+        # mode of the joint class and instance label), so they stay consistent and invent no ids.
+        out_w, out_h = job.output_size
+        rgb = resample.resample_rgb(rgb, out_w, out_h)
+        maps, index = resample.resample_label_maps({"instance": instance_ids, "class": class_ids}, out_w, out_h)
+        class_ids, instance_ids = maps["class"], maps["instance"]
+        depth = resample.gather(depth, index)
+        amodal = {i: resample.resample_pixel_set(pixels, (height, width), index) for i, pixels in amodal.items()}
+        width, height = out_w, out_h
+    instances = annotations.annotate(class_ids, instance_ids, snapshot.instances, amodal, truncations)
+    by_path = {inst.prim_path: inst for inst in snapshot.instances}
+    for entry in instances:  # the class of what a person uses, also when it is out of view
+        used = by_path.get(entry.get("relations", {}).get("uses", ""))
+        if used is not None:
+            entry["relations"]["uses_class"] = used.class_name
+    panoptic_png, segments = annotations.panoptic(class_ids, instance_ids, snapshot.instances, class_map)
+    scale = rendered.exposure.scale if rendered.exposure is not None else 1.0
+    display = images.linear_to_display(rgb * np.float32(scale))
+    measures = qa.measure(display, instances)
+    verdict, reasons = qa.verdict(measures, job.qa_thresholds)
+
+    name = image_name(planned.id, planned.camera_name, planned.time_code, planned.condition, planned.seed)
+    split = planned.split
+    cs = CityscapesName(job.city, job.camera_index.get(planned.camera_path, 0), planned.id)
+    files = {"rgb_png": Layout.rgb_png(split, name) if verdict != "rejected" else Layout.frame_file(name, "rgb.png"),
+             "class": Layout.frame_file(name, "class.png"),
+             "semantic": Layout.frame_file(name, "semantic.png"),
+             "instance": Layout.frame_file(name, "instance.png"),
+             "instance_preview": Layout.frame_file(name, "instance_preview.png")}
+    arrays = {"rgb_png": display, "class": class_ids, "semantic": class_map.palette()[class_ids],
+              "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
+    if verdict != "rejected":
+        labels, instance_cs, colour = cityscapes.cityscapes_arrays(class_ids, instance_ids, snapshot.instances,
+                                                                  class_map)
+        files.update({"panoptic": Layout.panoptic_png(split, name),
+                      "cs_labelIds": Layout.cityscapes(split, cs, "labelIds"),
+                      "cs_instanceIds": Layout.cityscapes(split, cs, "instanceIds"),
+                      "cs_color": Layout.cityscapes(split, cs, "color"),
+                      "cs_leftImg8bit": Layout.cityscapes(split, cs, "leftImg8bit"),
+                      "yolo_label": Layout.yolo_label(split, name)})
+        arrays.update({"panoptic": panoptic_png, "cs_labelIds": labels, "cs_instanceIds": instance_cs,
+                       "cs_color": colour, "yolo_label": yolo.yolo_lines(instances, width, height,
+                                                                        job.yolo_classes)})
+        yolo_count = sum(1 for line in arrays["yolo_label"].splitlines() if line.strip())
+        if job.depth:
+            files["depth"] = Layout.frame_file(name, "depth.exr")
+            arrays["depth"] = depth
+        if job.rgb_exr:
+            files["rgb_exr"] = Layout.frame_file(name, "rgb.exr")
+            arrays["rgb_exr"] = rgb
+        if job.onehot:
+            files["onehot"] = Layout.frame_file(name, "onehot.npz")
+            arrays["onehot"] = class_ids
+    record = {
+        "id": planned.id,
+        "name": name,
+        "split": split,
+        "width": width,
+        "height": height,
+        "camera": camera_document(camera, planned, job.render.width, job.render.height, width, height),
+        "time_code": planned.time_code,
+        "seed": planned.seed,
+        "condition": condition.to_dict() if condition is not None else None,
+        "exposure": rendered.exposure.to_dict() if rendered.exposure is not None else None,
+        "render": {"variant": rendered.variant, "spp": job.render.spp, "pixel_filter": job.render.pixel_filter,
+                   "max_depth": job.render.max_depth, "width": job.render.width, "height": job.render.height},
+        "layer_stack": job.layer_stack,
+        "files": files,
+        "class_pixel_counts": {class_map.by_id(int(c)).name: int(n)
+                               for c, n in enumerate(np.bincount(class_ids.ravel(), minlength=256)) if n},
+        "instances": instances,
+        "panoptic_segments": segments,
+        "qa": {"verdict": verdict, "reasons": list(reasons), "measures": measures},
+    }
+    if verdict != "rejected":
+        record["yolo_lines"] = yolo_count
+    seconds["annotate"] = time.perf_counter() - t0
+    return ImageBuffers(record, arrays, verdict == "rejected", seconds)
+
+
+def camera_document(camera, planned, render_w: int, render_h: int, width: int, height: int) -> dict:
+    """Intrinsics at the written size (K scaled from the render size) and extrinsics."""
+    K = camera.intrinsics(render_w, render_h).copy()
+    K[0] *= width / render_w
+    K[1] *= height / render_h
+    return {"prim_path": camera.path, "name": planned.camera_name, "rig_type": planned.rig_type,
+            "K": K.tolist(), "camera_to_world": camera.camera_to_world.tolist(),
+            "world_to_camera_opencv": camera.world_to_camera_opencv().tolist(),
+            "focal_length_mm": camera.focal_length_mm, "horizontal_aperture_mm": camera.horizontal_aperture_mm,
+            "vertical_aperture_mm": camera.vertical_aperture_mm, "clipping_range_m": [camera.clip_near_m,
+                                                                                     camera.clip_far_m],
+            "distortion": camera.distortion.to_dict() if camera.distortion is not None else None}
+
+
+_WRITERS = {
+    "rgb_png": lambda path, data: images.write_color_png(path, data),
+    "class": images.write_id_png,
+    "semantic": images.write_color_png,
+    "instance": images.write_id_png,
+    "instance_preview": images.write_color_png,
+    "panoptic": images.write_color_png,
+    "cs_labelIds": images.write_id_png,
+    "cs_instanceIds": images.write_id_png,
+    "cs_color": images.write_color_png,
+    "depth": lambda path, data: images.write_depth_exr(path, data, DEPTH_DEFINITION),
+    "rgb_exr": images.write_linear_exr,
+}
+
+
+def write_image(state: WorkerState, image: ImageBuffers) -> dict:
+    """Write every file of ``image`` (each atomically), then its record; returns the worker's result."""
+    t0 = time.perf_counter()
+    layout = Layout(Path(state.job.out_dir))
+    record = image.record
+    targets = {key: layout.path(rel) for key, rel in record["files"].items()}
+    for path in set(p.parent for p in targets.values()):
+        path.mkdir(parents=True, exist_ok=True)
+    jobs = []
+    for key, path in targets.items():
+        if key == "cs_leftImg8bit":
+            continue  # a link to the RGB image, made once that exists
+        data = image.arrays[key]
+        if key == "yolo_label":
+            jobs.append(state.encoders.submit(_write_text, path, data))
+        elif key == "onehot":
+            num_classes = max(c.id for c in state.class_map.classes) + 1
+            jobs.append(state.encoders.submit(lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)),
+                                              path, data))
+        else:
+            jobs.append(state.encoders.submit(_WRITERS[key], path, data))
+    for job in jobs:
+        job.result()
+    if "cs_leftImg8bit" in targets:
+        _link_or_copy(targets["rgb_png"], targets["cs_leftImg8bit"])
+    record["checksums"] = {key: file_entry(layout.root, rel) for key, rel in sorted(record["files"].items())}
+    record_path = layout.path(Layout.record(record["name"]))
+    record_path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(record_path) as tmp:
+        tmp.write_text(json.dumps(record, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    seconds = dict(image.seconds, write=time.perf_counter() - t0)
+    return {"record": record, "seconds": seconds, "peak_rss_mib": peak_rss_mib(), "pid": os.getpid()}
+
+
+def _write_text(path: Path, text: str) -> Path:
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path
+
+
+def _link_or_copy(source: Path, target: Path) -> None:
+    """``target`` as a hard link to ``source`` (the Cityscapes copy of the RGB image costs no space), or a
+    copy where the file system has no hard links; replaced atomically either way."""
+    import shutil
+
+    with atomic_path(target) as tmp:
+        os.unlink(tmp)
+        try:
+            os.link(source, tmp)
+        except OSError:
+            shutil.copyfile(source, tmp)
+
+
+def peak_rss_mib() -> float:
+    """This process's peak resident memory, MiB."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0

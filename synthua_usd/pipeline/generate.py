@@ -1,0 +1,389 @@
+"""``synthua generate``: a scenario and a generation config in, a complete, verifiable dataset out.
+
+1. Plan. The config's sweep (cameras × time codes × conditions × seeds) is the pool of candidate images.
+   A cheap label pass scores every (camera, time code) view for visible mobility-aid users, and the
+   sampler (:mod:`synthua_usd.dataset.sampling`) picks the images that meet the quotas and assigns the
+   train/val/test splits. The plan is written to ``generate.json`` with the config, so a rerun of the same
+   command finds it and resumes.
+2. Render. Images without a record are cut into shards; each shard runs start to end on one worker (one
+   render session, one scene load, :mod:`synthua_usd.pipeline.dataset_worker`) of a local process pool
+   or a Ray cluster (:mod:`synthua_usd.pipeline.executors`). An image's files are written as it finishes,
+   its record last.
+3. Assemble. From the records alone: COCO instances and panoptic files per split, YOLO's ``data.yaml``,
+   the metadata table, the coverage report, the rejected list, the class map and, last, the manifest.
+
+An image's bytes depend only on the scenario, the config and the image (box pixel filter; see the
+README's Reproducibility), never on which worker rendered it or what it rendered before: a resumed run,
+a run on more workers and a run on Ray give the same dataset, byte for byte.
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import io
+import json
+import logging
+import os
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from synthua_usd import __version__
+from synthua_usd.atomic import atomic_path
+from synthua_usd.dataset import coverage, sampling
+from synthua_usd.dataset.config import GenerationConfig
+from synthua_usd.dataset.formats import coco, panoptic, tables, yolo
+from synthua_usd.dataset.layout import SPLITS, Layout, cityscapes_city
+from synthua_usd.dataset.manifest import document_digest, file_entry, manifest_document
+from synthua_usd.errors import InputError, OutputError, StageError, echo
+from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, work
+from synthua_usd.render_config import RenderConfig
+from synthua_usd.resources import check_frame_memory
+from synthua_usd.taxonomy import ClassMap
+
+log = logging.getLogger(__name__)
+
+#: Images a worker renders before its shard ends and a fresh worker takes the next one (bounded so that
+#: work spreads over workers and a failure costs little).
+SHARD_IMAGES = 16
+#: Rounds of replacing images QA rejected (each round replaces the rejections of the one before).
+REPLACEMENT_ROUNDS = 3
+
+
+@dataclass(frozen=True)
+class GenerateRequest:
+    scenario: Path
+    config_path: Path
+    out_dir: Path
+    executor: str = "local"
+    workers: int | None = None
+    address: str | None = None
+    variant: str | None = None
+    class_map_path: Path | None = None
+    allow_external_assets: bool = False
+
+
+@dataclass
+class GenerateSummary:
+    """What a run did: images planned, rendered now, found complete, rejected; where time went; memory."""
+
+    out_dir: Path
+    planned: int = 0
+    rendered: int = 0
+    resumed: int = 0
+    rejected: int = 0
+    flagged: int = 0
+    seconds: dict = field(default_factory=dict)
+    wall_seconds: float = 0.0
+    peak_rss_mib: dict = field(default_factory=dict)
+    bytes_per_image: float = 0.0
+    shortfalls: list = field(default_factory=list)
+    #: (images rendered so far, worker, its peak resident memory in MiB) after each result: memory over a run.
+    rss_trace: list = field(default_factory=list)
+
+
+def _versions(variant: str) -> dict:
+    from importlib.metadata import version
+
+    return {"synthua": __version__, "usd-core": version("usd-core"), "mitsuba": version("mitsuba"),
+            "mitsuba_variant": variant}
+
+
+def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: ClassMap):
+    """Open the scenario and resolve the sweep against it: the candidate pool (cameras with their rig types ×
+    time codes × conditions × seeds), the render size and the layer stack digest."""
+    import math
+
+    from synthua_usd.usd.cameras import camera_paths, camera_rig_type, read_camera
+    from synthua_usd.usd.conditions import condition_names
+    from synthua_usd.usd.render_settings import render_defaults
+    from synthua_usd.usd.stage_io import layer_stack_digest, open_stage
+
+    stage = open_stage(request.scenario, request.allow_external_assets)
+    defaults = render_defaults(stage)
+    config.check_amodal_groups({c.group for c in class_map.classes}, [c.name for c in class_map.classes],
+                               source=f"{request.config_path}: amodal_groups")
+    cameras = [(p, p.rsplit("/", 1)[-1], camera_rig_type(stage, p)) for p in camera_paths(stage)]
+    if not cameras:
+        raise StageError(f"{request.scenario}: has no cameras; expected a scenario with at least one UsdGeom.Camera")
+    start, end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
+    stage_times = [float(t) for t in range(math.ceil(start), math.floor(end) + 1)] or [float(start)]
+    try:
+        pool = sampling.candidates(config, cameras, stage_times, condition_names(stage))
+    except InputError as exc:
+        raise InputError(f"{request.config_path}: {exc}") from None
+    chosen = list(dict.fromkeys((c.camera_path, c.camera_name, c.rig_type) for c in pool))
+    for path, _, _ in chosen:  # every camera is checked before anything renders
+        read_camera(stage, path, pool[0].time_code)
+    stage_size = defaults.resolution or (RenderConfig.width, RenderConfig.height)
+    width, height = config.render.size(*stage_size)
+    return stage, pool, chosen, (width, height), layer_stack_digest(stage)
+
+
+def score_views(stage, pool, render: RenderConfig, class_map: ClassMap, show_progress: bool):
+    """Visible pixels of every mobility-aid user (a person with a ``uses`` relation, and its device) in every
+    (camera, time code) view, from one label pass each: the sampler's view scores."""
+    from tqdm import tqdm
+
+    from synthua_usd.backends.mitsuba.session import RenderSession
+    from synthua_usd.usd.cameras import read_camera
+    from synthua_usd.usd.reader import StageReader
+
+    reader = StageReader(stage, class_map)
+    session = RenderSession(RenderConfig(width=render.width, height=render.height, spp=1, variant=render.variant))
+    scores = []
+    views = sorted(dict.fromkeys((c.time_code, c.camera_path) for c in pool))
+    for tc, path in tqdm(views, desc="score views", unit="view", disable=not show_progress):
+        snapshot = reader.snapshot(tc)
+        ids = session.quick_labels(snapshot, read_camera(stage, path, tc))
+        counts = np.bincount(ids.ravel(), minlength=len(snapshot.instances) + 1)
+        by_path = {inst.prim_path: inst for inst in snapshot.instances}
+        aid_users = []
+        for inst in snapshot.instances:
+            uses = dict(inst.relations).get("uses")
+            device = by_path.get(uses) if uses else None
+            if inst.class_name == "person" and device is not None:
+                aid_users.append(sampling.AidUserView(aid_type=device.class_name,
+                                                      person_pixels=int(counts[inst.id]),
+                                                      device_pixels=int(counts[device.id])))
+        scores.append(sampling.ViewScore(camera_path=path, time_code=tc, aid_users=tuple(aid_users)))
+    return scores
+
+
+def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateSummary:
+    """Plan (or find the plan of an earlier run), render what is missing, assemble the dataset files."""
+    from tqdm import tqdm
+
+
+    started = time.perf_counter()
+    config = GenerationConfig.load(request.config_path)
+    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    stage, pool, cameras, (width, height), stack = _stage_facts(request, config, class_map)
+    config.output_size(width, height)  # a resample size larger than the render is refused before anything runs
+    check_frame_memory(width, height)
+    from synthua_usd.backends.mitsuba import variants
+
+    variant = variants.activate(request.variant).variant()
+    render = config.render.render_config(width, height, seed=0, variant=variant)
+    out = Path(request.out_dir)
+    layout = Layout(out)
+    job_key = {"scenario": str(Path(request.scenario).resolve()), "layer_stack": stack["digest"],
+               "config": config.to_document(), "class_map": class_map.document(), "variant": variant}
+    existing = _read_job(out)
+    if existing is not None and existing.get("job_key_digest") != document_digest(job_key):
+        raise OutputError(f"{out}: holds a dataset generated from another scenario, config, class map or Mitsuba "
+                          f"variant (its generate.json differs); expected an empty folder or the same job to "
+                          f"resume: pick another --out or remove it")
+    if existing is not None:
+        plan = [sampling.PlannedImage(**p) for p in existing["plan"]]
+        scores = [_score_from_dict(s) for s in existing["scores"]]
+    else:
+        scores = score_views(stage, pool, render, class_map, show_progress)
+        plan = sampling.plan(pool, scores, config)
+        _write_job(out, {"synthua": __version__, "job_key": job_key, "job_key_digest": document_digest(job_key),
+                         "layer_stack": stack, "render": asdict(render),
+                         "cameras": [list(c) for c in cameras], "quota_targets": sampling.quota_targets(pool, config),
+                         "pool": sampling.pool_summary(pool, scores, config),
+                         "scores": [asdict(s) for s in scores], "plan": [p.to_dict() for p in plan]})
+    summary = GenerateSummary(out_dir=out)
+    _remove_partial_files(out)
+    done = _complete_records(layout, plan)
+    todo = [p for p in plan if p.id not in done]
+    summary.resumed = len(done)
+    job_document = _read_job(out)
+    job = worker_job_from_document(job_document, out, request.allow_external_assets)
+    seconds = {"render": 0.0, "annotate": 0.0, "write": 0.0}
+    peaks: dict = {}
+    config_workers = request.workers or config.workers or default_workers()
+    bar = tqdm(total=len(todo), desc="generate", unit="img", disable=not show_progress)
+
+    def collect(result) -> None:
+        for item in result.value:
+            if item["record"]["id"] not in done:
+                summary.rendered += 1
+                bar.update(1)
+            done[item["record"]["id"]] = item["record"]
+            for key in seconds:
+                seconds[key] += item["seconds"].get(key, 0.0)
+        peaks[result.worker] = max(peaks.get(result.worker, 0.0), result.peak_rss_mib)
+        summary.rss_trace.append((summary.rendered, result.worker, result.peak_rss_mib))
+
+    # A worker writes an image while it renders the next, so a worker lost mid-shard can take an image
+    # whose render the executor counts as delivered: rounds repeat until every planned image has a record.
+    # Images QA rejects are replaced by others of the pool (their quotas counted), for a few rounds.
+    for _ in range(REPLACEMENT_ROUNDS + 1):
+        _render_all(todo, done, job, request, config_workers, collect, out)
+        rejected = {p.id for p in plan if done[p.id]["qa"]["verdict"] == "rejected"}
+        todo = sampling.replacements(pool, scores, config, plan, rejected) if rejected else []
+        if not todo:
+            break
+        plan += todo
+        job_document["plan"] = [p.to_dict() for p in plan]
+        _write_job(out, job_document)
+        bar.total += len(todo)
+        bar.refresh()
+    bar.close()
+    summary.planned = len(plan)
+    records = [done[p.id] for p in plan]
+    assemble(layout, records, class_map, config, job_document)
+    summary.rejected = sum(r["qa"]["verdict"] == "rejected" for r in records)
+    summary.flagged = sum(r["qa"]["verdict"] == "flagged" for r in records)
+    summary.seconds = seconds
+    summary.peak_rss_mib = peaks
+    summary.wall_seconds = time.perf_counter() - started
+    total_bytes = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
+    summary.bytes_per_image = total_bytes / max(1, len(records))
+    summary.shortfalls = json.loads(layout.path(Layout.COVERAGE).read_text(encoding="utf-8")).get("shortfalls", [])
+    return summary
+
+
+def worker_job_from_document(document: dict, out_dir: Path, allow_external_assets: bool = False) -> WorkerJob:
+    """The workers' job from a run's ``generate.json``: the one place a :class:`WorkerJob` is made, for a
+    run, its resumption and ``synthua replay`` alike."""
+    key = document["job_key"]
+    config = GenerationConfig.from_document(key["config"], source=Layout.CONFIG)
+    class_map = ClassMap.from_document(key["class_map"], source=Layout.CONFIG)
+    render = RenderConfig.from_dict(document["render"])
+    cameras = [tuple(c) for c in document["cameras"]]
+    size = config.output_size(render.width, render.height)
+    output_size = None if size == (render.width, render.height) else size
+    return WorkerJob(scenario=key["scenario"], out_dir=str(Path(out_dir).resolve()), render=render,
+                     class_map_document=key["class_map"], allow_external_assets=allow_external_assets,
+                     output_size=output_size, rgb_exr=config.outputs.rgb_exr, depth=config.outputs.depth,
+                     onehot=config.outputs.onehot, amodal_groups=tuple(config.amodal_groups), qa_thresholds=config.qa,
+                     city=cityscapes_city(config.name), camera_index={p: i for i, (p, _, _) in enumerate(cameras)},
+                     layer_stack=document["layer_stack"]["digest"], yolo_classes=yolo.class_index(class_map))
+
+
+def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, workers: int, collect, out: Path) -> None:
+    """Render every planned image of ``todo`` on the executor, in shards; rounds repeat for images a lost
+    worker took with it."""
+    from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
+
+    while todo:
+        ordered = sorted(todo, key=lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id))
+        shards = [ordered[i:i + SHARD_IMAGES] + [FLUSH] for i in range(0, len(ordered), SHARD_IMAGES)]
+        executor = ExecutorConfig(kind=request.executor, workers=min(workers, len(shards)), address=request.address)
+        run_shards(shards, functools.partial(init_worker, job), work, collect, executor)
+        missing = [p for p in todo if p.id not in done]
+        if len(missing) == len(todo):
+            raise OutputError(f"{out}: {len(missing)} images were rendered but none was written; expected "
+                              f"their records in {out / 'records'}")
+        todo = missing
+
+
+def _score_from_dict(document: dict) -> sampling.ViewScore:
+    return sampling.ViewScore(camera_path=document["camera_path"], time_code=document["time_code"],
+                              aid_users=tuple(sampling.AidUserView(**a) for a in document["aid_users"]))
+
+
+def default_workers() -> int:
+    """One render worker per 8 cores: a Mitsuba LLVM session already uses every core it is given, so more
+    workers on a small machine only compete (``--workers`` overrides)."""
+    return max(1, (os.cpu_count() or 1) // 8)
+
+
+def _read_job(out: Path) -> dict | None:
+    path = out / Layout.CONFIG
+    if not path.exists():
+        if out.exists() and not out.is_dir():
+            raise OutputError(f"{out}: is a file; expected a dataset folder or a path that does not exist")
+        if out.is_dir() and any(out.iterdir()):
+            raise OutputError(f"{out}: is not empty and holds no generate.json; expected an empty folder, a "
+                              f"path that does not exist, or a dataset to resume")
+        return None
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise OutputError(f"{path}: unreadable ({exc}); expected the generate.json of an earlier run") from None
+
+
+def _write_job(out: Path, document: dict) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    _write_json(out / Layout.CONFIG, document)
+
+
+def _write_json(path: Path, document) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(document, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    return path
+
+
+def _remove_partial_files(out: Path) -> None:
+    """Delete what a killed run left half-written: the temporary files of atomic writes (dot files; the
+    dataset's own files never start with a dot, see :mod:`synthua_usd.dataset.layout`)."""
+    for path in sorted(out.rglob(".*")):
+        if path.is_file() or path.is_symlink():
+            path.unlink()
+
+
+def _complete_records(layout: Layout, plan) -> dict[int, dict]:
+    """Records of planned images already complete: a record that parses, names the planned image, and whose
+    files all exist with their recorded sizes (checksums are ``synthua verify``'s job)."""
+    from synthua_usd.dataset.layout import image_name
+
+    done = {}
+    for p in plan:
+        name = image_name(p.id, p.camera_name, p.time_code, p.condition, p.seed)
+        path = layout.path(Layout.record(name))
+        try:
+            record = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            continue
+        entries = record.get("checksums", {})
+        if record.get("id") == p.id and entries and all(
+                (layout.root / e["path"]).is_file() and (layout.root / e["path"]).stat().st_size == e["bytes"]
+                for e in entries.values()):
+            done[p.id] = record
+    return done
+
+
+def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: GenerationConfig,
+             job_document: dict) -> None:
+    """Every dataset-level file, from the records alone; the manifest last."""
+    root = layout.root
+    written = []
+    for split in SPLITS:
+        written.append(_write_json(layout.path(Layout.coco_instances(split)),
+                                   coco.coco_instances(records, class_map, split)))
+        written.append(_write_json(layout.path(Layout.coco_panoptic(split)),
+                                   panoptic.coco_panoptic(records, class_map, split)))
+    with atomic_path(layout.path(Layout.DATA_YAML)) as tmp:
+        tmp.write_text(yolo.data_yaml(class_map), encoding="utf-8")
+    written.append(layout.path(Layout.DATA_YAML))
+    rows = tables.metadata_rows(records, class_map)
+    tables.write_tables(rows, layout.path(Layout.METADATA_CSV), layout.path(Layout.METADATA_PARQUET))
+    written += [layout.path(Layout.METADATA_CSV), layout.path(Layout.METADATA_PARQUET)]
+    written.append(_write_json(layout.path(Layout.COVERAGE), coverage.coverage(
+        records, config, job_document.get("quota_targets"), job_document.get("pool"))))
+    written.append(_write_rejected(layout.path(Layout.REJECTED), records))
+    written.append(_write_json(layout.path(Layout.CLASS_MAP), class_map.document()))
+    key = job_document["job_key"]
+    provenance = {**_versions(key["variant"]), "config": key["config"], "config_digest": document_digest(key["config"]),
+                  "scenario": key["scenario"], "layer_stack": job_document["layer_stack"]}
+    images = [{"id": r["id"], "name": r["name"], "split": r["split"], "seed": r["seed"],
+               "layer_stack": r["layer_stack"], "qa": r["qa"]["verdict"],
+               "files": [r["checksums"][k] for k in sorted(r["checksums"])]
+               + [file_entry(root, Layout.record(r["name"]))]} for r in records]
+    dataset_files = [file_entry(root, p.relative_to(root).as_posix()) for p in written]
+    dataset_files.append(file_entry(root, Layout.CONFIG))
+    _write_json(layout.path(Layout.MANIFEST), manifest_document(provenance=provenance, images=images,
+                                                                dataset_files=sorted(dataset_files,
+                                                                                     key=lambda e: e["path"])))
+
+
+def _write_rejected(path: Path, records: list[dict]) -> Path:
+    """``rejected.csv``: every image QA rejected or flagged, with its reasons (nothing is dropped silently)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["image_id", "name", "verdict", "reasons"])
+    for r in records:
+        if r["qa"]["verdict"] != "accepted":
+            writer.writerow([r["id"], r["name"], r["qa"]["verdict"], "; ".join(r["qa"]["reasons"])])
+    with atomic_path(path) as tmp:
+        tmp.write_text(buffer.getvalue(), encoding="utf-8")
+    return path

@@ -1,0 +1,86 @@
+"""Cityscapes gtFine files read by cityscapesScripts, with synthua's label table patched in."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+
+import numpy as np
+import pytest
+
+from label_scenes import INSTANCES, scene
+from synthua_usd.backends.images import write_color_png, write_id_png
+from synthua_usd.dataset.formats.cityscapes import cityscapes_arrays, cityscapes_labels
+from synthua_usd.dataset.layout import CityscapesName, Layout, cityscapes_city
+from synthua_usd.errors import OutputError
+from synthua_usd.scene import Instance
+
+
+def test_instance_ids_follow_the_cityscapes_convention(class_map):
+    cls, ins, _, _ = scene()
+    label_ids, cs_ids, color = cityscapes_arrays(cls, ins, INSTANCES, class_map)
+    assert np.array_equal(label_ids, cls) and cs_ids.dtype == np.uint16
+    assert np.array_equal(color, class_map.palette()[cls])
+    # persons 3, 9, 11 are 18000, 18001, 18002; the road instance (stuff) stays its class id
+    assert np.array_equal(cs_ids == 18000, ins == 3) and np.array_equal(cs_ids == 18002, ins == 11)
+    assert np.array_equal(cs_ids == 19000, ins == 7)
+    assert np.all(cs_ids[cls == 1] == 1) and np.all(cs_ids[cls == 0] == 0)
+    assert np.array_equal(cs_ids // 1000 * (cs_ids >= 1000) + cs_ids * (cs_ids < 1000), cls)
+
+
+def test_more_than_1000_instances_of_a_class_is_refused(class_map):
+    ids = np.arange(1, 1002, dtype=np.uint16).reshape(1, -1)
+    cls = np.full(ids.shape, 18, np.uint8)
+    many = [Instance(int(i), f"/World/P{i}", 18, "person", True) for i in ids.ravel()]
+    with pytest.raises(OutputError, match="number 1000 of class 18"):
+        cityscapes_arrays(cls, ids, many, class_map)
+
+
+def test_cityscapes_scripts_pixel_evaluation_of_gt_against_itself_is_iou_one(tmp_path, class_map, monkeypatch):
+    from cityscapesscripts.evaluation import evalPixelLevelSemanticLabeling as ev
+    from cityscapesscripts.helpers import csHelpers
+    from cityscapesscripts.helpers.labels import Label
+
+    labels = [Label(**entry) for entry in cityscapes_labels(class_map)]
+    tables = {"labels": labels, "name2label": {l.name: l for l in labels}, "id2label": {l.id: l for l in labels},
+              "trainId2label": {l.trainId: l for l in reversed(labels)},
+              "category2labels": {}}
+    for l in labels:
+        tables["category2labels"].setdefault(l.category, []).append(l)
+    for name, value in tables.items():
+        monkeypatch.setattr(ev, name, value)
+    # cityscapesScripts 2.3 calls np.in1d, which NumPy 2.4 removed; np.isin is its documented replacement.
+    monkeypatch.setattr(np, "in1d", np.isin, raising=False)
+    args = ev.args
+    monkeypatch.setattr(args, "quiet", True)
+    monkeypatch.setattr(args, "JSONOutput", False)
+    monkeypatch.setattr(args, "evalInstLevelScore", True)
+    monkeypatch.setattr(args, "avgClassSize", {l.name: 100.0 for l in labels if l.hasInstances})
+
+    layout = Layout(tmp_path)
+    city = cityscapes_city("Largo da Ordem, Curitiba")
+    gts = []
+    for frame, flip in ((1, False), (2, True)):
+        cls, ins, _, _ = scene()
+        if flip:
+            cls, ins = np.ascontiguousarray(cls[:, ::-1]), np.ascontiguousarray(ins[:, ::-1])
+        name = CityscapesName(city, 3, frame)
+        label_ids, cs_ids, color = cityscapes_arrays(cls, ins, INSTANCES, class_map)
+        for kind, pixels, writer in (("labelIds", label_ids, write_id_png), ("instanceIds", cs_ids, write_id_png),
+                                     ("color", color, write_color_png)):
+            path = layout.path(Layout.cityscapes("val", name, kind))
+            path.parent.mkdir(parents=True, exist_ok=True)
+            writer(path, pixels)
+        gts.append(str(layout.path(Layout.cityscapes("val", name, "labelIds"))))
+        info = csHelpers.getCsFileInfo(gts[-1])
+        assert (info.city, info.sequenceNb, info.frameNb, info.type, info.type2) == (
+            city, "000003", f"{frame:06d}", "gtFine", "labelIds")
+    with contextlib.redirect_stdout(io.StringIO()):
+        result = ev.evaluateImgLists(gts, gts, args)
+    present = {class_map.by_id(int(c)).name for c in np.unique(scene()[0]) if c}
+    for name, iou in result["classScores"].items():
+        if name in present:
+            assert iou == pytest.approx(1.0), name
+    for name in present & {l.name for l in labels if l.hasInstances}:
+        assert result["classInstScores"][name] == pytest.approx(1.0), name
+    assert result["averageScoreClasses"] == pytest.approx(1.0)

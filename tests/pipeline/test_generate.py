@@ -1,0 +1,357 @@
+"""``synthua generate`` end to end on the demo street: reproducible bytes (reruns, more workers, Ray),
+resumption after kills at several points, ``verify`` catching damage, quotas, QA lists, resampling, replay,
+and hostile configs and folders. The formats themselves are read by the real tools in
+``test_generate_readers.py``."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import SCENARIO, TINY_CONFIG, generate_dataset
+from hostile import assert_refused, run_synthua, tree_state
+from synthua_usd.backends.images import read_image
+from synthua_usd.pipeline.verify import verify
+
+
+def tree_bytes(root: Path) -> dict[str, str]:
+    """SHA-256 of every file below ``root`` by relative path."""
+    return {p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def records(root: Path) -> list[dict]:
+    return [json.loads(p.read_text(encoding="utf-8")) for p in sorted((root / "records").glob("*.json"))]
+
+
+# --- what a run writes -----------------------------------------------------------------------------------
+
+def test_dataset_is_complete_and_verifies(generated):
+    result = verify(generated)
+    assert result.ok, result.problems
+    plan = json.loads((generated / "generate.json").read_text())["plan"]
+    kept = [r for r in records(generated) if r["qa"]["verdict"] != "rejected"]
+    assert len(records(generated)) == len(plan) and len(kept) == 6
+    manifest = json.loads((generated / "manifest.json").read_text())
+    assert manifest["provenance"]["mitsuba_variant"] and manifest["provenance"]["usd-core"]
+    assert {img["layer_stack"] for img in manifest["images"]} == {manifest["provenance"]["layer_stack"]["digest"]}
+
+
+def test_splits_never_share_a_camera(generated):
+    cameras = {}
+    for r in records(generated):
+        cameras.setdefault(r["camera"]["prim_path"], set()).add(r["split"])
+    assert all(len(splits) == 1 for splits in cameras.values()), cameras
+
+
+def test_quotas_met_and_reported(generated):
+    coverage = json.loads((generated / "coverage.json").read_text())
+    quotas = {(q["quota"], q["key"]): q for q in coverage["quotas"]}
+    assert coverage["shortfalls"] == [] and all(q["met"] for q in quotas.values()), coverage
+    assert quotas[("images", None)]["achieved"] == 6  # the image QA rejected was replaced
+    # counted independently from the records: at least half the images show an aid user of >= 5 px
+    with_aid = 0
+    for r in records(generated):
+        by_path = {i["prim_path"]: i for i in r["instances"]}
+        for person in r["instances"]:
+            device = by_path.get(person["relations"].get("uses", ""))
+            if person["class_name"] == "person" and device and person["area"] + device["area"] >= 5:
+                with_aid += 1
+                break
+    assert with_aid >= 3
+
+
+def test_rejected_images_are_listed_not_dropped(generated):
+    rejected = [r for r in records(generated) if r["qa"]["verdict"] == "rejected"]
+    assert rejected, "tests/data/configs/tiny.json rejects images with > 20 % clipped highlights"
+    listed = (generated / "rejected.csv").read_text().splitlines()[1:]
+    for r in rejected:
+        assert any(line.startswith(f"{r['id']},{r['name']},rejected,highlights") for line in listed)
+        assert "images/" not in json.dumps(r["files"]), "a rejected image stays out of the training formats"
+        coco = json.loads((generated / f"annotations/instances_{r['split']}.json").read_text())
+        assert r["id"] not in {img["id"] for img in coco["images"]}
+
+
+def test_amodal_masks_contain_the_visible_ones(generated):
+    from pycocotools import mask as mask_utils
+
+    checked = 0
+    for r in records(generated):
+        instance = read_image(generated / r["files"]["instance"])[0][..., 0]
+        for inst in r["instances"]:
+            visible = instance == inst["id"]
+            amodal = mask_utils.decode(inst["amodal_segmentation"]).astype(bool)
+            assert np.array_equal(mask_utils.decode(inst["segmentation"]).astype(bool), visible)
+            assert not (visible & ~amodal).any()
+            assert inst["amodal_area"] == int(amodal.sum())
+            assert inst["occlusion"] == pytest.approx(1.0 - inst["area"] / inst["amodal_area"])
+            checked += inst["amodal_area"] > inst["area"]
+    assert checked, "some instance of the demo street is partly occluded"
+
+
+def test_instance_preview_is_colourful(generated):
+    r = records(generated)[0]
+    preview = read_image(generated / r["files"]["instance_preview"])[0]
+    ids = read_image(generated / r["files"]["instance"])[0][..., 0]
+    assert preview.shape[-1] == 3 and preview.dtype == np.uint8
+    for i in np.unique(ids)[1:]:
+        colours = np.unique(preview[ids == i].reshape(-1, 3), axis=0)
+        assert len(colours) == 1 and colours[0].max() >= 64  # one visible colour per instance
+
+
+# --- reproducibility --------------------------------------------------------------------------------------
+
+def test_rerun_with_two_workers_is_byte_identical(generated, tmp_path):
+    out = tmp_path / "again"
+    generate_dataset(out, workers=2)
+    assert tree_bytes(out) == tree_bytes(generated)
+
+
+@pytest.mark.slow
+def test_ray_executor_gives_the_same_bytes(generated, tmp_path):
+    pytest.importorskip("ray")
+    out = tmp_path / "ray"
+    generate_dataset(out, executor="ray", workers=1)
+    assert tree_bytes(out) == tree_bytes(generated)
+
+
+def test_replay_is_byte_identical(generated, run_cli):
+    code, out, err = run_cli("replay", generated, "2")
+    assert code == 0, out + err
+    assert "byte-identical" in out
+
+
+# --- resumption ---------------------------------------------------------------------------------------------
+
+def _generate_command(out: Path) -> list[str]:
+    return [sys.executable, "-m", "synthua_usd", "generate", str(SCENARIO), "--config", str(TINY_CONFIG), "--out",
+            str(out)]
+
+
+def _kill_when(out: Path, ready, timeout: float = 120.0) -> bool:
+    """Start generate, SIGKILL it and its workers as soon as ``ready(out)``; True if it was killed in time."""
+    proc = subprocess.Popen(_generate_command(out), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    deadline = time.monotonic() + timeout
+    try:
+        while proc.poll() is None and time.monotonic() < deadline:
+            if ready(out):
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+                return True
+            time.sleep(0.02)
+        return False
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+
+
+KILL_POINTS = {
+    "planned": lambda out: (out / "generate.json").exists(),
+    "mid-images": lambda out: len(list((out / "records").glob("*.json"))) >= 2 if (out / "records").exists() else False,
+    "assembling": lambda out: (out / "data.yaml").exists(),
+}
+
+
+@pytest.mark.parametrize("point", list(KILL_POINTS))
+def test_resume_after_kill_gives_the_same_dataset(generated, tmp_path, point):
+    out = tmp_path / "killed"
+    killed = _kill_when(out, KILL_POINTS[point])
+    assert killed or (out / "manifest.json").exists()
+    generate_dataset(out)
+    assert verify(out).ok
+    assert tree_bytes(out) == tree_bytes(generated), "no missing, duplicate, stray or different file"
+
+
+def test_disk_error_is_one_line_and_resumable(generated, tmp_path):
+    """Files may not grow past 20 KiB (RLIMIT_FSIZE: writes fail with EFBIG, as on a full disk): one line,
+    exit 2; the same command without the limit then finishes the dataset."""
+    import resource
+
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+
+    out = tmp_path / "limited"
+    proc = subprocess.run(_generate_command(out), capture_output=True, timeout=180, preexec_fn=limit)
+    stderr = proc.stderr.decode()
+    assert proc.returncode == 2, stderr
+    assert "Traceback" not in stderr
+    assert stderr.strip().splitlines()[-1].startswith("synthua: error: "), stderr
+    generate_dataset(out)
+    assert tree_bytes(out) == tree_bytes(generated)
+
+
+# --- verify -------------------------------------------------------------------------------------------------
+
+@pytest.fixture
+def damaged(generated, tmp_path) -> Path:
+    copy = tmp_path / "copy"
+    shutil.copytree(generated, copy)
+    return copy
+
+
+def _some_file(root: Path, pattern: str) -> Path:
+    return sorted(root.glob(pattern))[0]
+
+
+@pytest.mark.parametrize("damage", ["delete", "truncate", "alter"])
+def test_verify_catches_damage(damaged, damage, run_cli):
+    target = _some_file(damaged, "frames/*/instance.png" if damage != "alter" else "annotations/instances_train.json")
+    if damage == "delete":
+        target.unlink()
+    elif damage == "truncate":
+        target.write_bytes(target.read_bytes()[:100])
+    else:
+        target.write_bytes(target.read_bytes().replace(b'"iscrowd": 0', b'"iscrowd": 1', 1))
+    code, out, _ = run_cli("verify", damaged)
+    assert code == 1
+    rel = target.relative_to(damaged).as_posix()
+    assert any(rel in line for line in out.splitlines() if line.startswith("problem:")), out
+
+
+def test_verify_checks_annotations_against_masks(damaged):
+    """A COCO box changed and the manifest updated to match: the checksums pass, the cross-file check does not."""
+    coco_path = damaged / "annotations" / "instances_train.json"
+    coco = json.loads(coco_path.read_text())
+    coco["annotations"][0]["bbox"][2] += 1
+    coco_path.write_text(json.dumps(coco))
+    manifest_path = damaged / "manifest.json"
+    manifest = json.loads(manifest_path.read_text())
+    for entry in manifest["dataset_files"]:
+        if entry["path"] == "annotations/instances_train.json":
+            entry["sha256"] = hashlib.sha256(coco_path.read_bytes()).hexdigest()
+            entry["bytes"] = coco_path.stat().st_size
+    manifest_path.write_text(json.dumps(manifest))
+    result = verify(damaged)
+    assert [p for p in result.problems if "bbox" in p], result.problems
+
+
+# --- resampling ---------------------------------------------------------------------------------------------
+
+def test_resampled_dataset_has_no_invented_labels(generated, tmp_path):
+    config = json.loads(TINY_CONFIG.read_text())
+    config["resample"] = {"width": 32, "height": 24}
+    path = tmp_path / "half.json"
+    path.write_text(json.dumps(config))
+    out = tmp_path / "half"
+    generate_dataset(out, config=path)
+    assert verify(out).ok
+    full = {r["id"]: r for r in records(generated)}
+    compared = 0
+    for r in records(out):
+        assert (r["width"], r["height"]) == (32, 24)
+        if r["id"] not in full:  # QA saw other images at this size and replaced another one
+            continue
+        compared += 1
+        small_class = read_image(out / r["files"]["class"])[0][..., 0]
+        small_inst = read_image(out / r["files"]["instance"])[0][..., 0]
+        big = full[r["id"]]
+        big_class = read_image(generated / big["files"]["class"])[0][..., 0]
+        big_inst = read_image(generated / big["files"]["instance"])[0][..., 0]
+        pairs = set(zip(small_class.ravel().tolist(), small_inst.ravel().tolist()))
+        assert pairs <= set(zip(big_class.ravel().tolist(), big_inst.ravel().tolist()))
+        rgb = read_image(out / r["files"]["rgb_png"])[0]
+        assert rgb.shape == (24, 32, 3)
+    assert compared >= 5
+
+
+# --- hostile input ------------------------------------------------------------------------------------------
+
+def _config(tmp_path: Path, **changes) -> Path:
+    document = json.loads(TINY_CONFIG.read_text())
+    document.update(changes)
+    path = tmp_path / "config.json"
+    path.write_text(json.dumps(document))
+    return path
+
+
+@pytest.mark.parametrize("changes, mentions", [
+    ({"images": 0}, ("images",)),
+    ({"cameras": ["/World/Cameras/Nope"]}, ("cameras", "/World/Cameras/Nope")),
+    ({"conditions": ["monsoon"]}, ("conditions", "monsoon")),
+    ({"time_codes": [500]}, ("time_codes", "500")),
+    ({"render": {"width": 64, "height": 48, "spp": 2, "pixel_filter": "gaussian"}}, ("pixel_filter",)),
+    ({"split": {"train": 0.9, "val": 0.9, "test": 0.1}}, ("split",)),
+])
+def test_bad_configs_are_refused(tmp_path, changes, mentions):
+    out = tmp_path / "out"
+    result = run_synthua("generate", SCENARIO, "--config", _config(tmp_path, **changes), "--out", out)
+    assert_refused(result, "config.json", *mentions)
+    assert not out.exists()
+
+
+def test_malformed_config_is_refused(tmp_path):
+    path = tmp_path / "config.json"
+    path.write_text('{"name": "x", "images": ')
+    assert_refused(run_synthua("generate", SCENARIO, "--config", path, "--out", tmp_path / "out"), "config.json")
+
+
+def test_foreign_folder_is_left_alone(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "thesis.tex").write_text("mine")
+    before = tree_state(out)
+    assert_refused(run_synthua("generate", SCENARIO, "--config", TINY_CONFIG, "--out", out), str(out), "not empty")
+    assert tree_state(out) == before
+
+
+def test_other_job_in_the_folder_is_refused(generated, tmp_path):
+    copy = tmp_path / "copy"
+    shutil.copytree(generated, copy)
+    before = tree_state(copy)
+    other = _config(tmp_path, images=5)
+    assert_refused(run_synthua("generate", SCENARIO, "--config", other, "--out", copy), "another")
+    assert tree_state(copy) == before
+
+
+def test_out_is_a_file(tmp_path):
+    out = tmp_path / "file"
+    out.write_text("x")
+    assert_refused(run_synthua("generate", SCENARIO, "--config", TINY_CONFIG, "--out", out), str(out))
+
+
+def test_hostile_config_name_is_refused(tmp_path):
+    out = tmp_path / "inside" / "out"
+    config = _config(tmp_path, name="../../escape/\n name")
+    assert_refused(run_synthua("generate", SCENARIO, "--config", config, "--out", out), "config.json", "name")
+    assert not (tmp_path / "inside").exists()
+
+
+def test_scene_names_stay_inside(tmp_path):
+    """A camera whose prim name is not ASCII (USD allows Unicode identifiers) and a scenario outside the
+    output folder: every file of the dataset lies below --out with a safe name."""
+    from pxr import Sdf, Usd, UsdGeom
+
+    root = tmp_path / "scenario.usda"
+    stage = Usd.Stage.CreateNew(str(root))
+    stage.GetRootLayer().subLayerPaths.append(str(SCENARIO))
+    demo = Usd.Stage.Open(str(SCENARIO))
+    source = demo.GetPrimAtPath("/World/Cameras/PedestrianEye")
+    for key in ("startTimeCode", "endTimeCode", "timeCodesPerSecond", "upAxis", "metersPerUnit", "defaultPrim"):
+        stage.SetMetadata(key, demo.GetMetadata(key))
+    camera = UsdGeom.Camera.Define(stage, "/World/Cameras/Câmera_Ωmega")
+    for attr in source.GetAttributes():
+        if attr.HasAuthoredValue():
+            camera.GetPrim().CreateAttribute(attr.GetName(), attr.GetTypeName()).Set(attr.Get())
+    stage.GetRootLayer().Save()
+    config = _config(tmp_path, cameras=["/World/Cameras/Câmera_Ωmega"], images=2, quotas={})
+    out = tmp_path / "inside" / "out"
+    generate_dataset(out, config=config, scenario=root, allow_external_assets=True)
+    assert verify(out).ok
+    assert sorted(p.name for p in (tmp_path / "inside").iterdir()) == ["out"]
+    names = [p.name for p in (out / "images").rglob("*.png")]
+    assert names and all(n.isascii() and "_C-mera-mega_" in n for n in names), names
+    for path in out.rglob("*"):
+        assert path.resolve().is_relative_to(out.resolve())

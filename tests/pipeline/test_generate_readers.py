@@ -1,0 +1,390 @@
+"""A dataset made by ``synthua generate`` read by the real tools, not by our own code: pycocotools (COCO,
+COCOeval), panopticapi (pq_compute), cityscapesScripts (getCsFileInfo, pixel-level evaluation), supervision
+(YOLO loader), pyarrow and csv (metadata), hashlib (manifest). The unit tests in tests/dataset/formats/ check
+each writer on hand-made records; these check the files of one whole run and that they agree with each other.
+
+The ``generated`` fixture is shared by the session: tests that need a reader to write copy the dataset first.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import hashlib
+import io
+import json
+import multiprocessing
+import shutil
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from synthua_usd.dataset.layout import SPLITS, Layout
+from synthua_usd.taxonomy import ClassMap
+
+
+def read_json(root: Path, relative: str):
+    return json.loads((root / relative).read_text(encoding="utf-8"))
+
+
+def read_png(path: Path) -> np.ndarray:
+    """Pixels as PIL (the reader of pycocotools' users, panopticapi and cityscapesScripts) decodes them."""
+    with Image.open(path) as image:
+        return np.array(image)
+
+
+def manifest_images(root: Path) -> list[dict]:
+    return read_json(root, Layout.MANIFEST)["images"]
+
+
+def coco_split(root: Path, split: str) -> dict:
+    return read_json(root, Layout.coco_instances(split))
+
+
+def splits_with_images(root: Path) -> list[str]:
+    splits = [s for s in SPLITS if coco_split(root, s)["images"]]
+    assert splits, f"{root}: no split holds an image"
+    return splits
+
+
+def dataset_class_map(root: Path) -> ClassMap:
+    return ClassMap.from_document(read_json(root, Layout.CLASS_MAP), source=Layout.CLASS_MAP)
+
+
+def quiet():
+    """pycocotools, panopticapi and cityscapesScripts print their progress and tables."""
+    return contextlib.redirect_stdout(io.StringIO())
+
+
+# ---------------------------------------------------------------------------------------------------- COCO
+
+
+def test_pycocotools_loads_every_split_and_cocoeval_of_gt_against_itself_is_one(generated):
+    from pycocotools.coco import COCO
+    from pycocotools.cocoeval import COCOeval
+
+    evaluated = 0
+    for split in splits_with_images(generated):
+        with quiet():
+            gt = COCO(str(generated / Layout.coco_instances(split)))
+        for image in gt.loadImgs(gt.getImgIds()):
+            assert (generated / "images" / split / image["file_name"]).is_file(), image
+        anns = gt.loadAnns(gt.getAnnIds())
+        if not anns:
+            continue
+        dets = [{"image_id": a["image_id"], "category_id": a["category_id"], "segmentation": a["segmentation"],
+                 "bbox": a["bbox"], "score": 1.0} for a in anns]
+        with quiet():
+            dt = gt.loadRes(dets)
+            for kind in ("bbox", "segm"):
+                ev = COCOeval(gt, dt, kind)
+                ev.evaluate()
+                ev.accumulate()
+                ev.summarize()
+                assert ev.stats[0] == pytest.approx(1.0), (split, kind, ev.stats[:3])
+                assert ev.stats[1] == pytest.approx(1.0), (split, kind, ev.stats[:3])
+        evaluated += 1
+    assert evaluated >= 1, "no split has COCO annotations"
+
+
+def test_coco_ids_categories_and_images_agree_with_the_manifest_and_class_map(generated):
+    class_map = dataset_class_map(generated)
+    things = {c.id for c in class_map.classes if c.isthing and c.id >= 1}
+    manifest = {m["id"]: m for m in manifest_images(generated)}
+    image_ids, ann_ids = [], []
+    for split in SPLITS:
+        doc = coco_split(generated, split)
+        assert {c["id"] for c in doc["categories"]} == things, split
+        assert all(c["name"] == class_map.by_id(c["id"]).name for c in doc["categories"])
+        for image in doc["images"]:
+            assert manifest[image["id"]]["split"] == split and manifest[image["id"]]["qa"] != "rejected"
+            assert image["file_name"] == f"{manifest[image['id']]['name']}.png"
+        image_ids += [i["id"] for i in doc["images"]]
+        ann_ids += [a["id"] for a in doc["annotations"]]
+        assert all(a["category_id"] in things for a in doc["annotations"])
+        assert {a["image_id"] for a in doc["annotations"]} <= {i["id"] for i in doc["images"]}
+    assert min(image_ids) >= 1 and len(set(image_ids)) == len(image_ids)
+    assert ann_ids and min(ann_ids) >= 1 and len(set(ann_ids)) == len(ann_ids)
+    # every image QA did not reject is in COCO, in its split; the rejected ones are listed in the manifest only
+    assert sorted(image_ids) == sorted(i for i, m in manifest.items() if m["qa"] != "rejected")
+
+
+def test_coco_amodal_masks_contain_the_visible_ones_and_occlusion_is_their_ratio(generated):
+    from pycocotools import mask as mask_utils
+
+    relations = occluded = 0
+    for split in SPLITS:
+        doc = coco_split(generated, split)
+        by_id = {a["id"]: a for a in doc["annotations"]}
+        for a in doc["annotations"]:
+            for key in ("amodal_segmentation", "amodal_area", "amodal_bbox", "occlusion", "truncation", "relations"):
+                assert key in a, (split, a["id"], key)
+            visible = mask_utils.decode(a["segmentation"]).astype(bool)
+            amodal = mask_utils.decode(a["amodal_segmentation"]).astype(bool)
+            assert visible.sum() == a["area"] == mask_utils.area(a["segmentation"]) > 0, (split, a["id"])
+            assert amodal.sum() == a["amodal_area"], (split, a["id"])
+            assert not np.any(visible & ~amodal), (split, a["id"], "visible pixels outside the amodal mask")
+            assert a["occlusion"] == pytest.approx(1 - a["area"] / a["amodal_area"], abs=1e-9), (split, a["id"])
+            assert 0.0 <= a["truncation"] <= 1.0
+            occluded += a["amodal_area"] > a["area"]
+            ys, xs = np.nonzero(visible)
+            assert a["bbox"] == [xs.min(), ys.min(), xs.max() - xs.min() + 1, ys.max() - ys.min() + 1], (split, a["id"])
+            if a["relations"]:
+                used = by_id[a["relations"]["uses_annotation_id"]]
+                assert used["image_id"] == a["image_id"] and used["prim_path"] == a["relations"]["uses"]
+                relations += 1
+    assert occluded >= 1, "no annotation is occluded: the amodal checks above would be vacuous"
+    assert relations >= 1, "the demo street has mobility-aid users: some annotation should carry a 'uses' relation"
+
+
+# ------------------------------------------------------------------------------------------------ panoptic
+
+
+def test_panopticapi_pq_of_gt_against_itself_is_100_for_every_split(generated, tmp_path, monkeypatch):
+    from panopticapi import evaluation
+
+    # pq_compute writes nothing, but the dataset is shared: evaluate a copy all the same.
+    root = tmp_path / "dataset"
+    shutil.copytree(generated / "annotations", root / "annotations")
+    # One worker: panopticapi starts a pool of cpu_count() processes and never closes it.
+    monkeypatch.setattr(multiprocessing, "cpu_count", lambda: 1)
+    evaluated = 0
+    for split in SPLITS:
+        doc = read_json(root, Layout.coco_panoptic(split))
+        if not doc["images"]:
+            continue
+        json_path = str(root / Layout.coco_panoptic(split))
+        folder = str(root / "annotations" / f"panoptic_{split}")
+        with quiet():
+            result = evaluation.pq_compute(json_path, json_path, folder, folder)
+        for group in ("All", "Things", "Stuff"):
+            assert result[group]["pq"] == pytest.approx(1.0), (split, group, result[group])
+            assert result[group]["sq"] == pytest.approx(1.0) and result[group]["rq"] == pytest.approx(1.0)
+        assert result["Things"]["n"] > 0 and result["Stuff"]["n"] > 0, split
+        evaluated += 1
+    assert evaluated >= 1
+
+
+def test_panoptic_segments_match_their_pngs_exactly(generated):
+    from panopticapi.utils import rgb2id
+
+    class_map = dataset_class_map(generated)
+    checked = 0
+    for split in splits_with_images(generated):
+        doc = read_json(generated, Layout.coco_panoptic(split))
+        categories = {c["id"]: c for c in doc["categories"]}
+        for c in class_map.classes:
+            if c.id >= 1:
+                assert categories[c.id]["isthing"] == int(c.isthing), c.name
+        assert sorted(a["image_id"] for a in doc["annotations"]) == sorted(i["id"] for i in doc["images"])
+        for ann in doc["annotations"]:
+            ids = rgb2id(read_png(generated / "annotations" / f"panoptic_{split}" / ann["file_name"]))
+            found, areas = np.unique(ids, return_counts=True)
+            in_png = {int(i): int(n) for i, n in zip(found, areas) if i != 0}
+            in_json = {s["id"]: s["area"] for s in ann["segments_info"]}
+            assert in_png == in_json, (split, ann["file_name"])
+            for s in ann["segments_info"]:
+                assert s["category_id"] in categories
+                ys, xs = np.nonzero(ids == s["id"])
+                assert s["bbox"] == [xs.min(), ys.min(), xs.max() - xs.min() + 1, ys.max() - ys.min() + 1], s
+            checked += 1
+    assert checked >= 1
+
+
+# ---------------------------------------------------------------------------------------------- Cityscapes
+
+
+def cityscapes_tables(monkeypatch, class_map: ClassMap):
+    """cityscapesScripts' pixel-level evaluation module with synthua's label table patched in (as its README
+    says to do for a dataset with other labels: edit labels.py), its options set for a quiet run."""
+    from cityscapesscripts.evaluation import evalPixelLevelSemanticLabeling as ev
+    from cityscapesscripts.helpers.labels import Label
+
+    from synthua_usd.dataset.formats.cityscapes import cityscapes_labels
+
+    labels = [Label(**entry) for entry in cityscapes_labels(class_map)]
+    tables = {"labels": labels, "name2label": {l.name: l for l in labels}, "id2label": {l.id: l for l in labels},
+              "trainId2label": {l.trainId: l for l in reversed(labels)}, "category2labels": {}}
+    for l in labels:
+        tables["category2labels"].setdefault(l.category, []).append(l)
+    for name, value in tables.items():
+        monkeypatch.setattr(ev, name, value)
+    # cityscapesScripts 2.3 calls np.in1d, which NumPy 2.4 removed; np.isin is its documented replacement.
+    monkeypatch.setattr(np, "in1d", np.isin, raising=False)
+    args = ev.args
+    for name, value in (("quiet", True), ("JSONOutput", False), ("evalInstLevelScore", True),
+                        ("evalLabels", list(args.evalLabels)),  # evaluateImgLists rewrites it: restore after
+                        ("avgClassSize", {l.name: 100.0 for l in labels if l.hasInstances})):
+        monkeypatch.setattr(args, name, value)
+    return ev, labels
+
+
+def cityscapes_files(root: Path, folder: str) -> list[Path]:
+    return sorted((root / folder).rglob("*.png"))
+
+
+def test_cityscapes_scripts_parses_every_name_and_its_evaluation_of_gt_against_itself_is_iou_one(
+        generated, monkeypatch):
+    from cityscapesscripts.helpers import csHelpers
+
+    class_map = dataset_class_map(generated)
+    ev, labels = cityscapes_tables(monkeypatch, class_map)
+    gt_files = cityscapes_files(generated, "gtFine")
+    assert gt_files
+    for path in gt_files + cityscapes_files(generated, "leftImg8bit"):
+        info = csHelpers.getCsFileInfo(str(path))
+        split, city = path.relative_to(generated).parts[1:3]
+        assert split in SPLITS and info.city == city, path
+        assert path.name == f"{info.city}_{info.sequenceNb}_{info.frameNb}_{info.type}" + (
+            f"_{info.type2}.png" if info.type == "gtFine" else ".png")
+        assert info.type2 in ({"labelIds", "instanceIds", "color"} if info.type == "gtFine" else {""}), path
+    evaluated = 0
+    for split in SPLITS:
+        gts = [str(p) for p in gt_files if p.parts[-3] == split and p.name.endswith("_gtFine_labelIds.png")]
+        if not gts:
+            continue
+        present = set()
+        for gt in gts:
+            present |= {int(c) for c in np.unique(read_png(Path(gt)))}
+        with quiet():
+            result = ev.evaluateImgLists(gts, gts, ev.args)
+        scored = {class_map.by_id(c).name for c in present if c != 0}
+        assert scored
+        for name in scored:
+            assert result["classScores"][name] == pytest.approx(1.0), (split, name)
+        for name in scored & {l.name for l in labels if l.hasInstances}:
+            assert result["classInstScores"][name] == pytest.approx(1.0), (split, name)
+        assert result["averageScoreClasses"] == pytest.approx(1.0), split
+        evaluated += 1
+    assert evaluated >= 1
+
+
+def test_cityscapes_instance_ids_are_class_times_1000_plus_k_and_agree_with_coco(generated):
+    class_map = dataset_class_map(generated)
+    things = {c.id for c in class_map.classes if c.isthing}
+    checked = 0
+    for split in splits_with_images(generated):
+        coco = coco_split(generated, split)
+        for image in coco["images"]:
+            stems = list((generated / "gtFine" / split).rglob(f"*_{image['id']:06d}_gtFine_labelIds.png"))
+            assert len(stems) == 1, (split, image["id"], stems)
+            label_path = stems[0]
+            label_ids = read_png(label_path)
+            instance_ids = read_png(Path(str(label_path).replace("_labelIds.png", "_instanceIds.png")))
+            assert label_ids.shape == instance_ids.shape == (image["height"], image["width"])
+            assert instance_ids.max() < 2 ** 16
+            big = instance_ids >= 1000
+            assert np.array_equal(instance_ids[big] // 1000, label_ids[big]), label_path
+            assert np.array_equal(instance_ids[~big], label_ids[~big]), label_path
+            assert np.all(big == np.isin(label_ids, list(things))), label_path  # every thing pixel has its instance
+            # each COCO annotation is one Cityscapes instance of the same class and area
+            cs = sorted((int(i) // 1000, int(n)) for i, n in zip(*np.unique(instance_ids[big], return_counts=True)))
+            anns = sorted((a["category_id"], a["area"]) for a in coco["annotations"] if a["image_id"] == image["id"])
+            assert cs == anns, label_path
+            # leftImg8bit is the very RGB file of images/
+            left = label_path.parents[3] / "leftImg8bit" / split / label_path.parent.name / label_path.name.replace(
+                "_gtFine_labelIds.png", "_leftImg8bit.png")
+            assert left.read_bytes() == (generated / "images" / split / image["file_name"]).read_bytes(), left
+            checked += 1
+    assert checked >= 1
+    assert len(cityscapes_files(generated, "leftImg8bit")) == checked  # no Cityscapes image without COCO image
+
+
+# ---------------------------------------------------------------------------------------------------- YOLO
+
+
+def test_supervision_loads_every_split_with_the_coco_boxes(generated):
+    import supervision as sv
+
+    class_map = dataset_class_map(generated)
+    compared = 0
+    for split in splits_with_images(generated):
+        ds = sv.DetectionDataset.from_yolo(images_directory_path=str(generated / "images" / split),
+                                           annotations_directory_path=str(generated / "labels" / split),
+                                           data_yaml_path=str(generated / Layout.DATA_YAML))
+        names = list(ds.classes)
+        assert names == [c.name for c in class_map.classes if c.isthing and c.id >= 1]  # COCO's categories
+        ids = {c.name: c.id for c in class_map.classes}
+        coco = coco_split(generated, split)
+        detections = {Path(path).name: dets for path, dets in ds.annotations.items()}
+        assert sorted(detections) == sorted(i["file_name"] for i in coco["images"]), split
+        for image in coco["images"]:
+            dets = detections[image["file_name"]]
+            found = [(ids[names[k]], box) for k, box in zip(dets.class_id, dets.xyxy)]
+            expected = [(a["category_id"], np.array([a["bbox"][0], a["bbox"][1], a["bbox"][0] + a["bbox"][2],
+                                                     a["bbox"][1] + a["bbox"][3]], float))
+                        for a in coco["annotations"] if a["image_id"] == image["id"]]
+            assert len(found) == len(expected), (split, image["file_name"])
+            # supervision scales float32 coordinates by the image size: exact up to float32 rounding
+            for cid, box in expected:
+                match = [j for j, (c, b) in enumerate(found) if c == cid and np.abs(b - box).max() < 1e-3]
+                assert match, (split, image["file_name"], cid, box.tolist())
+                found.pop(match[0])
+            compared += len(expected)
+    assert compared >= 1
+
+
+# ------------------------------------------------------------------------------------------------ metadata
+
+
+def test_metadata_tables_have_one_row_per_image_with_its_camera_condition_and_counts(generated):
+    import pyarrow.parquet as pq
+
+    class_map = dataset_class_map(generated)
+    manifest = {m["id"]: m for m in manifest_images(generated)}
+    sweep = read_json(generated, Layout.MANIFEST)["provenance"]["config"]  # the run's config, as it recorded it
+    table = pq.read_table(generated / Layout.METADATA_PARQUET).to_pylist()
+    with open(generated / Layout.METADATA_CSV, newline="", encoding="utf-8") as f:
+        text_rows = list(csv.DictReader(f))
+    assert sorted(r["image_id"] for r in table) == sorted(manifest)
+    assert [int(r["image_id"]) for r in text_rows] == [r["image_id"] for r in table]
+    assert list(text_rows[0]) == list(table[0])
+    columns = set(table[0])
+    wanted = {"camera_path", "rig_type", "fx", "fy", "cx", "cy", "condition", "seed", "time_code", "qa_verdict",
+              "qa_reasons"}
+    wanted |= {f"camera_to_world_{i}{j}" for i in range(4) for j in range(4)}
+    wanted |= {f"{kind}.{c.name}" for kind in ("instances", "pixels") for c in class_map.classes}
+    assert wanted <= columns, sorted(wanted - columns)
+    annotations = Counter()
+    for split in SPLITS:
+        annotations.update((a["image_id"], a["category_id"]) for a in coco_split(generated, split)["annotations"])
+    for row, text in zip(table, text_rows):
+        image = manifest[row["image_id"]]
+        assert row["qa_verdict"] == text["qa_verdict"] == image["qa"] and row["name"] == image["name"]
+        assert row["camera_path"].startswith("/") and row["camera_path"] == text["camera_path"]
+        assert row["fx"] > 0 and row["fy"] > 0 and 0 < row["cx"] < row["width"] and 0 < row["cy"] < row["height"]
+        assert float(text["fx"]) == row["fx"]
+        assert row["condition"] in sweep["conditions"] and row["seed"] in sweep["seeds"]
+        assert row["time_code"] in sweep["time_codes"]
+        assert row["seed"] == image["seed"] and row["split"] == image["split"]
+        if image["qa"] != "accepted":  # rejected and flagged images are listed with their reasons
+            assert row["qa_reasons"] and text["qa_reasons"] == row["qa_reasons"], row["image_id"]
+        # pixel counts add up to the image and match its class-id PNG
+        classes = read_png(generated / Layout.frame_file(image["name"], "class.png"))
+        counts = np.bincount(classes.ravel(), minlength=len(class_map.classes))
+        for c in class_map.classes:
+            assert row[f"pixels.{c.name}"] == counts[c.id] == int(text[f"pixels.{c.name}"]), (row["image_id"], c.name)
+            if c.isthing and c.id >= 1 and image["qa"] != "rejected":
+                assert row[f"instances.{c.name}"] == annotations[(row["image_id"], c.id)], (row["image_id"], c.name)
+
+
+# ------------------------------------------------------------------------------------------------ manifest
+
+
+def test_manifest_lists_every_file_with_its_sha256_and_nothing_else(generated):
+    manifest = read_json(generated, Layout.MANIFEST)
+    entries = [f for image in manifest["images"] for f in image["files"]] + manifest["dataset_files"]
+    paths = [e["path"] for e in entries]
+    assert len(set(paths)) == len(paths), [p for p, n in Counter(paths).items() if n > 1]
+    for entry in entries:
+        data = (generated / entry["path"]).read_bytes()
+        assert hashlib.sha256(data).hexdigest() == entry["sha256"], entry["path"]
+        assert len(data) == entry["bytes"], entry["path"]
+    on_disk = {p.relative_to(generated).as_posix() for p in generated.rglob("*") if p.is_file()}
+    listed = set(paths) | {Layout.MANIFEST}
+    assert on_disk == listed, sorted(on_disk ^ listed)
+    assert sorted(m["id"] for m in manifest["images"]) == sorted(
+        read_json(generated, Layout.record(m["name"]))["id"] for m in manifest["images"])
