@@ -111,7 +111,8 @@ class ExecutorConfig:
 
     def __post_init__(self) -> None:
         if self.kind not in EXECUTORS:
-            raise InputError(f"--executor: {echo(self.kind)!r} is not an executor; expected one of {', '.join(EXECUTORS)}")
+            raise InputError(f"--executor: {echo(self.kind)!r} is not an executor; expected one of "
+                             f"{', '.join(EXECUTORS)}")
         if not isinstance(self.workers, int) or isinstance(self.workers, bool) or self.workers < 1:
             raise InputError(f"--workers: {echo(self.workers)}; expected a whole number >= 1")
         if self.kind != "ray" and (self.address is not None or self.ray_runtime_env is not None):

@@ -68,6 +68,23 @@ class _Actor:
     in_flight: deque = field(default_factory=deque)
 
 
+def connect(ray, config: ExecutorConfig) -> None:
+    """Join the cluster at ``config.address``, or start a Ray instance of this process's own ("local": never
+    one that ``ray start`` left running here). A cluster that cannot be joined is a one-line InputError."""
+    options = {"address": config.address or "local", "runtime_env": config.ray_runtime_env, "log_to_driver": False}
+    if config.address is None:
+        options["include_dashboard"] = False
+    try:
+        ray.init(**options)
+    except ConnectionError as exc:
+        lines = [line for line in _ANSI.sub("", str(exc)).splitlines() if line.strip()]
+        found = echo(lines[0] if lines else type(exc).__name__)
+        raise InputError(f"--address {echo(config.address)}: cannot join the Ray cluster ({found});"
+                         f" expected a running cluster (`ray start --head` on that host) reachable from here; with "
+                         f"token authentication, RAY_AUTH_MODE=token and the cluster's token (~/.ray/auth_token or "
+                         f"RAY_AUTH_TOKEN) on this machine") from exc
+
+
 def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Callable[[ItemResult], None],
                config: ExecutorConfig, summary: RunSummary) -> None:
     """Run ``shards`` on ``config.workers`` actors (see :func:`~synthua_usd.pipeline.executors.run_shards`)."""
@@ -75,10 +92,7 @@ def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Ca
 
     started = not ray.is_initialized()
     if started:
-        options = {"address": config.address, "runtime_env": config.ray_runtime_env, "log_to_driver": False}
-        if config.address is None:
-            options["include_dashboard"] = False
-        ray.init(**options)
+        connect(ray, config)
     elif config.address is not None:
         log.warning("--address %s: Ray is already connected in this process; using that connection", config.address)
     actor_class = ray.remote(ShardActor).options(num_cpus=config.cpus_per_worker, max_restarts=0,
@@ -143,7 +157,8 @@ def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Ca
             try:
                 envelope = ray.get(done[0])
             except ray.exceptions.RayTaskError as exc:  # the actor's answer itself failed (it cannot be sent)
-                raise WorkerError(f"Ray actor {actor.name}: {type(exc).__name__}: {echo(str(exc).splitlines()[0])}") from exc
+                first = _ANSI.sub("", str(exc)).strip().splitlines()[:1]
+                raise WorkerError(f"Ray actor {actor.name}: {type(exc).__name__}: {echo(''.join(first))}") from exc
             except ray.exceptions.RayError as exc:
                 lost(actor, exc)
                 continue

@@ -10,6 +10,7 @@ from __future__ import annotations
 import errno
 import functools
 import hashlib
+import multiprocessing
 import os
 import signal
 import subprocess
@@ -166,6 +167,19 @@ def test_errors_reach_the_parent_with_their_type_and_message(item, cls, message)
     assert type(info.value) is cls and str(info.value) == message
 
 
+def test_an_error_in_the_parents_on_result_ends_the_workers():
+    seen = []
+
+    def on_result(r):
+        seen.append(r)
+        raise OutputError("out/annotations: disk full; expected free space")
+
+    with pytest.raises(OutputError, match="^out/annotations: disk full"):
+        run_shards(SHARDS, INIT, toy_work, on_result, ExecutorConfig("local", workers=2))
+    assert len(seen) == 1 and gone(int(seen[0].worker.rsplit(":", 1)[1]), 0.5)
+    assert not [p for p in multiprocessing.active_children() if p.name == "synthua-worker"]
+
+
 def test_os_errors_keep_errno_and_file():
     with pytest.raises(OSError) as info:
         run([[("os", "out/x.png")]], ExecutorConfig("local"))
@@ -212,7 +226,7 @@ def test_a_worker_killed_more_often_than_the_retries_allow_is_a_clear_error():
     message = str(info.value)
     assert "item 1 of shard 0" in message and "SIGKILL" in message and "on 2 workers in turn" in message
     assert "\n" not in message
-    assert not [p for p in __import__("multiprocessing").active_children() if p.name == "synthua-worker"]
+    assert not [p for p in multiprocessing.active_children() if p.name == "synthua-worker"]
 
 
 @pytest.mark.parametrize("fail, message", [
@@ -253,7 +267,8 @@ import sys
 sys.path.insert(0, {here!r})
 from test_executors import INIT, toy_work
 from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
-run_shards([[("sleep", {folder!r})], [("sleep", {folder!r})]], INIT, toy_work, print, ExecutorConfig("local", workers=2))
+shards = [[("sleep", {folder!r})], [("sleep", {folder!r})]]
+run_shards(shards, INIT, toy_work, print, ExecutorConfig("local", workers=2))
 """
 
 
@@ -290,7 +305,7 @@ def ray_instance():
     import ray
 
     # Ray's workers import the toy from this folder, as cluster nodes import synthua from the same install.
-    ray.init(num_cpus=2, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False,
+    ray.init(address="local", num_cpus=2, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False,
              runtime_env={"env_vars": {"PYTHONPATH": os.pathsep.join([str(HERE), *sys.path])}})
     yield ray
     ray.shutdown()
@@ -326,7 +341,8 @@ def test_ray_replaces_a_killed_actor_or_reports_it(ray_instance, tmp_path):
     # Item 2 is sent once item 0 is in: item 0 comes from the first state and item 2 from another. (Which item
     # the retry starts at depends on what was in flight: Ray may lose item 1's answer with the actor.)
     assert summary.workers_lost == 1 and got[(0, 0)][1] != got[(0, 2)][1]
-    with pytest.raises(WorkerLostError, match=r"item 1 of shard 0: the worker was lost \(.*\) on 2 workers in turn"):
+    with pytest.raises(WorkerLostError, match=r"item 1 of shard 0: the worker was lost \(.*\) on 2 workers in "
+                                              r"turn"):
         run([[0, ("die", None)]], ExecutorConfig("ray", retries=1))
 
 
