@@ -22,6 +22,7 @@ from synthua_usd.input_files import shown
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.rigs import RIG_TYPES
 from synthua_usd.schemas import load_schema, read_json, validate_document
+from synthua_usd.timecodes import parse_time_code_spec
 
 SCHEMA = "generate"
 #: Rig-type key of cameras that carry no ``synthua:rig:type``.
@@ -29,7 +30,6 @@ NO_RIG = "none"
 RIG_KEYS = (*RIG_TYPES, NO_RIG)
 QA_CHECKS = ("blur", "shadows", "highlights", "aid_size", "aid_occlusion")
 #: Most time codes one spec string may expand to.
-MAX_TIME_CODES = 100_000
 _RATIO_TOLERANCE = 1e-6
 
 
@@ -339,28 +339,3 @@ class _Builder:
         if total > images:
             self.fail(f"quotas.{name}", f"counts sum to {total}", f"expected at most images = {images}")
         return CountQuota(counts=tuple(sorted(value.items())))
-
-
-def parse_time_code_spec(text: str) -> tuple[float, ...]:
-    """Time codes from ``"24"``, ``"1,12"`` and ``"START:END[:STEP]"`` ranges (END included when the steps
-    reach it), in order, duplicates dropped. ``ValueError`` says what was expected."""
-    out: list[float] = []
-    expected = "comma-separated numbers and START:END[:STEP] ranges with finite numbers, STEP > 0 and END >= START"
-    for item in (part.strip() for part in text.split(",")):
-        try:
-            parts = [float(x) for x in item.split(":")]
-        except ValueError:
-            raise ValueError(expected) from None
-        if not all(map(math.isfinite, parts)) or len(parts) > 3:
-            raise ValueError(expected)
-        if len(parts) == 1:
-            out.append(parts[0])
-            continue
-        start, end, step = parts[0], parts[1], parts[2] if len(parts) == 3 else 1.0
-        if not (step > 0 and end >= start):
-            raise ValueError(expected)
-        count = int(math.floor((end - start) / step + 1e-9)) + 1
-        if count + len(out) > MAX_TIME_CODES:
-            raise ValueError(f"at most {MAX_TIME_CODES} time codes")
-        out += [start + k * step for k in range(count)]
-    return tuple(dict.fromkeys(out))

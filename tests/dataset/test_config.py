@@ -6,10 +6,11 @@ import pytest
 
 from conftest import REPO
 from synthua_usd.dataset.config import (
-    CountQuota, GenerationConfig, Outputs, QAThresholds, RenderSettings, SplitRatios, parse_time_code_spec,
+    CountQuota, GenerationConfig, Outputs, QAThresholds, RenderSettings, SplitRatios,
     schema_default,
 )
 from synthua_usd.errors import InputError, SchemaError
+from synthua_usd.timecodes import parse_time_code_spec
 
 BASE = {"name": "t", "images": 10}
 
