@@ -89,18 +89,12 @@ class ViewScore:
 
 
 @dataclass(frozen=True)
-class PlannedImage:
-    """One image to render: ``id`` 1-based in plan order, its ``split``, the candidate's fields, and whether
+class PlannedImage(Candidate):
+    """One image to render: a candidate with its ``id`` (1-based in plan order), its ``split``, and whether
     the plan counted it for the aid-user quota (``aid_user``)."""
 
-    id: int
-    split: str
-    camera_path: str
-    camera_name: str
-    rig_type: str | None
-    time_code: float
-    condition: str | None
-    seed: int
+    id: int = 0
+    split: str = "train"
     aid_user: bool = False
 
     def to_dict(self) -> dict:
@@ -246,7 +240,7 @@ def plan(pool: Sequence[Candidate], scores, config: GenerationConfig) -> list[Pl
                    targets["aid_users"] or 0)
     chosen.sort()
     splits = split_of([pool[i].camera_path for i in chosen], config.split)
-    return [PlannedImage(k, splits[pool[i].camera_path], **asdict(pool[i]), aid_user=qualifying[i])
+    return [PlannedImage(**asdict(pool[i]), id=k, split=splits[pool[i].camera_path], aid_user=qualifying[i])
             for k, i in enumerate(chosen, start=1)]
 
 
@@ -309,7 +303,8 @@ def replacements(pool: Sequence[Candidate], scores, config: GenerationConfig, pl
     chosen = sorted(_pick(_groups(pool, qualifying, rank, free), rank, targets["images"] - len(kept), need_condition,
                           need_rig, need_aid))
     first = max((p.id for p in planned), default=0) + 1
-    return [PlannedImage(first + k, split_of_camera[pool[i].camera_path], **asdict(pool[i]), aid_user=qualifying[i])
+    return [PlannedImage(**asdict(pool[i]), id=first + k, split=split_of_camera[pool[i].camera_path],
+                         aid_user=qualifying[i])
             for k, i in enumerate(chosen)]
 
 

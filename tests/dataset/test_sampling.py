@@ -6,7 +6,7 @@ import pytest
 
 from synthua_usd.dataset.config import GenerationConfig, SplitRatios
 from synthua_usd.dataset.sampling import (
-    ViewScore, candidates, plan, pool_summary, quota_targets, select_cameras, split_counts, split_of,
+    ViewScore, candidates, plan, pool_summary, quota_targets, replacements, select_cameras, split_counts, split_of,
 )
 from synthua_usd.errors import InputError
 
@@ -143,3 +143,24 @@ def test_split_of_ignores_order_and_depends_on_the_seed():
     assert split_of(groups, ratios) == split_of(reversed(groups + groups), ratios)
     assert Counter(split_of(groups, ratios).values()) == {"train": 12, "val": 4, "test": 4}
     assert split_of(groups, ratios) != split_of(groups, SplitRatios(0.6, 0.2, 0.2, seed=2))
+
+
+def test_replacements_restore_the_quotas_of_rejected_images():
+    cfg = config(images=12, quotas={"aid_users": {"min_share": 0.25, "min_pixels": 100},
+                                    "per_condition": "balanced"})
+    pool = candidates(cfg, CAMERAS, STAGE_TIMES, CONDITIONS)
+    planned = plan(pool, SCORES, cfg)
+    # QA rejects every clear_day image and one aid-user image
+    rejected = {p.id for p in planned if p.condition == "clear_day"}
+    rejected.add(next(p.id for p in planned if p.aid_user))
+    extra = replacements(pool, SCORES, cfg, planned, rejected)
+    assert len(extra) == len(rejected)
+    assert [p.id for p in extra] == list(range(len(planned) + 1, len(planned) + 1 + len(extra)))
+    key = lambda p: (p.camera_path, p.time_code, p.condition, p.seed)  # noqa: E731
+    assert not {key(p) for p in extra} & {key(p) for p in planned}
+    splits = {p.camera_path: p.split for p in planned}
+    assert all(splits[p.camera_path] == p.split for p in extra)  # cameras of the plan, splits unchanged
+    kept = [p for p in planned if p.id not in rejected] + extra
+    assert Counter(p.condition for p in kept) == Counter(p.condition for p in planned)
+    assert sum(p.aid_user for p in kept) >= quota_targets(pool, cfg)["aid_users"]
+    assert replacements(pool, SCORES, cfg, planned, rejected) == extra  # deterministic
