@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from format_readers import cityscapes_evaluation, coco_self_evaluation
 from synthua_usd.dataset.layout import SPLITS, Layout
 from synthua_usd.taxonomy import ClassMap
 
@@ -64,7 +65,6 @@ def quiet():
 
 def test_pycocotools_loads_every_split_and_cocoeval_of_gt_against_itself_is_one(generated):
     from pycocotools.coco import COCO
-    from pycocotools.cocoeval import COCOeval
 
     evaluated = 0
     for split in splits_with_images(generated):
@@ -75,17 +75,9 @@ def test_pycocotools_loads_every_split_and_cocoeval_of_gt_against_itself_is_one(
         anns = gt.loadAnns(gt.getAnnIds())
         if not anns:
             continue
-        dets = [{"image_id": a["image_id"], "category_id": a["category_id"], "segmentation": a["segmentation"],
-                 "bbox": a["bbox"], "score": 1.0} for a in anns]
-        with quiet():
-            dt = gt.loadRes(dets)
-            for kind in ("bbox", "segm"):
-                ev = COCOeval(gt, dt, kind)
-                ev.evaluate()
-                ev.accumulate()
-                ev.summarize()
-                assert ev.stats[0] == pytest.approx(1.0), (split, kind, ev.stats[:3])
-                assert ev.stats[1] == pytest.approx(1.0), (split, kind, ev.stats[:3])
+        for kind, stats in coco_self_evaluation(gt, anns).items():
+            assert stats[0] == pytest.approx(1.0), (split, kind, stats[:3])
+            assert stats[1] == pytest.approx(1.0), (split, kind, stats[:3])
         evaluated += 1
     assert evaluated >= 1, "no split has COCO annotations"
 
@@ -197,31 +189,6 @@ def test_panoptic_segments_match_their_pngs_exactly(generated):
 # ---------------------------------------------------------------------------------------------- Cityscapes
 
 
-def cityscapes_tables(monkeypatch, class_map: ClassMap):
-    """cityscapesScripts' pixel-level evaluation module with synthua's label table patched in (as its README
-    says to do for a dataset with other labels: edit labels.py), its options set for a quiet run."""
-    from cityscapesscripts.evaluation import evalPixelLevelSemanticLabeling as ev
-    from cityscapesscripts.helpers.labels import Label
-
-    from synthua_usd.dataset.formats.cityscapes import cityscapes_labels
-
-    labels = [Label(**entry) for entry in cityscapes_labels(class_map)]
-    tables = {"labels": labels, "name2label": {l.name: l for l in labels}, "id2label": {l.id: l for l in labels},
-              "trainId2label": {l.trainId: l for l in reversed(labels)}, "category2labels": {}}
-    for l in labels:
-        tables["category2labels"].setdefault(l.category, []).append(l)
-    for name, value in tables.items():
-        monkeypatch.setattr(ev, name, value)
-    # cityscapesScripts 2.3 calls np.in1d, which NumPy 2.4 removed; np.isin is its documented replacement.
-    monkeypatch.setattr(np, "in1d", np.isin, raising=False)
-    args = ev.args
-    for name, value in (("quiet", True), ("JSONOutput", False), ("evalInstLevelScore", True),
-                        ("evalLabels", list(args.evalLabels)),  # evaluateImgLists rewrites it: restore after
-                        ("avgClassSize", {l.name: 100.0 for l in labels if l.hasInstances})):
-        monkeypatch.setattr(args, name, value)
-    return ev, labels
-
-
 def cityscapes_files(root: Path, folder: str) -> list[Path]:
     return sorted((root / folder).rglob("*.png"))
 
@@ -231,7 +198,7 @@ def test_cityscapes_scripts_parses_every_name_and_its_evaluation_of_gt_against_i
     from cityscapesscripts.helpers import csHelpers
 
     class_map = dataset_class_map(generated)
-    ev, labels = cityscapes_tables(monkeypatch, class_map)
+    ev, labels = cityscapes_evaluation(monkeypatch, class_map)
     gt_files = cityscapes_files(generated, "gtFine")
     assert gt_files
     for path in gt_files + cityscapes_files(generated, "leftImg8bit"):

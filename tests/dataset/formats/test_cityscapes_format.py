@@ -8,9 +8,10 @@ import io
 import numpy as np
 import pytest
 
+from format_readers import cityscapes_evaluation
 from label_scenes import INSTANCES, scene
 from synthua_usd.backends.images import write_color_png, write_id_png
-from synthua_usd.dataset.formats.cityscapes import cityscapes_arrays, cityscapes_labels
+from synthua_usd.dataset.formats.cityscapes import cityscapes_arrays
 from synthua_usd.dataset.layout import CityscapesName, Layout, cityscapes_city
 from synthua_usd.errors import OutputError
 from synthua_usd.scene import Instance
@@ -37,25 +38,9 @@ def test_more_than_1000_instances_of_a_class_is_refused(class_map):
 
 
 def test_cityscapes_scripts_pixel_evaluation_of_gt_against_itself_is_iou_one(tmp_path, class_map, monkeypatch):
-    from cityscapesscripts.evaluation import evalPixelLevelSemanticLabeling as ev
     from cityscapesscripts.helpers import csHelpers
-    from cityscapesscripts.helpers.labels import Label
 
-    labels = [Label(**entry) for entry in cityscapes_labels(class_map)]
-    tables = {"labels": labels, "name2label": {l.name: l for l in labels}, "id2label": {l.id: l for l in labels},
-              "trainId2label": {l.trainId: l for l in reversed(labels)},
-              "category2labels": {}}
-    for l in labels:
-        tables["category2labels"].setdefault(l.category, []).append(l)
-    for name, value in tables.items():
-        monkeypatch.setattr(ev, name, value)
-    # cityscapesScripts 2.3 calls np.in1d, which NumPy 2.4 removed; np.isin is its documented replacement.
-    monkeypatch.setattr(np, "in1d", np.isin, raising=False)
-    args = ev.args
-    monkeypatch.setattr(args, "quiet", True)
-    monkeypatch.setattr(args, "JSONOutput", False)
-    monkeypatch.setattr(args, "evalInstLevelScore", True)
-    monkeypatch.setattr(args, "avgClassSize", {l.name: 100.0 for l in labels if l.hasInstances})
+    ev, labels = cityscapes_evaluation(monkeypatch, class_map)
 
     layout = Layout(tmp_path)
     city = cityscapes_city("Largo da Ordem, Curitiba")
@@ -76,7 +61,7 @@ def test_cityscapes_scripts_pixel_evaluation_of_gt_against_itself_is_iou_one(tmp
         assert (info.city, info.sequenceNb, info.frameNb, info.type, info.type2) == (
             city, "000003", f"{frame:06d}", "gtFine", "labelIds")
     with contextlib.redirect_stdout(io.StringIO()):
-        result = ev.evaluateImgLists(gts, gts, args)
+        result = ev.evaluateImgLists(gts, gts, ev.args)
     present = {class_map.by_id(int(c)).name for c in np.unique(scene()[0]) if c}
     for name, iou in result["classScores"].items():
         if name in present:

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from pycocotools import mask as mask_utils
 from pycocotools.coco import COCO
-from pycocotools.cocoeval import COCOeval
 
+from format_readers import coco_self_evaluation
 from label_scenes import record
 from synthua_usd.backends.images import write_color_png
 from synthua_usd.dataset.annotations import panoptic
@@ -49,16 +49,8 @@ def test_pycocotools_loads_it_and_cocoeval_of_gt_against_itself_is_one(tmp_path,
         assert ann["bbox"] == [xs.min(), ys.min(), xs.max() - xs.min() + 1, ys.max() - ys.min() + 1]
         assert ann["area"] == mask.sum() and ann["category_id"] in things and ann["id"] >= 1
     assert {c["id"] for c in doc["categories"]} == {c.id for c in class_map.classes if c.isthing and c.id >= 1}
-    dets = [{"image_id": a["image_id"], "category_id": a["category_id"], "segmentation": a["segmentation"],
-             "bbox": a["bbox"], "score": 1.0} for a in doc["annotations"]]
-    with contextlib.redirect_stdout(io.StringIO()):
-        dt = gt.loadRes(dets)
-        for kind in ("bbox", "segm"):
-            ev = COCOeval(gt, dt, kind)
-            ev.evaluate()
-            ev.accumulate()
-            ev.summarize()
-            assert ev.stats[0] == pytest.approx(1.0) and ev.stats[1] == pytest.approx(1.0), kind
+    for kind, stats in coco_self_evaluation(gt, doc["annotations"]).items():
+        assert stats[0] == pytest.approx(1.0) and stats[1] == pytest.approx(1.0), kind
 
 
 def test_annotation_ids_are_unique_across_splits_and_relations_point_to_annotations(class_map, dataset):
