@@ -21,11 +21,9 @@ QA flagging only, so that no rejected image is replaced by a later round on fres
 and prints, per worker, its memory after 10 %, 50 % and 100 % of the images and the growth from 10 % to
 100 %, which must stay near zero.
 
-Memory is given two ways. ``getrusage`` peak is what ``GenerateSummary.peak_rss_mib`` and ``rss_trace``
-report; for a spawned worker it starts at its parent's peak (the parent's high-water mark survives the
-vfork + exec of ``spawn``), so it floors at the driver's memory. The benchmark therefore also reads each
-worker's own ``/proc/PID/status`` (VmRSS now, VmHWM: the peak of its own address space) after each of its
-results (local executor only). Not a test: compare runs on the same machine and note its load.
+Memory is given two ways: the peak each worker reports with its results (``GenerateSummary.peak_rss_mib``
+and ``rss_trace``: its ``VmHWM`` on Linux), and each worker's ``/proc/PID/status`` read from here after
+each of its results (VmRSS now, VmHWM; local executor only), which must agree. Not a test: compare runs on the same machine and note its load.
 """
 
 from __future__ import annotations
@@ -65,7 +63,7 @@ class Probe:
     def __init__(self) -> None:
         self.phase: dict[str, float] = {}
         #: After each result: (images delivered so far, worker, the worker's own images so far, its VmRSS KiB,
-        #: its VmHWM KiB, its getrusage peak MiB as GenerateSummary reports it)
+        #: its VmHWM KiB, the peak MiB GenerateSummary reports)
         self.samples: list[tuple[int, str, int, int, int, float]] = []
         self.delivered = 0
         self.own: dict[str, int] = {}
@@ -273,7 +271,7 @@ def main() -> int:
     own = {w: [t for t in probe.samples if t[1] == w] for w in workers}
     print(f"\ndriver (this process) peak RSS {driver_peak:.0f} MiB; summary.rss_trace "
           f"{'matches' if trace_ok else 'does NOT match'} the probe's samples")
-    print(f"{'worker':28} {'images':>7} {'getrusage peak':>15} {'own peak VmHWM':>15} {'VmRSS at end':>13}")
+    print(f"{'worker':28} {'images':>7} {'reported peak':>15} {'own peak VmHWM':>15} {'VmRSS at end':>13}")
     for w in workers:
         rows = own[w]
         print(f"{w:28} {rows[-1][2] if rows else 0:7d} {summary.peak_rss_mib[w]:11.0f} MiB "
@@ -288,7 +286,7 @@ def main() -> int:
             rows = own[w]
             if not rows:
                 continue
-            for k, (label, col, scale) in enumerate((("getrusage peak", 5, 1.0), ("own VmHWM", 4, 1024.0),
+            for k, (label, col, scale) in enumerate((("reported peak", 5, 1.0), ("own VmHWM", 4, 1024.0),
                                                      ("VmRSS", 3, 1024.0))):
                 vals = [at_share(rows, f, col) for f in (0.1, 0.5, 1.0)]
                 vals = [None if v is None else v / scale for v in vals]

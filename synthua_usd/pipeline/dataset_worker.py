@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import json
 import os
-import resource
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -95,8 +94,8 @@ def init_worker(job: WorkerJob) -> WorkerState:
 
 def work(state: WorkerState, item) -> list[dict]:
     """Render ``item`` (a planned image) and start writing it; returns the results of images whose files
-    are now complete: ``{"record": ..., "seconds": ..., "peak_rss_mib": ...}`` (the previous image's, or
-    the last one's for :data:`FLUSH`)."""
+    are now complete: ``{"record": ..., "seconds": ...}`` (the previous image's, or the last one's for
+    :data:`FLUSH`)."""
     done = []
     if item == FLUSH:
         if state.pending is not None:
@@ -293,7 +292,7 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
     with atomic_path(record_path) as tmp:
         tmp.write_text(json.dumps(record, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     seconds = dict(image.seconds, write=time.perf_counter() - t0)
-    return {"record": record, "seconds": seconds, "peak_rss_mib": peak_rss_mib(), "pid": os.getpid()}
+    return {"record": record, "seconds": seconds}
 
 
 def _write_text(path: Path, text: str) -> Path:
@@ -313,8 +312,3 @@ def _link_or_copy(source: Path, target: Path) -> None:
             os.link(source, tmp)
         except OSError:
             shutil.copyfile(source, tmp)
-
-
-def peak_rss_mib() -> float:
-    """This process's peak resident memory, MiB."""
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0

@@ -153,9 +153,18 @@ class RunSummary:
 
 
 def peak_rss_mib() -> float:
-    """Peak resident set size of this process so far, MiB (``getrusage``: KiB on Linux, bytes on macOS)."""
+    """Peak resident set size of this process so far, MiB: ``VmHWM`` of ``/proc/self/status`` on Linux
+    (``getrusage``'s peak is carried over an exec, so a spawned worker would report its parent's), else
+    ``getrusage`` (KiB on Linux, bytes on macOS)."""
     import resource
 
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return peak / (1024 * 1024) if sys.platform == "darwin" else peak / 1024
 

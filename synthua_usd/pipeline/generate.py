@@ -158,7 +158,15 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     from tqdm import tqdm
 
 
+    from synthua_usd.pipeline.executors import ExecutorConfig
+
     started = time.perf_counter()
+    # the executor's options are checked before anything is planned or written
+    ExecutorConfig(kind=request.executor, workers=request.workers or 1, address=request.address)
+    if request.executor == "ray" and request.address not in (None, "auto"):
+        from synthua_usd.pipeline.ray_executor import check_reachable
+
+        check_reachable(request.address)
     config = GenerationConfig.load(request.config_path)
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
     stage, pool, cameras, (width, height), stack = _stage_facts(request, config, class_map)

@@ -74,6 +74,8 @@ def connect(ray, config: ExecutorConfig) -> None:
     options = {"address": config.address or "local", "runtime_env": config.ray_runtime_env, "log_to_driver": False}
     if config.address is None:
         options["include_dashboard"] = False
+    elif config.address != "auto":
+        check_reachable(config.address)
     try:
         ray.init(**options)
     except ConnectionError as exc:
@@ -83,6 +85,27 @@ def connect(ray, config: ExecutorConfig) -> None:
                          f" expected a running cluster (`ray start --head` on that host) reachable from here; with "
                          f"token authentication, RAY_AUTH_MODE=token and the cluster's token (~/.ray/auth_token or "
                          f"RAY_AUTH_TOKEN) on this machine") from exc
+
+
+#: Seconds to wait for a TCP connection to a Ray head before saying it cannot be reached (Ray itself retries
+#: for minutes without a word).
+CONNECT_TIMEOUT_S = 10.0
+
+
+def check_reachable(address: str) -> None:
+    """Refuse a ``HOST:PORT`` nothing answers on, in seconds rather than Ray's minutes of retries."""
+    import socket
+
+    host, _, port = address.rpartition(":")
+    if not host or not port.isdigit():
+        raise InputError(f"--address {echo(address)}: not HOST:PORT; expected the Ray head's address, e.g. "
+                         f"10.0.0.5:6379")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=CONNECT_TIMEOUT_S):
+            pass
+    except OSError as exc:
+        raise InputError(f"--address {echo(address)}: nothing answers there ({echo(exc.strerror or exc)}); "
+                         f"expected a running Ray head (`ray start --head --port {port}` on {echo(host)})") from None
 
 
 def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Callable[[ItemResult], None],

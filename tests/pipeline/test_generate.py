@@ -364,3 +364,12 @@ def test_scene_names_stay_inside(tmp_path):
     assert names and all(n.isascii() and "_C-mera-mega_" in n for n in names), names
     for path in out.rglob("*"):
         assert path.resolve().is_relative_to(out.resolve())
+
+
+def test_unreachable_ray_head_is_refused_before_anything_is_written(tmp_path):
+    pytest.importorskip("ray")
+    out = tmp_path / "out"
+    result = run_synthua("generate", SCENARIO, "--config", TINY_CONFIG, "--out", out, "--executor", "ray",
+                         "--address", "127.0.0.1:9")
+    assert_refused(result, "--address", "127.0.0.1:9")
+    assert result.seconds < 30 and not out.exists()
