@@ -40,13 +40,16 @@ stages: setup
 	$(BIN)/synthua create district stages/district --seed 0
 
 ## Benchmarks (not tests: ratios and timings measured side by side in one run): rendering through a
-## render session (first load, per-frame update, labels, RGB) and building the district, imports and agents.
+## render session (first load, per-frame update, labels, RGB), building the district, imports and agents, the
+## amodal pass, and dataset workers' memory over 500 images.
 bench: setup
 	$(BIN)/python tools/bench_render.py
 	$(BIN)/python tools/bench_conditions.py
 	$(BIN)/python tools/bench_label_agreement.py
 	$(BIN)/python tools/bench_memory.py
 	$(BIN)/python tools/bench_twin.py
+	$(BIN)/python tools/bench_amodal.py
+	$(BIN)/python tools/bench_generate.py --memory 500
 
 clean:
 	rm -rf out .pytest_cache
