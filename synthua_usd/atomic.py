@@ -37,6 +37,21 @@ def atomic_path(path: str | Path, mode: int = 0o644) -> Iterator[Path]:
             os.unlink(tmp)
 
 
+def write_text_atomic(path: str | Path, text: str) -> Path:
+    """Write UTF-8 ``text`` to ``path`` atomically."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path
+
+
+def write_json_atomic(path: str | Path, document, indent: int = 2) -> Path:
+    """Write ``document`` as UTF-8 JSON (a final newline) to ``path`` atomically."""
+    import json
+
+    return write_text_atomic(path, json.dumps(document, indent=indent, ensure_ascii=False) + "\n")
+
+
 @contextmanager
 def output_set(out_dir: str | Path) -> Iterator[Path]:
     """Yield an empty staging folder beside ``out_dir``; write every output into it (subfolders allowed).

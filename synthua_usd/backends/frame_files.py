@@ -7,22 +7,15 @@ caller writes a whole command's frames into a staging folder (:func:`synthua_usd
 
 from __future__ import annotations
 
-import json
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.atomic import atomic_path
+from synthua_usd.atomic import write_json_atomic
 from synthua_usd.backends import images
 from synthua_usd.outputs import DEPTH_DEFINITION, FRAME_DOCUMENT, RenderOutput
 from synthua_usd.schemas import validate_document
-
-
-def write_json_atomic(path: Path, document: dict) -> Path:
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(document, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
-    return path
 
 
 def _jobs(output: RenderOutput, out_dir: Path, *, rgb, class_ids, instance_ids, z_depth, palette, display_scale):

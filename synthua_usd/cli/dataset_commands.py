@@ -21,16 +21,19 @@ from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK
 @click.option("--workers", type=click.IntRange(1, 1024),
               help="Render workers, each with one scene load [default: the config's, else one per 8 cores].")
 @click.option("--address", help="Ray cluster address (HOST:6379) for --executor ray [default: a local Ray instance].")
+@click.option("--cpus-per-worker", type=click.FloatRange(0.01, 1024), default=1.0, show_default=True,
+              help="CPUs Ray reserves for each worker (--executor ray): give each a node's share of cores.")
 @click.option("--variant", help="Mitsuba variant (cuda_ad_rgb, llvm_ad_rgb, scalar_rgb) [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--allow-external-assets", is_flag=True,
               help="Accept layers outside the stage's folder tree (refused by default).")
 def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, workers: int | None,
-             address: str | None, variant: str | None, class_map: Path | None, allow_external_assets: bool) -> int:
+             address: str | None, cpus_per_worker: float, variant: str | None, class_map: Path | None,
+             allow_external_assets: bool) -> int:
     """Generate a dataset from SCENARIO as --config says, into --out.
 
     \b
-    Example (the demo street, about two minutes on 2 cores):
+    Example (the demo street, under a minute on 2 cores):
       synthua generate stages/scenario.usda --config configs/demo.json --out out/dataset
       synthua verify out/dataset
     \b
@@ -47,7 +50,8 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
     from synthua_usd.pipeline.generate import GenerateRequest, generate as run_generate
 
     summary = run_generate(GenerateRequest(scenario=scenario, config_path=config_path, out_dir=out_dir,
-                                           executor=executor, workers=workers, address=address, variant=variant,
+                                           executor=executor, workers=workers, address=address,
+                                           cpus_per_worker=cpus_per_worker, variant=variant,
                                            class_map_path=class_map, allow_external_assets=allow_external_assets),
                            show_progress=sys.stderr.isatty())
     s = summary

@@ -92,10 +92,12 @@ class AidUserQuota:
         return math.ceil(self.min_share * total - 1e-9)
 
     def qualifies(self, visible_pixels: int, occlusion: float | None) -> bool:
-        """Whether one aid user counts for the quota (an unknown occlusion fails a ``max_occlusion``)."""
+        """Whether one aid user counts for the quota. An unknown occlusion (the planner's label pass counts
+        visible pixels only) passes ``max_occlusion``; the images' records, which know it, are what
+        ``coverage.json`` reports as achieved."""
         if visible_pixels < self.min_pixels:
             return False
-        return self.max_occlusion is None or (occlusion is not None and occlusion <= self.max_occlusion)
+        return self.max_occlusion is None or occlusion is None or occlusion <= self.max_occlusion
 
 
 @dataclass(frozen=True)

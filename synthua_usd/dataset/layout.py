@@ -29,6 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from synthua_usd.errors import OutputError
+from synthua_usd.errors import echo as escape
 
 SPLITS = ("train", "val", "test")
 
@@ -132,5 +133,6 @@ def inside(root: Path, relative: str) -> Path:
     parts = PurePosixPath(relative).parts
     if (not parts or PurePosixPath(relative).is_absolute() or "\\" in relative
             or any(p in ("", ".", "..") or p.startswith(".") or "\n" in p or "\0" in p for p in parts)):
-        raise OutputError(f"{relative!r}: not a plain relative path inside the dataset folder")
+        raise OutputError(f"{escape(relative)!r}: a path that leaves the dataset folder or hides in it; expected a "
+                          f"plain relative path inside the dataset folder")
     return Path(root).joinpath(*parts)

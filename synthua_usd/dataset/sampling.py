@@ -90,12 +90,14 @@ class ViewScore:
 
 @dataclass(frozen=True)
 class PlannedImage(Candidate):
-    """One image to render: a candidate with its ``id`` (1-based in plan order), its ``split``, and whether
-    the plan counted it for the aid-user quota (``aid_user``)."""
+    """One image to render: a candidate with its ``id`` (1-based in plan order), its ``split``, whether the
+    plan counted it for the aid-user quota (``aid_user``), and the ``round`` that planned it (0: the plan,
+    k: the k-th round of replacing images QA rejected)."""
 
     id: int = 0
     split: str = "train"
     aid_user: bool = False
+    round: int = 0
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -279,7 +281,7 @@ def _pick(groups: dict[tuple, deque], rank: np.ndarray, count: int, need_conditi
 
 
 def replacements(pool: Sequence[Candidate], scores, config: GenerationConfig, planned: Sequence[PlannedImage],
-                 rejected: set[int]) -> list[PlannedImage]:
+                 rejected: set[int], round: int = 1) -> list[PlannedImage]:
     """Images to render in place of the ``rejected`` ids of ``planned``, chosen like :func:`plan` from the
     candidates not planned yet, counting what the kept images already give the quotas. Only cameras of
     the plan are used, so each replacement inherits its camera's split; ids continue after the plan's."""
@@ -304,7 +306,7 @@ def replacements(pool: Sequence[Candidate], scores, config: GenerationConfig, pl
                           need_rig, need_aid))
     first = max((p.id for p in planned), default=0) + 1
     return [PlannedImage(**asdict(pool[i]), id=first + k, split=split_of_camera[pool[i].camera_path],
-                         aid_user=qualifying[i])
+                         aid_user=qualifying[i], round=round)
             for k, i in enumerate(chosen)]
 
 

@@ -13,7 +13,6 @@ Every file is written atomically (a temporary sibling renamed into place), and e
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -22,9 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.atomic import atomic_path
+from synthua_usd.atomic import atomic_path, write_json_atomic, write_text_atomic
 from synthua_usd.backends import images
 from synthua_usd.dataset import annotations, qa, resample
+from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, onehot, previews, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
 from synthua_usd.dataset.manifest import file_entry
@@ -43,15 +43,11 @@ class WorkerJob:
     scenario: str
     out_dir: str
     render: RenderConfig
+    config: GenerationConfig
     class_map_document: dict
     allow_external_assets: bool = False
     #: Written size when smaller than the render size (resampled), else None.
     output_size: tuple[int, int] | None = None
-    rgb_exr: bool = False
-    depth: bool = True
-    onehot: bool = False
-    amodal_groups: tuple[str, ...] = ()
-    qa_thresholds: object = None
     city: str = "synthua"
     camera_index: dict = field(default_factory=dict)
     layer_stack: str = ""
@@ -134,8 +130,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     visible = [int(i) for i in np.unique(rendered.instance_ids) if i]
     group_of = {c.id: c.group for c in class_map.classes}
     by_id = {inst.id: inst for inst in snapshot.instances}
-    wanted = [i for i in visible if by_id[i].class_name in job.amodal_groups
-              or group_of.get(by_id[i].class_id) in job.amodal_groups]
+    wanted = [i for i in visible if job.config.amodal_wanted(by_id[i].class_name, group_of.get(by_id[i].class_id))]
     amodal = state.session.amodal(snapshot, camera, wanted) if wanted else {}
     seconds = {"render": time.perf_counter() - t0}
 
@@ -171,7 +166,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     scale = rendered.exposure.scale if rendered.exposure is not None else 1.0
     display = images.linear_to_display(rgb * np.float32(scale))
     measures = qa.measure(display, instances)
-    verdict, reasons = qa.verdict(measures, job.qa_thresholds)
+    verdict, reasons = qa.verdict(measures, job.config.qa)
 
     name = image_name(planned.id, planned.camera_name, planned.time_code, planned.condition, planned.seed)
     split = planned.split
@@ -195,14 +190,14 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         arrays.update({"panoptic": panoptic_png, "cs_labelIds": labels, "cs_instanceIds": instance_cs,
                        "cs_color": colour, "yolo_label": yolo.yolo_lines(instances, width, height,
                                                                         job.yolo_classes)})
-        yolo_count = sum(1 for line in arrays["yolo_label"].splitlines() if line.strip())
-        if job.depth:
+        outputs = job.config.outputs
+        if outputs.depth:
             files["depth"] = Layout.frame_file(name, "depth.exr")
             arrays["depth"] = depth
-        if job.rgb_exr:
+        if outputs.rgb_exr:
             files["rgb_exr"] = Layout.frame_file(name, "rgb.exr")
             arrays["rgb_exr"] = rgb
-        if job.onehot:
+        if outputs.onehot:
             files["onehot"] = Layout.frame_file(name, "onehot.npz")
             arrays["onehot"] = class_ids
     record = {
@@ -226,8 +221,6 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         "panoptic_segments": segments,
         "qa": {"verdict": verdict, "reasons": list(reasons), "measures": measures},
     }
-    if verdict != "rejected":
-        record["yolo_lines"] = yolo_count
     seconds["annotate"] = time.perf_counter() - t0
     return ImageBuffers(record, arrays, verdict == "rejected", seconds)
 
@@ -275,7 +268,7 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
             continue  # a link to the RGB image, made once that exists
         data = image.arrays[key]
         if key == "yolo_label":
-            jobs.append(state.encoders.submit(_write_text, path, data))
+            jobs.append(state.encoders.submit(write_text_atomic, path, data))
         elif key == "onehot":
             num_classes = max(c.id for c in state.class_map.classes) + 1
             jobs.append(state.encoders.submit(lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)),
@@ -289,16 +282,9 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
     record["checksums"] = {key: file_entry(layout.root, rel) for key, rel in sorted(record["files"].items())}
     record_path = layout.path(Layout.record(record["name"]))
     record_path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(record_path) as tmp:
-        tmp.write_text(json.dumps(record, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    write_json_atomic(record_path, record, indent=1)
     seconds = dict(image.seconds, write=time.perf_counter() - t0)
     return {"record": record, "seconds": seconds}
-
-
-def _write_text(path: Path, text: str) -> Path:
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-    return path
 
 
 def _link_or_copy(source: Path, target: Path) -> None:

@@ -19,9 +19,7 @@ a run on more workers and a run on Ray give the same dataset, byte for byte.
 
 from __future__ import annotations
 
-import csv
 import functools
-import io
 import json
 import logging
 import os
@@ -32,10 +30,11 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd import __version__
-from synthua_usd.atomic import atomic_path
-from synthua_usd.dataset import coverage, sampling
+from synthua_usd.atomic import write_json_atomic, write_text_atomic
+from synthua_usd.dataset import coverage, qa, sampling
 from synthua_usd.dataset.config import GenerationConfig
-from synthua_usd.dataset.formats import coco, panoptic, tables, yolo
+from synthua_usd.dataset.formats import cityscapes, coco, panoptic, tables, yolo
+from synthua_usd.dataset.formats.records import is_rejected
 from synthua_usd.dataset.layout import SPLITS, Layout, cityscapes_city
 from synthua_usd.dataset.manifest import document_digest, file_entry, manifest_document
 from synthua_usd.errors import InputError, OutputError, StageError, echo
@@ -61,6 +60,8 @@ class GenerateRequest:
     executor: str = "local"
     workers: int | None = None
     address: str | None = None
+    #: CPUs Ray reserves for each worker (ray only): give each a node's share, since a session uses many threads.
+    cpus_per_worker: float = 1.0
     variant: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
@@ -106,6 +107,7 @@ def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: 
     defaults = render_defaults(stage)
     config.check_amodal_groups({c.group for c in class_map.classes}, [c.name for c in class_map.classes],
                                source=f"{request.config_path}: amodal_groups")
+    cityscapes.check_class_map(class_map)
     cameras = [(p, p.rsplit("/", 1)[-1], camera_rig_type(stage, p)) for p in camera_paths(stage)]
     if not cameras:
         raise StageError(f"{request.scenario}: has no cameras; expected a scenario with at least one UsdGeom.Camera")
@@ -123,9 +125,11 @@ def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: 
     return stage, pool, chosen, (width, height), layer_stack_digest(stage)
 
 
-def score_views(stage, pool, render: RenderConfig, class_map: ClassMap, show_progress: bool):
-    """Visible pixels of every mobility-aid user (a person with a ``uses`` relation, and its device) in every
-    (camera, time code) view, from one label pass each: the sampler's view scores."""
+def score_views(stage, pool, render: RenderConfig, output_size: tuple[int, int], class_map: ClassMap,
+                show_progress: bool) -> list[sampling.ViewScore]:
+    """The sampler's view scores: every mobility-aid user (:func:`synthua_usd.dataset.qa.aid_users`, the one
+    definition QA and coverage use too) visible in each (camera, time code) view, from one label pass each
+    at the render size, pixel counts scaled to the written size (``output_size``)."""
     from tqdm import tqdm
 
     from synthua_usd.backends.mitsuba.session import RenderSession
@@ -134,35 +138,40 @@ def score_views(stage, pool, render: RenderConfig, class_map: ClassMap, show_pro
 
     reader = StageReader(stage, class_map)
     session = RenderSession(RenderConfig(width=render.width, height=render.height, spp=1, variant=render.variant))
+    scale = output_size[0] * output_size[1] / (render.width * render.height)
     scores = []
     views = sorted(dict.fromkeys((c.time_code, c.camera_path) for c in pool))
     for tc, path in tqdm(views, desc="score views", unit="view", disable=not show_progress):
         snapshot = reader.snapshot(tc)
-        ids = session.quick_labels(snapshot, read_camera(stage, path, tc))
-        counts = np.bincount(ids.ravel(), minlength=len(snapshot.instances) + 1)
-        by_path = {inst.prim_path: inst for inst in snapshot.instances}
-        aid_users = []
+        counts = np.bincount(session.quick_labels(snapshot, read_camera(stage, path, tc)).ravel(),
+                             minlength=len(snapshot.instances) + 1)
+        class_of = {inst.prim_path: inst.class_name for inst in snapshot.instances}
+        visible = []
         for inst in snapshot.instances:
-            uses = dict(inst.relations).get("uses")
-            device = by_path.get(uses) if uses else None
-            if inst.class_name == "person" and device is not None:
-                aid_users.append(sampling.AidUserView(aid_type=device.class_name,
-                                                      person_pixels=int(counts[inst.id]),
-                                                      device_pixels=int(counts[device.id])))
-        scores.append(sampling.ViewScore(camera_path=path, time_code=tc, aid_users=tuple(aid_users)))
+            if counts[inst.id]:
+                relations = dict(inst.relations)
+                if relations.get("uses") in class_of:
+                    relations["uses_class"] = class_of[relations["uses"]]
+                visible.append({"class_name": inst.class_name, "prim_path": inst.prim_path,
+                                "area": int(round(counts[inst.id] * scale)), "relations": relations})
+        users = tuple(sampling.AidUserView(aid_type=u.aid_type, person_pixels=u.person_pixels,
+                                           device_pixels=u.device_pixels) for u in qa.aid_users(visible))
+        scores.append(sampling.ViewScore(camera_path=path, time_code=tc, aid_users=users))
     return scores
 
 
 def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateSummary:
-    """Plan (or find the plan of an earlier run), render what is missing, assemble the dataset files."""
+    """Plan (or find the plan of an earlier run), render what is missing, replace what QA rejected, assemble
+    the dataset files."""
     from tqdm import tqdm
 
-
+    from synthua_usd.backends.mitsuba import variants
     from synthua_usd.pipeline.executors import ExecutorConfig
 
     started = time.perf_counter()
     # the executor's options are checked before anything is planned or written
-    ExecutorConfig(kind=request.executor, workers=request.workers or 1, address=request.address)
+    ExecutorConfig(kind=request.executor, workers=request.workers or 1, address=request.address,
+                   cpus_per_worker=request.cpus_per_worker)
     if request.executor == "ray" and request.address not in (None, "auto"):
         from synthua_usd.pipeline.ray_executor import check_reachable
 
@@ -170,39 +179,42 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     config = GenerationConfig.load(request.config_path)
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
     stage, pool, cameras, (width, height), stack = _stage_facts(request, config, class_map)
-    config.output_size(width, height)  # a resample size larger than the render is refused before anything runs
+    output_size = config.output_size(width, height)  # a resample larger than the render is refused here
     check_frame_memory(width, height)
-    from synthua_usd.backends.mitsuba import variants
-
     variant = variants.activate(request.variant).variant()
     render = config.render.render_config(width, height, seed=0, variant=variant)
     out = Path(request.out_dir)
     layout = Layout(out)
-    job_key = {"scenario": str(Path(request.scenario).resolve()), "layer_stack": stack["digest"],
-               "config": config.to_document(), "class_map": class_map.document(), "variant": variant}
-    existing = _read_job(out)
-    if existing is not None and existing.get("job_key_digest") != document_digest(job_key):
+    # What makes a dataset this one: the composed layers (by content, wherever they are), the config (its
+    # worker count aside), the class map and the variant. Resuming asks for the same.
+    job_key = {"layer_stack": stack["digest"], "config": _config_document(config), "class_map": class_map.document(),
+               "variant": variant}
+    job_document = _read_job(out)
+    if job_document is not None and job_document.get("job_key_digest") != document_digest(job_key):
         raise OutputError(f"{out}: holds a dataset generated from another scenario, config, class map or Mitsuba "
                           f"variant (its generate.json differs); expected an empty folder or the same job to "
                           f"resume: pick another --out or remove it")
-    if existing is not None:
-        plan = [sampling.PlannedImage(**p) for p in existing["plan"]]
-        scores = [_score_from_dict(s) for s in existing["scores"]]
-    else:
-        scores = score_views(stage, pool, render, class_map, show_progress)
+    if job_document is None:
+        scores = score_views(stage, pool, render, output_size, class_map, show_progress)
         plan = sampling.plan(pool, scores, config)
-        _write_job(out, {"synthua": __version__, "job_key": job_key, "job_key_digest": document_digest(job_key),
-                         "layer_stack": stack, "render": asdict(render),
-                         "cameras": [list(c) for c in cameras], "quota_targets": sampling.quota_targets(pool, config),
-                         "pool": sampling.pool_summary(pool, scores, config),
-                         "scores": [asdict(s) for s in scores], "plan": [p.to_dict() for p in plan]})
+        job_document = {"synthua": __version__, "job_key": job_key, "job_key_digest": document_digest(job_key),
+                        "scenario": str(Path(request.scenario).resolve()),
+                        "allow_external_assets": request.allow_external_assets, "layer_stack": stack,
+                        "render": asdict(render), "cameras": [list(c) for c in cameras],
+                        "quota_targets": sampling.quota_targets(pool, config),
+                        "pool": sampling.pool_summary(pool, scores, config), "scores": [asdict(s) for s in scores],
+                        "plan": [p.to_dict() for p in plan]}
+        _write_job(out, job_document)
+    plan = [sampling.PlannedImage(**p) for p in job_document["plan"]]
+    scores = [_score_from_dict(s) for s in job_document["scores"]]
     summary = GenerateSummary(out_dir=out)
     _remove_partial_files(out)
     done = _complete_records(layout, plan)
     todo = [p for p in plan if p.id not in done]
     summary.resumed = len(done)
-    job_document = _read_job(out)
-    job = worker_job_from_document(job_document, out, request.allow_external_assets)
+    # the scenario as this run names it (it may have moved since the plan; its layers are the same)
+    job = worker_job_from_document(job_document, out, scenario=request.scenario,
+                                   allow_external_assets=request.allow_external_assets)
     seconds = {"render": 0.0, "annotate": 0.0, "write": 0.0}
     peaks: dict = {}
     config_workers = request.workers or config.workers or default_workers()
@@ -219,13 +231,14 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
         peaks[result.worker] = max(peaks.get(result.worker, 0.0), result.peak_rss_mib)
         summary.rss_trace.append((summary.rendered, result.worker, result.peak_rss_mib))
 
-    # A worker writes an image while it renders the next, so a worker lost mid-shard can take an image
-    # whose render the executor counts as delivered: rounds repeat until every planned image has a record.
-    # Images QA rejects are replaced by others of the pool (their quotas counted), for a few rounds.
-    for _ in range(REPLACEMENT_ROUNDS + 1):
+    # Images QA rejects are replaced by others of the pool (their quotas counted), round by round; the plan
+    # records each image's round, so a resumed run goes on where the killed one stood.
+    while True:
         _render_all(todo, done, job, request, config_workers, collect, out)
-        rejected = {p.id for p in plan if done[p.id]["qa"]["verdict"] == "rejected"}
-        todo = sampling.replacements(pool, scores, config, plan, rejected) if rejected else []
+        rejected = {p.id for p in plan if is_rejected(done[p.id])}
+        last_round = max(p.round for p in plan)
+        todo = (sampling.replacements(pool, scores, config, plan, rejected, round=last_round + 1)
+                if rejected and last_round < REPLACEMENT_ROUNDS else [])
         if not todo:
             break
         plan += todo
@@ -237,31 +250,53 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     summary.planned = len(plan)
     records = [done[p.id] for p in plan]
     assemble(layout, records, class_map, config, job_document)
-    summary.rejected = sum(r["qa"]["verdict"] == "rejected" for r in records)
+    summary.rejected = sum(is_rejected(r) for r in records)
     summary.flagged = sum(r["qa"]["verdict"] == "flagged" for r in records)
     summary.seconds = seconds
     summary.peak_rss_mib = peaks
     summary.wall_seconds = time.perf_counter() - started
-    total_bytes = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
-    summary.bytes_per_image = total_bytes / max(1, len(records))
+    summary.bytes_per_image = _dataset_bytes(out) / max(1, len(records))
     summary.shortfalls = json.loads(layout.path(Layout.COVERAGE).read_text(encoding="utf-8")).get("shortfalls", [])
     return summary
 
 
-def worker_job_from_document(document: dict, out_dir: Path, allow_external_assets: bool = False) -> WorkerJob:
+def _config_document(config: GenerationConfig) -> dict:
+    """The config as the dataset records it: everything but ``workers`` (how many workers made a dataset
+    does not change a byte of it)."""
+    document = config.to_document()
+    document.pop("workers", None)
+    return document
+
+
+def _dataset_bytes(out: Path) -> int:
+    """Bytes the dataset holds on disk, each file once (the Cityscapes images are hard links)."""
+    seen, total = set(), 0
+    for path in out.rglob("*"):
+        if path.is_file():
+            st = path.stat()
+            if (st.st_dev, st.st_ino) not in seen:
+                seen.add((st.st_dev, st.st_ino))
+                total += st.st_size
+    return total
+
+
+def worker_job_from_document(document: dict, out_dir: Path, scenario: Path | None = None,
+                             allow_external_assets: bool | None = None) -> WorkerJob:
     """The workers' job from a run's ``generate.json``: the one place a :class:`WorkerJob` is made, for a
-    run, its resumption and ``synthua replay`` alike."""
+    run, its resumption and ``synthua replay`` alike. ``scenario`` and ``allow_external_assets`` default to
+    what the run that planned the dataset used."""
     key = document["job_key"]
     config = GenerationConfig.from_document(key["config"], source=Layout.CONFIG)
     class_map = ClassMap.from_document(key["class_map"], source=Layout.CONFIG)
     render = RenderConfig.from_dict(document["render"])
     cameras = [tuple(c) for c in document["cameras"]]
     size = config.output_size(render.width, render.height)
-    output_size = None if size == (render.width, render.height) else size
-    return WorkerJob(scenario=key["scenario"], out_dir=str(Path(out_dir).resolve()), render=render,
-                     class_map_document=key["class_map"], allow_external_assets=allow_external_assets,
-                     output_size=output_size, rgb_exr=config.outputs.rgb_exr, depth=config.outputs.depth,
-                     onehot=config.outputs.onehot, amodal_groups=tuple(config.amodal_groups), qa_thresholds=config.qa,
+    return WorkerJob(scenario=str(Path(scenario).resolve()) if scenario is not None else document["scenario"],
+                     out_dir=str(Path(out_dir).resolve()), render=render, config=config,
+                     class_map_document=key["class_map"],
+                     allow_external_assets=(document.get("allow_external_assets", False)
+                                            if allow_external_assets is None else allow_external_assets),
+                     output_size=None if size == (render.width, render.height) else size,
                      city=cityscapes_city(config.name), camera_index={p: i for i, (p, _, _) in enumerate(cameras)},
                      layer_stack=document["layer_stack"]["digest"], yolo_classes=yolo.class_index(class_map))
 
@@ -274,7 +309,8 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
     while todo:
         ordered = sorted(todo, key=lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id))
         shards = [ordered[i:i + SHARD_IMAGES] + [FLUSH] for i in range(0, len(ordered), SHARD_IMAGES)]
-        executor = ExecutorConfig(kind=request.executor, workers=min(workers, len(shards)), address=request.address)
+        executor = ExecutorConfig(kind=request.executor, workers=min(workers, len(shards)), address=request.address,
+                                  cpus_per_worker=request.cpus_per_worker)
         run_shards(shards, functools.partial(init_worker, job), work, collect, executor)
         missing = [p for p in todo if p.id not in done]
         if len(missing) == len(todo):
@@ -299,7 +335,7 @@ def _read_job(out: Path) -> dict | None:
     if not path.exists():
         if out.exists() and not out.is_dir():
             raise OutputError(f"{out}: is a file; expected a dataset folder or a path that does not exist")
-        if out.is_dir() and any(out.iterdir()):
+        if out.is_dir() and any(not p.name.startswith(".") for p in out.iterdir()):
             raise OutputError(f"{out}: is not empty and holds no generate.json; expected an empty folder, a "
                               f"path that does not exist, or a dataset to resume")
         return None
@@ -316,9 +352,7 @@ def _write_job(out: Path, document: dict) -> None:
 
 def _write_json(path: Path, document) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(document, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
-    return path
+    return write_json_atomic(path, document, indent=1)
 
 
 def _remove_partial_files(out: Path) -> None:
@@ -337,15 +371,15 @@ def _complete_records(layout: Layout, plan) -> dict[int, dict]:
     done = {}
     for p in plan:
         name = image_name(p.id, p.camera_name, p.time_code, p.condition, p.seed)
-        path = layout.path(Layout.record(name))
         try:
-            record = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
-            continue
-        entries = record.get("checksums", {})
-        if record.get("id") == p.id and entries and all(
-                (layout.root / e["path"]).is_file() and (layout.root / e["path"]).stat().st_size == e["bytes"]
-                for e in entries.values()):
+            record = json.loads(layout.path(Layout.record(name)).read_text(encoding="utf-8"))
+            entries = record.get("checksums", {})
+            complete = record.get("id") == p.id and entries and all(
+                layout.path(e["path"]).is_file() and layout.path(e["path"]).stat().st_size == e["bytes"]
+                for e in entries.values())
+        except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError):
+            continue  # unreadable, or an edited record naming paths outside the dataset: render it again
+        if complete:
             done[p.id] = record
     return done
 
@@ -360,19 +394,17 @@ def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: G
                                    coco.coco_instances(records, class_map, split)))
         written.append(_write_json(layout.path(Layout.coco_panoptic(split)),
                                    panoptic.coco_panoptic(records, class_map, split)))
-    with atomic_path(layout.path(Layout.DATA_YAML)) as tmp:
-        tmp.write_text(yolo.data_yaml(class_map), encoding="utf-8")
-    written.append(layout.path(Layout.DATA_YAML))
+    written.append(write_text_atomic(layout.path(Layout.DATA_YAML), yolo.data_yaml(class_map)))
     rows = tables.metadata_rows(records, class_map)
     tables.write_tables(rows, layout.path(Layout.METADATA_CSV), layout.path(Layout.METADATA_PARQUET))
     written += [layout.path(Layout.METADATA_CSV), layout.path(Layout.METADATA_PARQUET)]
     written.append(_write_json(layout.path(Layout.COVERAGE), coverage.coverage(
         records, config, job_document.get("quota_targets"), job_document.get("pool"))))
-    written.append(_write_rejected(layout.path(Layout.REJECTED), records))
+    written.append(tables.write_rejected(records, layout.path(Layout.REJECTED)))
     written.append(_write_json(layout.path(Layout.CLASS_MAP), class_map.document()))
     key = job_document["job_key"]
     provenance = {**_versions(key["variant"]), "config": key["config"], "config_digest": document_digest(key["config"]),
-                  "scenario": key["scenario"], "layer_stack": job_document["layer_stack"]}
+                  "scenario": Path(job_document["scenario"]).name, "layer_stack": job_document["layer_stack"]}
     images = [{"id": r["id"], "name": r["name"], "split": r["split"], "seed": r["seed"],
                "layer_stack": r["layer_stack"], "qa": r["qa"]["verdict"],
                "files": [r["checksums"][k] for k in sorted(r["checksums"])]
@@ -382,16 +414,3 @@ def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: G
     _write_json(layout.path(Layout.MANIFEST), manifest_document(provenance=provenance, images=images,
                                                                 dataset_files=sorted(dataset_files,
                                                                                      key=lambda e: e["path"])))
-
-
-def _write_rejected(path: Path, records: list[dict]) -> Path:
-    """``rejected.csv``: every image QA rejected or flagged, with its reasons (nothing is dropped silently)."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(["image_id", "name", "verdict", "reasons"])
-    for r in records:
-        if r["qa"]["verdict"] != "accepted":
-            writer.writerow([r["id"], r["name"], r["qa"]["verdict"], "; ".join(r["qa"]["reasons"])])
-    with atomic_path(path) as tmp:
-        tmp.write_text(buffer.getvalue(), encoding="utf-8")
-    return path

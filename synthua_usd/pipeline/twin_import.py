@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from synthua_usd.atomic import output_set
-from synthua_usd.backends.frame_files import write_json_atomic
+from synthua_usd.atomic import write_json_atomic
 from synthua_usd.framing import automatic_cameras
 from synthua_usd.scenario import ScenarioSpec, StageMetadata
 from synthua_usd.taxonomy import ClassMap

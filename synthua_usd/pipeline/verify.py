@@ -73,6 +73,15 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         result.files += 1
         if not _check_file(layout, entry, result):
             damaged.add(entry["path"])
+    from synthua_usd.dataset.formats.records import is_rejected
+    from synthua_usd.dataset.formats.yolo import class_index
+    from synthua_usd.taxonomy import ClassMap
+
+    try:
+        yolo_classes = class_index(ClassMap.load(root / Layout.CLASS_MAP))
+    except InputError as exc:
+        result.add(f"{Layout.CLASS_MAP}: {exc}")
+        yolo_classes = {}
     records = []
     for img in manifest.get("images", []):
         try:
@@ -80,7 +89,7 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         except (OSError, ValueError):
             continue  # already reported by the checksums
     result.images = len(records)
-    coco_by_image = {}
+    coco_by_image, coco_images = {}, {}
     for split in SPLITS:
         path = layout.path(Layout.coco_instances(split))
         if path.exists():
@@ -88,8 +97,16 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
                 document = json.loads(path.read_text(encoding="utf-8"))
             except (UnicodeDecodeError, json.JSONDecodeError):
                 continue  # reported by the checksums
+            coco_images.update({img["id"]: split for img in document.get("images", [])})
             for ann in document.get("annotations", []):
                 coco_by_image.setdefault(ann["image_id"], []).append(ann)
+    kept = {r["id"]: r for r in records if not is_rejected(r)}
+    for image_id in sorted(set(coco_by_image) - set(kept)):
+        result.add(f"COCO annotations of image {image_id}: no such image kept in the dataset (unknown or rejected)")
+    for image_id, record in kept.items():
+        if coco_images.get(image_id) != record["split"]:
+            result.add(f"image {image_id} ({record['name']}): not among the COCO images of its split "
+                       f"{record['split']}")
     panoptic_by_image = {}
     for split in SPLITS:
         path = layout.path(Layout.coco_panoptic(split))
@@ -101,11 +118,11 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
             for ann in document.get("annotations", []):
                 panoptic_by_image[ann["image_id"]] = ann
     for record in tqdm(records, desc="consistency", unit="image", disable=not show_progress):
-        if record["qa"]["verdict"] == "rejected" or damaged & set(record["files"].values()):
+        if is_rejected(record) or damaged & set(record["files"].values()):
             continue  # a damaged file is reported already; its image is not read
         try:
             _check_image(layout, record, coco_by_image.get(record["id"], []), panoptic_by_image.get(record["id"]),
-                         result)
+                         yolo_classes, result)
         except Exception as exc:  # noqa: BLE001 - whatever a broken file raises, it is a problem of the dataset
             result.add(f"image {record['id']} ({record['name']}): cannot be checked: {type(exc).__name__}: "
                        f"{echo(exc)}")
@@ -139,7 +156,7 @@ def _read(layout: Layout, relative: str) -> np.ndarray:
 
 
 def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], panoptic_annotation: dict | None,
-                 result: Verification) -> None:
+                 yolo_classes: dict[int, int], result: Verification) -> None:
     from pycocotools import mask as mask_utils
 
     where = f"image {record['id']} ({record['name']})"
@@ -182,9 +199,10 @@ def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], pan
         result.add(f"{where}: {files['cs_labelIds']} differs from {files['class']}")
     if "yolo_label" in files:
         lines = [ln for ln in layout.path(files["yolo_label"]).read_text(encoding="utf-8").splitlines() if ln.strip()]
-        expected = record.get("yolo_lines")
-        if expected is not None and len(lines) != expected:
-            result.add(f"{where}: {files['yolo_label']} has {len(lines)} lines; the record says {expected}")
+        expected = sum(1 for i in record["instances"] if i["category_id"] in yolo_classes)
+        if len(lines) != expected:
+            result.add(f"{where}: {files['yolo_label']} has {len(lines)} lines; the image has {expected} instances "
+                       f"of YOLO classes")
 
 
 @dataclass

@@ -161,6 +161,8 @@ KILL_POINTS = {
     "planned": lambda out: (out / "generate.json").exists(),
     "mid-images": lambda out: len(list((out / "records").glob("*.json"))) >= 2 if (out / "records").exists() else False,
     "assembling": lambda out: (out / "data.yaml").exists(),
+    # QA rejected an image and the plan holds its replacement (round 1), not rendered yet
+    "replacing": lambda out: (out / "generate.json").exists() and '"round": 1' in (out / "generate.json").read_text(),
 }
 
 
@@ -221,21 +223,50 @@ def test_verify_catches_damage(damaged, damage, run_cli):
     assert any(rel in line for line in out.splitlines() if line.startswith("problem:")), out
 
 
+def _rewrite_with_checksum(root: Path, path: Path, content: bytes) -> None:
+    """Replace a file and make the manifest agree with it: only the cross-file checks can notice."""
+    path.write_bytes(content)
+    manifest_path = root / "manifest.json"
+    manifest = json.loads(manifest_path.read_text())
+    rel = path.relative_to(root).as_posix()
+    for entry in manifest["dataset_files"] + [e for img in manifest["images"] for e in img["files"]]:
+        if entry["path"] == rel:
+            entry["sha256"] = hashlib.sha256(content).hexdigest()
+            entry["bytes"] = len(content)
+    manifest_path.write_text(json.dumps(manifest))
+
+
 def test_verify_checks_annotations_against_masks(damaged):
     """A COCO box changed and the manifest updated to match: the checksums pass, the cross-file check does not."""
     coco_path = damaged / "annotations" / "instances_train.json"
     coco = json.loads(coco_path.read_text())
     coco["annotations"][0]["bbox"][2] += 1
-    coco_path.write_text(json.dumps(coco))
-    manifest_path = damaged / "manifest.json"
-    manifest = json.loads(manifest_path.read_text())
-    for entry in manifest["dataset_files"]:
-        if entry["path"] == "annotations/instances_train.json":
-            entry["sha256"] = hashlib.sha256(coco_path.read_bytes()).hexdigest()
-            entry["bytes"] = coco_path.stat().st_size
-    manifest_path.write_text(json.dumps(manifest))
+    _rewrite_with_checksum(damaged, coco_path, json.dumps(coco).encode())
     result = verify(damaged)
     assert [p for p in result.problems if "bbox" in p], result.problems
+
+
+def test_verify_counts_yolo_lines_against_the_instances(damaged):
+    label = next(p for p in sorted(damaged.glob("labels/*/*.txt")) if p.read_text().count("\n") >= 2)
+    lines = label.read_text().splitlines(keepends=True)
+    _rewrite_with_checksum(damaged, label, "".join(lines[1:]).encode())
+    result = verify(damaged)
+    assert [p for p in result.problems if "YOLO" in p and label.name in p], result.problems
+
+
+def test_leftover_temporary_file_does_not_block_a_new_run_and_occlusion_quota_is_planned(tmp_path):
+    """A run killed while writing its first generate.json leaves only a dot file: the same command then
+    starts. A quota with max_occlusion is planned for (the planner knows pixels, not occlusion) and met."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / ".generate.k3j2.json").write_text("{")
+    config = _config(tmp_path, quotas={"aid_users": {"min_share": 0.5, "min_pixels": 5, "max_occlusion": 0.95}})
+    generate_dataset(out, config=config)
+    assert not (out / ".generate.k3j2.json").exists()
+    job = json.loads((out / "generate.json").read_text())
+    assert job["pool"]["aid_users"] > 0
+    quotas = {q["quota"]: q for q in json.loads((out / "coverage.json").read_text())["quotas"]}
+    assert quotas["aid_users"]["met"], quotas
 
 
 # --- resampling ---------------------------------------------------------------------------------------------

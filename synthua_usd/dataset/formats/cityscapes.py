@@ -67,8 +67,8 @@ def cityscapes_arrays(class_ids: np.ndarray, instance_ids: np.ndarray, instances
         counters[inst.class_id] = k + 1
         if k >= MAX_INSTANCES_PER_CLASS or inst.class_id * 1000 + k > np.iinfo(np.uint16).max:
             raise OutputError(f"Cityscapes instanceIds: instance {inst_id} is number {k} of class {inst.class_id} "
-                              f"in this image; class*1000+k must stay below {MAX_INSTANCES_PER_CLASS} per class "
-                              f"and within 16 bits")
+                              f"in this image; expected at most {MAX_INSTANCES_PER_CLASS} instances of a class and "
+                              f"class*1000+k within 16 bits")
         flat = out.reshape(-1)
         flat[idx[class_ids.reshape(-1)[idx] == inst.class_id]] = inst.class_id * 1000 + k
     return class_ids.copy(), out, class_map.palette()[class_ids]
@@ -86,3 +86,14 @@ def cityscapes_labels(class_map: ClassMap) -> list[dict]:
         out.append({"name": c.name, "id": c.id, "trainId": c.id, "category": c.group, "categoryId": category_id,
                     "hasInstances": bool(c.isthing), "ignoreInEval": c.id == 0, "color": tuple(c.color)})
     return out
+
+
+def check_class_map(class_map: ClassMap) -> None:
+    """Refuse, before anything renders, a class map whose thing classes cannot take Cityscapes' 16-bit
+    ``instanceIds`` (class·1000 + k: thing class ids up to 65)."""
+    limit = np.iinfo(np.uint16).max // 1000 - 1
+    too_high = [c for c in class_map.classes if c.isthing and c.id > limit]
+    if too_high:
+        c = too_high[0]
+        raise InputError(f"{class_map.source}: thing class '{c.name}' has id {c.id}; expected thing class ids up to "
+                         f"{limit}, so that Cityscapes instanceIds (class*1000 + k) fit 16 bits")

@@ -111,3 +111,19 @@ def _column(values: list) -> pa.Array:
         return pa.array(values)
     except (pa.ArrowInvalid, pa.ArrowTypeError):
         return pa.array([None if v is None else _csv_text(v) for v in values], pa.string())
+
+
+def write_rejected(records: Iterable[dict], path: str | Path) -> Path:
+    """``rejected.csv``: every image QA rejected or flagged, with its verdict and reasons, in image order
+    (nothing is dropped silently), atomically."""
+    import io
+
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["image_id", "name", "verdict", "reasons"])
+    for r in ordered(records):
+        if r["qa"]["verdict"] != "accepted":
+            writer.writerow([r["id"], r["name"], r["qa"]["verdict"], "; ".join(r["qa"]["reasons"])])
+    with atomic_path(path) as tmp:
+        tmp.write_text(buffer.getvalue(), encoding="utf-8")
+    return Path(path)

@@ -37,7 +37,8 @@ def class_index(class_map: ClassMap, class_ids: Iterable[int] | None = None) -> 
     known = {c.id for c in class_map.classes}
     unknown = [i for i in chosen if i not in known]
     if unknown:
-        raise InputError(f"YOLO classes: ids {unknown[:5]} are not in class map {class_map.source}")
+        raise InputError(f"YOLO classes: ids {unknown[:5]} are not in class map {class_map.source}; expected ids of "
+                         f"its classes")
     return {cid: k for k, cid in enumerate(chosen)}
 
 
