@@ -5,20 +5,89 @@ Coordinates are world space in metres with the stage's up axis; colours are line
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 
+#: Which output of a texture feeds an input: the colour, or one channel.
+TEXTURE_CHANNELS = ("rgb", "r", "g", "b", "a")
+#: How texel values are decoded: 'auto' is UsdUVTexture's rule (sRGB for 8-bit images of 3 or 4 channels,
+#: raw otherwise), resolved when the file is read.
+COLOR_SPACES = ("auto", "sRGB", "raw")
+WRAP_MODES = ("repeat", "mirror", "clamp", "black")
+
+
+@dataclass(frozen=True)
+class Texture:
+    """An image feeding one material input: a UsdUVTexture reduced to plain data.
+
+    ``path`` is the image file: absolute when read from a stage; in a :class:`synthua_usd.twin.TwinModel`,
+    relative to the folder the twin layer is written in (e.g. ``textures/asphalt.png``). Texel values are
+    decoded by ``color_space`` to linear values, then ``value * scale + bias`` per RGBA channel (UsdUVTexture's
+    order), then ``channel`` is taken. Texture coordinates follow USD's ``st``: (0, 0) is the image's
+    bottom-left corner, t grows upwards; ``wrap_s``/``wrap_t`` say what lies outside [0, 1].
+    """
+
+    path: str
+    channel: str = "rgb"
+    color_space: str = "auto"
+    wrap_s: str = "repeat"
+    wrap_t: str = "repeat"
+    scale: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)
+    bias: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        for name, value, allowed in (("channel", self.channel, TEXTURE_CHANNELS),
+                                     ("color_space", self.color_space, COLOR_SPACES),
+                                     ("wrap_s", self.wrap_s, WRAP_MODES), ("wrap_t", self.wrap_t, WRAP_MODES)):
+            if value not in allowed:
+                raise ValueError(f"texture {self.path}: {name} should be one of {', '.join(allowed)}, but was {value!r}")
+        for name in ("scale", "bias"):
+            value = tuple(float(v) for v in getattr(self, name))
+            if len(value) != 4 or not all(math.isfinite(v) for v in value):
+                raise ValueError(f"texture {self.path}: {name} should be 4 finite numbers (RGBA), but was {value}")
+            object.__setattr__(self, name, value)
+
+
 @dataclass(frozen=True)
 class Material:
-    """A UsdPreviewSurface reduced to constants. Colours linear Rec.709, 0..1."""
+    """A UsdPreviewSurface reduced to constants and textures. Colours linear Rec.709, 0..1.
+
+    A ``*_texture`` replaces its constant where the mesh has texture coordinates (the constant stays the
+    fallback: meshes without them render with it). ``normal_texture`` is a tangent-space normal map whose
+    values (after scale and bias) lie in [-1, 1]. ``opacity`` below ``opacity_threshold`` cuts the surface
+    away when the threshold is above 0 (UsdPreviewSurface's cutout); otherwise it is partial coverage.
+    ``uv_primvar`` names the mesh primvar holding the texture coordinates.
+    """
 
     key: str
     base_color: tuple[float, float, float] = (0.18, 0.18, 0.18)
     roughness: float = 0.5
     metallic: float = 0.0
     emissive_color: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    opacity: float = 1.0
+    opacity_threshold: float = 0.0
+    base_color_texture: Texture | None = None
+    roughness_texture: Texture | None = None
+    metallic_texture: Texture | None = None
+    normal_texture: Texture | None = None
+    opacity_texture: Texture | None = None
+    uv_primvar: str = "st"
+
+    @property
+    def textures(self) -> dict[str, Texture]:
+        """The textured inputs by field name (``base_color_texture``, ...), in field order."""
+        return {name: getattr(self, name) for name in TEXTURED_INPUTS if getattr(self, name) is not None}
+
+    def untextured(self) -> "Material":
+        """The same material with its constants only: what meshes without texture coordinates render with."""
+        return replace(self, **{name: None for name in TEXTURED_INPUTS})
+
+
+#: Material fields that hold a texture, in the order backends build them.
+TEXTURED_INPUTS = ("base_color_texture", "roughness_texture", "metallic_texture", "normal_texture", "opacity_texture")
 
 
 @dataclass(frozen=True)
@@ -56,6 +125,9 @@ class MeshItem:
     instance_id : int, an id of :attr:`SceneSnapshot.instances` (0 for unlabelled geometry)
     class_id : int
     lamp : str, the gprim's authored ``synthua:lamp`` role ('' when none; see :mod:`synthua_usd.lamps`)
+    uvs : (n, 2) float32 texture coordinates per point in USD's ``st`` convention (origin at the image's
+        bottom-left), or None when the mesh has none or its material has no textures. Face-varying
+        coordinates arrive here already per point: the reader splits points where corners disagree.
     """
 
     prim_path: str
@@ -65,6 +137,7 @@ class MeshItem:
     instance_id: int
     class_id: int
     lamp: str = ""
+    uvs: np.ndarray | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """Stage → :class:`SceneSnapshot`: the composed stage at one time code as plain world-space data.
 
 Gprims are triangulated in world space (metres) by a handler registered per prim type; materials are
-UsdPreviewSurface constants; lights are UsdLux distant and dome lights. Each gprim gets the class and
+UsdPreviewSurface constants and textures (:mod:`synthua_usd.usd.shading`); lights are UsdLux distant and dome lights. Each gprim gets the class and
 instance of the labelled prim above it (see :mod:`synthua_usd.usd.semantics`). What the reader refuses it
 finds with the checks of :mod:`synthua_usd.usd.prim_checks`, which ``synthua validate stage`` runs too.
 """
@@ -12,7 +12,7 @@ import logging
 from typing import Callable
 
 import numpy as np
-from pxr import Gf, Usd, UsdGeom, UsdLux, UsdShade
+from pxr import Usd, UsdGeom, UsdLux
 
 from synthua_usd import geometry as geo
 from synthua_usd.errors import StageError, UnsupportedPrimError, echo
@@ -21,7 +21,9 @@ from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
+from synthua_usd.usd.shading import material_for
 from synthua_usd.usd.stage_io import check_time_code, meters_per_unit
+from synthua_usd.usd.texcoords import fan_corners, read_uvs
 
 log = logging.getLogger(__name__)
 
@@ -42,27 +44,20 @@ def gprim_handler(type_name: str):
 
 @gprim_handler("Mesh")
 def _mesh(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
+    points, indices, corners = _mesh_corners(prim, t)
+    return points, indices[corners]
+
+
+def _mesh_corners(prim: Usd.Prim, t: Usd.TimeCode) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A Mesh's points (n, 3), faceVertexIndices and triangle corners (m, 3) (:func:`texcoords.fan_corners`,
+    wound counter-clockwise)."""
     findings, (points, counts, indices) = mesh_topology(prim, t)
     raise_first_error(findings)
     holes = set(np.asarray(UsdGeom.Mesh(prim).GetHoleIndicesAttr().Get(t) or [], np.int64).tolist())
-    tris = _fan_triangulate(counts, indices, holes)
+    corners, _ = fan_corners(counts, holes)
     if UsdGeom.Mesh(prim).GetOrientationAttr().Get(t) == UsdGeom.Tokens.leftHanded:
-        tris = tris[:, ::-1]
-    return points, tris
-
-
-def _fan_triangulate(counts: np.ndarray, indices: np.ndarray, holes: set[int]) -> np.ndarray:
-    """(m, 3) int64 triangles from polygon faces; faces with fewer than 3 vertices are skipped."""
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]) if len(counts) else np.zeros(0, np.int64)
-    if np.all(counts == 3) and not holes:
-        return indices.reshape(-1, 3)
-    out = []
-    for face, (start, n) in enumerate(zip(starts, counts)):
-        if n < 3 or face in holes:
-            continue
-        for k in range(1, n - 1):
-            out.append((indices[start], indices[start + k], indices[start + k + 1]))
-    return np.asarray(out, np.int64).reshape(-1, 3)
+        corners = corners[:, ::-1]
+    return points, np.asarray(indices, np.int64), corners
 
 
 @gprim_handler("Cube")
@@ -95,53 +90,6 @@ def _capsule(prim: Usd.Prim, t: Usd.TimeCode) -> geo.Mesh:
     cap = UsdGeom.Capsule(prim)
     return geo.capsule(float(cap.GetRadiusAttr().Get(t)), float(cap.GetHeightAttr().Get(t)),
                        axis=str(cap.GetAxisAttr().Get(t)).lower())
-
-
-# --- materials ------------------------------------------------------------------------------------------
-
-_DEFAULT_MATERIAL = Material("default", (0.18, 0.18, 0.18), 0.5)
-
-
-def _input_value(shader: UsdShade.Shader, name: str, fallback):
-    inp = shader.GetInput(name)
-    if not inp:
-        return fallback
-    if inp.HasConnectedSource():
-        log.warning("%s: input '%s' is connected to a texture or node graph; textures are not supported yet, "
-                    "using the constant %s", shader.GetPath(), name, fallback)
-        return fallback
-    value = inp.Get()
-    return fallback if value is None else value
-
-
-def _material_for(prim: Usd.Prim, t: Usd.TimeCode, cache: dict[str, Material]) -> Material:
-    bound, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
-    if bound:
-        key = str(bound.GetPath())
-        if key not in cache:
-            cache[key] = _preview_surface(bound, key)
-        return cache[key]
-    color = UsdGeom.Gprim(prim).GetDisplayColorAttr().Get(t)
-    if color is not None and len(color) >= 1:
-        rgb = tuple(float(c) for c in color[0])
-        key = "displayColor(%.4f,%.4f,%.4f)" % rgb
-        cache.setdefault(key, Material(key, rgb, 0.6))
-        return cache[key]
-    cache.setdefault(_DEFAULT_MATERIAL.key, _DEFAULT_MATERIAL)
-    return _DEFAULT_MATERIAL
-
-
-def _preview_surface(material: UsdShade.Material, key: str) -> Material:
-    shader = material.ComputeSurfaceSource()[0]
-    if not shader or shader.GetIdAttr().Get() != "UsdPreviewSurface":
-        found = shader.GetIdAttr().Get() if shader else "no surface shader"
-        log.warning("%s: surface is %s, not UsdPreviewSurface; rendering it grey", key, found)
-        return Material(key, _DEFAULT_MATERIAL.base_color, _DEFAULT_MATERIAL.roughness)
-    return Material(key,
-                    base_color=tuple(float(c) for c in _input_value(shader, "diffuseColor", Gf.Vec3f(0.18))),
-                    roughness=float(_input_value(shader, "roughness", 0.5)),
-                    metallic=float(_input_value(shader, "metallic", 0.0)),
-                    emissive_color=tuple(float(c) for c in _input_value(shader, "emissiveColor", Gf.Vec3f(0.0))))
 
 
 # --- lights -----------------------------------------------------------------------------------------------
@@ -276,7 +224,8 @@ class StageReader:
         message = unsupported_gprim_message(prim)
         if message:
             raise UnsupportedPrimError(f"{prim.GetPath()}: {message}")
-        points, tris = GPRIM_HANDLERS[prim.GetTypeName()](prim, t)
+        material = material_for(prim, t, self._materials)
+        points, tris, uvs = self._geometry(prim, t, material)
         if len(tris) == 0:
             return None
         m = np.array(xcache.GetLocalToWorldTransform(prim), float)  # row-vector convention
@@ -288,9 +237,24 @@ class StageReader:
         sites = label_sites(prim, self.class_map.taxonomy)
         inst = self.instances.get(sites[0].prim_path) if sites else None
         return MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
-                        material_key=_material_for(prim, t, self._materials).key,
-                        instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0,
-                        lamp=_lamp_role(prim))
+                        material_key=material.key, instance_id=inst.id if inst else 0,
+                        class_id=inst.class_id if inst else 0, lamp=_lamp_role(prim), uvs=uvs)
+
+    def _geometry(self, prim: Usd.Prim, t: Usd.TimeCode, material: Material
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Local points, triangles and, when ``material`` has textures and the gprim is a Mesh with its texture
+        coordinates, (n, 2) float32 uvs (points split at face-varying seams); else uvs is None."""
+        if not material.textures:
+            points, tris = GPRIM_HANDLERS[prim.GetTypeName()](prim, t)
+            return points, tris, None
+        if prim.GetTypeName() != "Mesh":
+            log.warning("%s: a %s has no texture coordinates; rendering the constants of its textured material %s",
+                        prim.GetPath(), prim.GetTypeName(), material.key)
+            points, tris = GPRIM_HANDLERS[prim.GetTypeName()](prim, t)
+            return points, tris, None
+        points, indices, corners = _mesh_corners(prim, t)
+        found = read_uvs(prim, t, material.uv_primvar, indices, corners, points)
+        return (points, indices[corners], None) if found is None else found
 
     def snapshot(self, time_code: float) -> SceneSnapshot:
         """Everything renderable at ``time_code`` (checked against the stage's time range). Asking for the
@@ -309,7 +273,8 @@ class StageReader:
                 item = self._mesh_item(prim, t, xcache)
                 before = previous.get(key)
                 if (item is not None and before is not None and np.array_equal(before.points, item.points)
-                        and np.array_equal(before.triangles, item.triangles)):
+                        and np.array_equal(before.triangles, item.triangles)
+                        and _same_uvs(before.uvs, item.uvs)):
                     item = before
             else:
                 if key not in self._static:
@@ -329,6 +294,10 @@ class StageReader:
                                    meshes=tuple(meshes), materials=dict(self._materials), lights=lights,
                                    instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)))
         return self._last
+
+
+def _same_uvs(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    return (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
 
 
 def read_snapshot(stage: Usd.Stage, time_code: float, class_map: ClassMap) -> SceneSnapshot:

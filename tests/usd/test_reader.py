@@ -6,7 +6,8 @@ from pxr import UsdGeom
 
 from conftest import DATA
 from synthua_usd.errors import StageError, UnsupportedPrimError
-from synthua_usd.usd.reader import StageReader, _fan_triangulate, read_snapshot
+from synthua_usd.usd.reader import StageReader, read_snapshot
+from synthua_usd.usd.texcoords import fan_corners
 from synthua_usd.usd.semantics import renderable_gprims
 from synthua_usd.usd.stage_io import open_stage
 
@@ -76,8 +77,9 @@ def test_tiny_scene_primitives_and_materials(class_map):
 def test_fan_triangulation_skips_degenerate_faces_and_holes():
     counts = np.array([4, 2, 3])
     indices = np.array([0, 1, 2, 3, 4, 5, 6, 7, 8])
-    tris = _fan_triangulate(counts, indices, holes={2})
-    assert tris.tolist() == [[0, 1, 2], [0, 2, 3]]
+    corners, faces = fan_corners(counts, holes={2})
+    assert indices[corners].tolist() == [[0, 1, 2], [0, 2, 3]]
+    assert faces.tolist() == [0, 0]
 
 
 def test_unknown_label_is_an_error_naming_the_prim(class_map):

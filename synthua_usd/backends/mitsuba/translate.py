@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synthua_usd.backends.mitsuba import weather_scene
+from synthua_usd.backends.mitsuba import surfaces, weather_scene
 from synthua_usd.backends.mitsuba.weather_scene import LampMesh
 from synthua_usd.cameras import PinholeCamera
 from synthua_usd.conditions import Condition
@@ -39,11 +39,9 @@ def shape_id(index: int) -> str:
 
 
 def bsdf_dict(material: Material) -> dict:
-    """UsdPreviewSurface constants → Mitsuba ``principled`` BSDF (linear Rec.709 base colour)."""
-    return {"type": "principled",
-            "base_color": {"type": "rgb", "value": list(material.base_color)},
-            "roughness": float(np.clip(material.roughness, 0.0, 1.0)),
-            "metallic": float(np.clip(material.metallic, 0.0, 1.0))}
+    """UsdPreviewSurface constants → Mitsuba ``principled`` BSDF (linear Rec.709 base colour); textured
+    materials are built by :mod:`surfaces` with the translation's :class:`surfaces.TextureImages`."""
+    return surfaces.principled_dict(material)
 
 
 def emitter_dict(light: Light) -> dict:
@@ -90,15 +88,20 @@ def sampler_dict(config: RenderConfig, spp: int | None = None) -> dict:
     return {"type": "independent", "sample_count": spp or config.spp, "seed": 0}
 
 
-def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter=None, face_attributes=None):
+def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter=None, face_attributes=None,
+          uvs: np.ndarray | None = None):
+    """A Mitsuba mesh of ``points`` (n, 3) and ``triangles`` (m, 3); ``uvs`` (n, 2) in USD's st convention."""
     props = mi.Properties()
     props["bsdf"] = bsdf
     if emitter is not None:
         props["emitter"] = emitter
-    mesh = mi.Mesh(key, len(points), len(triangles), props=props, has_vertex_normals=False, has_vertex_texcoords=False)
+    mesh = mi.Mesh(key, len(points), len(triangles), props=props, has_vertex_normals=False,
+                   has_vertex_texcoords=uvs is not None)
     params = mi.traverse(mesh)
     params["vertex_positions"] = type(params["vertex_positions"])(np.ascontiguousarray(points, np.float32).ravel())
     params["faces"] = type(params["faces"])(np.ascontiguousarray(triangles, np.uint32).ravel())
+    if uvs is not None:
+        params["vertex_texcoords"] = type(params["vertex_texcoords"])(surfaces.mitsuba_uvs(uvs).ravel())
     params.update()
     for name, values in (face_attributes or {}).items():
         mesh.add_attribute(name, 1, type(params["vertex_positions"])(values))
@@ -117,6 +120,7 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
     lamps = weather_scene.lamp_meshes(snapshot) if condition is not None else ()
     lamp_indices = {lamp.index for lamp in lamps}
     bsdfs: dict = {}
+    images = surfaces.TextureImages(mi)
     scene: dict = {"type": "scene",
                    "integrator": {"type": "path", "max_depth": config.max_depth},
                    "sensor": sensor_dict(mi, camera, config)}
@@ -124,17 +128,20 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
     for i, item in enumerate(snapshot.meshes):
         key = shape_id(i)
         material = snapshot.materials[item.material_key]
+        textured = item.uvs is not None and bool(material.textures)
+        if not textured:  # a mesh without texture coordinates renders its material's constants
+            material = material.untextured()
         layers = frozenset(face_weights[i])
-        if (material.key, layers) not in bsdfs:
-            bsdfs[(material.key, layers)] = mi.load_dict(
-                weather_scene.surface_bsdf_dict(bsdf_dict(material), material, layers))
+        if (material.key, textured, layers) not in bsdfs:
+            bsdfs[(material.key, textured, layers)] = mi.load_dict(
+                weather_scene.surface_bsdf_dict(material, layers, images))
         emitter = None
         if i in lamp_indices:
             emitter = weather_scene.dark_area_emitter(mi)
         elif any(material.emissive_color):
             emitter = mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": list(material.emissive_color)}})
-        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[(material.key, layers)], emitter,
-                           face_weights[i])
+        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[(material.key, textured, layers)], emitter,
+                           face_weights[i], item.uvs if textured else None)
         shape_ids.append(key)
     for k, light in enumerate(weather_scene.own_lights(snapshot, condition)):
         scene[f"light_{k:03d}"] = emitter_dict(light)

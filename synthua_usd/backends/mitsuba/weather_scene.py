@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from synthua_usd.backends.mitsuba import surfaces
 from synthua_usd.backends.weather import fog_lighting
 from synthua_usd.conditions import SNOW_FREE_CLASSES, SNOW_SLOPE_DEG, WET_GROUND_CLASSES, WET_MAX_SLOPE_DEG, Condition
 from synthua_usd.lamps import KINDS, is_on, lamp_role
@@ -148,27 +149,26 @@ def face_weights(item, class_name: str, up: np.ndarray, condition: Condition) ->
     return {k: v.astype(np.float32) for k, v in out.items() if np.any(v > 0)}
 
 
-def _wet_dict(dry: dict, material: Material) -> dict:
-    wet = dict(dry)
-    wet["base_color"] = {"type": "rgb", "value": wet_albedo(material.base_color).tolist()}
-    wet["roughness"] = 0.5 * dry["roughness"]
+def _wet_dict(material: Material, images: surfaces.TextureImages | None) -> dict:
+    wet = surfaces.principled_dict(material, images, albedo=wet_albedo, roughness_factor=0.5, name="wet")
     wet["clearcoat"] = 1.0
     wet["clearcoat_gloss"] = 0.9
     return wet
 
 
-def surface_bsdf_dict(dry: dict, material: Material, layers: frozenset[str]) -> dict:
-    """The BSDF dict of ``material`` with the weathering ``layers`` (``face_wet``, ``face_snow``) over its dry
-    ``principled`` dict ``dry``."""
-    node = dry
+def surface_bsdf_dict(material: Material, layers: frozenset[str], images: surfaces.TextureImages | None = None) -> dict:
+    """The BSDF dict of ``material`` (:mod:`surfaces`, textured when ``images`` is given) with the weathering
+    ``layers`` (``face_wet``, ``face_snow``) over its dry ``principled`` BSDF; the normal map and the opacity
+    mask wrap the whole (water and snow follow the surface's relief and holes)."""
+    node = surfaces.principled_dict(material, images)
     if "face_wet" in layers:
         node = {"type": "blendbsdf", "weight": {"type": "mesh_attribute", "name": "face_wet"},
-                "bsdf_0": node, "bsdf_1": _wet_dict(dry, material)}
+                "bsdf_0": node, "bsdf_1": _wet_dict(material, images)}
     if "face_snow" in layers:
         node = {"type": "blendbsdf", "weight": {"type": "mesh_attribute", "name": "face_snow"},
                 "bsdf_0": node, "bsdf_1": {"type": "principled", "roughness": 0.7,
                                            "base_color": {"type": "rgb", "value": [SNOW_ALBEDO] * 3}}}
-    return node
+    return surfaces.wrapped(node, material, images)
 
 
 def mesh_face_weights(snapshot: SceneSnapshot, condition: Condition | None) -> list[dict[str, np.ndarray]]:

@@ -1,0 +1,157 @@
+"""A :class:`Material` → Mitsuba BSDF dicts: ``principled`` with constants or ``bitmap`` textures, wrapped in a
+``normalmap`` and a ``mask`` when the material has a normal map or an opacity below one.
+
+Texture files are decoded here, once per file and colour space per translation (:class:`TextureImages`), with
+OpenImageIO: 8-bit sRGB images (and ``sRGB`` textures) through the exact sRGB transfer function, alpha never;
+raw images as stored. Then UsdUVTexture's ``scale`` and ``bias`` and the chosen channel, and the result goes
+to Mitsuba as a float bitmap with ``raw=True``: Mitsuba never converts it again, and a single channel stays
+single (Mitsuba would take an RGB bitmap's luminance for a roughness, not its green). Mitsuba's bitmap puts
+v = 0 on the image's first (top) row, USD's t = 0 on its bottom row: meshes get (s, 1 − t)
+(:func:`mitsuba_uvs`).
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Callable
+
+import numpy as np
+
+from synthua_usd.errors import InputError, echo
+from synthua_usd.scene import Material, Texture
+
+log = logging.getLogger(__name__)
+
+#: Our wrap modes → Mitsuba's. Mitsuba's bitmap has no black border: 'black' clamps (with a warning).
+WRAP = {"repeat": "repeat", "mirror": "mirror", "clamp": "clamp", "black": "clamp"}
+CHANNEL = {"r": 0, "g": 1, "b": 2, "a": 3}
+
+
+def srgb_to_linear(values: np.ndarray) -> np.ndarray:
+    """The sRGB transfer function's inverse (IEC 61966-2-1), elementwise on values in [0, 1]."""
+    v = np.asarray(values, np.float32)
+    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+def mitsuba_uvs(uvs: np.ndarray) -> np.ndarray:
+    """(n, 2) USD st → (n, 2) float32 Mitsuba uv: the same image point, v measured from the top row."""
+    out = np.array(uvs, np.float32, copy=True)
+    out[:, 1] = 1.0 - out[:, 1]
+    return out
+
+
+class TextureImages:
+    """Decoded texture images and their Mitsuba bitmaps for one translation (``mi`` with its variant active)."""
+
+    def __init__(self, mi) -> None:
+        self.mi = mi
+        self._rgba: dict[tuple[str, str], np.ndarray] = {}
+        self._nodes: dict[tuple, dict] = {}
+
+    def rgba(self, path: str, color_space: str) -> np.ndarray:
+        """(H, W, 4) float32 linear RGBA of the image at ``path`` (grey fills RGB, missing alpha is 1), decoded
+        by ``color_space`` ('auto' resolved by UsdUVTexture's rule). Raises :class:`InputError` when the file
+        cannot be read as an image."""
+        import OpenImageIO as oiio
+
+        key = (path, color_space)
+        if key in self._rgba:
+            return self._rgba[key]
+        image = oiio.ImageInput.open(path)
+        if image is None:
+            raise InputError(f"{path}: cannot read the texture image: {echo(oiio.geterror())}; expected a PNG, JPEG, "
+                             f"EXR or another image OpenImageIO reads")
+        try:
+            spec = image.spec()
+            pixels = image.read_image(0, 0, 0, spec.nchannels, "float")
+        finally:
+            image.close()
+        if pixels is None:
+            raise InputError(f"{path}: cannot decode the texture image; expected a readable image file")
+        pixels = np.asarray(pixels, np.float32).reshape(spec.height, spec.width, spec.nchannels)
+        if color_space == "auto":
+            color_space = "sRGB" if spec.format == oiio.UINT8 and spec.nchannels in (3, 4) else "raw"
+        colour = pixels[..., : min(3, spec.nchannels)] if spec.nchannels != 2 else pixels[..., :1]
+        if color_space == "sRGB":
+            colour = srgb_to_linear(colour)
+        if colour.shape[2] == 1:
+            colour = np.repeat(colour, 3, axis=2)
+        alpha_index = {2: 1, 4: 3}.get(spec.nchannels)
+        alpha = pixels[..., alpha_index:alpha_index + 1] if alpha_index else np.ones_like(colour[..., :1])
+        rgba = np.ascontiguousarray(np.concatenate([colour, alpha], axis=2), np.float32)
+        self._rgba[key] = rgba
+        return rgba
+
+    def values(self, texture: Texture) -> np.ndarray:
+        """(H, W, 3) or (H, W, 1) float32: ``texture``'s decoded values after scale, bias and channel."""
+        rgba = self.rgba(texture.path, texture.color_space) * np.float32(texture.scale) + np.float32(texture.bias)
+        if texture.channel == "rgb":
+            return rgba[..., :3]
+        return rgba[..., CHANNEL[texture.channel]:CHANNEL[texture.channel] + 1]
+
+    def node(self, texture: Texture, transform: Callable[[np.ndarray], np.ndarray] | None = None,
+             name: str = "") -> dict:
+        """A ``bitmap`` texture dict of ``texture``'s values, passed through ``transform`` first (``name``
+        tells transforms apart in the cache)."""
+        key = (texture, name)
+        if key not in self._nodes:
+            data = self.values(texture)
+            if transform is not None:
+                data = transform(data)
+            if texture.wrap_s != texture.wrap_t or texture.wrap_s == "black":
+                log.warning("%s: wrap modes %s/%s: Mitsuba wraps both axes alike and has no black border; using %s",
+                            texture.path, texture.wrap_s, texture.wrap_t, WRAP[texture.wrap_s])
+            self._nodes[key] = {"type": "bitmap", "bitmap": self.mi.Bitmap(np.ascontiguousarray(data, np.float32)),
+                                "raw": True, "filter_type": "bilinear", "wrap_mode": WRAP[texture.wrap_s]}
+        return self._nodes[key]
+
+
+def principled_dict(material: Material, images: TextureImages | None = None,
+                    albedo: Callable[[np.ndarray], np.ndarray] | None = None, roughness_factor: float = 1.0,
+                    name: str = "") -> dict:
+    """Mitsuba ``principled`` of ``material``: constants, or bitmaps where it has textures and ``images`` is
+    given. ``albedo`` maps base colours (weathering), ``roughness_factor`` scales roughness; ``name`` keys
+    those variants' bitmaps."""
+    def clip(v):
+        return np.clip(v, 0.0, 1.0)
+
+    def colour():
+        if material.base_color_texture is not None and images is not None:
+            return images.node(material.base_color_texture, lambda d: (albedo or clip)(clip(d)), f"albedo{name}")
+        value = np.asarray(material.base_color, np.float64)
+        return {"type": "rgb", "value": (albedo(value) if albedo else value).tolist()}
+
+    def scalar(texture: Texture | None, constant: float, factor: float = 1.0, field: str = ""):
+        if texture is not None and images is not None:
+            return images.node(texture, lambda d: clip(d) * np.float32(factor), f"{field}{name}")
+        return float(np.clip(constant, 0.0, 1.0)) * factor
+
+    return {"type": "principled", "base_color": colour(),
+            "roughness": scalar(material.roughness_texture, material.roughness, roughness_factor, "roughness"),
+            "metallic": scalar(material.metallic_texture, material.metallic, field="metallic")}
+
+
+def wrapped(bsdf: dict, material: Material, images: TextureImages | None = None) -> dict:
+    """``bsdf`` under ``material``'s normal map (Mitsuba's ``normalmap`` reads [0, 1]-encoded tangent-space
+    normals: UsdPreviewSurface's [-1, 1] values are mapped there) and its opacity (``mask``; with
+    ``opacity_threshold`` > 0 a cutout: coverage 0 below it, 1 from it on)."""
+    node = bsdf
+    if material.normal_texture is not None and images is not None:
+        node = {"type": "normalmap", "bsdf": node,
+                "normalmap": images.node(material.normal_texture, _encoded_normals, "normal")}
+    threshold = material.opacity_threshold
+
+    def coverage(d):
+        d = np.clip(d, 0.0, 1.0)
+        return (d >= threshold).astype(np.float32) if threshold > 0 else d
+
+    if material.opacity_texture is not None and images is not None:
+        node = {"type": "mask", "bsdf": node, "opacity": images.node(material.opacity_texture, coverage, "opacity")}
+    elif float(coverage(np.float32(material.opacity))) < 1.0:
+        node = {"type": "mask", "bsdf": node, "opacity": float(coverage(np.float32(material.opacity)))}
+    return node
+
+
+def _encoded_normals(values: np.ndarray) -> np.ndarray:
+    n = values / np.maximum(np.linalg.norm(values, axis=2, keepdims=True), 1e-6)
+    return (0.5 * n + 0.5).astype(np.float32)

@@ -1,0 +1,187 @@
+"""UsdPreviewSurface networks → :class:`synthua_usd.scene.Material`: constants and UsdUVTexture images.
+
+An input of the surface shader is either a value or a connection. Connections are followed through node
+graphs and interface inputs (``UsdShade.Utils.GetValueProducingAttributes``) to what produces the value:
+
+* an interface input of the material or a node graph: its value;
+* an output of a ``UsdUVTexture`` whose ``st`` comes from a ``UsdPrimvarReader_float2`` (its ``varname``
+  often an interface input such as ``frame:stPrimvarName``): a :class:`Texture` (file, ``sourceColorSpace``,
+  ``wrapS``/``wrapT``, ``scale``, ``bias``, the output used) on the input;
+* anything else (``UsdTransform2d``, other shaders, node graphs without a value): the input's constant,
+  after a one-line warning naming the prim. So is a texture whose file is missing.
+
+Supported textured inputs: diffuseColor, roughness, metallic, normal, opacity.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
+
+from synthua_usd.errors import echo
+from synthua_usd.scene import Material, Texture
+
+log = logging.getLogger(__name__)
+
+DEFAULT_MATERIAL = Material("default", (0.18, 0.18, 0.18), 0.5)
+
+#: UsdPreviewSurface input → (Material constant field, Material texture field, channel count).
+TEXTURED = {"diffuseColor": ("base_color", "base_color_texture", 3), "roughness": ("roughness", "roughness_texture", 1),
+            "metallic": ("metallic", "metallic_texture", 1), "normal": (None, "normal_texture", 3),
+            "opacity": ("opacity", "opacity_texture", 1)}
+#: UsdUVTexture's wrap tokens → ours. 'useMetadata' asks the image file, which for PNG and JPEG says
+#: nothing; repeat is what glTF and the DCC tools exporting UsdPreviewSurface assume.
+WRAP = {"repeat": "repeat", "mirror": "mirror", "clamp": "clamp", "black": "black", "useMetadata": "repeat"}
+COLOR_SPACE = {"auto": "auto", "sRGB": "sRGB", "raw": "raw"}
+
+
+def material_for(prim: Usd.Prim, t: Usd.TimeCode, cache: dict[str, Material]) -> Material:
+    """The material of gprim ``prim``: its bound UsdPreviewSurface, else its displayColor, else grey;
+    ``cache`` holds materials already read, by key."""
+    bound, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
+    if bound:
+        key = str(bound.GetPath())
+        if key not in cache:
+            cache[key] = preview_surface(bound, key)
+        return cache[key]
+    color = UsdGeom.Gprim(prim).GetDisplayColorAttr().Get(t)
+    if color is not None and len(color) >= 1:
+        rgb = tuple(float(c) for c in color[0])
+        key = "displayColor(%.4f,%.4f,%.4f)" % rgb
+        cache.setdefault(key, Material(key, rgb, 0.6))
+        return cache[key]
+    cache.setdefault(DEFAULT_MATERIAL.key, DEFAULT_MATERIAL)
+    return DEFAULT_MATERIAL
+
+
+def preview_surface(material: UsdShade.Material, key: str) -> Material:
+    """``material``'s UsdPreviewSurface as a :class:`Material` keyed ``key`` (grey, after a warning, when its
+    surface is another shader)."""
+    shader = material.ComputeSurfaceSource()[0]
+    if not shader or shader.GetIdAttr().Get() != "UsdPreviewSurface":
+        found = shader.GetIdAttr().Get() if shader else "no surface shader"
+        log.warning("%s: surface is %s, not UsdPreviewSurface; rendering it grey", key, found)
+        return Material(key, DEFAULT_MATERIAL.base_color, DEFAULT_MATERIAL.roughness)
+    fields: dict = {}
+    primvars: list[str] = []
+    defaults = {"diffuseColor": Gf.Vec3f(0.18), "roughness": 0.5, "metallic": 0.0, "emissiveColor": Gf.Vec3f(0.0),
+                "opacity": 1.0, "opacityThreshold": 0.0, "normal": None}
+    values = {}
+    for name, fallback in defaults.items():
+        value, texture, primvar = _input(shader, name, fallback)
+        values[name] = value
+        if texture is not None:
+            fields[TEXTURED[name][1]] = texture
+            primvars.append(primvar)
+    if len(set(primvars)) > 1:
+        log.warning("%s: textures read texture coordinates from different primvars (%s); using '%s' for all",
+                    key, ", ".join(sorted(set(primvars))), primvars[0])
+    return Material(key, base_color=tuple(float(c) for c in values["diffuseColor"]),
+                    roughness=float(values["roughness"]), metallic=float(values["metallic"]),
+                    emissive_color=tuple(float(c) for c in values["emissiveColor"]),
+                    opacity=float(values["opacity"]), opacity_threshold=float(values["opacityThreshold"]),
+                    uv_primvar=primvars[0] if primvars else "st", **fields)
+
+
+def _input(shader: UsdShade.Shader, name: str, fallback):
+    """(constant, texture or None, primvar name or None) of the surface input ``name``."""
+    inp = shader.GetInput(name)
+    if not inp:
+        return fallback, None, None
+    own = inp.Get() if inp.GetAttr().HasAuthoredValue() else None
+    constant = fallback if own is None else own
+    if not inp.HasConnectedSource():
+        return constant, None, None
+    where = f"{shader.GetPath()}: input '{name}'"
+    attrs = UsdShade.Utils.GetValueProducingAttributes(inp)
+    if not attrs:
+        log.warning("%s is connected to nothing that produces a value; using the constant %s", where, constant)
+        return constant, None, None
+    attr = attrs[0]
+    base, kind = UsdShade.Utils.GetBaseNameAndType(attr.GetName())
+    if kind != UsdShade.AttributeType.Output:  # an interface input with a value
+        value = attr.Get()
+        return (constant if value is None else value), None, None
+    source = UsdShade.Shader(attr.GetPrim())
+    shader_id = source.GetShaderId() if source else None
+    if shader_id != "UsdUVTexture" or name not in TEXTURED:
+        what = f"'{shader_id}'" if shader_id else "a node graph"
+        log.warning("%s is connected to %s at %s, which synthua does not translate; using the constant %s",
+                    where, echo(what), attr.GetPrim().GetPath(), constant)
+        return constant, None, None
+    found = _texture(source, base, where)
+    if found is None:
+        return constant, None, None
+    return constant, found[0], found[1]
+
+
+def _texture(shader: UsdShade.Shader, output: str, where: str) -> tuple[Texture, str] | None:
+    """The UsdUVTexture ``shader`` read through its ``output`` as (texture, st primvar name), or None after a
+    warning that says why the input falls back to its constant."""
+    path = shader.GetPath()
+    asset = _value(shader, "file", Sdf.AssetPath(""))
+    authored = asset.path if isinstance(asset, Sdf.AssetPath) else str(asset)
+    if "<UDIM>" in authored:
+        log.warning("%s: texture %s: UDIM file '%s' is not supported; using the input's constant", where, path,
+                    echo(authored))
+        return None
+    resolved = asset.resolvedPath if isinstance(asset, Sdf.AssetPath) else ""
+    if not authored or not resolved or not Path(resolved).is_file():
+        log.warning("%s: texture file '%s' of %s was not found; using the input's constant", where, echo(authored),
+                    path)
+        return None
+    primvar = _st_primvar(shader, where)
+    if primvar is None:
+        return None
+    wrap = []
+    for axis in ("wrapS", "wrapT"):
+        token = str(_value(shader, axis, "useMetadata"))
+        if token not in WRAP:
+            log.warning("%s: %s: %s '%s' is not a UsdUVTexture wrap mode; using repeat", where, path, axis, echo(token))
+        wrap.append(WRAP.get(token, "repeat"))
+    space = str(_value(shader, "sourceColorSpace", "auto"))
+    if space not in COLOR_SPACE:
+        log.warning("%s: %s: sourceColorSpace '%s' is not auto, sRGB or raw; using auto", where, path, echo(space))
+    channel = output if output in ("rgb", "r", "g", "b", "a") else None
+    if channel is None:
+        log.warning("%s: %s: output '%s' is not rgb, r, g, b or a; using the input's constant", where, path,
+                    echo(output))
+        return None
+    scale = tuple(float(v) for v in _value(shader, "scale", Gf.Vec4f(1.0)))
+    bias = tuple(float(v) for v in _value(shader, "bias", Gf.Vec4f(0.0)))
+    return Texture(str(Path(resolved).resolve()), channel=channel, color_space=COLOR_SPACE.get(space, "auto"),
+                   wrap_s=wrap[0], wrap_t=wrap[1], scale=scale, bias=bias), primvar
+
+
+def _st_primvar(shader: UsdShade.Shader, where: str) -> str | None:
+    """The primvar name the texture's ``st`` reads, through a UsdPrimvarReader_float2; None after a warning."""
+    st = shader.GetInput("st")
+    attrs = UsdShade.Utils.GetValueProducingAttributes(st) if st and st.HasConnectedSource() else []
+    reader = UsdShade.Shader(attrs[0].GetPrim()) if attrs else None
+    kind = UsdShade.Utils.GetBaseNameAndType(attrs[0].GetName())[1] if attrs else None
+    if not reader or kind != UsdShade.AttributeType.Output or reader.GetShaderId() != "UsdPrimvarReader_float2":
+        found = f"'{reader.GetShaderId()}' at {reader.GetPath()}" if reader and kind == UsdShade.AttributeType.Output \
+            else "no primvar reader"
+        log.warning("%s: texture %s: st comes from %s; supported: a UsdPrimvarReader_float2; using the input's "
+                    "constant", where, shader.GetPath(), echo(found))
+        return None
+    name = _value(reader, "varname", "")
+    if not name:
+        log.warning("%s: primvar reader %s has no varname; using the input's constant", where, reader.GetPath())
+        return None
+    return str(name)
+
+
+def _value(shader: UsdShade.Shader, name: str, fallback):
+    """The value of ``shader``'s input ``name``, following a connection to an interface input."""
+    inp = shader.GetInput(name)
+    if not inp:
+        return fallback
+    if inp.HasConnectedSource():
+        attrs = UsdShade.Utils.GetValueProducingAttributes(inp)
+        value = attrs[0].Get() if attrs else None
+    else:
+        value = inp.Get()
+    return fallback if value is None else value

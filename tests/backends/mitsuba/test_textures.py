@@ -1,0 +1,304 @@
+"""Textured materials rendered by Mitsuba, checked against an independent computation.
+
+The reference casts the same pixel-centre rays with Embree (trimesh), interpolates the reader's texture
+coordinates with the hit's barycentric coordinates, and looks the texel up in numpy (bilinear, texel centres
+at (i + 0.5) / N, t measured from the image's bottom row as USD says), decoding 8-bit values with
+colour-science's sRGB transfer function. Mitsuba's side is the BSDF's diffuse reflectance (its albedo) at the
+first hit of each ray, which for ``principled`` is the base colour: no light transport, exact values.
+"""
+
+from __future__ import annotations
+
+import logging
+import shutil
+
+import colour
+import numpy as np
+import OpenImageIO as oiio
+import pytest
+import trimesh
+from conftest import DATA, third_party
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdShade
+
+from synthua_usd.backends.mitsuba import variants
+from synthua_usd.backends.mitsuba.session import RenderSession
+from synthua_usd.backends.mitsuba.translate import translate
+from synthua_usd.render_config import RenderConfig
+from synthua_usd.usd.cameras import read_camera
+from synthua_usd.usd.reader import read_snapshot
+from synthua_usd.usd.stage_io import open_stage
+
+W, H = 64, 48
+
+
+def write_png(path, pixels: np.ndarray) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    pixels = np.ascontiguousarray(pixels, np.uint8)
+    out = oiio.ImageOutput.create(str(path))
+    assert out.open(str(path), oiio.ImageSpec(pixels.shape[1], pixels.shape[0], pixels.shape[2], oiio.UINT8))
+    assert out.write_image(pixels)
+    out.close()
+
+
+#: 8 wide, 6 tall, every texel different: a transposed, mirrored or flipped lookup cannot pass.
+TEXELS = np.random.default_rng(7).integers(0, 256, (6, 8, 3), dtype=np.uint8)
+
+
+@pytest.fixture
+def quads(tmp_path):
+    """A copy of tests/data/valid/textured_quads.usda with its texture written beside it."""
+    shutil.copy(DATA / "valid" / "textured_quads.usda", tmp_path / "quads.usda")
+    write_png(tmp_path / "textures" / "quadrants.png", TEXELS)
+    return tmp_path / "quads.usda"
+
+
+def bilinear(image: np.ndarray, st: np.ndarray) -> np.ndarray:
+    """(k, C) values of ``image`` (H, W, C; row 0 at the top) at USD ``st`` (k, 2), bilinear, repeat wrap."""
+    h, w = image.shape[:2]
+    x = st[:, 0] * w - 0.5
+    y = (1.0 - st[:, 1]) * h - 0.5
+    x0, y0 = np.floor(x).astype(int), np.floor(y).astype(int)
+    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
+
+    def at(yy, xx):
+        return image[yy % h, xx % w]
+
+    return ((1 - fx) * (1 - fy) * at(y0, x0) + fx * (1 - fy) * at(y0, x0 + 1)
+            + (1 - fx) * fy * at(y0 + 1, x0) + fx * fy * at(y0 + 1, x0 + 1))
+
+
+def reference_albedo(snapshot, camera, linear_texels: np.ndarray):
+    """(H*W, 3) texel values at the first hit of every pixel-centre ray, and the (H*W,) hit mask."""
+    from trimesh.ray.ray_pyembree import RayMeshIntersector
+
+    origins, dirs = camera.pixel_center_rays(W, H)
+    verts, faces, owner = snapshot.world_triangles()
+    uvs = np.concatenate([m.uvs for m in snapshot.meshes])
+    mesh = trimesh.Trimesh(verts, faces, process=False, validate=False)
+    tri, ray, where = RayMeshIntersector(mesh).intersects_id(origins, dirs, multiple_hits=False,
+                                                             return_locations=True)
+    bary = trimesh.triangles.points_to_barycentric(verts[faces[tri]], where)
+    st = np.einsum("kc,kcd->kd", bary, uvs[faces[tri]])
+    out = np.zeros((W * H, 3))
+    out[ray] = bilinear(linear_texels, st)
+    hit = np.zeros(W * H, bool)
+    hit[ray] = True
+    return out, hit
+
+
+def mitsuba_albedo(mi, snapshot, camera):
+    """(H*W, 3) diffuse reflectance of the BSDF at the first hit of every pixel-centre ray, and the hit mask."""
+    tr = translate(mi, snapshot, camera, RenderConfig(width=W, height=H, spp=1))
+    scene = mi.load_dict(tr.scene, optimize=False)
+    origins, dirs = (a.astype(np.float32) for a in camera.pixel_center_rays(W, H))
+    if mi.variant().startswith("scalar"):
+        albedo, hit = np.zeros((W * H, 3)), np.zeros(W * H, bool)
+        for k, (o, d) in enumerate(zip(origins, dirs)):
+            si = scene.ray_intersect(mi.Ray3f(mi.Point3f(*o), mi.Vector3f(*d)))
+            if si.is_valid():
+                hit[k] = True
+                albedo[k] = np.array(si.bsdf().eval_diffuse_reflectance(si))
+        return albedo, hit
+    ray = mi.Ray3f(mi.Point3f(*origins.T), mi.Vector3f(*dirs.T))
+    si = scene.ray_intersect(ray)
+    return np.array(si.bsdf().eval_diffuse_reflectance(si, si.is_valid())).T, np.array(si.is_valid())
+
+
+def srgb_decoded(texels: np.ndarray) -> np.ndarray:
+    return colour.models.eotf_sRGB(texels / 255.0)
+
+
+@pytest.mark.parametrize("space", ["sRGB", "raw", "auto"])
+def test_texels_land_where_the_independent_lookup_puts_them(quads, class_map, variant, space):
+    mi = variants.activate(variant)
+    stage = open_stage(quads)
+    stage.GetPrimAtPath("/World/Looks/Quadrants/Image").GetAttribute("inputs:sourceColorSpace").Set(space)
+    snap = read_snapshot(stage, 1.0, class_map)
+    cam = read_camera(stage, "/World/Cam", 1.0)
+    decoded = TEXELS / 255.0 if space == "raw" else srgb_decoded(TEXELS)  # auto: an 8-bit RGB PNG is sRGB
+    expected, hit_ref = reference_albedo(snap, cam, decoded)
+    got, hit = mitsuba_albedo(mi, snap, cam)
+    assert np.array_equal(hit, hit_ref)
+    assert hit.sum() > 0.35 * W * H  # the quads cover 43 % of the view
+    # Both quads: Left's st per point, Right's per face corner (indexed).
+    assert np.abs(got[hit] - expected[hit]).max() < 2e-3
+
+
+def test_face_varying_seams_split_points_but_keep_triangles(quads, class_map):
+    stage = open_stage(quads)
+    right = UsdGeom.Mesh(stage.GetPrimAtPath("/World/Right"))
+    # The second triangle maps the image mirrored: its corners disagree with the first's at the shared edge.
+    st = UsdGeom.PrimvarsAPI(right).GetPrimvar("st")
+    st.Set([(0, 0), (1, 0), (1, 1), (0, 0), (-1, 1), (0, 1)])
+    st.SetIndices([0, 1, 2, 3, 4, 5])
+    snap = read_snapshot(stage, 1.0, class_map)
+    mesh = next(m for m in snap.meshes if m.prim_path == "/World/Right")
+    assert len(mesh.points) == 5  # point 2 is split (its two corners disagree); 0 and 1, 3 are not
+    corners = mesh.points[mesh.triangles]
+    assert np.allclose(corners, [[(0.1, -1, 0), (2.1, -1, 0), (2.1, 1, 0)], [(0.1, -1, 0), (2.1, 1, 0), (0.1, 1, 0)]])
+    assert np.allclose(mesh.uvs[mesh.triangles], [[(0, 0), (1, 0), (1, 1)], [(0, 0), (-1, 1), (0, 1)]])
+
+
+def test_labels_are_byte_identical_with_and_without_textures(quads, class_map):
+    stage = open_stage(quads)
+    right = UsdGeom.PrimvarsAPI(stage.GetPrimAtPath("/World/Right")).GetPrimvar("st")
+    right.Set([(0, 0), (1, 0), (1, 1), (0, 0), (-1, 1), (0, 1)])  # a seam: Right's points are split
+    right.SetIndices([0, 1, 2, 3, 4, 5])
+    cam = read_camera(stage, "/World/Cam", 1.0)
+    textured = read_snapshot(stage, 1.0, class_map)
+    surface = UsdShade.Shader(stage.GetPrimAtPath("/World/Looks/Quadrants/Surface"))
+    surface.GetInput("diffuseColor").DisconnectSource()
+    flat = read_snapshot(stage, 1.0, class_map)
+    assert all(m.uvs is None for m in flat.meshes) and all(m.uvs is not None for m in textured.meshes)
+    config = RenderConfig(width=W, height=H, spp=1)
+    a = RenderSession(config).render(textured, cam, rgb=False)
+    b = RenderSession(config).render(flat, cam, rgb=False)
+    assert a.class_ids.tobytes() == b.class_ids.tobytes()
+    assert a.instance_ids.tobytes() == b.instance_ids.tobytes()
+    assert a.hits.distance_m.tobytes() == b.hits.distance_m.tobytes()
+
+
+def test_a_missing_texture_file_renders_the_constant_after_a_warning(tmp_path, class_map, caplog):
+    shutil.copy(DATA / "valid" / "textured_quads.usda", tmp_path / "quads.usda")  # no texture written
+    stage = open_stage(tmp_path / "quads.usda")
+    with caplog.at_level(logging.WARNING):
+        snap = read_snapshot(stage, 1.0, class_map)
+    assert "texture file './textures/quadrants.png' of /World/Looks/Quadrants/Image was not found" in caplog.text
+    material = snap.materials["/World/Looks/Quadrants"]
+    assert material.base_color_texture is None and material.base_color == pytest.approx((0.5, 0.5, 0.5))
+    mi = variants.activate("scalar_rgb")
+    got, hit = mitsuba_albedo(mi, snap, read_camera(stage, "/World/Cam", 1.0))
+    assert np.allclose(got[hit], 0.5)
+
+
+def _add_texture(stage, name: str, file: str, output: str, target: str, type_name, **inputs) -> None:
+    """A UsdUVTexture ``name`` reading ``file`` through the material's st reader, feeding surface input
+    ``target`` from ``output``."""
+    looks = "/World/Looks/Quadrants"
+    shader = UsdShade.Shader.Define(stage, f"{looks}/{name}")
+    shader.CreateIdAttr("UsdUVTexture")
+    shader.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(file)
+    shader.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(
+        UsdShade.Shader(stage.GetPrimAtPath(f"{looks}/StReader")).ConnectableAPI(), "result")
+    for key, (vtype, value) in inputs.items():
+        shader.CreateInput(key, vtype).Set(value)
+    shader.CreateOutput(output, type_name)
+    surface = UsdShade.Shader(stage.GetPrimAtPath(f"{looks}/Surface"))
+    surface.CreateInput(target, type_name).ConnectToSource(shader.ConnectableAPI(), output)
+
+
+def _lit_from_plus_x(stage) -> None:
+    """Replace the sky by a sun 60° off vertical, shining from +X, and a dim sky."""
+    stage.GetPrimAtPath("/World/Sky").GetAttribute("inputs:intensity").Set(0.05)
+    sun = UsdLux.DistantLight.Define(stage, "/World/Sun")
+    sun.CreateIntensityAttr(3.0)
+    UsdGeom.Xformable(sun).AddRotateYOp().Set(60.0)  # the light's -Z towards -X and down
+
+
+def _mean_rgb(stage, class_map, prim: str):
+    snap = read_snapshot(stage, 1.0, class_map)
+    cam = read_camera(stage, "/World/Cam", 1.0)
+    frame = RenderSession(RenderConfig(width=W, height=H, spp=16, variant="scalar_rgb")).render(snap, cam)
+    index = next(i for i, m in enumerate(snap.meshes) if m.prim_path == prim)
+    return frame.rgb[frame.hits.mesh_index == index].mean(axis=0)
+
+
+@pytest.mark.parametrize("tilt_x, brighter", [(0.6, True), (-0.6, False)])
+def test_a_normal_map_tilts_the_shading(tmp_path, class_map, tilt_x, brighter):
+    shutil.copy(DATA / "valid" / "textured_quads.usda", tmp_path / "quads.usda")
+    write_png(tmp_path / "textures" / "quadrants.png", np.full((2, 2, 3), 200, np.uint8))
+    n = np.array([tilt_x, 0.0, 1.0]) / np.linalg.norm([tilt_x, 0.0, 1.0])
+    write_png(tmp_path / "textures" / "normal.png", np.tile(np.round((n * 0.5 + 0.5) * 255), (2, 2, 1)))
+    stage = open_stage(tmp_path / "quads.usda")
+    _lit_from_plus_x(stage)
+    flat = _mean_rgb(stage, class_map, "/World/Left")
+    _add_texture(stage, "Normals", "./textures/normal.png", "rgb", "normal", Sdf.ValueTypeNames.Normal3f,
+                 sourceColorSpace=(Sdf.ValueTypeNames.Token, "raw"),
+                 scale=(Sdf.ValueTypeNames.Float4, Gf.Vec4f(2, 2, 2, 1)),
+                 bias=(Sdf.ValueTypeNames.Float4, Gf.Vec4f(-1, -1, -1, 0)))
+    tilted = _mean_rgb(stage, class_map, "/World/Left")
+    # Lambert: cos(60°) = 0.5 flat; a normal tilted ±31° about Y faces the sun at 29° or 91°.
+    assert (tilted.mean() > 1.3 * flat.mean()) if brighter else (tilted.mean() < 0.5 * flat.mean())
+
+
+def test_an_opacity_texture_cuts_the_surface_away(tmp_path, class_map):
+    shutil.copy(DATA / "valid" / "textured_quads.usda", tmp_path / "quads.usda")
+    rgba = np.zeros((2, 8, 4), np.uint8)
+    rgba[:, 4:, 3] = 255  # the image's right half opaque, its left half a hole
+    write_png(tmp_path / "textures" / "quadrants.png", rgba)
+    stage = open_stage(tmp_path / "quads.usda")
+    clamp = (Sdf.ValueTypeNames.Token, "clamp")  # repeat would blend the opaque right edge into the left one
+    _add_texture(stage, "Alpha", "./textures/quadrants.png", "a", "opacity", Sdf.ValueTypeNames.Float, wrapS=clamp,
+                 wrapT=clamp)
+    stage.GetPrimAtPath("/World/Looks/Quadrants/Surface").CreateAttribute(
+        "inputs:opacityThreshold", Sdf.ValueTypeNames.Float).Set(0.5)
+    snap = read_snapshot(stage, 1.0, class_map)
+    cam = read_camera(stage, "/World/Cam", 1.0)
+    frame = RenderSession(RenderConfig(width=W, height=H, spp=4, variant="scalar_rgb")).render(snap, cam)
+    left = frame.hits.mesh_index == 0
+    xs = np.nonzero(left.any(axis=0))[0]
+    hole = frame.rgb[:, xs[2]:xs[len(xs) // 2 - 2]][left[:, xs[2]:xs[len(xs) // 2 - 2]]]
+    solid = frame.rgb[:, xs[len(xs) // 2 + 2]:xs[-2]][left[:, xs[len(xs) // 2 + 2]:xs[-2]]]
+    assert hole.mean() == pytest.approx(1.0, abs=0.02)  # the sky seen through the hole
+    assert solid.mean() < 0.05  # black, opaque
+    assert left.sum() > 0.2 * W * H  # labels still see the whole quad: they come from geometry
+
+
+def teapot_stage() -> Usd.Stage:
+    """The usd-wg teapot with its textured 'Fancy' model, a sky and a camera, added in the session layer."""
+    stage = Usd.Stage.Open(str(third_party("usd-wg-teapot", "Teapot.usd")))
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        stage.GetPrimAtPath("/Teapot").GetVariantSet("modelVariant").SetVariantSelection("Fancy")
+        UsdLux.DomeLight.Define(stage, "/Sky").CreateIntensityAttr(1.0)
+        cam = UsdGeom.Camera.Define(stage, "/Cam")
+        cam.CreateFocalLengthAttr(0.5)
+        cam.CreateHorizontalApertureAttr(0.36)
+        cam.CreateVerticalApertureAttr(0.27)
+        cam.CreateClippingRangeAttr(Gf.Vec2f(0.01, 100))
+        UsdGeom.Xformable(cam).AddTranslateOp().Set(Gf.Vec3d(0.0, 0.12, 0.75))
+    return stage
+
+
+@pytest.fixture(scope="module")
+def teapot():
+    return teapot_stage()
+
+
+def test_the_teapot_renders_its_texture_colours(teapot, class_map, variant):
+    mi = variants.activate(variant)
+    snap = read_snapshot(teapot, 1.0, class_map)
+    cam = read_camera(teapot, "/Cam", 1.0)
+    material = next(m for m in snap.materials.values() if m.base_color_texture is not None)
+    assert material.base_color_texture.path.endswith("tea_set_01_diff_2k.jpg")
+    assert (material.roughness_texture.channel, material.metallic_texture.channel) == ("g", "b")
+    assert material.roughness_texture.color_space == "raw"
+    image = oiio.ImageBuf(material.base_color_texture.path).get_pixels(oiio.UINT8)
+    expected, hit_ref = reference_albedo(snap, cam, srgb_decoded(np.asarray(image, np.float64)))
+    got, hit = mitsuba_albedo(mi, snap, cam)
+    both = hit & hit_ref
+    assert both.sum() > 0.2 * W * H
+    assert np.std(got[both], axis=0).max() > 0.05  # patterned, not one flat colour
+    # The texture's 2k texels are far smaller than a pixel: silhouettes and the mip-free lookups still agree.
+    close = np.abs(got[both] - expected[both]).max(axis=1) < 2e-3
+    assert close.mean() > 0.99
+
+
+def test_teapot_labels_are_the_same_with_its_textures_split_seams(class_map):
+    stage = teapot_stage()
+    cam = read_camera(stage, "/Cam", 1.0)
+    snap = read_snapshot(stage, 1.0, class_map)
+    assert all(m.uvs is not None for m in snap.meshes)
+    config = RenderConfig(width=W, height=H, spp=1)
+    textured = RenderSession(config).render(snap, cam, rgb=False)
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        for prim in stage.Traverse():
+            if prim.IsA(UsdGeom.Mesh):
+                UsdShade.MaterialBindingAPI.Apply(prim).UnbindAllBindings()
+    flat_snap = read_snapshot(stage, 1.0, class_map)
+    flat = RenderSession(config).render(flat_snap, cam, rgb=False)
+    # The texture seams split points: same triangles, more points.
+    assert sum(len(m.points) for m in flat_snap.meshes) < sum(len(m.points) for m in snap.meshes)
+    assert sum(len(m.triangles) for m in flat_snap.meshes) == sum(len(m.triangles) for m in snap.meshes)
+    assert textured.instance_ids.tobytes() == flat.instance_ids.tobytes()
+    assert textured.hits.mesh_index.tobytes() == flat.hits.mesh_index.tobytes()
+    assert textured.hits.distance_m.tobytes() == flat.hits.distance_m.tobytes()
