@@ -44,6 +44,9 @@ class TwinPart:
     triangles: np.ndarray = field(repr=False)
     material: str
     attributes: dict = field(default_factory=dict)
+    #: (n, 2) float32 texture coordinates per point in USD's st convention (authored as ``primvars:st``), or
+    #: None. Parts whose material has textures need them (:func:`synthua_usd.uv` makes them).
+    uvs: np.ndarray | None = field(default=None, repr=False)
 
     @classmethod
     def of(cls, name: str, mesh: Mesh, material: str, **attributes) -> "TwinPart":
@@ -56,7 +59,15 @@ class TwinPart:
 
     def moved(self, points: np.ndarray) -> "TwinPart":
         """The same part with new ``points`` (same topology)."""
-        return TwinPart(self.name, points, self.triangles, self.material, self.attributes)
+        return TwinPart(self.name, points, self.triangles, self.material, self.attributes, self.uvs)
+
+    def renamed(self, name: str) -> "TwinPart":
+        """The same part under another ``name``."""
+        return TwinPart(name, self.points, self.triangles, self.material, self.attributes, self.uvs)
+
+    def with_mesh(self, points: np.ndarray, triangles: np.ndarray, uvs: np.ndarray | None) -> "TwinPart":
+        """The same part with new geometry and texture coordinates (e.g. points split at texture seams)."""
+        return TwinPart(self.name, points, triangles, self.material, self.attributes, uvs)
 
     def __post_init__(self) -> None:
         if self.points.ndim != 2 or self.points.shape[1] != 3:
@@ -69,6 +80,12 @@ class TwinPart:
         if len(self.triangles) and (self.triangles.min() < 0 or self.triangles.max() >= len(self.points)):
             raise InputError(f"part {self.name}: triangle indices reach outside its {len(self.points)} points; "
                              f"expected indices in [0, {len(self.points) - 1}]")
+        if self.uvs is not None:
+            uvs = np.asarray(self.uvs)
+            if uvs.shape != (len(self.points), 2) or not np.all(np.isfinite(uvs)):
+                raise InputError(f"part {self.name}: texture coordinates of shape {uvs.shape}; expected "
+                                 f"({len(self.points)}, 2) finite numbers, one pair per point")
+            object.__setattr__(self, "uvs", uvs.astype(np.float32))
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,7 +103,12 @@ class TwinObject:
 
 @dataclass(frozen=True, eq=False)
 class TwinModel:
-    """Everything an importer or generator produced, plus provenance for stage metadata."""
+    """Everything an importer or generator produced, plus provenance for stage metadata.
+
+    ``images`` are the texture images the materials' textures name: each texture's ``path`` (relative to
+    the folder the twin layer is written in, e.g. ``textures/asphalt.png``) → (H, W, C) uint8 pixels, C 1 to
+    4, row 0 at the image's top. They are written beside the twin layer, with it (:mod:`synthua_usd.texture_images`).
+    """
 
     objects: tuple[TwinObject, ...]
     materials: dict[str, Material]
@@ -94,6 +116,7 @@ class TwinModel:
     origin_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     crs: str | None = None
     report: dict = field(default_factory=dict)
+    images: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
 
     def triangle_count(self) -> int:
         return int(sum(len(p.triangles) for o in self.objects for p in o.parts))

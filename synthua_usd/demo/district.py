@@ -98,7 +98,7 @@ class _Builder:
         for i, p in enumerate(pieces):
             name = f"{p.name}_{i}" if p.name in seen else p.name  # repeated part names get their index
             seen.add(p.name)
-            parts.append(p if name == p.name else TwinPart(name, p.points, p.triangles, p.material))
+            parts.append(p if name == p.name else TwinPart(name, p.points, p.triangles, p.material, uvs=p.uvs))
         parts = tuple(parts)
         self.objects.append(TwinObject(path, label, parts, attributes))
         return path

@@ -1,6 +1,7 @@
 """Meshes (OBJ, PLY, GLB/glTF, STL) through trimesh, keeping the source's object/material structure.
 
-Each source object becomes one prim per class found in it (usually one), with one mesh per material.
+Each source object becomes one prim per class found in it (usually one), with one mesh per material;
+materials keep their textures (:mod:`synthua_usd.importers.mesh_materials`) and meshes their texture coordinates.
 Classes come from :class:`AssignmentRules` matched against the object name, material name and group;
 geometry no rule matches gets the rules' default class (``unlabelled``) and is listed in the report.
 """
@@ -19,6 +20,7 @@ from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.errors import InputError, echo
 from synthua_usd.importers.limits import MAX_MESH_BYTES, MAX_TRIANGLES, SCALE
 from synthua_usd.input_files import check_input_file, shown
+from synthua_usd.importers.mesh_materials import geometry_material
 from synthua_usd.scene import Material
 from synthua_usd.ranges import COORDINATE
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
@@ -29,40 +31,6 @@ SUFFIXES = {".obj": "obj", ".ply": "ply", ".glb": "glb", ".gltf": "gltf", ".stl"
 #: glTF is Y-up by specification; the others say nothing, and survey/CAD exports are usually Z-up.
 DEFAULT_UP = {"glb": "Y", "gltf": "Y"}
 _Y_TO_Z = trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0])
-
-
-def _srgb8_to_linear(rgb8) -> tuple[float, float, float]:
-    # Colours come from the file: anything but 0..255 (NaN included) is clipped into it.
-    c = np.clip(np.nan_to_num(np.asarray(rgb8[:3], float), nan=0.0), 0.0, 255.0) / 255.0
-    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-    return tuple(float(v) for v in lin)
-
-
-def _unit(value, default: float) -> float:
-    """A factor of the file's material in [0, 1] (``default`` when absent or not a number)."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        return default
-    return float(np.clip(number, 0.0, 1.0)) if np.isfinite(number) else default
-
-
-def _material(geom: trimesh.Trimesh, fallback: str) -> tuple[str, Material]:
-    visual = geom.visual
-    mat = getattr(visual, "material", None)
-    if mat is not None:
-        name = getattr(mat, "name", None) or fallback
-        if hasattr(mat, "baseColorFactor") and mat.baseColorFactor is not None:
-            color = _srgb8_to_linear(np.asarray(mat.baseColorFactor))
-            rough = _unit(getattr(mat, "roughnessFactor", None), 0.8)
-            metal = _unit(getattr(mat, "metallicFactor", None), 0.0)
-            return name, Material(name, color, rough, metal)
-        if hasattr(mat, "diffuse") and mat.diffuse is not None:
-            return name, Material(name, _srgb8_to_linear(np.asarray(mat.diffuse)), 0.8)
-        return name, Material(name)
-    if getattr(visual, "kind", None) == "vertex" and len(visual.vertex_colors):
-        return fallback, Material(fallback, _srgb8_to_linear(np.asarray(visual.vertex_colors).mean(axis=0)), 0.8)
-    return fallback, Material(fallback)
 
 
 def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = None, scale: float = 1.0,
@@ -92,6 +60,7 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
     # Object name -> class -> parts, in file order.
     grouped: dict[str, dict[str, list[TwinPart]]] = defaultdict(lambda: defaultdict(list))
     materials: dict[str, Material] = {}
+    images: dict[str, np.ndarray] = {}
     unmatched: list[str] = []
     matched_by: dict[str, int] = defaultdict(int)
     nodes = list(scene.graph.nodes_geometry)
@@ -121,8 +90,10 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
         if np.abs(points).max() > COORDINATE.high:
             raise InputError(f"{where}: object '{echo(node)}' has coordinates up to {np.abs(points).max():.3g} m "
                              f"(after scale {scale:g}); expected coordinates within ±{COORDINATE.high:g} m")
-        mat_name, material = _material(geom, "default")
+        mat_name, material, material_images, uvs = geometry_material(geom, "default")
         materials.setdefault(mat_name, material)
+        for rel, pixels in material_images.items():
+            images.setdefault(rel, pixels)
         obj = _object_name(node, geom_name, mat_name, kind, path)
         fields = {"object": obj, "material": mat_name, "group": geom_name}
         label, rule = rules.classify(fields)
@@ -130,8 +101,9 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
             unmatched.append(geom_name)
         else:
             matched_by[f"rules[{rule}]"] += 1
-        grouped[obj][label].append(TwinPart(prim_name(mat_name, "Mesh"), points, faces,
-                                            mat_name, {"source_group": geom_name, "source_material": mat_name}))
+        grouped[obj][label].append(TwinPart(prim_name(mat_name, "Mesh"), points, faces, mat_name,
+                                            {"source_group": geom_name, "source_material": mat_name},
+                                            uvs if materials[mat_name].textures else None))
     objects = []
     for obj, by_class in grouped.items():
         for label, parts in by_class.items():
@@ -142,7 +114,7 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
                     len(meshes), rules.default, echo(", ".join(unmatched[:5]) + (" ..." if len(unmatched) > 5 else "")))
     model = TwinModel(objects=tuple(unique_paths(objects)), materials=materials, source=str(path),
                       report={"meshes": len(meshes), "unmatched": unmatched, "matched_by": dict(matched_by),
-                              "rules": rules.source})
+                              "rules": rules.source, "textures": sorted(images)}, images=images)
     return model
 
 
@@ -161,5 +133,5 @@ def _unique_part_names(parts: list[TwinPart]) -> list[TwinPart]:
     for p in parts:
         n = seen.get(p.name, 0)
         seen[p.name] = n + 1
-        out.append(p if n == 0 else TwinPart(f"{p.name}_{n + 1}", p.points, p.triangles, p.material, p.attributes))
+        out.append(p if n == 0 else p.renamed(f"{p.name}_{n + 1}"))
     return out

@@ -32,13 +32,14 @@ def write_scenario_with_rigs(spec: ScenarioSpec, aimed: AimedRigs, out_dir: str 
     result (its report). A render camera that was rejected leaves the spec's own render camera in place."""
     out_dir = Path(out_dir)
     with output_set(out_dir) as staging:
-        write_scenario(spec, staging, ClassMap.load(class_map_path) if class_map_path else None)
+        written = write_scenario(spec, staging, ClassMap.load(class_map_path) if class_map_path else None)
+        images = [str(p.relative_to(staging)) for p in written if p.parent != staging]
         result = author_rigs(RigRequest(stage_path=staging / ROOT_FILE, out_path=staging / RIGS_FILE, rigs=aimed.rigs,
                                         width=spec.render.width, height=spec.render.height,
                                         time_codes=aimed.time_codes, min_target_px=aimed.min_target_px,
                                         class_map_path=class_map_path))
         names = join_rigs(spec, staging, aimed, result.report)
-    files = names + [result.report_path.name, ROOT_FILE]
+    files = names + [result.report_path.name, ROOT_FILE] + images
     return [out_dir / n for n in files], result
 
 

@@ -31,4 +31,4 @@ def write_import(model: TwinModel, out_dir: str | Path, class_map: ClassMap, rep
     with output_set(out_dir) as staging:
         written = write_scenario(spec, staging, class_map)
         write_json_atomic(staging / REPORT_FILE, report)
-    return [out_dir / p.name for p in written] + [out_dir / REPORT_FILE]
+    return [out_dir / p.relative_to(staging) for p in written] + [out_dir / REPORT_FILE]

@@ -60,8 +60,10 @@ def define_xform(stage: Usd.Stage, path: str, kind: str | None = None,
 
 
 def define_mesh(stage: Usd.Stage, path: str, points: np.ndarray, triangles: np.ndarray,
-                material: UsdShade.Material | None = None) -> UsdGeom.Mesh:
-    """A triangle mesh. ``points`` (n, 3) float, local metres; ``triangles`` (m, 3) int, CCW front faces."""
+                material: UsdShade.Material | None = None, uvs: np.ndarray | None = None,
+                uv_primvar: str = "st") -> UsdGeom.Mesh:
+    """A triangle mesh. ``points`` (n, 3) float, local metres; ``triangles`` (m, 3) int, CCW front faces;
+    ``uvs`` (n, 2) texture coordinates per point, authored as ``primvars:<uv_primvar>`` (texCoord2f, vertex)."""
     mesh = UsdGeom.Mesh.Define(stage, path)
     pts = np.asarray(points, np.float32)
     tris = np.asarray(triangles, np.int32)
@@ -70,6 +72,10 @@ def define_mesh(stage: Usd.Stage, path: str, points: np.ndarray, triangles: np.n
     mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(tris.reshape(-1)))
     mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     mesh.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*map(float, pts.min(0))), Gf.Vec3f(*map(float, pts.max(0)))]))
+    if uvs is not None:
+        UsdGeom.PrimvarsAPI(mesh).CreatePrimvar(uv_primvar, Sdf.ValueTypeNames.TexCoord2fArray,
+                                                UsdGeom.Tokens.vertex).Set(
+            Vt.Vec2fArray.FromNumpy(np.ascontiguousarray(uvs, np.float32)))
     if material is not None:
         bind_material(mesh.GetPrim(), material)
     return mesh
@@ -80,7 +86,9 @@ def bind_material(prim: Usd.Prim, material: UsdShade.Material) -> None:
 
 
 def define_preview_material(stage: Usd.Stage, path: str, spec: Material) -> UsdShade.Material:
-    """A UsdPreviewSurface material with constant inputs."""
+    """A UsdPreviewSurface material: constant inputs, and a UsdUVTexture per texture of ``spec`` (its path
+    authored relative to the layer, ``./textures/...``) reading st through one UsdPrimvarReader_float2 whose
+    varname is the material's interface input ``frame:stPrimvarName``, as USD's own examples do."""
     material = UsdShade.Material.Define(stage, path)
     shader = UsdShade.Shader.Define(stage, f"{path}/PreviewSurface")
     shader.CreateIdAttr("UsdPreviewSurface")
@@ -89,8 +97,49 @@ def define_preview_material(stage: Usd.Stage, path: str, spec: Material) -> UsdS
     shader.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(float(spec.metallic))
     if any(spec.emissive_color):
         shader.CreateInput("emissiveColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*spec.emissive_color))
+    if spec.opacity != 1.0:
+        shader.CreateInput("opacity", Sdf.ValueTypeNames.Float).Set(float(spec.opacity))
+    if spec.opacity_threshold != 0.0:
+        shader.CreateInput("opacityThreshold", Sdf.ValueTypeNames.Float).Set(float(spec.opacity_threshold))
+    if spec.textures:
+        _define_textures(stage, material, shader, spec)
     material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
     return material
+
+
+#: Material texture field → (UsdPreviewSurface input, its value type).
+_TEXTURE_INPUTS = {"base_color_texture": ("diffuseColor", Sdf.ValueTypeNames.Color3f),
+                   "roughness_texture": ("roughness", Sdf.ValueTypeNames.Float),
+                   "metallic_texture": ("metallic", Sdf.ValueTypeNames.Float),
+                   "normal_texture": ("normal", Sdf.ValueTypeNames.Normal3f),
+                   "opacity_texture": ("opacity", Sdf.ValueTypeNames.Float)}
+
+
+def _define_textures(stage: Usd.Stage, material: UsdShade.Material, surface: UsdShade.Shader, spec: Material) -> None:
+    path = material.GetPath()
+    frame = material.CreateInput("frame:stPrimvarName", Sdf.ValueTypeNames.Token)
+    frame.Set(spec.uv_primvar)
+    reader = UsdShade.Shader.Define(stage, path.AppendChild("StReader"))
+    reader.CreateIdAttr("UsdPrimvarReader_float2")
+    reader.CreateInput("varname", Sdf.ValueTypeNames.Token).ConnectToSource(frame)
+    st = reader.CreateOutput("result", Sdf.ValueTypeNames.Float2)
+    for field_name, texture in spec.textures.items():
+        name, value_type = _TEXTURE_INPUTS[field_name]
+        image = UsdShade.Shader.Define(stage, path.AppendChild(f"{name[0].upper()}{name[1:]}Texture"))
+        image.CreateIdAttr("UsdUVTexture")
+        file = texture.path if texture.path.startswith(("./", "../", "/")) else f"./{texture.path}"
+        image.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(file))
+        image.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(st)
+        image.CreateInput("sourceColorSpace", Sdf.ValueTypeNames.Token).Set(texture.color_space)
+        image.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set(texture.wrap_s)
+        image.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set(texture.wrap_t)
+        if texture.scale != (1.0, 1.0, 1.0, 1.0):
+            image.CreateInput("scale", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(*texture.scale))
+        if texture.bias != (0.0, 0.0, 0.0, 0.0):
+            image.CreateInput("bias", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(*texture.bias))
+        output_type = Sdf.ValueTypeNames.Float3 if texture.channel == "rgb" else Sdf.ValueTypeNames.Float
+        output = image.CreateOutput(texture.channel, output_type)
+        surface.CreateInput(name, value_type).ConnectToSource(output)
 
 
 def apply_label(prim: Usd.Prim, taxonomy: str, label: str) -> None:

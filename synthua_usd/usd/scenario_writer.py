@@ -10,6 +10,7 @@ from pxr import Usd
 from synthua_usd.atomic import output_set
 from synthua_usd.scenario import LAYER_FILE, ROOT_FILE, ScenarioSpec, StageMetadata
 from synthua_usd.taxonomy import ClassMap
+from synthua_usd.texture_images import write_texture_images
 from synthua_usd.twin import TwinModel
 from synthua_usd.usd.agents_writer import build_agents_layer
 from synthua_usd.usd.authoring import save_layer_atomic
@@ -44,6 +45,7 @@ def write_scenario(spec: ScenarioSpec, out_dir: str | Path, class_map: ClassMap 
     with output_set(out_dir) as staging:
         for name, stage in stages.items():
             save_layer_atomic(stage.GetRootLayer(), staging / name)
+        names += [str(p.relative_to(staging)) for p in write_texture_images(spec.twin.images, staging)]
         compose_layers(staging / ROOT_FILE, [staging / name for name in stages], doc=f"{spec.doc} scenario.")
     return [out_dir / name for name in names]
 
@@ -56,4 +58,5 @@ def write_twin_layers(model: TwinModel, out_dir: str | Path, class_map: ClassMap
     with output_set(out_dir) as staging:
         for name, stage in zip(names, (twin, semantics)):
             save_layer_atomic(stage.GetRootLayer(), staging / name)
-    return [out_dir / name for name in names]
+        images = [str(p.relative_to(staging)) for p in write_texture_images(model.images, staging)]
+    return [out_dir / name for name in (*names, *images)]

@@ -3,6 +3,8 @@ semantics (UsdSemantics label overs). Every object path and label is checked aga
 
 from __future__ import annotations
 
+import logging
+
 from pxr import Gf, Kind, Sdf, Usd
 
 from synthua_usd.errors import InputError
@@ -11,6 +13,8 @@ from synthua_usd.taxonomy import ClassMap
 from synthua_usd.twin import TwinModel, prim_name
 from synthua_usd.usd.authoring import (apply_label, define_mesh, define_preview_material, define_xform, new_layer,
                                        set_kind)
+
+log = logging.getLogger(__name__)
 
 TWIN_ROOT = "/World/Twin"
 
@@ -21,6 +25,7 @@ def author_twin(model: TwinModel, class_map: ClassMap, meta: StageMetadata) -> t
         if class_map.resolve(obj.label) is None:
             raise InputError(f"{model.source}: object {obj.path}: label '{obj.label}' is not a class of "
                              f"{class_map.source}")
+    _check_textures(model)
     twin = new_layer(meta, f"synthua twin from {model.source}: geometry and UsdPreviewSurface materials.")
     twin.SetDefaultPrim(define_xform(twin, "/World", kind=Kind.Tokens.assembly).GetPrim())
     define_xform(twin, TWIN_ROOT, kind=Kind.Tokens.group)
@@ -50,12 +55,30 @@ def author_twin(model: TwinModel, class_map: ClassMap, meta: StageMetadata) -> t
         for part in obj.parts:
             if len(part.triangles) == 0:
                 continue
-            mesh = define_mesh(twin, f"{path}/{part.name}", part.points, part.triangles, looks[part.material])
+            spec = model.materials[part.material]
+            uvs = part.uvs if spec.textures else None
+            mesh = define_mesh(twin, f"{path}/{part.name}", part.points, part.triangles, looks[part.material], uvs,
+                               spec.uv_primvar)
             for key, value in sorted(part.attributes.items()):
                 _set_custom(mesh.GetPrim(), key, value)
         apply_label(semantics.OverridePrim(path), class_map.taxonomy, class_map.resolve(obj.label).name)
     return twin, semantics
 
+
+
+def _check_textures(model: TwinModel) -> None:
+    """Every texture a material names is one of the model's images, and every textured part has uvs."""
+    for key, spec in model.materials.items():
+        for texture in spec.textures.values():
+            if texture.path not in model.images:
+                raise InputError(f"{model.source}: material {key}: texture '{texture.path}' is not among the "
+                                 f"twin's images ({', '.join(sorted(model.images)) or 'none'}); expected every "
+                                 f"texture to come with its image")
+    for obj in model.objects:
+        for part in obj.parts:
+            if part.uvs is None and model.materials[part.material].textures:
+                log.warning("%s: %s/%s has textured material %s but no texture coordinates; it renders the "
+                            "material's constants", model.source, obj.path, part.name, part.material)
 
 
 def _safe(key: str) -> str:

@@ -1,43 +1,26 @@
-"""Textured materials rendered by Mitsuba, checked against an independent computation.
-
-The reference casts the same pixel-centre rays with Embree (trimesh), interpolates the reader's texture
-coordinates with the hit's barycentric coordinates, and looks the texel up in numpy (bilinear, texel centres
-at (i + 0.5) / N, t measured from the image's bottom row as USD says), decoding 8-bit values with
-colour-science's sRGB transfer function. Mitsuba's side is the BSDF's diffuse reflectance (its albedo) at the
-first hit of each ray, which for ``principled`` is the base colour: no light transport, exact values.
-"""
+"""Textured materials rendered by Mitsuba, checked against an independent computation
+(tests/texture_checks.py: Embree hits, the reader's uvs, a numpy texel lookup, colour-science's sRGB)."""
 
 from __future__ import annotations
 
 import logging
 import shutil
 
-import colour
 import numpy as np
 import OpenImageIO as oiio
 import pytest
-import trimesh
 from conftest import DATA, third_party
+from texture_checks import mitsuba_albedo, reference_albedo, srgb_decoded, write_png
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdShade
 
 from synthua_usd.backends.mitsuba import variants
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.backends.mitsuba.translate import translate
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import read_snapshot
 from synthua_usd.usd.stage_io import open_stage
 
 W, H = 64, 48
-
-
-def write_png(path, pixels: np.ndarray) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    pixels = np.ascontiguousarray(pixels, np.uint8)
-    out = oiio.ImageOutput.create(str(path))
-    assert out.open(str(path), oiio.ImageSpec(pixels.shape[1], pixels.shape[0], pixels.shape[2], oiio.UINT8))
-    assert out.write_image(pixels)
-    out.close()
 
 
 #: 8 wide, 6 tall, every texel different: a transposed, mirrored or flipped lookup cannot pass.
@@ -52,62 +35,6 @@ def quads(tmp_path):
     return tmp_path / "quads.usda"
 
 
-def bilinear(image: np.ndarray, st: np.ndarray) -> np.ndarray:
-    """(k, C) values of ``image`` (H, W, C; row 0 at the top) at USD ``st`` (k, 2), bilinear, repeat wrap."""
-    h, w = image.shape[:2]
-    x = st[:, 0] * w - 0.5
-    y = (1.0 - st[:, 1]) * h - 0.5
-    x0, y0 = np.floor(x).astype(int), np.floor(y).astype(int)
-    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
-
-    def at(yy, xx):
-        return image[yy % h, xx % w]
-
-    return ((1 - fx) * (1 - fy) * at(y0, x0) + fx * (1 - fy) * at(y0, x0 + 1)
-            + (1 - fx) * fy * at(y0 + 1, x0) + fx * fy * at(y0 + 1, x0 + 1))
-
-
-def reference_albedo(snapshot, camera, linear_texels: np.ndarray):
-    """(H*W, 3) texel values at the first hit of every pixel-centre ray, and the (H*W,) hit mask."""
-    from trimesh.ray.ray_pyembree import RayMeshIntersector
-
-    origins, dirs = camera.pixel_center_rays(W, H)
-    verts, faces, owner = snapshot.world_triangles()
-    uvs = np.concatenate([m.uvs for m in snapshot.meshes])
-    mesh = trimesh.Trimesh(verts, faces, process=False, validate=False)
-    tri, ray, where = RayMeshIntersector(mesh).intersects_id(origins, dirs, multiple_hits=False,
-                                                             return_locations=True)
-    bary = trimesh.triangles.points_to_barycentric(verts[faces[tri]], where)
-    st = np.einsum("kc,kcd->kd", bary, uvs[faces[tri]])
-    out = np.zeros((W * H, 3))
-    out[ray] = bilinear(linear_texels, st)
-    hit = np.zeros(W * H, bool)
-    hit[ray] = True
-    return out, hit
-
-
-def mitsuba_albedo(mi, snapshot, camera):
-    """(H*W, 3) diffuse reflectance of the BSDF at the first hit of every pixel-centre ray, and the hit mask."""
-    tr = translate(mi, snapshot, camera, RenderConfig(width=W, height=H, spp=1))
-    scene = mi.load_dict(tr.scene, optimize=False)
-    origins, dirs = (a.astype(np.float32) for a in camera.pixel_center_rays(W, H))
-    if mi.variant().startswith("scalar"):
-        albedo, hit = np.zeros((W * H, 3)), np.zeros(W * H, bool)
-        for k, (o, d) in enumerate(zip(origins, dirs)):
-            si = scene.ray_intersect(mi.Ray3f(mi.Point3f(*o), mi.Vector3f(*d)))
-            if si.is_valid():
-                hit[k] = True
-                albedo[k] = np.array(si.bsdf().eval_diffuse_reflectance(si))
-        return albedo, hit
-    ray = mi.Ray3f(mi.Point3f(*origins.T), mi.Vector3f(*dirs.T))
-    si = scene.ray_intersect(ray)
-    return np.array(si.bsdf().eval_diffuse_reflectance(si, si.is_valid())).T, np.array(si.is_valid())
-
-
-def srgb_decoded(texels: np.ndarray) -> np.ndarray:
-    return colour.models.eotf_sRGB(texels / 255.0)
-
-
 @pytest.mark.parametrize("space", ["sRGB", "raw", "auto"])
 def test_texels_land_where_the_independent_lookup_puts_them(quads, class_map, variant, space):
     mi = variants.activate(variant)
@@ -116,8 +43,8 @@ def test_texels_land_where_the_independent_lookup_puts_them(quads, class_map, va
     snap = read_snapshot(stage, 1.0, class_map)
     cam = read_camera(stage, "/World/Cam", 1.0)
     decoded = TEXELS / 255.0 if space == "raw" else srgb_decoded(TEXELS)  # auto: an 8-bit RGB PNG is sRGB
-    expected, hit_ref = reference_albedo(snap, cam, decoded)
-    got, hit = mitsuba_albedo(mi, snap, cam)
+    expected, hit_ref = reference_albedo(snap, cam, decoded, W, H)
+    got, hit = mitsuba_albedo(mi, snap, cam, W, H)
     assert np.array_equal(hit, hit_ref)
     assert hit.sum() > 0.35 * W * H  # the quads cover 43 % of the view
     # Both quads: Left's st per point, Right's per face corner (indexed).
@@ -167,7 +94,7 @@ def test_a_missing_texture_file_renders_the_constant_after_a_warning(tmp_path, c
     material = snap.materials["/World/Looks/Quadrants"]
     assert material.base_color_texture is None and material.base_color == pytest.approx((0.5, 0.5, 0.5))
     mi = variants.activate("scalar_rgb")
-    got, hit = mitsuba_albedo(mi, snap, read_camera(stage, "/World/Cam", 1.0))
+    got, hit = mitsuba_albedo(mi, snap, read_camera(stage, "/World/Cam", 1.0), W, H)
     assert np.allclose(got[hit], 0.5)
 
 
@@ -273,8 +200,8 @@ def test_the_teapot_renders_its_texture_colours(teapot, class_map, variant):
     assert (material.roughness_texture.channel, material.metallic_texture.channel) == ("g", "b")
     assert material.roughness_texture.color_space == "raw"
     image = oiio.ImageBuf(material.base_color_texture.path).get_pixels(oiio.UINT8)
-    expected, hit_ref = reference_albedo(snap, cam, srgb_decoded(np.asarray(image, np.float64)))
-    got, hit = mitsuba_albedo(mi, snap, cam)
+    expected, hit_ref = reference_albedo(snap, cam, srgb_decoded(np.asarray(image, np.float64)), W, H)
+    got, hit = mitsuba_albedo(mi, snap, cam, W, H)
     both = hit & hit_ref
     assert both.sum() > 0.2 * W * H
     assert np.std(got[both], axis=0).max() > 0.05  # patterned, not one flat colour
