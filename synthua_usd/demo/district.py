@@ -21,6 +21,7 @@ from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
 from synthua_usd.assets import buildings, devices, market, nature, place, street, vehicles
 from synthua_usd.cameras import CameraSpec
+from synthua_usd.demo.district_textures import add_textures
 from synthua_usd.materials import WALL_COLOURS, subset
 from synthua_usd.rigs import AimedRigs, RigSpec
 from synthua_usd.scenario import ScenarioSpec, StageMetadata
@@ -151,8 +152,9 @@ def _sidewalk_x_strip(x0, x1, y_kerb, y_back, gaps: list[float], z_of=None) -> l
     return [TwinPart.of("Slab", geo.merge(*slab), "Concrete"), TwinPart.of("Kerb", geo.merge(*kerb), "Granite")]
 
 
-def build_district(seed: int = 0) -> TwinModel:
-    """The district for ``seed`` as a :class:`TwinModel` (local metres, origin at the layout's centre)."""
+def build_district(seed: int = 0, textures: bool = True) -> TwinModel:
+    """The district for ``seed`` as a :class:`TwinModel` (local metres, origin at the layout's centre), with
+    its procedural textures (:mod:`synthua_usd.demo.district_textures`) unless ``textures`` is False."""
     rng = np.random.default_rng(seed)
     b = _Builder()
     _streets(b, rng)
@@ -162,8 +164,9 @@ def build_district(seed: int = 0) -> TwinModel:
     _vehicles(b, rng)
     _nature(b, rng)
     _mobility_aids(b)
-    return TwinModel(objects=tuple(b.objects), materials=subset(p.material for o in b.objects for p in o.parts), source=f"largo-da-ordem demo district (seed {seed})",
-                     report={"seed": seed})
+    model = TwinModel(objects=tuple(b.objects), materials=subset(p.material for o in b.objects for p in o.parts),
+                      source=f"largo-da-ordem demo district (seed {seed})", report={"seed": seed})
+    return add_textures(model, seed) if textures else model
 
 
 def _streets(b: _Builder, rng: np.random.Generator) -> None:

@@ -117,11 +117,11 @@ _TEXTURE_INPUTS = {"base_color_texture": ("diffuseColor", Sdf.ValueTypeNames.Col
 
 def _define_textures(stage: Usd.Stage, material: UsdShade.Material, surface: UsdShade.Shader, spec: Material) -> None:
     path = material.GetPath()
-    frame = material.CreateInput("frame:stPrimvarName", Sdf.ValueTypeNames.Token)
+    frame = material.CreateInput("frame:stPrimvarName", Sdf.ValueTypeNames.String)
     frame.Set(spec.uv_primvar)
     reader = UsdShade.Shader.Define(stage, path.AppendChild("StReader"))
     reader.CreateIdAttr("UsdPrimvarReader_float2")
-    reader.CreateInput("varname", Sdf.ValueTypeNames.Token).ConnectToSource(frame)
+    reader.CreateInput("varname", Sdf.ValueTypeNames.String).ConnectToSource(frame)
     st = reader.CreateOutput("result", Sdf.ValueTypeNames.Float2)
     for field_name, texture in spec.textures.items():
         name, value_type = _TEXTURE_INPUTS[field_name]

@@ -15,6 +15,8 @@ import logging
 import numpy as np
 from pxr import Usd, UsdGeom
 
+from synthua_usd.uv import split_corners
+
 log = logging.getLogger(__name__)
 
 #: Interpolations of a texture-coordinate primvar that become per-point coordinates.
@@ -77,20 +79,3 @@ def read_uvs(prim: Usd.Prim, t: Usd.TimeCode, name: str, indices: np.ndarray, co
                     interpolation, len(points))
         return None
     return points, triangles, data.astype(np.float32)
-
-
-def split_corners(points: np.ndarray, triangles: np.ndarray, corner_uvs: np.ndarray
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per-corner coordinates ``corner_uvs`` (m, 3, 2) float32 of ``triangles`` (m, 3) → (points, triangles,
-    uvs) with one point per distinct (point, uv) pair, in first-use order."""
-    flat_uv = np.ascontiguousarray(corner_uvs.reshape(-1, 2), np.float32)
-    keys = np.concatenate([triangles.reshape(-1, 1).astype(np.int64),
-                           flat_uv.view(np.uint32).astype(np.int64)], axis=1)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    # np.unique sorts; renumber in order of first use so that a mesh without seams keeps its point order.
-    order = np.argsort(first, kind="stable")
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    chosen = first[order]
-    new_triangles = rank[inverse.reshape(-1)].reshape(-1, 3).astype(np.int64)
-    return points[triangles.reshape(-1)[chosen]], new_triangles, flat_uv[chosen]

@@ -82,11 +82,12 @@ def test_committed_district_is_seed_0_and_deterministic(scenario0, tmp_path):
         shutil.copy(DISTRICT / name, tmp_path / name)
     names = join_rigs(scenario0, tmp_path, district_aimed_rigs(),
                       json.loads((DISTRICT / "rigs.report.json").read_text()))
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in DISTRICT.iterdir())
-    assert set(names) == {p.name for p in written} - {"scenario.usda"} | {RIGS_FILE}
-    for path in tmp_path.iterdir():
-        assert filecmp.cmp(path, DISTRICT / path.name, shallow=False), \
-            f"stages/district/{path.name} differs from seed 0: run `synthua create district stages/district`"
+    files = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file())
+    assert files == sorted(p.relative_to(DISTRICT) for p in DISTRICT.rglob("*") if p.is_file())
+    assert set(names) == {p.name for p in written if p.parent == tmp_path} - {"scenario.usda"} | {RIGS_FILE}
+    for rel in files:  # the layers and the texture images
+        assert filecmp.cmp(tmp_path / rel, DISTRICT / rel, shallow=False), \
+            f"stages/district/{rel} differs from seed 0: run `synthua create district stages/district`"
 
 
 @pytest.mark.slow
@@ -129,7 +130,7 @@ def test_twin_demo_cli(run_cli, tmp_path, monkeypatch, seed1):
     monkeypatch.setattr(district, "build_district", lambda seed: seeds.append(seed) or seed1)
     code, out, _ = run_cli("twin", "demo", "--seed", "1", "--out", tmp_path)
     assert code == 0 and seeds == [1] and f"district seed 1: {len(seed1.objects)} objects" in out
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["semantics.usda", "twin.usdc"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["semantics.usda", "textures", "twin.usdc"]
     twin = Usd.Stage.Open(str(tmp_path / "twin.usdc"))
     assert sum(1 for p in twin.Traverse() if p.IsA(UsdGeom.Mesh)) == sum(len(o.parts) for o in seed1.objects)
 

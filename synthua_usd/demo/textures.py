@@ -1,0 +1,120 @@
+"""Procedural texture images of the demo district, made from a seeded numpy Generator (no downloads).
+
+Each image is tileable (every filter wraps around the edges) and holds *variation around a mean*: the
+district tints it per material through UsdUVTexture's ``scale`` so that a textured surface keeps its flat
+colour's mean (:mod:`synthua_usd.demo.district_textures`). Images are 8-bit sRGB RGB, ``SIZE`` pixels square.
+
+* ``stone``: granite for cobbles, pavers and kerbs: mineral speckles (light quartz and feldspar, dark mica)
+  over mottling, and blotches of a few stones' size, with a slight warm/cool colour drift, so that stones
+  next to each other differ;
+* ``plaster``: walls: low-frequency damp and dirt blotches, fine sand grain, rain streaks running down;
+* ``wood``: planks with grain: wavy stripes along the planks, per-plank tone and a few knots;
+* ``asphalt``: bitumen with bright and dark aggregate, lighter worn patches where the binder is gone, and
+  a few darker stains.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+
+SIZE = 512
+#: Image name → function of (rng, size) → (size, size, 3) linear values around 1.
+TEXTURES: dict = {}
+
+
+def texture(fn):
+    TEXTURES[fn.__name__] = fn
+    return fn
+
+
+def _noise(rng: np.random.Generator, size: int, sigma_px: float) -> np.ndarray:
+    """(size, size) tileable noise of feature size ``sigma_px``, zero mean, unit standard deviation."""
+    field = ndimage.gaussian_filter(rng.standard_normal((size, size)), sigma_px, mode="wrap")
+    return (field - field.mean()) / max(field.std(), 1e-12)
+
+
+def _fractal(rng: np.random.Generator, size: int, sigmas: tuple[float, ...], gains: tuple[float, ...]) -> np.ndarray:
+    return sum(g * _noise(rng, size, s) for s, g in zip(sigmas, gains))
+
+
+def _tint(rng: np.random.Generator, size: int, grey: np.ndarray, drift: float, sigma_px: float) -> np.ndarray:
+    """(size, size, 3): ``grey`` with a low-frequency colour drift of relative amplitude ``drift``."""
+    warm = drift * _noise(rng, size, sigma_px)
+    return np.stack([grey * (1 + warm), grey, grey * (1 - warm)], axis=2)
+
+
+@texture
+def stone(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
+    mottle = _fractal(rng, size, (24.0, 6.0), (0.12, 0.06))
+    grain = rng.random((size, size))
+    speckle = np.where(grain > 0.93, 0.35, 0.0) - np.where(grain < 0.05, 0.3, 0.0)
+    speckle = ndimage.gaussian_filter(speckle, 0.6, mode="wrap")
+    grey = np.clip(1.0 + mottle + speckle + 0.04 * rng.standard_normal((size, size)), 0.35, 1.8)
+    return _tint(rng, size, grey, 0.06, 40.0)
+
+
+@texture
+def plaster(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
+    blotches = _fractal(rng, size, (48.0, 16.0), (0.1, 0.05))
+    sand = 0.03 * rng.standard_normal((size, size))
+    # Rain streaks: noise stretched down the image (rows are t, row 0 at the top), darker towards the bottom
+    # of each streak.
+    streaks = ndimage.gaussian_filter(rng.standard_normal((size, size)), (40.0, 1.5), mode="wrap")
+    streaks = np.minimum(streaks / max(streaks.std(), 1e-12), 0.0) * 0.05
+    grey = np.clip(1.0 + blotches + sand + streaks, 0.5, 1.5)
+    return _tint(rng, size, grey, 0.03, 60.0)
+
+
+@texture
+def wood(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
+    planks = 4
+    rows = np.arange(size)[:, None] * np.ones((1, size))
+    cols = np.ones((size, 1)) * np.arange(size)[None, :]
+    plank = (rows * planks // size).astype(int)
+    tone = 1.0 + 0.12 * rng.standard_normal(planks)[plank]
+    warp = 6.0 * _noise(rng, size, 30.0)
+    rings = np.sin(2 * np.pi * (rows + warp) / (size / planks / 5.5) + 3.0 * plank)
+    fine = ndimage.gaussian_filter(rng.standard_normal((size, size)), (0.7, 12.0), mode="wrap")
+    grey = tone * (1.0 + 0.1 * rings + 0.05 * fine / max(fine.std(), 1e-12))
+    for _ in range(3):  # knots: dark ellipses
+        cy, cx = rng.integers(0, size, 2)
+        dy = (rows - cy + size / 2) % size - size / 2
+        dx = (cols - cx + size / 2) % size - size / 2
+        grey = grey * (1.0 - 0.35 * np.exp(-((dx / 9.0) ** 2 + (dy / 5.0) ** 2)))
+    seams = (rows % (size // planks)) < 2  # the gaps between planks
+    grey = np.where(seams, 0.45, grey)
+    return _tint(rng, size, np.clip(grey, 0.3, 1.6), 0.02, 50.0)
+
+
+@texture
+def asphalt(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
+    grain = rng.random((size, size))
+    aggregate = np.where(grain > 0.9, 0.9, 0.0) + np.where(grain < 0.06, -0.3, 0.0)
+    aggregate = ndimage.gaussian_filter(aggregate, 0.8, mode="wrap")
+    wear = np.clip(_fractal(rng, size, (60.0, 20.0), (1.0, 0.4)), 0.0, None)
+    stains = np.clip(-_noise(rng, size, 25.0) - 1.6, 0.0, None)
+    grey = (1.0 + 0.2 * wear) * (1.0 + aggregate * (0.5 + 0.5 * np.tanh(wear))) * (1.0 - 0.3 * stains)
+    grey += 0.05 * rng.standard_normal((size, size))
+    return _tint(rng, size, np.clip(grey, 0.4, 2.5), 0.02, 60.0)
+
+
+def encode_srgb8(linear: np.ndarray) -> np.ndarray:
+    """(H, W, 3) linear values in [0, 1] → 8-bit sRGB."""
+    c = np.clip(linear, 0.0, 1.0)
+    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1 / 2.4) - 0.055)
+    return np.round(srgb * 255.0).astype(np.uint8)
+
+
+def decode_srgb8(pixels: np.ndarray) -> np.ndarray:
+    """8-bit sRGB → linear float64 (what a renderer decodes)."""
+    c = pixels / 255.0
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def district_images(seed: int, size: int = SIZE) -> dict[str, np.ndarray]:
+    """Every texture as 8-bit sRGB pixels, by name. The variation is stored around linear 0.4 (sRGB 170)
+    so that 8 bits resolve it; the tint brings it to the material's colour. ``seed`` seeds its own
+    Generator stream, apart from the district's geometry."""
+    rng = np.random.default_rng([seed, 0x7E77])
+    return {name: encode_srgb8(0.4 * make(rng, size)) for name, make in TEXTURES.items()}
