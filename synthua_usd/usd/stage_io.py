@@ -53,7 +53,7 @@ def open_stage(path: str | Path, allow_external_assets: bool = False) -> Usd.Sta
     Raises :class:`StageError` naming the file when it is missing, not USD, or fails to parse; when any
     sublayer, reference or payload is missing, unreadable or cyclic (OpenUSD only warns and skips it, which
     would silently render a scene without it); and, unless ``allow_external_assets``, when a layer it
-    composes lies outside the folder tree of the root layer.
+    composes, or a texture file a UsdUVTexture reads, lies outside the folder tree of the root layer.
     """
     path = Path(path)
     stage = _read(path, "stage", lambda: Usd.Stage.Open(str(path), Usd.Stage.LoadAll))
@@ -65,6 +65,7 @@ def open_stage(path: str | Path, allow_external_assets: bool = False) -> Usd.Sta
                          f"stage to exist, open and compose without cycles")
     if not allow_external_assets:
         check_layers_inside(stage, path)
+        check_textures_inside(stage, path)
     check_stage_metadata(stage, path)
     return stage
 
@@ -79,6 +80,23 @@ def check_layers_inside(stage: Usd.Stage, path: Path) -> None:
         if not real.is_relative_to(root):
             raise StageError(f"{path}: composes {echo(real)}, outside the scenario's folder {echo(root)}; expected "
                              f"layers in that folder tree (pass --allow-external-assets to accept it)")
+
+
+def check_textures_inside(stage: Usd.Stage, path: Path) -> None:
+    """Refuse texture files (``UsdUVTexture`` ``inputs:file``) outside the root layer's folder tree, as layers are
+    refused: a texture is read like a layer is. Missing files are left to the reader (a warning and the
+    constant) and to validation (an error)."""
+    root = path.resolve().parent
+    prims = list(stage.Traverse()) + [p for proto in stage.GetPrototypes() for p in Usd.PrimRange(proto)]
+    for prim in prims:
+        if prim.GetTypeName() != "Shader" or prim.GetAttribute("info:id").Get() != "UsdUVTexture":
+            continue
+        asset = prim.GetAttribute("inputs:file").Get()
+        resolved = asset.resolvedPath if isinstance(asset, Sdf.AssetPath) else ""
+        if resolved and not Path(resolved).resolve().is_relative_to(root):
+            raise StageError(f"{path}: {prim.GetPath()} reads the texture {echo(Path(resolved).resolve())}, outside the "
+                             f"scenario's folder {echo(root)}; expected textures in that folder tree (pass "
+                             f"--allow-external-assets to accept it)")
 
 
 def check_stage_metadata(stage: Usd.Stage, path: Path) -> None:

@@ -132,3 +132,19 @@ def test_written_materials_read_back_with_their_textures(tmp_path, class_map):
                                                                            want.bias), field
     assert got.opacity_threshold == 0.5 and got.base_color == pytest.approx((0.2, 0.3, 0.4))
     assert read.meshes[0].uvs.tolist() == [[0, 0], [1, 0], [1, 1]]
+
+
+def test_a_texture_outside_the_scenario_folder_is_refused_unless_allowed(tmp_path, class_map):
+    from synthua_usd.errors import StageError
+
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "elsewhere" / "quadrants.png").write_bytes(b"")
+    (tmp_path / "scenario").mkdir()
+    text = (DATA / "valid" / "textured_quads.usda").read_text().replace("@./textures/quadrants.png@",
+                                                                         "@../elsewhere/quadrants.png@")
+    (tmp_path / "scenario" / "quads.usda").write_text(text)
+    with pytest.raises(StageError, match=r"/World/Looks/Quadrants/Image reads the texture .*elsewhere/quadrants.png, "
+                                         r"outside the scenario's folder .*--allow-external-assets"):
+        open_stage(tmp_path / "scenario" / "quads.usda")
+    stage = open_stage(tmp_path / "scenario" / "quads.usda", allow_external_assets=True)
+    assert material(stage, class_map).base_color_texture.path == str(tmp_path / "elsewhere" / "quadrants.png")

@@ -25,6 +25,8 @@ log = logging.getLogger(__name__)
 #: Our wrap modes → Mitsuba's. Mitsuba's bitmap has no black border: 'black' clamps (with a warning).
 WRAP = {"repeat": "repeat", "mirror": "mirror", "clamp": "clamp", "black": "clamp"}
 CHANNEL = {"r": 0, "g": 1, "b": 2, "a": 3}
+#: The largest texture read: decoded to float RGBA it takes 1 GiB.
+MAX_TEXELS = 8192 * 8192
 
 
 def srgb_to_linear(values: np.ndarray) -> np.ndarray:
@@ -63,20 +65,24 @@ class TextureImages:
                              f"EXR or another image OpenImageIO reads")
         try:
             spec = image.spec()
-            pixels = image.read_image(0, 0, 0, spec.nchannels, "float")
+            if spec.width * spec.height > MAX_TEXELS or spec.nchannels < 1:
+                raise InputError(f"{path}: texture image of {spec.width}x{spec.height} pixels, {spec.nchannels} "
+                                 f"channels; expected at most {MAX_TEXELS} pixels (8192 x 8192) and a channel")
+            pixels = image.read_image(0, 0, 0, min(spec.nchannels, 4), "float")
         finally:
             image.close()
         if pixels is None:
             raise InputError(f"{path}: cannot decode the texture image; expected a readable image file")
-        pixels = np.asarray(pixels, np.float32).reshape(spec.height, spec.width, spec.nchannels)
+        channels = min(spec.nchannels, 4)
+        pixels = np.asarray(pixels, np.float32).reshape(spec.height, spec.width, channels)
         if color_space == "auto":
-            color_space = "sRGB" if spec.format == oiio.UINT8 and spec.nchannels in (3, 4) else "raw"
-        colour = pixels[..., : min(3, spec.nchannels)] if spec.nchannels != 2 else pixels[..., :1]
+            color_space = "sRGB" if spec.format == oiio.UINT8 and channels in (3, 4) else "raw"
+        colour = pixels[..., : min(3, channels)] if channels != 2 else pixels[..., :1]
         if color_space == "sRGB":
             colour = srgb_to_linear(colour)
         if colour.shape[2] == 1:
             colour = np.repeat(colour, 3, axis=2)
-        alpha_index = {2: 1, 4: 3}.get(spec.nchannels)
+        alpha_index = {2: 1, 4: 3}.get(channels)
         alpha = pixels[..., alpha_index:alpha_index + 1] if alpha_index else np.ones_like(colour[..., :1])
         rgba = np.ascontiguousarray(np.concatenate([colour, alpha], axis=2), np.float32)
         self._rgba[key] = rgba

@@ -98,6 +98,31 @@ def test_a_missing_texture_file_renders_the_constant_after_a_warning(tmp_path, c
     assert np.allclose(got[hit], 0.5)
 
 
+def test_an_oversized_texture_is_refused_before_it_is_decoded(quads, class_map, monkeypatch):
+    from synthua_usd.backends.mitsuba import surfaces
+    from synthua_usd.errors import InputError
+
+    monkeypatch.setattr(surfaces, "MAX_TEXELS", 40)
+    snap = read_snapshot(open_stage(quads), 1.0, class_map)
+    with pytest.raises(InputError, match=r"quadrants.png: texture image of 8x6 pixels, 3 channels; expected at most 40"):
+        mitsuba_albedo(variants.activate("scalar_rgb"), snap, read_camera(open_stage(quads), "/World/Cam", 1.0), W, H)
+
+
+def test_wet_weathering_darkens_every_texel(quads, class_map):
+    from synthua_usd.backends.mitsuba import surfaces, weather_scene
+
+    mi = variants.activate("scalar_rgb")
+    material = read_snapshot(open_stage(quads), 1.0, class_map).materials["/World/Looks/Quadrants"]
+    images = surfaces.TextureImages(mi)
+    node = weather_scene.surface_bsdf_dict(material, frozenset({"face_wet"}), images)
+    assert node["type"] == "blendbsdf" and node["bsdf_1"]["base_color"]["type"] == "bitmap"
+    dry = np.asarray(node["bsdf_0"]["base_color"]["bitmap"])
+    wet = np.asarray(node["bsdf_1"]["base_color"]["bitmap"])
+    assert np.allclose(dry, srgb_decoded(TEXELS), atol=1e-6)
+    assert np.allclose(wet, weather_scene.wet_albedo(dry), atol=1e-6)
+    mi.load_dict(node)  # a valid Mitsuba BSDF
+
+
 def _add_texture(stage, name: str, file: str, output: str, target: str, type_name, **inputs) -> None:
     """A UsdUVTexture ``name`` reading ``file`` through the material's st reader, feeding surface input
     ``target`` from ``output``."""
