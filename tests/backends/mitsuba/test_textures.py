@@ -17,7 +17,7 @@ from synthua_usd.backends.mitsuba import variants
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
-from synthua_usd.usd.reader import read_snapshot
+from synthua_usd.usd.reader import StageReader, read_snapshot
 from synthua_usd.usd.stage_io import open_stage
 
 W, H = 64, 48
@@ -121,6 +121,25 @@ def test_wet_weathering_darkens_every_texel(quads, class_map):
     assert np.allclose(dry, srgb_decoded(TEXELS), atol=1e-6)
     assert np.allclose(wet, weather_scene.wet_albedo(dry), atol=1e-6)
     mi.load_dict(node)  # a valid Mitsuba BSDF
+
+
+def test_a_session_moves_a_textured_mesh_and_keeps_its_uvs(quads, class_map):
+    stage = open_stage(quads)
+    stage.SetEndTimeCode(2)
+    op = UsdGeom.Xformable(stage.GetPrimAtPath("/World/Right")).AddTranslateOp()
+    op.Set(Gf.Vec3d(0, 0, 0), 1.0)
+    op.Set(Gf.Vec3d(-0.5, 0.3, 0), 2.0)  # the textured face-varying quad slides under the camera
+    cam = read_camera(stage, "/World/Cam", 1.0)
+    config = RenderConfig(width=W, height=H, spp=4, pixel_filter="box", variant="scalar_rgb")
+    reader = StageReader(stage, class_map)
+    session = RenderSession(config)
+    before = session.render(reader.snapshot(1.0), cam)
+    moved = session.render(reader.snapshot(2.0), cam)
+    assert "update" in moved.seconds and session.loads == 1
+    assert not np.array_equal(before.instance_ids, moved.instance_ids)
+    fresh = RenderSession(config).render(read_snapshot(stage, 2.0, class_map), cam)
+    assert np.array_equal(moved.instance_ids, fresh.instance_ids)
+    assert np.allclose(moved.rgb, fresh.rgb, atol=1e-6)
 
 
 def _add_texture(stage, name: str, file: str, output: str, target: str, type_name, **inputs) -> None:
