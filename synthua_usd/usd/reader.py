@@ -21,7 +21,7 @@ from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
-from synthua_usd.usd.shading import material_for
+from synthua_usd.usd.shading import Materials
 from synthua_usd.usd.stage_io import check_time_code, meters_per_unit
 from synthua_usd.usd.texcoords import fan_corners, read_uvs
 
@@ -206,7 +206,7 @@ class StageReader:
         self.class_map = class_map
         self.meters_per_unit = meters_per_unit(stage)
         self.instances = collect_instances(stage, class_map)
-        self._materials: dict[str, Material] = {}
+        self._materials = Materials()
         self._static: dict[str, MeshItem | None] = {}
         self._varying: dict[str, bool] = {}
         self._xform_memo: dict[str, bool] = {}
@@ -224,7 +224,7 @@ class StageReader:
         message = unsupported_gprim_message(prim)
         if message:
             raise UnsupportedPrimError(f"{prim.GetPath()}: {message}")
-        material = material_for(prim, t, self._materials)
+        material = self._materials.of(prim, t)
         points, tris, uvs = self._geometry(prim, t, material)
         if len(tris) == 0:
             return None
@@ -291,7 +291,7 @@ class StageReader:
         if not lights:
             log.warning("%s: no UsdLux lights; RGB will be black", self.stage.GetRootLayer().identifier)
         self._last = SceneSnapshot(time_code=time_code, up_axis=str(UsdGeom.GetStageUpAxis(self.stage)),
-                                   meshes=tuple(meshes), materials=dict(self._materials), lights=lights,
+                                   meshes=tuple(meshes), materials=dict(self._materials.by_key), lights=lights,
                                    instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)))
         return self._last
 

@@ -7,6 +7,7 @@ graphs and interface inputs (``UsdShade.Utils.GetValueProducingAttributes``) to 
 * an output of a ``UsdUVTexture`` whose ``st`` comes from a ``UsdPrimvarReader_float2`` (its ``varname``
   often an interface input such as ``frame:stPrimvarName``): a :class:`Texture` (file, ``sourceColorSpace``,
   ``wrapS``/``wrapT``, ``scale``, ``bias``, the output used) on the input;
+* for diffuseColor, a ``UsdPrimvarReader_float3``: the gprim's primvar (:class:`Materials`);
 * anything else (``UsdTransform2d``, other shaders, node graphs without a value): the input's constant,
   after a one-line warning naming the prim. So is a texture whose file is missing.
 
@@ -16,7 +17,10 @@ Supported textured inputs: diffuseColor, roughness, metallic, normal, opacity.
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 from pathlib import Path
+
+import numpy as np
 
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 
@@ -37,23 +41,47 @@ WRAP = {"repeat": "repeat", "mirror": "mirror", "clamp": "clamp", "black": "blac
 COLOR_SPACE = {"auto": "auto", "sRGB": "sRGB", "raw": "raw"}
 
 
-def material_for(prim: Usd.Prim, t: Usd.TimeCode, cache: dict[str, Material]) -> Material:
-    """The material of gprim ``prim``: its bound UsdPreviewSurface, else its displayColor, else grey;
-    ``cache`` holds materials already read, by key."""
-    bound, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
-    if bound:
-        key = str(bound.GetPath())
-        if key not in cache:
-            cache[key] = preview_surface(bound, key)
-        return cache[key]
-    color = UsdGeom.Gprim(prim).GetDisplayColorAttr().Get(t)
-    if color is not None and len(color) >= 1:
-        rgb = tuple(float(c) for c in color[0])
-        key = "displayColor(%.4f,%.4f,%.4f)" % rgb
-        cache.setdefault(key, Material(key, rgb, 0.6))
-        return cache[key]
-    cache.setdefault(DEFAULT_MATERIAL.key, DEFAULT_MATERIAL)
-    return DEFAULT_MATERIAL
+class Materials:
+    """The materials of a stage's gprims, each network read once: what a stage reader holds.
+
+    ``by_key`` maps material keys (a bound material's path, a ``displayColor(...)`` or ``default``) to
+    :class:`Material`. A surface whose diffuseColor comes from a ``UsdPrimvarReader_float3`` (``displayColor``,
+    as the usd-wg teapot's ceramic variants author it) takes each gprim's own primvar value: one material per
+    colour, keyed ``<material>[<primvar>=(r,g,b)]``.
+    """
+
+    def __init__(self) -> None:
+        self.by_key: dict[str, Material] = {}
+        self._colour_primvar: dict[str, tuple[str, tuple[float, float, float] | None] | None] = {}
+
+    def of(self, prim: Usd.Prim, t: Usd.TimeCode) -> Material:
+        """The material of gprim ``prim``: its bound UsdPreviewSurface, else its displayColor, else grey."""
+        bound, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
+        if bound:
+            key = str(bound.GetPath())
+            if key not in self.by_key:
+                self.by_key[key] = preview_surface(bound, key)
+                self._colour_primvar[key] = _colour_primvar(bound)
+            reader = self._colour_primvar[key]
+            return self.by_key[key] if reader is None else self._coloured(prim, t, self.by_key[key], *reader)
+        color = UsdGeom.Gprim(prim).GetDisplayColorAttr().Get(t)
+        if color is not None and len(color) >= 1:
+            rgb = tuple(float(c) for c in color[0])
+            key = "displayColor(%.4f,%.4f,%.4f)" % rgb
+            return self.by_key.setdefault(key, Material(key, rgb, 0.6))
+        return self.by_key.setdefault(DEFAULT_MATERIAL.key, DEFAULT_MATERIAL)
+
+    def _coloured(self, prim: Usd.Prim, t: Usd.TimeCode, base: Material, name: str,
+                  fallback: tuple[float, float, float] | None) -> Material:
+        primvar = UsdGeom.PrimvarsAPI(prim).FindPrimvarWithInheritance(name)
+        values = primvar.ComputeFlattened(t) if primvar and primvar.HasValue() else None
+        data = np.asarray(values, np.float64) if values is not None else np.zeros((0, 3))
+        if data.ndim == 2 and data.shape[1] == 3 and len(data) and np.all(np.isfinite(data)):
+            rgb = tuple(float(c) for c in data.mean(axis=0))  # vertex colours: their mean, as flat shading can
+        else:
+            rgb = fallback if fallback is not None else base.base_color
+        key = "%s[%s=(%.4f,%.4f,%.4f)]" % (base.key, name, *rgb)
+        return self.by_key.setdefault(key, replace(base, key=key, base_color=rgb))
 
 
 def preview_surface(material: UsdShade.Material, key: str) -> Material:
@@ -106,6 +134,8 @@ def _input(shader: UsdShade.Shader, name: str, fallback):
         return (constant if value is None else value), None, None
     source = UsdShade.Shader(attr.GetPrim())
     shader_id = source.GetShaderId() if source else None
+    if shader_id == "UsdPrimvarReader_float3" and name == "diffuseColor":  # per gprim: Materials.of
+        return constant, None, None
     if shader_id != "UsdUVTexture" or name not in TEXTURED:
         what = f"'{shader_id}'" if shader_id else "a node graph"
         log.warning("%s is connected to %s at %s, which synthua does not translate; using the constant %s",
@@ -115,6 +145,24 @@ def _input(shader: UsdShade.Shader, name: str, fallback):
     if found is None:
         return constant, None, None
     return constant, found[0], found[1]
+
+
+def _colour_primvar(material: UsdShade.Material) -> tuple[str, tuple[float, float, float] | None] | None:
+    """(primvar name, the reader's fallback colour or None) when ``material``'s diffuseColor comes from a
+    UsdPrimvarReader_float3, else None."""
+    shader = material.ComputeSurfaceSource()[0]
+    inp = shader.GetInput("diffuseColor") if shader else None
+    if not inp or not inp.HasConnectedSource():
+        return None
+    attrs = UsdShade.Utils.GetValueProducingAttributes(inp)
+    if not attrs or UsdShade.Utils.GetBaseNameAndType(attrs[0].GetName())[1] != UsdShade.AttributeType.Output:
+        return None
+    reader = UsdShade.Shader(attrs[0].GetPrim())
+    if not reader or reader.GetShaderId() != "UsdPrimvarReader_float3":
+        return None
+    name = _value(reader, "varname", "")
+    fallback = _value(reader, "fallback", None)
+    return (str(name), tuple(float(c) for c in fallback) if fallback is not None else None) if name else None
 
 
 def _texture(shader: UsdShade.Shader, output: str, where: str) -> tuple[Texture, str] | None:

@@ -148,3 +148,22 @@ def test_a_texture_outside_the_scenario_folder_is_refused_unless_allowed(tmp_pat
         open_stage(tmp_path / "scenario" / "quads.usda")
     stage = open_stage(tmp_path / "scenario" / "quads.usda", allow_external_assets=True)
     assert material(stage, class_map).base_color_texture.path == str(tmp_path / "elsewhere" / "quadrants.png")
+
+
+def test_a_display_color_primvar_reader_gives_each_gprim_its_colour(class_map, caplog):
+    from pxr import Usd
+
+    from conftest import third_party
+
+    stage = Usd.Stage.Open(str(third_party("usd-wg-teapot", "Teapot.usd")))  # default: Utah, CeramicLimeGreen
+    with caplog.at_level(logging.WARNING):
+        snap = read_snapshot(stage, 1.0, class_map)
+    assert "does not translate" not in caplog.text
+    (mesh,) = snap.meshes
+    m = snap.materials[mesh.material_key]
+    assert m.key == "/Teapot/Materials/Ceramic[displayColor=(0.3250,0.8250,0.0000)]"
+    assert m.base_color == pytest.approx((0.325, 0.825, 0.0)) and m.roughness == pytest.approx(0.125)
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        stage.GetPrimAtPath("/Teapot").GetVariantSet("shadingVariant").SetVariantSelection("CeramicBlue")
+    blue = read_snapshot(stage, 1.0, class_map)
+    assert blue.materials[blue.meshes[0].material_key].base_color == pytest.approx((0.013679987, 0.19873393, 0.912))
