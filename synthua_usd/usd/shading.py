@@ -17,6 +17,7 @@ Supported textured inputs: diffuseColor, roughness, metallic, normal, opacity.
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -197,10 +198,17 @@ def _texture(shader: UsdShade.Shader, output: str, where: str) -> tuple[Texture,
         log.warning("%s: %s: output '%s' is not rgb, r, g, b or a; using the input's constant", where, path,
                     echo(output))
         return None
-    scale = tuple(float(v) for v in _value(shader, "scale", Gf.Vec4f(1.0)))
-    bias = tuple(float(v) for v in _value(shader, "bias", Gf.Vec4f(0.0)))
+    factors = {}
+    for name, default in (("scale", Gf.Vec4f(1.0)), ("bias", Gf.Vec4f(0.0))):
+        value = _value(shader, name, default)
+        numbers = tuple(float(v) for v in value) if hasattr(value, "__len__") else (value,)
+        if len(numbers) != 4 or not all(math.isfinite(v) for v in numbers):
+            log.warning("%s: texture %s: %s is %s; expected 4 finite numbers (float4, RGBA); using the input's "
+                        "constant", where, path, name, echo(numbers))
+            return None
+        factors[name] = numbers
     return Texture(str(Path(resolved).resolve()), channel=channel, color_space=COLOR_SPACE.get(space, "auto"),
-                   wrap_s=wrap[0], wrap_t=wrap[1], scale=scale, bias=bias), primvar
+                   wrap_s=wrap[0], wrap_t=wrap[1], **factors), primvar
 
 
 def _st_primvar(shader: UsdShade.Shader, where: str) -> str | None:

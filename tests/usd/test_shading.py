@@ -167,3 +167,14 @@ def test_a_display_color_primvar_reader_gives_each_gprim_its_colour(class_map, c
         stage.GetPrimAtPath("/Teapot").GetVariantSet("shadingVariant").SetVariantSelection("CeramicBlue")
     blue = read_snapshot(stage, 1.0, class_map)
     assert blue.materials[blue.meshes[0].material_key].base_color == pytest.approx((0.013679987, 0.19873393, 0.912))
+
+
+@pytest.mark.parametrize("value", [Gf.Vec4f(float("nan"), 1, 1, 1), Gf.Vec3f(1, 1, 1)])
+def test_a_bad_scale_falls_back_to_the_constant(quads, class_map, caplog, value):
+    image = UsdShade.Shader(quads.GetPrimAtPath(f"{LOOKS}/Image"))
+    kind = Sdf.ValueTypeNames.Float4 if isinstance(value, Gf.Vec4f) else Sdf.ValueTypeNames.Float3
+    image.CreateInput("scale", kind).Set(value)
+    with caplog.at_level(logging.WARNING):
+        m = material(quads, class_map)
+    assert m.base_color_texture is None
+    assert f"texture {LOOKS}/Image: scale is (" in caplog.text and "expected 4 finite numbers" in caplog.text

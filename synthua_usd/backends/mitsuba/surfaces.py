@@ -48,7 +48,7 @@ class TextureImages:
     def __init__(self, mi) -> None:
         self.mi = mi
         self._rgba: dict[tuple[str, str], np.ndarray] = {}
-        self._nodes: dict[tuple, dict] = {}
+        self._nodes: dict[tuple, object] = {}
 
     def rgba(self, path: str, color_space: str) -> np.ndarray:
         """(H, W, 4) float32 linear RGBA of the image at ``path`` (grey fills RGB, missing alpha is 1), decoded
@@ -96,9 +96,10 @@ class TextureImages:
         return rgba[..., CHANNEL[texture.channel]:CHANNEL[texture.channel] + 1]
 
     def node(self, texture: Texture, transform: Callable[[np.ndarray], np.ndarray] | None = None,
-             name: str = "") -> dict:
-        """A ``bitmap`` texture dict of ``texture``'s values, passed through ``transform`` first (``name``
-        tells transforms apart in the cache)."""
+             name: str = ""):
+        """A loaded ``bitmap`` texture of ``texture``'s values, passed through ``transform`` first (``name``
+        tells transforms apart in the cache). Loaded once and shared by every BSDF that uses it: a dict would
+        make Mitsuba copy the pixels into each."""
         key = (texture, name)
         if key not in self._nodes:
             data = self.values(texture)
@@ -107,8 +108,9 @@ class TextureImages:
             if texture.wrap_s != texture.wrap_t or texture.wrap_s == "black":
                 log.warning("%s: wrap modes %s/%s: Mitsuba wraps both axes alike and has no black border; using %s",
                             texture.path, texture.wrap_s, texture.wrap_t, WRAP[texture.wrap_s])
-            self._nodes[key] = {"type": "bitmap", "bitmap": self.mi.Bitmap(np.ascontiguousarray(data, np.float32)),
-                                "raw": True, "filter_type": "bilinear", "wrap_mode": WRAP[texture.wrap_s]}
+            self._nodes[key] = self.mi.load_dict({
+                "type": "bitmap", "bitmap": self.mi.Bitmap(np.ascontiguousarray(data, np.float32)), "raw": True,
+                "filter_type": "bilinear", "wrap_mode": WRAP[texture.wrap_s]})
         return self._nodes[key]
 
 

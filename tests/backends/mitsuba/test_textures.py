@@ -115,9 +115,9 @@ def test_wet_weathering_darkens_every_texel(quads, class_map):
     material = read_snapshot(open_stage(quads), 1.0, class_map).materials["/World/Looks/Quadrants"]
     images = surfaces.TextureImages(mi)
     node = weather_scene.surface_bsdf_dict(material, frozenset({"face_wet"}), images)
-    assert node["type"] == "blendbsdf" and node["bsdf_1"]["base_color"]["type"] == "bitmap"
-    dry = np.asarray(node["bsdf_0"]["base_color"]["bitmap"])
-    wet = np.asarray(node["bsdf_1"]["base_color"]["bitmap"])
+    assert node["type"] == "blendbsdf"
+    dry = np.asarray(mi.traverse(node["bsdf_0"]["base_color"])["data"])
+    wet = np.asarray(mi.traverse(node["bsdf_1"]["base_color"])["data"])
     assert np.allclose(dry, srgb_decoded(TEXELS), atol=1e-6)
     assert np.allclose(wet, weather_scene.wet_albedo(dry), atol=1e-6)
     mi.load_dict(node)  # a valid Mitsuba BSDF
