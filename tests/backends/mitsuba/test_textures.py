@@ -108,6 +108,15 @@ def test_an_oversized_texture_is_refused_before_it_is_decoded(quads, class_map, 
         mitsuba_albedo(variants.activate("scalar_rgb"), snap, read_camera(open_stage(quads), "/World/Cam", 1.0), W, H)
 
 
+def test_a_texture_that_is_no_image_is_an_input_error(quads, class_map, run_cli):
+    (quads.parent / "textures" / "quadrants.png").write_text("not an image")
+    code, _, err = run_cli("render", quads, "--camera", "/World/Cam", "--width", 16, "--height", 12, "--spp", 1,
+                           "--variant", "scalar_rgb", "--out", quads.parent / "out")
+    assert code == 2
+    assert "quadrants.png: cannot read the texture image" in err and "expected a PNG, JPEG, EXR" in err
+    assert not (quads.parent / "out").exists()
+
+
 def test_wet_weathering_darkens_every_texel(quads, class_map):
     from synthua_usd.backends.mitsuba import surfaces, weather_scene
 
