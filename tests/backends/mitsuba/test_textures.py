@@ -167,12 +167,15 @@ def _add_texture(stage, name: str, file: str, output: str, target: str, type_nam
     surface.CreateInput(target, type_name).ConnectToSource(shader.ConnectableAPI(), output)
 
 
-def _lit_from_plus_x(stage) -> None:
-    """Replace the sky by a sun 60° off vertical, shining from +X, and a dim sky."""
+def _lit_from(stage, axis: str) -> None:
+    """Replace the sky by a sun 60° off vertical, shining from +X or +Y (``axis``), and a dim sky."""
     stage.GetPrimAtPath("/World/Sky").GetAttribute("inputs:intensity").Set(0.05)
     sun = UsdLux.DistantLight.Define(stage, "/World/Sun")
     sun.CreateIntensityAttr(3.0)
-    UsdGeom.Xformable(sun).AddRotateYOp().Set(60.0)  # the light's -Z towards -X and down
+    if axis == "x":
+        UsdGeom.Xformable(sun).AddRotateYOp().Set(60.0)  # the light's -Z towards -X and down
+    else:
+        UsdGeom.Xformable(sun).AddRotateXOp().Set(-60.0)  # the light's -Z towards -Y and down
 
 
 def _mean_rgb(stage, class_map, prim: str):
@@ -183,21 +186,25 @@ def _mean_rgb(stage, class_map, prim: str):
     return frame.rgb[frame.hits.mesh_index == index].mean(axis=0)
 
 
-@pytest.mark.parametrize("tilt_x, brighter", [(0.6, True), (-0.6, False)])
-def test_a_normal_map_tilts_the_shading(tmp_path, class_map, tilt_x, brighter):
+@pytest.mark.parametrize("axis, tilt, brighter", [("x", 0.6, True), ("x", -0.6, False), ("y", 0.6, True),
+                                                   ("y", -0.6, False)])
+def test_a_normal_map_tilts_the_shading(tmp_path, class_map, axis, tilt, brighter):
+    # The quad's s runs along +X and t along +Y: a tangent-space normal's red tilts it towards +s, its green
+    # towards +t (UsdPreviewSurface's and glTF's convention), whatever way Mitsuba's v runs.
     shutil.copy(DATA / "valid" / "textured_quads.usda", tmp_path / "quads.usda")
     write_png(tmp_path / "textures" / "quadrants.png", np.full((2, 2, 3), 200, np.uint8))
-    n = np.array([tilt_x, 0.0, 1.0]) / np.linalg.norm([tilt_x, 0.0, 1.0])
+    n = np.array([tilt, 0.0, 1.0] if axis == "x" else [0.0, tilt, 1.0])
+    n /= np.linalg.norm(n)
     write_png(tmp_path / "textures" / "normal.png", np.tile(np.round((n * 0.5 + 0.5) * 255), (2, 2, 1)))
     stage = open_stage(tmp_path / "quads.usda")
-    _lit_from_plus_x(stage)
+    _lit_from(stage, axis)
     flat = _mean_rgb(stage, class_map, "/World/Left")
     _add_texture(stage, "Normals", "./textures/normal.png", "rgb", "normal", Sdf.ValueTypeNames.Normal3f,
                  sourceColorSpace=(Sdf.ValueTypeNames.Token, "raw"),
                  scale=(Sdf.ValueTypeNames.Float4, Gf.Vec4f(2, 2, 2, 1)),
                  bias=(Sdf.ValueTypeNames.Float4, Gf.Vec4f(-1, -1, -1, 0)))
     tilted = _mean_rgb(stage, class_map, "/World/Left")
-    # Lambert: cos(60°) = 0.5 flat; a normal tilted ±31° about Y faces the sun at 29° or 91°.
+    # Lambert: cos(60°) = 0.5 flat; a normal tilted ±31° towards the sun faces it at 29° or 91°.
     assert (tilted.mean() > 1.3 * flat.mean()) if brighter else (tilted.mean() < 0.5 * flat.mean())
 
 
