@@ -109,7 +109,7 @@ class TextureImages:
                 log.warning("%s: wrap modes %s/%s: Mitsuba wraps both axes alike and has no black border; using %s",
                             texture.path, texture.wrap_s, texture.wrap_t, WRAP[texture.wrap_s])
             self._nodes[key] = self.mi.load_dict({
-                "type": "bitmap", "bitmap": self.mi.Bitmap(np.ascontiguousarray(data, np.float32)), "raw": True,
+                "type": "bitmap", "data": self.mi.TensorXf(np.ascontiguousarray(data, np.float32)), "raw": True,
                 "filter_type": "bilinear", "wrap_mode": WRAP[texture.wrap_s]})
         return self._nodes[key]
 

@@ -92,11 +92,12 @@ def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter
           uvs: np.ndarray | None = None):
     """A Mitsuba mesh of ``points`` (n, 3) and ``triangles`` (m, 3); ``uvs`` (n, 2) in USD's st convention."""
     props = mi.Properties()
-    props["bsdf"] = bsdf
     if emitter is not None:
         props["emitter"] = emitter
     mesh = mi.Mesh(key, len(points), len(triangles), props=props, has_vertex_normals=False,
                    has_vertex_texcoords=uvs is not None)
+    # The BSDF joins after the arrays: traversing a mesh traverses its BSDF too, and textured BSDFs made
+    # every traversal copy their texture data (measured: 0.5 MB and ~9 ms per mesh on the district).
     params = mi.traverse(mesh)
     params["vertex_positions"] = type(params["vertex_positions"])(np.ascontiguousarray(points, np.float32).ravel())
     params["faces"] = type(params["faces"])(np.ascontiguousarray(triangles, np.uint32).ravel())
@@ -105,6 +106,7 @@ def _mesh(mi, key: str, points: np.ndarray, triangles: np.ndarray, bsdf, emitter
     params.update()
     for name, values in (face_attributes or {}).items():
         mesh.add_attribute(name, 1, type(params["vertex_positions"])(values))
+    mesh.set_bsdf(bsdf)
     return mesh
 
 
