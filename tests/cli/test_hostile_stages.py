@@ -45,6 +45,9 @@ BROKEN_STAGES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
                         ("gone.usda",)),
     "layer outside the folder": ('#usda 1.0\n(\n    subLayers = [@../outside/tiny.usda@]\n)\n',
                                  ("outside", "--allow-external-assets")),
+    "texture is a system file": ((DATA / "valid" / "textured_quads.usda").read_text().replace(
+        "@./textures/quadrants.png@", "@/etc/passwd@"), ("/World/Looks/Quadrants/Image", "/etc/passwd",
+                                                        "--allow-external-assets")),
     "not UTF-8": (TINY.encode("utf-8").replace(b'"Ground"', b'"Gr\xff\xfeund"'), ("not a readable usd",)),
     "syntax error": (TINY[: len(TINY) // 2], ("not a readable usd",)),
     "empty file": ("", ("not a readable usd",)),
