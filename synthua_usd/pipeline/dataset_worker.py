@@ -212,7 +212,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         "condition": condition.to_dict() if condition is not None else None,
         "exposure": rendered.exposure.to_dict() if rendered.exposure is not None else None,
         "render": {"variant": rendered.variant, "spp": job.render.spp, "pixel_filter": job.render.pixel_filter,
-                   "max_depth": job.render.max_depth, "width": job.render.width, "height": job.render.height},
+                   "max_depth": job.render.max_depth, "width": job.render.width, "height": job.render.height,
+                   "denoise": rendered.denoised},
         "layer_stack": job.layer_stack,
         "files": files,
         "class_pixel_counts": {class_map.by_id(int(c)).name: int(n)

@@ -62,6 +62,8 @@ class FrameRequest:
     keep_buffers: bool | None = None
     #: A condition the stage offers (its ``condition`` variant); None: the stage's own selection.
     condition: str | None = None
+    #: Denoise RGB (:attr:`RenderConfig.denoise`); None: the default.
+    denoise: bool | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,7 +124,8 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     width, height = defaults.resolution or (RenderConfig.width, RenderConfig.height)
     spp = request.spp if request.spp is not None else defaults.spp if defaults.spp is not None else RenderConfig.spp
     config = RenderConfig(width=request.width or width, height=request.height or height, spp=spp, seed=request.seed,
-                          variant=request.variant)
+                          variant=request.variant,
+                          denoise=RenderConfig.denoise if request.denoise is None else request.denoise)
     condition = read_condition(stage, request.condition)
     reader = StageReader(stage, class_map)
     if not reader.snapshot(time_codes[0]).meshes:
@@ -192,6 +195,7 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
         },
         "render": {"renderer": "mitsuba", "variant": rendered.variant, "spp": config.spp,
                    "max_depth": config.max_depth, "pixel_filter": config.pixel_filter, "seed": config.seed,
+                   "denoise": rendered.denoised,
                    "labels": "one ray through each pixel centre", "seconds": rendered.seconds},
         "files": {f.key: f.document() for o in outputs for f in o.files},
         "class_map": {"source": class_map.source, "taxonomy": class_map.taxonomy,
