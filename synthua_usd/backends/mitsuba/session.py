@@ -61,12 +61,10 @@ class RenderSession:
         self._lighting: weather_scene.Lighting | None = None
         self._meter: weather_scene.LightMeter | None = None
         self._amodal: AmodalScene | None = None
-        # With denoise on: the aov integrator that adds the denoiser's guides, and the OIDN device (made once).
+        # With denoise on: the aov integrator that adds the denoiser's guides and the OIDN device, made with the
+        # first RGB frame (a session that only traces labels needs neither).
         self._guides = None
-        if config.denoise:  # the scalar variant needs the guides wrapped around the path tracer (see there)
-            wrapped = self.variant.startswith("scalar")
-            self._guides = self.mi.load_dict(guide_integrator_dict(config if wrapped else None))
-        self._denoiser: Denoiser | None = Denoiser() if config.denoise else None
+        self._denoiser: Denoiser | None = None
 
     def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
         self._translation = translate(self.mi, snapshot, camera, self.config, condition)
@@ -170,6 +168,11 @@ class RenderSession:
                 self._focus_lamps(hits, camera)
             # Mitsuba's perspective sensor cannot distort: a lens with distortion renders through its own sensor.
             sensor = distorted_sensor(self.mi, camera, self.config) if camera.distortion is not None else None
+            if self.config.denoise and self._denoiser is None:
+                # The scalar variant needs the guides wrapped around the path tracer (see guide_integrator_dict).
+                wrapped = self.variant.startswith("scalar")
+                self._guides = self.mi.load_dict(guide_integrator_dict(self.config if wrapped else None))
+                self._denoiser = Denoiser()
             rgb_pass = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor, seed=seed,
                                   guides=self._guides)
             image = rgb_pass.rgb

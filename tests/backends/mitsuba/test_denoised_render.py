@@ -54,9 +54,8 @@ def test_denoising_measurably_improves_a_few_sample_render(lit, variant):
 def test_guides_are_the_first_hit_albedo_and_a_unit_normal_facing_the_camera(lit, variant):
     snapshot, camera = lit
     session = RenderSession(RenderConfig(width=WIDTH, height=HEIGHT, spp=4, variant=variant))
-    frame = session.render(snapshot, camera, rgb=False)
-    mi = session.mi
-    result = render_rgb(mi, session._scene, session.config, guides=session._guides)
+    frame = session.render(snapshot, camera)  # the first RGB frame makes the session's guide integrator
+    result = render_rgb(session.mi, session._scene, session.config, guides=session._guides)
     assert result.albedo.shape == result.normal.shape == (HEIGHT, WIDTH, 3)
     inner = _interior(frame.class_ids == 1)
     assert inner.sum() > 100
