@@ -12,6 +12,8 @@ as EXR under --cache, keyed by view, size, spp, seed and variant). Then every se
 
   16 spp gaussian            the old default filter, no denoiser
   16 spp box                 no denoiser
+  64 spp gaussian            the old default (64 spp, gaussian filter), no denoiser
+  64 spp box                 no denoiser
   N spp box + OIDN           N in --spp: the firefly filter, then OIDN guided by albedo and normal
   N spp box + OIDN, no ff    (ablation, the default N only) the same without the firefly filter
   N spp gaussian + OIDN      (ablation, the default N only) OIDN on correlated noise
@@ -49,7 +51,8 @@ class Setting:
 
 
 def settings(spp_list, default_spp: int, ablation: bool) -> list[Setting]:
-    rows = [Setting("16 spp gaussian", 16, "gaussian", False), Setting("16 spp box", 16, "box", False)]
+    rows = [Setting("16 spp gaussian", 16, "gaussian", False), Setting("16 spp box", 16, "box", False),
+            Setting("64 spp gaussian (the old default)", 64, "gaussian", False), Setting("64 spp box", 64, "box", False)]
     rows += [Setting(f"{n} spp box + OIDN", n, "box", True) for n in spp_list]
     if ablation:
         rows.append(Setting(f"{default_spp} spp box + OIDN, no firefly filter", default_spp, "box", True, False))
