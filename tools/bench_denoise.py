@@ -19,6 +19,8 @@ as EXR under --cache, keyed by view, size, spp, seed and variant). Then every se
   N spp gaussian + OIDN      (ablation, the default N only) OIDN on correlated noise
 
 and is scored with synthua_usd.image_quality (PSNR and SSIM on display values at the reference's exposure).
+The reference's own noise caps every score: the ceiling printed per view is what a noise-free image would score
+(estimated from the 16-spp box row, whose error is 32 parts its own noise to 1 part the reference's at 512).
 Time is the RGB pass plus denoising (labels and scene loads left out; each setting renders one warm-up
 frame first so kernel compilation is not counted). Other seeds than the reference's. Printed: one row per
 view and setting, then per setting the mean PSNR, the minimum PSNR, the mean SSIM, the mean time and the
@@ -30,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import math
 import statistics
 import sys
 import time
@@ -152,6 +155,13 @@ def main() -> int:
             print(f"{path.rsplit('/', 1)[-1]:34} {row.label:44} {p:8.2f} {s:7.4f} {seconds:7.2f} {ff!s:>9}",
                   flush=True)
 
+    # The reference has noise of its own: with independent box-filtered samples, the expected squared error of
+    # the 16-spp box row is s2/16 + s2/R (R the reference's spp), so the reference alone contributes s2/R, and
+    # a noise-free image would score PSNR(16 spp box) + 10 log10(1 + R/16) against it: the ceiling of the table.
+    lift = 10 * math.log10(1 + args.reference_spp / 16)
+    ceilings = [p + lift for p, _, _ in results["16 spp box"]]
+    print("\nreference noise ceiling (what a noise-free image would score), per view: "
+          + ", ".join(f"{path.rsplit('/', 1)[-1]} {c:.1f} dB" for path, c in zip(cameras, ceilings)))
     base = results["16 spp gaussian"]
     base_time = statistics.mean(r[2] for r in base)
     base_psnr = statistics.mean(r[0] for r in base)
