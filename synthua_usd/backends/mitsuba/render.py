@@ -82,13 +82,13 @@ def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sen
         for k in range(passes):
             spp = min(SPP_PER_PASS, config.spp - done)
             pass_seed = seed * 100_003 + k
-            film = 0 if sensor is None else sensor
-            aux = None if guides is None else np.asarray(mi.render(scene, spp=spp, seed=pass_seed, sensor=film,
+            which = 0 if sensor is None else sensor  # the scene's own sensor, or the given one
+            aux = None if guides is None else np.asarray(mi.render(scene, spp=spp, seed=pass_seed, sensor=which,
                                                                    integrator=guides), np.float64)
             if aux is not None and aux.shape[2] >= 9:  # wrapped around the path tracer: R, G, B, then the guides
                 total += aux[..., :9] * spp
             else:
-                image = mi.render(scene, spp=spp, seed=pass_seed, sensor=film)
+                image = mi.render(scene, spp=spp, seed=pass_seed, sensor=which)
                 total[..., :3] += np.asarray(image, np.float64)[..., :3] * spp
                 if aux is not None:  # albedo (3), then shading normal (3)
                     total[..., 3:] += aux[..., :6] * spp
