@@ -39,6 +39,9 @@ log = logging.getLogger(__name__)
 
 #: A pixel brighter than this many times its brightest neighbour is a firefly (see the module docstring).
 FIREFLY_RATIO = 4.0
+#: OIDN's memory limit per filter: it denoises larger images in overlapping tiles. Measured at 1280x960: peak
+#: memory 531 MiB against 787 MiB without a limit, the same bytes out, no slower.
+MAX_MEMORY_MB = 512
 
 
 class DenoiserError(RuntimeError):
@@ -136,6 +139,7 @@ class Denoiser:
             flt.set_bool("hdr", True)
             flt.set_bool("cleanAux", False)  # few-sample guides: see the module docstring
             flt.set_quality(pyoidn.OIDN_QUALITY_HIGH)
+            flt.set_int("maxMemoryMB", MAX_MEMORY_MB)
             flt.commit()
             self._check("filter set-up")
             flt.execute()
