@@ -41,7 +41,7 @@ stages: setup
 
 ## Benchmarks (not tests: ratios and timings measured side by side in one run): rendering through a
 ## render session (first load, per-frame update, labels, RGB), building the district, imports and agents, the
-## amodal pass, and dataset workers' memory over 500 images.
+## amodal pass, dataset workers' memory over 500 images, and denoised RGB against 512-spp references.
 bench: setup
 	$(BIN)/python tools/bench_render.py
 	$(BIN)/python tools/bench_conditions.py
@@ -50,6 +50,7 @@ bench: setup
 	$(BIN)/python tools/bench_twin.py
 	$(BIN)/python tools/bench_amodal.py
 	$(BIN)/python tools/bench_generate.py --memory 500
+	$(BIN)/python tools/bench_denoise.py
 
 clean:
 	rm -rf out .pytest_cache

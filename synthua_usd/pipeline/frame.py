@@ -2,8 +2,10 @@
 
 Several (camera, time code) pairs render from one :class:`RenderSession` (one scene load). One frame
 writes its files straight into the output folder; several write ``<camera name>/<time code>/`` below it.
-All frames are written into a staging folder and moved into place together, so a failed run leaves the
-output folder as it was.
+A frame's files are written on a background thread while the next frame renders
+(:class:`synthua_usd.pipeline.background.BackgroundWriter`, bounded: one frame waits at most). All frames are
+written into a staging folder and moved into place together, so a failed run (a failed write included)
+leaves the output folder as it was.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.cameras import CONFORM_EXPAND, PinholeCamera
 from synthua_usd.errors import InputError, StageError, echo
 from synthua_usd.outputs import OUTPUT_NAMES, RenderOutput, select_outputs
+from synthua_usd.pipeline.background import BackgroundWriter
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.resources import check_frame_memory
 from synthua_usd.scene import SceneSnapshot
@@ -62,6 +65,8 @@ class FrameRequest:
     keep_buffers: bool | None = None
     #: A condition the stage offers (its ``condition`` variant); None: the stage's own selection.
     condition: str | None = None
+    #: Denoise RGB (:attr:`RenderConfig.denoise`); None: the default.
+    denoise: bool | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,7 +127,8 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     width, height = defaults.resolution or (RenderConfig.width, RenderConfig.height)
     spp = request.spp if request.spp is not None else defaults.spp if defaults.spp is not None else RenderConfig.spp
     config = RenderConfig(width=request.width or width, height=request.height or height, spp=spp, seed=request.seed,
-                          variant=request.variant)
+                          variant=request.variant,
+                          denoise=RenderConfig.denoise if request.denoise is None else request.denoise)
     condition = read_condition(stage, request.condition)
     reader = StageReader(stage, class_map)
     if not reader.snapshot(time_codes[0]).meshes:
@@ -133,7 +139,9 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     run = RenderRun()
     single = len(frames) == 1
     want_rgb = any(o.var == "rgb" for o in outputs)
-    with output_set(request.out_dir) as staging:
+    keep = request.keep_buffers if request.keep_buffers is not None else single
+    # Frame N's files are written on a background thread while frame N+1 renders; at most one frame waits.
+    with output_set(request.out_dir) as staging, BackgroundWriter(max_pending=1) as writer:
         bar = tqdm(frames, unit="frame", desc="render", disable=not show_progress or single)
         for cam_path, tc in bar:
             snapshot = reader.snapshot(tc)
@@ -143,18 +151,25 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
             rel = Path() if single else Path(cam_path.rsplit("/", 1)[-1]) / time_code_folder(tc)
             doc = frame_document(request.stage_path, outputs, time_code=tc, camera=camera, config=config,
                                  snapshot=snapshot, rendered=rendered, class_map=class_map)
-            t0 = time.perf_counter()
-            written = write_frame(staging / rel, outputs, rgb=rendered.rgb, class_ids=rendered.class_ids,
-                                  instance_ids=rendered.instance_ids, z_depth=rendered.hits.z_m,
-                                  palette=class_map.palette(), frame_doc=doc,
-                                  display_scale=rendered.exposure.scale if rendered.exposure else 1.0)
-            log.info("wrote %d files for %s at %g in %.2f s", len(written), cam_path, tc, time.perf_counter() - t0)
-            files = [request.out_dir / rel / p.name for p in written]
-            keep = request.keep_buffers if request.keep_buffers is not None else single
-            run.frames.append(FrameResult(request.out_dir / rel, files, doc, snapshot if keep else None, camera,
-                                          rendered if keep else None))
+            run.frames += writer.submit(_write_frame, writer, staging, rel, request.out_dir, outputs, doc,
+                                        snapshot if keep else None, camera, rendered, class_map, keep)
+        run.frames += writer.drain()
     run.loads, run.reloads = session.loads, session.reloads
     return run
+
+
+def _write_frame(writer: BackgroundWriter, staging: Path, rel: Path, out_dir: Path, outputs, doc: dict, snapshot,
+                 camera: PinholeCamera, rendered: RenderedFrame, class_map: ClassMap, keep: bool) -> FrameResult:
+    """Write one frame's files into ``staging / rel`` (on the writer's thread); its :class:`FrameResult`."""
+    t0 = time.perf_counter()
+    written = write_frame(staging / rel, outputs, rgb=rendered.rgb, class_ids=rendered.class_ids,
+                          instance_ids=rendered.instance_ids, z_depth=rendered.hits.z_m, palette=class_map.palette(),
+                          frame_doc=doc, display_scale=rendered.exposure.scale if rendered.exposure else 1.0,
+                          encoders=writer.encoders)
+    log.info("wrote %d files for %s at %g in %.2f s", len(written), camera.path, doc["time_code"],
+             time.perf_counter() - t0)
+    return FrameResult(out_dir / rel, [out_dir / rel / p.name for p in written], doc, snapshot, camera,
+                       rendered if keep else None)
 
 
 def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_code: float, camera: PinholeCamera,
@@ -192,6 +207,7 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
         },
         "render": {"renderer": "mitsuba", "variant": rendered.variant, "spp": config.spp,
                    "max_depth": config.max_depth, "pixel_filter": config.pixel_filter, "seed": config.seed,
+                   "denoise": rendered.denoised,
                    "labels": "one ray through each pixel centre", "seconds": rendered.seconds},
         "files": {f.key: f.document() for o in outputs for f in o.files},
         "class_map": {"source": class_map.source, "taxonomy": class_map.taxonomy,

@@ -117,6 +117,21 @@ def test_rerun_with_two_workers_is_byte_identical(generated, tmp_path):
     assert tree_bytes(out) == tree_bytes(generated)
 
 
+def test_denoised_dataset_is_byte_identical_on_one_and_two_workers(tmp_path):
+    """tests/data/configs/tiny.json renders without the denoiser (its QA expectations were made on noisy
+    images); here the same job with the default quality, denoised: OIDN's output must not depend on the worker
+    count or the run."""
+    config = json.loads(TINY_CONFIG.read_text())
+    config["render"]["denoise"] = True
+    config["images"] = 4
+    path = tmp_path / "denoised.json"
+    path.write_text(json.dumps(config))
+    generate_dataset(tmp_path / "one", config=path, workers=1)
+    generate_dataset(tmp_path / "two", config=path, workers=2)
+    assert tree_bytes(tmp_path / "one") == tree_bytes(tmp_path / "two")
+    assert all(r["render"]["denoise"] for r in records(tmp_path / "one"))
+
+
 @pytest.mark.slow
 def test_ray_executor_gives_the_same_bytes(generated, tmp_path):
     pytest.importorskip("ray")

@@ -41,7 +41,8 @@ class LabelHits:
 class RenderedFrame:
     """All buffers of one frame. ``rgb`` (H, W, 3) float32 scene-linear Rec.709; ``class_ids`` (H, W) uint8;
     ``instance_ids`` (H, W) uint16; depths as in :class:`LabelHits`. ``exposure`` is chosen from ``rgb``
-    (None without RGB); ``condition`` is the condition rendered (None: the stage's UsdLux lights)."""
+    (None without RGB); ``condition`` is the condition rendered (None: the stage's UsdLux lights); ``denoised``
+    says how ``rgb`` was denoised (the denoiser and the firefly pixels scaled down; None: not denoised)."""
 
     rgb: np.ndarray = field(repr=False)
     class_ids: np.ndarray = field(repr=False)
@@ -51,25 +52,52 @@ class RenderedFrame:
     seconds: dict
     exposure: Exposure | None = None
     condition: Condition | None = None
+    denoised: dict | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class RgbPass:
+    """The RGB pass of one frame, all (H, W, 3) float32: ``rgb`` scene-linear Rec.709 radiance; with guides (see
+    :func:`render_rgb`), ``albedo`` (diffuse reflectance of the first hit, 0 on a miss) and ``normal`` (world-space
+    shading normal of the first hit, 0 on a miss), averaged over the same film positions as ``rgb``; None
+    without."""
+
+    rgb: np.ndarray = field(repr=False)
+    albedo: np.ndarray | None = field(default=None, repr=False)
+    normal: np.ndarray | None = field(default=None, repr=False)
 
 
 def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sensor=None,
-               seed: int | None = None) -> np.ndarray:
-    """(H, W, 3) float32 linear RGB: the mean of passes of at most SPP_PER_PASS samples each; ``sensor`` (e.g. a
+               seed: int | None = None, guides=None) -> RgbPass:
+    """The RGB pass: the mean of passes of at most SPP_PER_PASS samples each; ``sensor`` (e.g. a
     :func:`synthua_usd.backends.mitsuba.lens.distorted_sensor`) replaces the scene's own; ``seed`` replaces
-    ``config.seed``."""
+    ``config.seed``. ``guides`` (a loaded :func:`synthua_usd.backends.mitsuba.translate.guide_integrator_dict`)
+    adds albedo and normal at the colour's film positions: a guides-only integrator is rendered after the colour
+    with the same seed and sample count (JIT variants); one wrapped around the path tracer renders both."""
     seed = config.seed if seed is None else seed
     passes = math.ceil(config.spp / SPP_PER_PASS)
-    total = np.zeros((config.height, config.width, 3), np.float64)
+    total = np.zeros((config.height, config.width, 3 if guides is None else 9), np.float64)
     done = 0
     with tqdm(total=config.spp, unit="spp", desc="rgb", disable=not show_progress, leave=False) as bar:
         for k in range(passes):
             spp = min(SPP_PER_PASS, config.spp - done)
-            image = mi.render(scene, spp=spp, seed=seed * 100_003 + k, sensor=0 if sensor is None else sensor)
-            total += np.asarray(image, np.float64)[..., :3] * spp
+            pass_seed = seed * 100_003 + k
+            which = 0 if sensor is None else sensor  # the scene's own sensor, or the given one
+            aux = None if guides is None else np.asarray(mi.render(scene, spp=spp, seed=pass_seed, sensor=which,
+                                                                   integrator=guides), np.float64)
+            if aux is not None and aux.shape[2] >= 9:  # wrapped around the path tracer: R, G, B, then the guides
+                total += aux[..., :9] * spp
+            else:
+                image = mi.render(scene, spp=spp, seed=pass_seed, sensor=which)
+                total[..., :3] += np.asarray(image, np.float64)[..., :3] * spp
+                if aux is not None:  # albedo (3), then shading normal (3)
+                    total[..., 3:] += aux[..., :6] * spp
             done += spp
             bar.update(spp)
-    return (total / config.spp).astype(np.float32)
+    mean = (total / config.spp).astype(np.float32)
+    if guides is None:
+        return RgbPass(mean)
+    return RgbPass(*(np.ascontiguousarray(mean[..., i:i + 3]) for i in (0, 3, 6)))
 
 
 def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCamera, width: int, height: int,

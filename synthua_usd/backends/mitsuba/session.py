@@ -28,12 +28,13 @@ from typing import Iterable
 import numpy as np
 
 from synthua_usd.backends import weather
+from synthua_usd.backends.denoise import Denoiser
 from synthua_usd.backends.exposure import choose_exposure
 from synthua_usd.backends.mitsuba import variants, weather_scene
 from synthua_usd.backends.mitsuba.amodal import AmodalScene, checked_ids
 from synthua_usd.backends.mitsuba.lens import distorted_sensor
 from synthua_usd.backends.mitsuba.render import RenderedFrame, label_maps, render_rgb, trace_pixel_centres
-from synthua_usd.backends.mitsuba.translate import Translation, sensor_to_world, translate
+from synthua_usd.backends.mitsuba.translate import Translation, guide_integrator_dict, sensor_to_world, translate
 from synthua_usd.cameras import PinholeCamera
 from synthua_usd.conditions import Condition
 from synthua_usd.render_config import RenderConfig
@@ -60,6 +61,10 @@ class RenderSession:
         self._lighting: weather_scene.Lighting | None = None
         self._meter: weather_scene.LightMeter | None = None
         self._amodal: AmodalScene | None = None
+        # With denoise on: the aov integrator that adds the denoiser's guides and the OIDN device, made with the
+        # first RGB frame (a session that only traces labels needs neither).
+        self._guides = None
+        self._denoiser: Denoiser | None = None
 
     def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
         self._translation = translate(self.mi, snapshot, camera, self.config, condition)
@@ -137,7 +142,8 @@ class RenderSession:
         sampler and the rain.
 
         ``seconds`` in the result holds ``load`` (first load or reload) or ``update``, then ``labels``,
-        ``rgb`` and ``weather`` (fog, rain and exposure in image space)."""
+        ``rgb``, ``denoise`` (with the config's ``denoise``: fireflies and OIDN, before any weather) and
+        ``weather`` (fog, rain and exposure in image space)."""
         seconds = {}
         t0 = time.perf_counter()
         if self._scene is None:
@@ -155,15 +161,29 @@ class RenderSession:
         hits = trace_pixel_centres(self.mi, self._scene, self._translation.shape_ids, camera, w, h)
         class_ids, instance_ids = label_maps(hits, snapshot)
         seconds["labels"] = time.perf_counter() - t0
-        image = exposure = None
+        image = exposure = denoised = None
         if rgb:
             t0 = time.perf_counter()
             if condition is not None and self._translation.lamps:
                 self._focus_lamps(hits, camera)
             # Mitsuba's perspective sensor cannot distort: a lens with distortion renders through its own sensor.
             sensor = distorted_sensor(self.mi, camera, self.config) if camera.distortion is not None else None
-            image = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor, seed=seed)
+            if self.config.denoise and self._denoiser is None:
+                # The scalar variant needs the guides wrapped around the path tracer (see guide_integrator_dict).
+                wrapped = self.variant.startswith("scalar")
+                self._guides = self.mi.load_dict(guide_integrator_dict(self.config if wrapped else None))
+                self._denoiser = Denoiser()
+            rgb_pass = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor, seed=seed,
+                                  guides=self._guides)
+            image = rgb_pass.rgb
             seconds["rgb"] = time.perf_counter() - t0
+            if self._denoiser is not None:
+                # Path-traced radiance only: fog and rain are added afterwards, noise-free, in image space.
+                t0 = time.perf_counter()
+                image, fireflies = self._denoiser.denoise_pass(image, rgb_pass.albedo, rgb_pass.normal)
+                seconds["denoise"] = time.perf_counter() - t0
+                denoised = {"denoiser": "Intel Open Image Denoise (RT filter, HDR, albedo and normal guides)",
+                            "firefly_pixels": fireflies.pixels}
             t0 = time.perf_counter()
             if condition is not None:
                 image = self._weather(image, hits, camera, condition, snapshot,
@@ -171,7 +191,8 @@ class RenderSession:
             exposure = choose_exposure(image, hits.mesh_index >= 0)
             seconds["weather"] = time.perf_counter() - t0
         return RenderedFrame(rgb=image, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
-                             variant=self.variant, seconds=seconds, exposure=exposure, condition=condition)
+                             variant=self.variant, seconds=seconds, exposure=exposure, condition=condition,
+                             denoised=denoised)
 
     def amodal(self, snapshot: SceneSnapshot, camera: PinholeCamera, instance_ids: Iterable[int]) -> dict[int, np.ndarray]:
         """Amodal masks of ``instance_ids`` (ids of ``snapshot.instances``) seen by ``camera``: each id → (k,)

@@ -41,7 +41,8 @@ def test_labels_are_the_classes_and_instances_of_the_hit_meshes(tiny, variant):
 
 def test_tiny_render_rgb_is_lit_and_seeded(tiny, variant):
     snap, cam = tiny
-    config = RenderConfig(width=32, height=24, spp=4, seed=3, variant=variant)
+    # The path tracer itself (tests/backends/mitsuba/test_denoised_render.py covers denoising).
+    config = RenderConfig(width=32, height=24, spp=4, seed=3, denoise=False, variant=variant)
     a = RenderSession(config).render(snap, cam)
     b = RenderSession(config).render(snap, cam)
     assert a.rgb.shape == (24, 32, 3) and a.rgb.dtype == np.float32
@@ -55,5 +56,5 @@ def test_tiny_render_rgb_is_lit_and_seeded(tiny, variant):
     sky_rows = np.flatnonzero((a.class_ids == 0).all(axis=1))[:-2]
     assert len(sky_rows) > 3 and np.allclose(a.rgb[sky_rows], 1.0, atol=1e-5)
     # Another seed draws other samples.
-    c = RenderSession(RenderConfig(width=32, height=24, spp=4, seed=4, variant=variant)).render(snap, cam)
+    c = RenderSession(RenderConfig(width=32, height=24, spp=4, seed=4, denoise=False, variant=variant)).render(snap, cam)
     assert not np.allclose(a.rgb[ground], c.rgb[ground], rtol=0, atol=1e-6)

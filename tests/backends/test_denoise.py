@@ -1,0 +1,72 @@
+"""The denoiser on its own (no renderer): the firefly filter, OIDN's determinism, and refused inputs."""
+
+import numpy as np
+import pytest
+
+from synthua_usd.backends.denoise import FIREFLY_RATIO, Denoiser, suppress_fireflies
+from synthua_usd.photometry import luminance
+
+
+def noisy_scene(seed: int = 0, size=(48, 64)):
+    """(colour, albedo, normal, clean): a lit wall and a floor with a shadow edge, and Monte Carlo-like noise
+    (each pixel the mean of 2 samples that are 0 or a lit value)."""
+    h, w = size
+    rng = np.random.default_rng(seed)
+    albedo = np.zeros((h, w, 3), np.float32)
+    albedo[: h // 2] = (0.6, 0.3, 0.2)
+    albedo[h // 2:] = (0.3, 0.3, 0.3)
+    normal = np.zeros((h, w, 3), np.float32)
+    normal[: h // 2] = (0, 0, -1)
+    normal[h // 2:] = (0, 1, 0)
+    light = np.where(np.arange(w)[None, :, None] < w // 2, 1.0, 0.3).astype(np.float32)
+    clean = albedo * light
+    hits = rng.random((h, w, 2)) < 0.5
+    colour = (clean * hits.mean(axis=2, keepdims=True) * 2).astype(np.float32)
+    return colour, albedo, normal, clean
+
+
+def test_an_isolated_spike_is_scaled_down_and_a_bright_region_kept():
+    rgb = np.full((9, 9, 3), 0.1, np.float32)
+    rgb[2, 2] = (50.0, 40.0, 30.0)  # a firefly
+    rgb[5:8, 5:8] = 20.0  # a lamp: every pixel has bright neighbours
+    out, report = suppress_fireflies(rgb)
+    assert report.pixels == 1 and report.share == pytest.approx(1 / 81)
+    assert luminance(out[2, 2]) == pytest.approx(FIREFLY_RATIO * 0.1, rel=1e-5)
+    assert out[2, 2, 0] / out[2, 2, 2] == pytest.approx(50 / 30, rel=1e-5)  # hue kept
+    mask = np.ones((9, 9), bool)
+    mask[2, 2] = False
+    assert np.array_equal(out[mask], rgb[mask])
+    assert 0 < report.energy_share < 1
+    assert rgb[2, 2, 0] == 50.0  # the input is not changed
+
+
+def test_a_clean_image_is_left_alone():
+    rgb = np.random.default_rng(0).uniform(0.1, 0.3, (16, 16, 3)).astype(np.float32)
+    out, report = suppress_fireflies(rgb)
+    assert report.pixels == 0 and np.array_equal(out, rgb)
+
+
+def test_denoising_brings_noise_close_to_the_clean_image():
+    colour, albedo, normal, clean = noisy_scene()
+    with Denoiser() as denoise:
+        out = denoise(colour, albedo, normal)
+    assert out.shape == colour.shape and out.dtype == np.float32
+    before = np.mean((colour - clean) ** 2)
+    after = np.mean((out - clean) ** 2)
+    assert after < before / 10, (before, after)
+
+
+def test_oidn_gives_the_same_bytes_run_after_run_and_on_any_thread_count():
+    colour, albedo, normal, _ = noisy_scene(seed=1, size=(96, 128))
+    results = []
+    for threads in (None, None, 1, 2, 4):
+        with Denoiser(num_threads=threads) as denoise:
+            results.append(denoise(colour, albedo, normal).tobytes())
+    assert len(set(results)) == 1
+
+
+def test_refuses_guides_of_another_shape():
+    colour, albedo, normal, _ = noisy_scene()
+    with Denoiser() as denoise:
+        with pytest.raises(ValueError, match=r"denoiser normal: shape \(48, 63, 3\)"):
+            denoise(colour, albedo, normal[:, :63])
