@@ -30,7 +30,8 @@ PALETTE: dict[str, Material] = {m.key: m for m in [
     Material("RoadPaint", (0.8, 0.8, 0.78), 0.6), Material("Mortar", (0.12, 0.11, 0.1), 0.95),
     Material("Cobble0", (0.2, 0.19, 0.18), 0.75), Material("Cobble1", (0.28, 0.26, 0.23), 0.75),
     Material("Cobble2", (0.16, 0.16, 0.17), 0.7), Material("PaverLight", (0.55, 0.53, 0.5), 0.8),
-    Material("PaverDark", (0.12, 0.12, 0.12), 0.8), Material("Grass", (0.1, 0.28, 0.05), 0.95),
+    Material("PaverWarm", (0.45, 0.41, 0.35), 0.8), Material("PaverGrey", (0.33, 0.32, 0.31), 0.8),
+    Material("Grass", (0.1, 0.28, 0.05), 0.95),
     # Buildings.
     Material("Stucco", (0.8, 0.78, 0.72), 0.9), Material("Whitewash", (0.85, 0.84, 0.8), 0.9),
     Material("RoofTile", (0.35, 0.12, 0.07), 0.8), Material("Glass", (0.04, 0.06, 0.08), 0.15),

@@ -217,9 +217,10 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
                      "RampConcrete")])
     bars = [geo.box((x, cy - 1.5, 0.072), (x + 0.5, cy + 1.5, 0.085)) for x in np.arange(x0 + 0.25, x1 - 0.4, 1.0)]
     b.add("Crosswalks", "Zebra", "crosswalk", [TwinPart.of("Bars", _shear(geo.merge(*bars)), "RoadPaint")])
-    # The largo: a slab paved with light and dark stones (Curitiba's petit-pavé).
+    # The largo: a slab paved with stones of three close shades (light, warm, grey); with two far apart
+    # (light and near-black) it read as a checkerboard from every camera.
     pavers = _cobbles(rng, PLAZA_X[0], PLAZA_X[1], PLAZA_Y[0], PLAZA_Y[1], (0.35, 0.35), 0.02, PAVER_H,
-                      ["PaverLight", "PaverLight", "PaverDark"])
+                      ["PaverLight", "PaverWarm", "PaverGrey"])
     b.add("Sidewalks", "Largo", "sidewalk",
           [TwinPart.of("Bed", geo.box((PLAZA_X[0], PLAZA_Y[0], PLAZA_Z - 3.5), (PLAZA_X[1], PLAZA_Y[1], PLAZA_Z)), "Mortar")]
           + [TwinPart.of(p.name, (p.mesh[0] + [0, 0, PLAZA_Z], p.mesh[1]), p.material) for p in pavers])

@@ -28,7 +28,7 @@ from synthua_usd.uv import box_uvs, planar_uvs
 TEXTURED: dict[str, tuple[str, float, str]] = {
     "Asphalt": ("asphalt", 4.0, "box"),
     **{k: ("stone", 1.5, "ground") for k in ("Cobble0", "Cobble1", "Cobble2")},
-    **{k: ("stone", 2.0, "ground") for k in ("PaverLight", "PaverDark")},
+    **{k: ("stone", 2.0, "ground") for k in ("PaverLight", "PaverWarm", "PaverGrey")},
     "Granite": ("stone", 1.0, "box"),
     **{k: ("plaster", 2.5, "box") for k in ("Concrete", "RampConcrete", "Mortar")},
     **{k: ("plaster", 3.0, "box") for k in ("Stucco", "Whitewash", *(f"Wall{i}" for i in range(8)))},
