@@ -98,6 +98,26 @@ def trace_pixel_centres(mi, scene, shape_ids: tuple[str, ...], camera: PinholeCa
     return LabelHits(mesh_index.reshape(shape), distance.astype(np.float32).reshape(shape), z.reshape(shape))
 
 
+def intersect_pixel_centres(mi, scene, camera: PinholeCamera, width: int, height: int) -> int:
+    """The raw primary-ray bound of the label pass: the same pixel-centre rays (:func:`pixel_centre_rays`) and
+    ``scene.ray_intersect_preliminary``, evaluated (JIT variants: one kernel, waited for), with nothing read
+    back, mapped or converted. Returns the number of rays traced (W * H). For benchmarks: the label pass can
+    only approach this time."""
+    rays = pixel_centre_rays(mi, scene, camera, width, height)
+    if mi.variant().startswith("scalar"):
+        count = 0
+        for ray in rays:
+            scene.ray_intersect_preliminary(ray)
+            count += 1
+        return count
+    import drjit as dr
+
+    pi = scene.ray_intersect_preliminary(rays, coherent=True)
+    dr.eval(pi.t, pi.shape, pi.prim_index)
+    dr.sync_thread()
+    return dr.width(pi.t)
+
+
 def pixel_centre_rays(mi, scene, camera: PinholeCamera, width: int, height: int, camera_rays: bool = False):
     """The rays :func:`trace_pixel_centres` traces, row-major from the top-left pixel: from the scene's sensor for
     an ideal pinhole, else (or with ``camera_rays``) from the plain-data camera. One ``mi.Ray3f`` of H*W lanes on

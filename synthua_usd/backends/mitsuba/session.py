@@ -61,6 +61,11 @@ class RenderSession:
         self._meter: weather_scene.LightMeter | None = None
         self._amodal: AmodalScene | None = None
 
+    @property
+    def mitsuba_scene(self):
+        """The loaded Mitsuba scene (None before the first render), e.g. to time raw ray casts against it."""
+        return self._scene
+
     def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
         self._translation = translate(self.mi, snapshot, camera, self.config, condition)
         # optimize=False: Mitsuba would otherwise merge meshes and lose the identity labels depend on.
