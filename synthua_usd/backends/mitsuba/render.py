@@ -170,6 +170,9 @@ def _trace_jit(mi, scene, keys, ray):
     import drjit as dr
 
     pi = scene.ray_intersect_preliminary(ray, coherent=True)
+    # One kernel for everything read back below: each lazy array converted on its own would launch its own
+    # (the ray generation again, the intersection again), measured 3-4x the raw ray cast at 1280x960.
+    dr.eval(pi.t, pi.shape, ray.o, ray.d)
     valid = np.asarray(pi.is_valid(), bool)
     registry = np.asarray(dr.reinterpret_array(mi.UInt32, pi.shape), np.int64)
     distance = np.where(valid, np.asarray(pi.t, np.float64), 0.0)
