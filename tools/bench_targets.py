@@ -301,7 +301,9 @@ def save_display(path: Path, rgb: np.ndarray, reference: np.ndarray) -> None:
 
 # ---- the table ----------------------------------------------------------------------------------------------
 
-def build_rows(args, s: dict, pipeline: dict | None, cycles: dict | str | None, cycles_note: str) -> tuple[list[Row], list[str]]:
+def build_rows(args, s: dict, pipeline: dict | None, cycles: dict | None,
+               cycles_note: str) -> tuple[list[Row], list[str]]:
+    """The table's rows and one line per target saying where it stands."""
     rows, stands = [], []
     views = list(s["views"].values())
     labels = float(np.mean([v["labels_s"] for v in views]))
@@ -322,7 +324,8 @@ def build_rows(args, s: dict, pipeline: dict | None, cycles: dict | str | None, 
                     ratio(rgb16, labels) + " of labels", "", ""))
     dn = s["denoise"]
     if dn is None:
-        rows.append(Row("RGB denoised", "not available: denoiser not built", "", "", f">= {db16:.1f} dB (16 spp)", "n/a"))
+        rows.append(Row("RGB denoised", "not available: denoiser not built", "", "", f">= {db16:.1f} dB (16 spp)",
+                        "n/a"))
         mode = {"name": f"{RGB_SPP} spp", "rgb_s": rgb16, "psnr_db": db16, "spp": RGB_SPP, "denoise": False}
     else:
         rows.append(Row(f"RGB denoised ({dn['spp']} spp box + OIDN)", f"{dn['rgb_s']:.2f} s, {dn['psnr_db']:.1f} dB",
@@ -331,19 +334,22 @@ def build_rows(args, s: dict, pipeline: dict | None, cycles: dict | str | None, 
         mode = {"name": f"{dn['spp']} spp + OIDN", "rgb_s": dn["rgb_s"], "psnr_db": dn["psnr_db"], "spp": dn["spp"],
                 "denoise": True}
     frame = s["update_time_code_s"] + labels + mode["rgb_s"]
-    rows.append(Row("first load (read + translate + load)", f"{s['first_load_s']:.2f} s", f"per-frame update "
-                    f"{s['update_time_code_s']:.3f} s", ratio(s["first_load_s"], s["update_time_code_s"], nd=0), "", ""))
+    rows.append(Row("first load (read + translate + load)", f"{s['first_load_s']:.2f} s",
+                    f"per-frame update {s['update_time_code_s']:.3f} s",
+                    ratio(s["first_load_s"], s["update_time_code_s"], nd=0), "", ""))
     share = s["update_time_code_s"] / frame
     parts = s["update_time_code_parts_s"]
     rows.append(Row("per-frame update, next time code (read moving prims + upload + BVH)",
                     f"{s['update_time_code_s']:.3f} s (read {parts['read_snapshot']:.3f} + update "
-                    f"{parts.get('update', parts.get('load', 0.0)):.3f})", f"frame (update + labels + RGB {mode['name']}) {frame:.2f} s",
+                    f"{parts.get('update', parts.get('load', 0.0)):.3f})",
+                    f"frame (update + labels + RGB {mode['name']}) {frame:.2f} s",
                     ratio(s["update_time_code_s"], frame, "%", 1), "<= 5 %", verdict(share <= 0.05)))
     if "update_camera_s" in s:
         rows.append(Row("per-frame update, another camera (sensor only)", f"{s['update_camera_s']:.4f} s",
                         f"frame {frame:.2f} s", ratio(s["update_camera_s"], frame, "%", 2), "<= 5 %",
                         verdict(s["update_camera_s"] / frame <= 0.05)))
-    stands.append(f"frame-to-frame update at most 5 % of a frame: {verdict(share <= 0.05, f'{share:.1%} (next time code)')}")
+    detail = f"{share:.1%} (next time code)"
+    stands.append(f"frame-to-frame update at most 5 % of a frame: {verdict(share <= 0.05, detail)}")
     gpu = s["variant"].startswith("cuda")
     target_ipm = 300 if gpu else 15
     if pipeline is None:

@@ -15,8 +15,10 @@ PYTHON=${CYCLES_BASE_PYTHON:-python3.11}
 if [ -x "$CYCLES_VENV/bin/python" ] && "$CYCLES_VENV/bin/python" -c 'import bpy' >/dev/null 2>&1; then
   exit 0
 fi
-if ! command -v "$PYTHON" >/dev/null 2>&1 || ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))'; then
-  echo "setup_cycles: Blender (bpy $BPY_VERSION) not installed: it needs CPython 3.11 ($PYTHON not found or another version; set CYCLES_BASE_PYTHON)" >&2
+if ! command -v "$PYTHON" >/dev/null 2>&1 \
+   || ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))'; then
+  echo "setup_cycles: Blender (bpy $BPY_VERSION) not installed: it needs CPython 3.11" \
+       "($PYTHON not found or another version; set CYCLES_BASE_PYTHON)" >&2
   exit 1
 fi
 if [ ! -x "$CYCLES_VENV/bin/python" ]; then

@@ -5,7 +5,7 @@
 Run by the Python of a virtual environment holding PyPI's ``bpy`` (Blender as a Python module), never
 imported by synthua itself (:mod:`synthua_usd.backends.cycles.runner` starts it). It builds the Blender scene
 from what :mod:`synthua_usd.backends.cycles.interchange` wrote (one mesh per material, Principled BSDF
-constants, a sun lamp and a uniform world for UsdLux distant and dome lights, the camera with its conformed
+constants, flat shading, a sun lamp and a uniform world for UsdLux distant and dome lights, the camera with its conformed
 horizontal field of view and clipping range), sets Cycles up (CPU, fixed threads, path length, view
 transform ``Standard`` so the output stays scene-linear), renders a warm-up frame (scene sync and BVH build,
 kept by ``use_persistent_data``), then renders every job of ``JOBS_JSON`` and writes ``OUT_DIR/{name}.exr``
@@ -49,6 +49,9 @@ def build_scene(document: dict, soups: list) -> bpy.types.Scene:
         mesh.polygons.add(m)
         mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * m, 3, dtype=np.int32))
         mesh.update(calc_edges=True)
+        # Flat shading, as Mitsuba renders these meshes (no vertex normals): a Blender mesh made through the API
+        # is smooth-shaded unless its faces are marked sharp, which rounds every box and tilts walls to the sun.
+        mesh.polygons.foreach_set("use_smooth", np.zeros(m, dtype=bool))
         mesh.materials.append(principled(material))
         obj = bpy.data.objects.new(mesh.name, mesh)
         scene.collection.objects.link(obj)

@@ -86,8 +86,8 @@ def test_cycles_renders_the_exported_scene_like_mitsuba(lit, tmp_path):
         pytest.skip(f"{exc} (the Cycles comparison needs it; the rest of synthua does not)")
     snap, cam = lit
     write_interchange(snap, cam, 32, 24, tmp_path / "scene")
-    result = render_jobs(python, tmp_path / "scene", [CyclesJob("a", 64), CyclesJob("b", 4, denoise=True, adaptive=True)],
-                         tmp_path / "out", threads=2, max_bounces=2, timeout_s=300)
+    jobs = [CyclesJob("a", 64), CyclesJob("b", 4, denoise=True, adaptive=True)]
+    result = render_jobs(python, tmp_path / "scene", jobs, tmp_path / "out", threads=2, max_bounces=2, timeout_s=300)
     assert set(result.images) == {"a", "b"} and all(s > 0 for s in result.seconds.values())
     image = result.images["a"]
     assert image.shape == (24, 32, 3) and image.dtype == np.float32 and np.isfinite(image).all()
