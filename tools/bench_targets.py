@@ -3,7 +3,8 @@
 
 Usage: python tools/bench_targets.py [--width 1280 --height 960] [--views CAMERA ...] [--time-code 24]
        [--variant llvm_ad_rgb|cuda_ad_rgb] [--reference-spp 512] [--pipeline-images 4]
-       [--cycles-samples 4,8,16,32] [--cycles-python PATH] [--skip-cycles] [--skip-pipeline] [--json OUT]
+       [--cycles-samples 1,2,4,8,16] [--cycles-plain-samples 16] [--cycles-python PATH] [--skip-cycles]
+       [--skip-pipeline] [--json OUT] [--save-images DIR]
 
 Prints one markdown table with ratios, then where each target stands:
 
@@ -19,8 +20,8 @@ Prints one markdown table with ratios, then where each target stands:
   camera) against the frame time — target at most 5 %;
 * Blender Cycles (PyPI ``bpy``, in its own interpreter) rendering the same exported scene (meshes, material
   constants, the stage's UsdLux sun and dome, same camera) on the CPU with 2 threads, max_bounces 2 (Mitsuba
-  max_depth 4), adaptive sampling and OpenImageDenoise, at the fewest samples that reach the Mitsuba mode's
-  PSNR, each renderer measured against its own reference at ``--reference-spp``; and the PSNR between the two
+  max_depth 4), adaptive sampling with and without OpenImageDenoise, its fastest setting that reaches the Mitsuba
+  mode's PSNR, each renderer measured against its own reference at ``--reference-spp``; and the PSNR between the two
   references, which says how close the two scenes are — target Mitsuba 3x Cycles' throughput.
 
 Every Mitsuba render here uses max_depth 4 and the stage's own UsdLux lights (no condition), except the
@@ -146,7 +147,9 @@ def timed(fn):
     return time.perf_counter() - t0, value
 
 
-def measure_session(args, stage, reader, views, psnr) -> tuple[dict, list[Row]]:
+def measure_session(args, stage, reader, views, psnr) -> dict:
+    """Label pass and raw bound, RGB (reference, 16 spp, denoised), first load and per-frame updates, through one
+    render session; also hands on the snapshot, cameras and references for the Cycles comparison."""
     from synthua_usd.backends.mitsuba.render import intersect_pixel_centres, render_rgb
     from synthua_usd.backends.mitsuba.session import RenderSession
     from synthua_usd.render_config import RenderConfig
@@ -215,7 +218,7 @@ def measure_session(args, stage, reader, views, psnr) -> tuple[dict, list[Row]]:
             if db >= target:
                 break
     out["snapshot"], out["cameras"] = snapshot, cameras
-    return out, []
+    return out
 
 
 def measure_pipeline(args, views, spp: int, denoise: bool) -> dict:
@@ -449,7 +452,7 @@ def main(argv: list[str] | None = None) -> int:
     psnr, psnr_note = quality_metric()
     stage = open_stage(args.scenario)
     reader = StageReader(stage, ClassMap.default())
-    session_out, _ = measure_session(args, stage, reader, args.views, psnr)
+    session_out = measure_session(args, stage, reader, args.views, psnr)
     dn = session_out["denoise"]
     mode_spp, mode_denoise = (dn["spp"], True) if dn else (RGB_SPP, False)
     mode_db = dn["psnr_db"] if dn else float(np.mean([v["rgb16_psnr_db"] for v in session_out["views"].values()]))
