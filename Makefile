@@ -4,7 +4,7 @@ BIN := $(VENV)/bin
 DEMO_OUT ?= out/demo
 SCENARIO := stages/scenario.usda
 
-.PHONY: setup demo test refs stages bench clean
+.PHONY: setup demo test refs stages bench cycles clean
 
 setup:
 	@bash tools/setup.sh
@@ -41,8 +41,17 @@ stages: setup
 
 ## Benchmarks (not tests: ratios and timings measured side by side in one run): rendering through a
 ## render session (first load, per-frame update, labels, RGB), building the district, imports and agents, the
-## amodal pass, dataset workers' memory over 500 images, and denoised RGB against 512-spp references.
+## amodal pass, dataset workers' memory over 500 images, denoised RGB against 512-spp references, and issue 11's
+## targets against the raw ray bound and Blender Cycles (tools/setup_cycles.sh installs PyPI bpy into
+## $(CYCLES_VENV) first; without it the table says Blender is not installed and the rest is measured).
+CYCLES_VENV ?= $(VENV)-cycles
+
+cycles:
+	@CYCLES_VENV=$(CYCLES_VENV) bash tools/setup_cycles.sh
+
 bench: setup
+	-@CYCLES_VENV=$(CYCLES_VENV) bash tools/setup_cycles.sh
+	SYNTHUA_CYCLES_PYTHON=$(CYCLES_VENV)/bin/python $(BIN)/python tools/bench_targets.py
 	$(BIN)/python tools/bench_render.py
 	$(BIN)/python tools/bench_conditions.py
 	$(BIN)/python tools/bench_label_agreement.py

@@ -56,17 +56,21 @@ def bbox_xywh(flat_indices: np.ndarray, width: int) -> list[int]:
     return [x0, y0, int(cols.max()) - x0 + 1, int(rows.max()) - y0 + 1]
 
 
-def mask_from_indices(flat_indices: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
-    """(H, W) bool mask with the given flat indices set."""
-    out = np.zeros(shape[0] * shape[1], bool)
-    out[flat_indices] = True
-    return out.reshape(shape)
-
-
 def encode_rle(mask: np.ndarray) -> dict:
     """COCO compressed RLE of an (H, W) bool mask: ``{"size": [H, W], "counts": str}``."""
     rle = mask_utils.encode(np.asfortranarray(mask, dtype=np.uint8))
     return {"size": [int(rle["size"][0]), int(rle["size"][1])], "counts": rle["counts"].decode("ascii")}
+
+
+def rle_from_indices(flat_indices: np.ndarray, shape: tuple[int, int]) -> dict:
+    """:func:`encode_rle` of the mask of row-major ``flat_indices``, written straight into the column-major
+    uint8 array pycocotools reads (converting a full-size row-major mask for each instance cost 0.8 s an image
+    for 231 instances at 1280x960)."""
+    h, w = shape
+    rows, cols = np.divmod(np.asarray(flat_indices, np.int64), w)
+    column_major = np.zeros(h * w, np.uint8)
+    column_major[cols * h + rows] = 1
+    return encode_rle(column_major.reshape((h, w), order="F"))
 
 
 def annotate(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequence[Instance],
@@ -125,9 +129,9 @@ def annotate(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
             "id": inst.id, "category_id": inst.class_id, "class_name": inst.class_name,
             "isthing": bool(inst.isthing), "prim_path": inst.prim_path,
             "area": area, "bbox": bbox_xywh(visible, width),
-            "segmentation": encode_rle(mask_from_indices(visible, shape)),
+            "segmentation": rle_from_indices(visible, shape),
             "amodal_area": amodal_area, "amodal_bbox": bbox_xywh(amodal_idx, width),
-            "amodal_segmentation": encode_rle(mask_from_indices(amodal_idx, shape)),
+            "amodal_segmentation": rle_from_indices(amodal_idx, shape),
             "occlusion": 1.0 - area / amodal_area, "truncation": trunc,
             "relations": {name: target for name, target in inst.relations},
         })

@@ -124,8 +124,11 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     group_of = {c.id: c.group for c in class_map.classes}
     by_id = {inst.id: inst for inst in snapshot.instances}
     wanted = [i for i in visible if job.config.amodal_wanted(by_id[i].class_name, group_of.get(by_id[i].class_id))]
+    t_amodal = time.perf_counter()
     amodal = state.session.amodal(snapshot, camera, wanted) if wanted else {}
-    seconds = {"render": time.perf_counter() - t0}
+    # "render" is all of it (snapshot, session, amodal); the render_* parts say where it went
+    seconds = {"render": time.perf_counter() - t0, "render_amodal": time.perf_counter() - t_amodal,
+               **{f"render_{key}": value for key, value in rendered.seconds.items()}}
 
     t0 = time.perf_counter()
     meshes_of: dict[int, list] = {}

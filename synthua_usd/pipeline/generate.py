@@ -226,8 +226,8 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
                 summary.rendered += 1
                 bar.update(1)
             done[item["record"]["id"]] = item["record"]
-            for key in seconds:
-                seconds[key] += item["seconds"].get(key, 0.0)
+            for key, value in item["seconds"].items():  # render, annotate, write and the parts of render
+                seconds[key] = seconds.get(key, 0.0) + value
         peaks[result.worker] = max(peaks.get(result.worker, 0.0), result.peak_rss_mib)
         summary.rss_trace.append((summary.rendered, result.worker, result.peak_rss_mib))
 

@@ -66,6 +66,11 @@ class RenderSession:
         self._guides = None
         self._denoiser: Denoiser | None = None
 
+    @property
+    def mitsuba_scene(self):
+        """The loaded Mitsuba scene (None before the first render), e.g. to time raw ray casts against it."""
+        return self._scene
+
     def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
         self._translation = translate(self.mi, snapshot, camera, self.config, condition)
         # optimize=False: Mitsuba would otherwise merge meshes and lose the identity labels depend on.

@@ -158,10 +158,13 @@ def merge_parts(parts: Sequence[np.ndarray]) -> np.ndarray:
 def instance_polygon(rle: dict) -> np.ndarray:
     """The single YOLO polygon (n, 2) int64 pixel-corner coordinates of a COCO RLE mask."""
     mask = mask_utils.decode(rle).astype(bool)
-    parts = outer_outlines(mask)
+    # Outline the mask's bounding box only (the RLE's own box, no scan): the same outlines, offset back,
+    # without scanning the whole image per instance (0.8 s an image for 222 instances at 1280x960).
+    x, y, w, h = (int(round(v)) for v in mask_utils.toBbox(rle))
+    parts = outer_outlines(mask[y:y + h, x:x + w])
     if not parts:
         raise InputError(f"YOLO polygon: empty mask of size {rle.get('size')}; expected at least one pixel")
-    return merge_parts(parts)
+    return merge_parts([part + np.array([x, y], np.int64) for part in parts])
 
 
 def yolo_lines(record_instances: Sequence[dict], width: int, height: int, class_index: dict[int, int]) -> str:

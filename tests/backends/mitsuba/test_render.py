@@ -58,3 +58,13 @@ def test_tiny_render_rgb_is_lit_and_seeded(tiny, variant):
     # Another seed draws other samples.
     c = RenderSession(RenderConfig(width=32, height=24, spp=4, seed=4, denoise=False, variant=variant)).render(snap, cam)
     assert not np.allclose(a.rgb[ground], c.rgb[ground], rtol=0, atol=1e-6)
+
+
+def test_the_raw_ray_bound_traces_one_ray_per_pixel(tiny, variant):
+    from synthua_usd.backends.mitsuba.render import intersect_pixel_centres
+
+    snap, cam = tiny
+    session = RenderSession(RenderConfig(width=16, height=12, spp=1, variant=variant))
+    assert session.mitsuba_scene is None
+    session.render(snap, cam, rgb=False)
+    assert intersect_pixel_centres(session.mi, session.mitsuba_scene, cam, 16, 12) == 16 * 12

@@ -1,0 +1,504 @@
+#!/usr/bin/env python
+"""Benchmark: issue 11's speed targets, measured side by side in one run on the demo district.
+
+Usage: python tools/bench_targets.py [--width 1280 --height 960] [--views CAMERA ...] [--time-code 24]
+       [--variant llvm_ad_rgb|cuda_ad_rgb] [--reference-spp 512] [--pipeline-images 4]
+       [--cycles-samples 1,2,4,8,16] [--cycles-plain-samples 16] [--cycles-python PATH] [--skip-cycles]
+       [--skip-pipeline] [--json OUT] [--save-images DIR]
+
+Prints one markdown table with ratios, then where each target stands:
+
+* the label pass (``RenderSession.render(rgb=False)``: pixel-centre rays, first hits, ids, depths) against the
+  raw primary-ray bound (:func:`synthua_usd.backends.mitsuba.render.intersect_pixel_centres`: the same rays
+  and ``ray_intersect_preliminary``, evaluated, nothing read back) — target within 1.5x;
+* RGB at 16 spp (box filter) and, where the denoiser is built (``RenderConfig.denoise``), the denoised mode at
+  the fewest spp that reaches 16 spp's PSNR; PSNR against a ``--reference-spp`` render of the same view;
+* the whole annotated image through the dataset pipeline (``synthua generate`` on ``--views`` x seeds: RGB,
+  labels, amodal masks, annotations, QA, every file written): images/min and seconds per image by part —
+  target 15 images/min on 2 cores (300 on cuda_ad_rgb) with RGB at 40 dB or better;
+* the render session's first load and its per-frame update (next time code: moving agents; another
+  camera) against the frame time — target at most 5 %;
+* Blender Cycles (PyPI ``bpy``, in its own interpreter) rendering the same exported scene (meshes, material
+  constants, the stage's UsdLux sun and dome, same camera) on the CPU with 2 threads, max_bounces 2 (Mitsuba
+  max_depth 4), adaptive sampling with and without OpenImageDenoise, its fastest setting that reaches the Mitsuba
+  mode's PSNR, each renderer measured against its own reference at ``--reference-spp``; and the PSNR between the two
+  references, which says how close the two scenes are — target Mitsuba 3x Cycles' throughput.
+
+Every Mitsuba render here uses max_depth 4 and the stage's own UsdLux lights (no condition), except the
+dataset pipeline, which renders the stage's selected condition (the district's clear_day sky). Not a test:
+ratios measured in one run on one machine; the machine's load is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tools"))
+
+#: Mitsuba path length of every render here; Cycles' max_bounces 2 is the same path length.
+MAX_DEPTH = 4
+CYCLES_BOUNCES = 2
+CYCLES_THREADS = 2
+RGB_SPP = 16
+DENOISE_SPPS = (1, 2, 4, 8)
+
+
+@dataclass
+class Row:
+    """One line of the table. ``ratio`` is measured / against (a speed ratio, or a share)."""
+
+    measure: str
+    value: str
+    against: str = ""
+    ratio: str = ""
+    target: str = ""
+    status: str = ""
+
+
+def ratio(a: float | None, b: float | None, unit: str = "x", nd: int = 2) -> str:
+    """``a / b`` formatted (``"1.23x"``, or ``"4.5 %"`` with ``unit="%"``); ``"-"`` when either is missing or b is 0."""
+    if a is None or b is None or not b:
+        return "-"
+    if unit == "%":
+        return f"{100 * a / b:.{nd}f} %"
+    return f"{a / b:.{nd}f}{unit}"
+
+
+def markdown_table(rows: list[Row]) -> str:
+    """The rows as a GitHub markdown table (``|`` in cells escaped)."""
+    head = ("measure", "value", "against", "ratio", "target", "status")
+    lines = ["| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"]
+    for row in rows:
+        cells = [str(getattr(row, f.name)).replace("|", "\\|") for f in dataclasses.fields(row)]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def verdict(met: bool | None, detail: str = "") -> str:
+    text = "n/a" if met is None else ("met" if met else "NOT met")
+    return f"{text} ({detail})" if detail else text
+
+
+# ---- quality ------------------------------------------------------------------------------------------------
+
+def quality_metric():
+    """(psnr(test, reference) -> dB, a line saying which), both (H, W, 3) float32 scene-linear, compared
+    display-referred with the reference's exposure. ``synthua_usd.image_quality.psnr_db`` where it is built;
+    until then OpenImageIO's ``ImageBufAlgo.compare`` on the 8-bit sRGB images (``images.linear_to_display``),
+    said so in the output."""
+    from synthua_usd.backends.exposure import choose_exposure
+    from synthua_usd.backends.images import linear_to_display
+
+    try:
+        from synthua_usd.image_quality import psnr_db
+    except ImportError:
+        psnr_db = None
+
+    def exposed(test, reference):
+        scale = np.float32(choose_exposure(reference).scale)
+        return test * scale, reference * scale
+
+    if psnr_db is not None:
+        return (lambda test, reference: float(psnr_db(*exposed(test, reference))),
+                "PSNR: synthua_usd.image_quality.psnr_db, display-referred at the reference's exposure")
+
+    import OpenImageIO as oiio
+
+    def psnr_oiio(test, reference):
+        a, b = (oiio.ImageBuf(np.ascontiguousarray(linear_to_display(x), np.uint8)) for x in exposed(test, reference))
+        return float(oiio.ImageBufAlgo.compare(a, b, 1.0, 1.0).PSNR)
+
+    return psnr_oiio, ("PSNR: OpenImageIO ImageBufAlgo.compare of 8-bit sRGB images at the reference's exposure "
+                       "(synthua_usd.image_quality not built yet: branch denoise)")
+
+
+def denoise_supported(settings: bool = False) -> bool:
+    """Whether the denoiser is built: ``RenderConfig.denoise`` (with ``settings``: also a generation config's
+    ``render.denoise``)."""
+    from synthua_usd.dataset.config import RenderSettings
+    from synthua_usd.render_config import RenderConfig
+
+    owners = (RenderConfig, RenderSettings) if settings else (RenderConfig,)
+    return all("denoise" in {f.name for f in dataclasses.fields(owner)} for owner in owners)
+
+
+def rgb_seconds(seconds: dict) -> float:
+    """RGB time of a frame: the RGB pass and, where there is one, the denoiser."""
+    return sum(v for k, v in seconds.items() if k == "rgb" or "denois" in k)
+
+
+# ---- the measurements ---------------------------------------------------------------------------------------
+
+def timed(fn):
+    t0 = time.perf_counter()
+    value = fn()
+    return time.perf_counter() - t0, value
+
+
+def measure_session(args, stage, reader, views, psnr) -> dict:
+    """Label pass and raw bound, RGB (reference, 16 spp, denoised), first load and per-frame updates, through one
+    render session; also hands on the snapshot, cameras and references for the Cycles comparison."""
+    from synthua_usd.backends.mitsuba.render import intersect_pixel_centres, render_rgb
+    from synthua_usd.backends.mitsuba.session import RenderSession
+    from synthua_usd.render_config import RenderConfig
+    from synthua_usd.usd.cameras import camera_paths, read_camera
+
+    w, h, tc = args.width, args.height, args.time_code
+    base = RenderConfig(width=w, height=h, spp=RGB_SPP, max_depth=MAX_DEPTH, pixel_filter="box",
+                        variant=args.variant)
+    session = RenderSession(base)
+    out: dict = {"variant": session.variant, "views": {}}
+    read_s, snapshot = timed(lambda: reader.snapshot(tc))
+    cameras = {v: read_camera(stage, v, tc) for v in views}
+    first = session.render(snapshot, cameras[views[0]], rgb=False)
+    out["first_load_s"] = read_s + first.seconds["load"]
+    out["first_load_parts_s"] = {"read_snapshot": read_s, "load": first.seconds["load"]}
+    mi, scene = session.mi, session.mitsuba_scene
+    for view in views:
+        cam = cameras[view]
+        r: dict = {}
+        session.render(snapshot, cam, rgb=False)  # sensor on this view; kernels compiled
+        intersect_pixel_centres(mi, scene, cam, w, h)
+        r["labels_s"] = min(session.render(snapshot, cam, rgb=False).seconds["labels"] for _ in range(args.repeat))
+        r["raw_rays"] = intersect_pixel_centres(mi, scene, cam, w, h)
+        r["raw_bound_s"] = min(timed(lambda: intersect_pixel_centres(mi, scene, cam, w, h))[0]
+                               for _ in range(args.repeat))
+        # RGB: a converged reference, then 16 spp (after a warm-up render that compiles its kernels)
+        ref_config = dataclasses.replace(base, spp=args.reference_spp, seed=7)
+        r["reference_s"], reference = timed(lambda: render_rgb(mi, scene, ref_config, show_progress=args.progress))
+        session.render(snapshot, cam, rgb=True, seed=1)
+        frame = session.render(snapshot, cam, rgb=True, seed=2)
+        r["rgb16_s"] = rgb_seconds(frame.seconds)
+        r["rgb16_psnr_db"] = psnr(frame.rgb, reference)
+        if args.save_images:
+            save_display(args.save_images / f"mitsuba_{RGB_SPP}spp_{len(out['views'])}.png", frame.rgb, reference)
+        r["reference"] = reference
+        out["views"][view] = r
+    # per-frame update: the next time code (moving agents re-read and re-uploaded) and another camera
+    view, cam = views[0], cameras[views[0]]
+    others = [p for p in camera_paths(stage) if p != view]
+    next_tc = tc + 1
+    read2_s, snapshot2 = timed(lambda: reader.snapshot(next_tc))
+    cam2 = read_camera(stage, view, next_tc)
+    moved = session.render(snapshot2, cam2, rgb=False)
+    out["update_time_code_s"] = read2_s + moved.seconds.get("update", moved.seconds.get("load", 0.0))
+    out["update_time_code_parts_s"] = {"read_snapshot": read2_s, **moved.seconds}
+    out["update_reloaded"] = "load" in moved.seconds
+    if others:
+        switched = session.render(snapshot2, read_camera(stage, others[0], next_tc), rgb=False)
+        out["update_camera_s"] = switched.seconds.get("update", switched.seconds.get("load", 0.0))
+        out["update_camera_to"] = others[0]
+    session.render(snapshot, cam, rgb=False)  # back to the measured view
+    # the denoised mode, where the denoiser is built: the fewest spp that reach 16 spp's PSNR
+    out["denoise"] = None
+    if denoise_supported():
+        target = np.mean([r["rgb16_psnr_db"] for r in out["views"].values()])
+        for spp in DENOISE_SPPS:
+            dn = RenderSession(dataclasses.replace(base, spp=spp, denoise=True))
+            results = []
+            for v in views:
+                dn.render(snapshot, cameras[v], rgb=True, seed=1)  # load and compile
+                f = dn.render(snapshot, cameras[v], rgb=True, seed=2)
+                results.append((rgb_seconds(f.seconds), psnr(f.rgb, out["views"][v]["reference"])))
+            del dn
+            seconds, db = float(np.mean([x[0] for x in results])), float(np.mean([x[1] for x in results]))
+            out["denoise"] = {"spp": spp, "rgb_s": seconds, "psnr_db": db, "reached_16spp": db >= target}
+            if db >= target:
+                break
+    out["snapshot"], out["cameras"] = snapshot, cameras
+    return out
+
+
+def measure_pipeline(args, views, spp: int, denoise: bool) -> dict:
+    """``synthua generate`` on ``views`` x seeds at the benchmark's size: images/min and where the time goes."""
+    from bench_generate import Probe
+
+    from synthua_usd.pipeline.generate import GenerateRequest, generate
+
+    seeds = list(range(max(1, -(-args.pipeline_images // len(views)))))
+    render = {"width": args.width, "height": args.height, "spp": spp, "max_depth": MAX_DEPTH, "pixel_filter": "box"}
+    if denoise:
+        render["denoise"] = True
+    doc = {"name": "bench-targets", "images": args.pipeline_images, "render": render, "cameras": list(views),
+           "time_codes": [args.time_code], "seeds": seeds, "sampling_seed": 0,
+           "quotas": {"aid_users": None, "per_condition": None, "per_rig_type": None},
+           "split": {"train": 1.0, "val": 0.0, "test": 0.0, "seed": 0},
+           "qa": {"reject": []},
+           "outputs": {"rgb_exr": False, "depth": True, "onehot": False}, "workers": 1}
+    work = Path(tempfile.mkdtemp(prefix="bench_targets_"))
+    config = work / "bench.json"
+    config.write_text(json.dumps(doc, indent=1), encoding="utf-8")
+    probe = Probe()
+    probe.install()
+    try:
+        summary = generate(GenerateRequest(scenario=args.scenario, config_path=config, out_dir=work / "dataset",
+                                           workers=1, variant=args.variant), show_progress=args.progress)
+        files = sum(1 for p in (work / "dataset").rglob("*") if p.is_file())
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    n = max(1, summary.rendered)
+    per_image = {k: v / n for k, v in summary.seconds.items()}
+    render_wall = probe.phase.get("render") or float("nan")
+    return {"images": summary.rendered, "wall_s": summary.wall_seconds, "phases_s": dict(probe.phase),
+            "images_per_min_end_to_end": 60 * summary.rendered / summary.wall_seconds,
+            "images_per_min_render_phase": 60 * summary.rendered / render_wall,
+            "seconds_per_image": per_image, "files_in_dataset": files, "bytes_per_image": summary.bytes_per_image,
+            "spp": spp, "denoise": denoise, "config": doc}
+
+
+def measure_cycles(args, session_out: dict, target_db: float, psnr, views) -> dict:
+    from synthua_usd.backends.cycles.interchange import write_interchange
+    from synthua_usd.backends.cycles.runner import CyclesJob, find_cycles_python, render_jobs
+
+    python = find_cycles_python(args.cycles_python)
+    view = views[0]
+    snapshot, camera = session_out["snapshot"], session_out["cameras"][view]
+    mitsuba_ref = session_out["views"][view]["reference"]
+    work = Path(tempfile.mkdtemp(prefix="bench_cycles_"))
+    try:
+        t_export, _ = timed(lambda: write_interchange(snapshot, camera, args.width, args.height, work / "scene"))
+        jobs = [CyclesJob("reference", args.reference_spp, denoise=False, adaptive=False, seed=7)]
+        jobs += [CyclesJob(f"oidn_{s}", s, denoise=True, adaptive=True, seed=1) for s in args.cycles_samples]
+        jobs += [CyclesJob(f"plain_{s}", s, denoise=False, adaptive=True, seed=1) for s in args.cycles_plain_samples]
+        result = render_jobs(python, work / "scene", jobs, work / "out", CYCLES_THREADS, CYCLES_BOUNCES)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    reference = result.images["reference"]
+    if args.save_images:
+        save_display(args.save_images / "mitsuba_reference.png", mitsuba_ref, mitsuba_ref)
+        save_display(args.save_images / "cycles_reference.png", reference, mitsuba_ref)
+        for name, image in result.images.items():
+            if name != "reference":
+                save_display(args.save_images / f"cycles_{name}.png", image, reference)
+    candidates = []
+    for name in result.images:
+        if name != "reference":
+            kind, samples = name.split("_")
+            candidates.append({"samples": int(samples), "denoise": kind == "oidn", "render_s": result.seconds[name],
+                               "psnr_db": psnr(result.images[name], reference)})
+    reached = [c for c in candidates if c["psnr_db"] >= target_db]
+    chosen = min(reached, key=lambda c: c["render_s"]) if reached else None
+    return {"blender": result.blender, "export_s": t_export, "build_s": result.build_s, "warmup_s": result.warmup_s,
+            "reference_s": result.seconds["reference"], "candidates": candidates, "chosen": chosen,
+            "target_db": target_db, "cross_renderer_psnr_db": psnr(reference, mitsuba_ref),
+            "cross_renderer_mean_ratio": (reference.mean(axis=(0, 1)) / np.maximum(mitsuba_ref.mean(axis=(0, 1)),
+                                                                                  1e-9)).tolist()}
+
+
+def save_display(path: Path, rgb: np.ndarray, reference: np.ndarray) -> None:
+    """``rgb`` as an sRGB PNG at ``reference``'s exposure (what the PSNR compares)."""
+    from synthua_usd.backends.exposure import choose_exposure
+    from synthua_usd.backends.images import write_display_png
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_display_png(path, rgb * np.float32(choose_exposure(reference).scale))
+
+
+# ---- the table ----------------------------------------------------------------------------------------------
+
+def build_rows(args, s: dict, pipeline: dict | None, cycles: dict | None, cycles_note: str,
+               pipeline_note: str = "skipped (--skip-pipeline)") -> tuple[list[Row], list[str]]:
+    """The table's rows and one line per target saying where it stands."""
+    rows, stands = [], []
+    views = list(s["views"].values())
+    labels = float(np.mean([v["labels_s"] for v in views]))
+    raw = float(np.mean([v["raw_bound_s"] for v in views]))
+    lr = labels / raw
+    rows.append(Row("label pass (ids + depth, exact)", f"{labels:.3f} s", f"raw primary-ray bound {raw:.3f} s "
+                    f"({views[0]['raw_rays']:,} rays)", ratio(labels, raw), "<= 1.5x", verdict(lr <= 1.5)))
+    stands.append(f"label pass within 1.5x of the raw ray bound: {verdict(lr <= 1.5, f'{lr:.2f}x')}")
+    rgb16 = float(np.mean([v["rgb16_s"] for v in views]))
+    db16 = float(np.mean([v["rgb16_psnr_db"] for v in views]))
+    ref_s = float(np.mean([v["reference_s"] for v in views]))
+    # The reference has noise of its own: with variance falling as 1/spp, MSE(16 spp vs reference) is
+    # sigma^2 (1/16 + 1/R), so the reference is off the converged image by about this PSNR, and no PSNR
+    # measured against it means much beyond it.
+    floor = db16 + 10 * np.log10((args.reference_spp + RGB_SPP) / RGB_SPP)
+    rows.append(Row(f"RGB {RGB_SPP} spp (box)", f"{rgb16:.2f} s, {db16:.1f} dB",
+                    f"reference {args.reference_spp} spp {ref_s:.1f} s (its own noise ~{floor:.1f} dB)",
+                    ratio(rgb16, labels) + " of labels", "", ""))
+    dn = s["denoise"]
+    if dn is None:
+        rows.append(Row("RGB denoised", "not available: denoiser not built", "", "", f">= {db16:.1f} dB (16 spp)",
+                        "n/a"))
+        mode = {"name": f"{RGB_SPP} spp", "rgb_s": rgb16, "psnr_db": db16, "spp": RGB_SPP, "denoise": False}
+    else:
+        rows.append(Row(f"RGB denoised ({dn['spp']} spp box + OIDN)", f"{dn['rgb_s']:.2f} s, {dn['psnr_db']:.1f} dB",
+                        f"{RGB_SPP} spp {rgb16:.2f} s", ratio(rgb16, dn["rgb_s"]) + " faster",
+                        f">= {db16:.1f} dB", verdict(dn["reached_16spp"])))
+        mode = {"name": f"{dn['spp']} spp + OIDN", "rgb_s": dn["rgb_s"], "psnr_db": dn["psnr_db"], "spp": dn["spp"],
+                "denoise": True}
+    frame = s["update_time_code_s"] + labels + mode["rgb_s"]
+    rows.append(Row("first load (read + translate + load)", f"{s['first_load_s']:.2f} s",
+                    f"per-frame update {s['update_time_code_s']:.3f} s",
+                    ratio(s["first_load_s"], s["update_time_code_s"], nd=0), "", ""))
+    share = s["update_time_code_s"] / frame
+    parts = s["update_time_code_parts_s"]
+    rows.append(Row("per-frame update, next time code (read moving prims + upload + BVH)",
+                    f"{s['update_time_code_s']:.3f} s (read {parts['read_snapshot']:.3f} + update "
+                    f"{parts.get('update', parts.get('load', 0.0)):.3f})",
+                    f"frame (update + labels + RGB {mode['name']}) {frame:.2f} s",
+                    ratio(s["update_time_code_s"], frame, "%", 1), "<= 5 %", verdict(share <= 0.05)))
+    if "update_camera_s" in s:
+        rows.append(Row("per-frame update, another camera (sensor only)", f"{s['update_camera_s']:.4f} s",
+                        f"frame {frame:.2f} s", ratio(s["update_camera_s"], frame, "%", 2), "<= 5 %",
+                        verdict(s["update_camera_s"] / frame <= 0.05)))
+    detail = f"{share:.1%} (next time code)"
+    stands.append(f"frame-to-frame update at most 5 % of a frame: {verdict(share <= 0.05, detail)}")
+    gpu = s["variant"].startswith("cuda")
+    target_ipm = 300 if gpu else 15
+    if pipeline is None:
+        rows.append(Row("annotated image, every file written (synthua generate)", pipeline_note, "",
+                        "", f">= {target_ipm}/min, RGB >= 40 dB", "n/a"))
+        stands.append(f"annotated images/min: not measured ({pipeline_note})")
+    else:
+        p = pipeline["seconds_per_image"]
+        ipm = pipeline["images_per_min_render_phase"]
+        parts = ", ".join(f"{label} {p.get(key, 0.0):.2f}" for key, label in (
+            ("render_rgb", "RGB"), ("render_labels", "labels"), ("render_amodal", "amodal"),
+            ("render_update", "update"), ("render_weather", "sky/exposure"), ("annotate", "annotation"),
+            ("write", "writing (background)")))
+        # what the pipeline rendered: the denoised mode where generation configs can ask for it, else 16 spp
+        rendered = mode if pipeline["denoise"] else {"name": f"{RGB_SPP} spp", "psnr_db": db16}
+        ok = ipm >= target_ipm and rendered["psnr_db"] >= 40.0
+        rows.append(Row(f"annotated image, every file written (synthua generate, RGB {rendered['name']})",
+                        f"{ipm:.1f} images/min ({60 / ipm:.2f} s/image; end to end with planning "
+                        f"{pipeline['images_per_min_end_to_end']:.1f}/min)",
+                        f"s/image: {parts}", f"RGB {rendered['psnr_db']:.1f} dB", f">= {target_ipm}/min, RGB >= 40 dB",
+                        verdict(ok)))
+        detail = f"{ipm:.1f}/min ({ipm / target_ipm:.2f}x the target), RGB {rendered['psnr_db']:.1f} dB"
+        stands.append(f"at least {target_ipm} fully annotated images/min with RGB >= 40 dB: {verdict(ok, detail)}")
+    if isinstance(cycles, dict):
+        c = cycles
+        rows.append(Row("Cycles reference vs Mitsuba reference (same scene, converged)",
+                        f"{c['cross_renderer_psnr_db']:.1f} dB", "", "mean RGB ratio " + " ".join(
+                            f"{x:.2f}" for x in c["cross_renderer_mean_ratio"]), "", "how close the two scenes are"))
+        cand = ", ".join(f"{x['samples']}{' + OIDN' if x['denoise'] else ''}: {x['render_s']:.1f} s "
+                         f"{x['psnr_db']:.1f} dB" for x in c["candidates"])
+        if c["chosen"] is not None:
+            ch = c["chosen"]
+            r3 = ch["render_s"] / mode["rgb_s"]
+            how = "adaptive + OIDN" if ch["denoise"] else "adaptive, no denoiser"
+            rows.append(Row(f"Cycles CPU {CYCLES_THREADS} threads, {ch['samples']} samples {how} (its fastest at "
+                            f">= {c['target_db']:.1f} dB)",
+                            f"{ch['render_s']:.2f} s, {ch['psnr_db']:.1f} dB (own reference)",
+                            f"Mitsuba RGB {mode['name']} {mode['rgb_s']:.2f} s, {mode['psnr_db']:.1f} dB",
+                            f"Mitsuba {r3:.2f}x faster", ">= 3x", verdict(r3 >= 3.0)))
+            stands.append(f"3x Cycles' throughput at the same measured quality: {verdict(r3 >= 3.0, f'{r3:.2f}x')}")
+        else:
+            rows.append(Row("Cycles CPU, adaptive (+ OIDN)", f"no setting tried reached {c['target_db']:.1f} dB",
+                            f"Mitsuba RGB {mode['name']} {mode['rgb_s']:.2f} s", "", ">= 3x", "n/a"))
+            stands.append(f"3x Cycles' throughput: not decided (Cycles did not reach {c['target_db']:.1f} dB at "
+                          f"the settings tried)")
+        rows.append(Row("Cycles settings tried (samples: render s, PSNR against its own reference)", cand,
+                        f"reference {args.reference_spp} samples {c['reference_s']:.1f} s; Blender {c['blender']}",
+                        "", "", f"scene build {c['build_s']:.1f} s, sync+BVH {c['warmup_s']:.1f} s (not counted)"))
+    else:
+        rows.append(Row("Blender Cycles", cycles_note, "", "", ">= 3x", "n/a"))
+        stands.append(f"3x Cycles' throughput: not measured ({cycles_note})")
+    return rows, stands
+
+
+def _counts(text: str) -> list[int]:
+    """``"1,2,4"`` -> [1, 2, 4]; empty text -> []."""
+    return [int(x) for x in text.split(",") if x.strip()]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter,
+                                     epilog="\n".join(__doc__.splitlines()[2:5]))
+    parser.add_argument("--scenario", type=Path, default=REPO / "stages" / "district" / "scenario.usda")
+    parser.add_argument("--views", nargs="+", default=["/World/Cameras/CCTV_Largo"], help="camera prim paths")
+    parser.add_argument("--time-code", type=float, default=24.0)
+    parser.add_argument("--width", type=int, default=1280)
+    parser.add_argument("--height", type=int, default=960)
+    parser.add_argument("--variant", default=None, help="Mitsuba variant [default: cuda -> llvm -> scalar]")
+    parser.add_argument("--reference-spp", type=int, default=512, help="spp of both renderers' references")
+    parser.add_argument("--repeat", type=int, default=3, help="best of N for the label pass and the raw bound")
+    parser.add_argument("--pipeline-images", type=int, default=4)
+    parser.add_argument("--cycles-samples", type=_counts, default=[1, 2, 4, 8, 16],
+                        help="Cycles sample counts to try with adaptive sampling and OIDN [1,2,4,8,16]")
+    parser.add_argument("--cycles-plain-samples", type=_counts, default=[16],
+                        help="Cycles sample counts to try with adaptive sampling and no denoiser [16]")
+    parser.add_argument("--cycles-python", default=None, help="interpreter with bpy [default: $SYNTHUA_CYCLES_PYTHON, "
+                                                               "else .venv-cycles/bin/python]")
+    parser.add_argument("--skip-cycles", action="store_true")
+    parser.add_argument("--skip-pipeline", action="store_true")
+    parser.add_argument("--progress", action="store_true")
+    parser.add_argument("--save-images", type=Path, default=None,
+                        help="write the references and test images here as sRGB PNGs at the reference's exposure")
+    parser.add_argument("--json", type=Path, default=None, help="write the measurements here")
+    args = parser.parse_args(argv)
+
+    from synthua_usd.backends.cycles.runner import CyclesUnavailable
+    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.usd.reader import StageReader
+    from synthua_usd.usd.stage_io import open_stage
+
+    load_before = os.getloadavg()
+    psnr, psnr_note = quality_metric()
+    stage = open_stage(args.scenario)
+    reader = StageReader(stage, ClassMap.default())
+    session_out = measure_session(args, stage, reader, args.views, psnr)
+    dn = session_out["denoise"]
+    mode_spp, mode_denoise = (dn["spp"], True) if dn else (RGB_SPP, False)
+    mode_db = dn["psnr_db"] if dn else float(np.mean([v["rgb16_psnr_db"] for v in session_out["views"].values()]))
+    pipeline, pipeline_note = None, "skipped (--skip-pipeline)"
+    if not args.skip_pipeline:
+        if mode_denoise and not denoise_supported(settings=True):
+            mode_spp, mode_denoise = RGB_SPP, False  # generation configs cannot ask for the denoiser yet
+        try:
+            pipeline = measure_pipeline(args, args.views, mode_spp, mode_denoise)
+        except Exception as exc:  # noqa: BLE001 - the rest of the table is still worth printing
+            pipeline_note = f"failed: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+            print(f"bench_targets: synthua generate {pipeline_note}", file=sys.stderr)
+    cycles, cycles_note = None, "skipped (--skip-cycles)"
+    if not args.skip_cycles:
+        try:
+            cycles = measure_cycles(args, session_out, mode_db, psnr, args.views)
+        except CyclesUnavailable as exc:
+            cycles_note = str(exc).splitlines()[0]
+            print(f"bench_targets: {cycles_note}", file=sys.stderr)
+        except Exception as exc:  # noqa: BLE001 - the rest of the table is still worth printing
+            cycles_note = f"failed: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+            print(f"bench_targets: Cycles {cycles_note}", file=sys.stderr)
+    rows, stands = build_rows(args, session_out, pipeline, cycles, cycles_note, pipeline_note)
+    load_after = os.getloadavg()
+    print(f"{args.scenario.name if args.scenario.is_relative_to(REPO) else args.scenario} "
+          f"({args.scenario.relative_to(REPO) if args.scenario.is_relative_to(REPO) else ''}), views "
+          f"{', '.join(args.views)} at t={args.time_code:g}, {args.width}x{args.height}, {session_out['variant']}, "
+          f"max_depth {MAX_DEPTH} (Cycles max_bounces {CYCLES_BOUNCES}); {os.cpu_count()} CPUs; load average "
+          f"before {load_before[0]:.2f}, after {load_after[0]:.2f}")
+    print(psnr_note)
+    print()
+    print(markdown_table(rows))
+    print()
+    for line in stands:
+        print(f"- {line}")
+    if args.json:
+        views = {k: {kk: vv for kk, vv in v.items() if kk != "reference"} for k, v in session_out["views"].items()}
+        doc = {"args": {k: str(v) if isinstance(v, Path) else v for k, v in vars(args).items()},
+               "psnr": psnr_note, "load_average": [load_before, load_after],
+               "session": {k: v for k, v in session_out.items() if k not in ("views", "snapshot", "cameras")},
+               "views": views, "pipeline": pipeline, "cycles": cycles if isinstance(cycles, dict) else cycles_note,
+               "rows": [dataclasses.asdict(r) for r in rows], "targets": stands}
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(doc, indent=1, default=float) + "\n", encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
