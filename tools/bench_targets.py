@@ -94,44 +94,12 @@ def verdict(met: bool | None, detail: str = "") -> str:
 # ---- quality ------------------------------------------------------------------------------------------------
 
 def quality_metric():
-    """(psnr(test, reference) -> dB, a line saying which), both (H, W, 3) float32 scene-linear, compared
-    display-referred with the reference's exposure. ``synthua_usd.image_quality.psnr_db`` where it is built;
-    until then OpenImageIO's ``ImageBufAlgo.compare`` on the 8-bit sRGB images (``images.linear_to_display``),
-    said so in the output."""
-    from synthua_usd.backends.exposure import choose_exposure
-    from synthua_usd.backends.images import linear_to_display
+    """(psnr(test, reference) -> dB, a line saying which), both (H, W, 3) float32 scene-linear:
+    :func:`synthua_usd.image_quality.psnr_db`, display-referred at the reference's exposure."""
+    from synthua_usd.image_quality import psnr_db
 
-    try:
-        from synthua_usd.image_quality import psnr_db
-    except ImportError:
-        psnr_db = None
-
-    def exposed(test, reference):
-        scale = np.float32(choose_exposure(reference).scale)
-        return test * scale, reference * scale
-
-    if psnr_db is not None:
-        return (lambda test, reference: float(psnr_db(*exposed(test, reference))),
-                "PSNR: synthua_usd.image_quality.psnr_db, display-referred at the reference's exposure")
-
-    import OpenImageIO as oiio
-
-    def psnr_oiio(test, reference):
-        a, b = (oiio.ImageBuf(np.ascontiguousarray(linear_to_display(x), np.uint8)) for x in exposed(test, reference))
-        return float(oiio.ImageBufAlgo.compare(a, b, 1.0, 1.0).PSNR)
-
-    return psnr_oiio, ("PSNR: OpenImageIO ImageBufAlgo.compare of 8-bit sRGB images at the reference's exposure "
-                       "(synthua_usd.image_quality not built yet: branch denoise)")
-
-
-def denoise_supported(settings: bool = False) -> bool:
-    """Whether the denoiser is built: ``RenderConfig.denoise`` (with ``settings``: also a generation config's
-    ``render.denoise``)."""
-    from synthua_usd.dataset.config import RenderSettings
-    from synthua_usd.render_config import RenderConfig
-
-    owners = (RenderConfig, RenderSettings) if settings else (RenderConfig,)
-    return all("denoise" in {f.name for f in dataclasses.fields(owner)} for owner in owners)
+    return (lambda test, reference: float(psnr_db(test, reference)),
+            "PSNR: synthua_usd.image_quality.psnr_db, display-referred at the reference's exposure")
 
 
 def rgb_seconds(seconds: dict) -> float:
@@ -156,7 +124,7 @@ def measure_session(args, stage, reader, views, psnr) -> dict:
     from synthua_usd.usd.cameras import camera_paths, read_camera
 
     w, h, tc = args.width, args.height, args.time_code
-    base = RenderConfig(width=w, height=h, spp=RGB_SPP, max_depth=MAX_DEPTH, pixel_filter="box",
+    base = RenderConfig(width=w, height=h, spp=RGB_SPP, max_depth=MAX_DEPTH, pixel_filter="box", denoise=False,
                         variant=args.variant)
     session = RenderSession(base)
     out: dict = {"variant": session.variant, "views": {}}
@@ -203,20 +171,19 @@ def measure_session(args, stage, reader, views, psnr) -> dict:
     session.render(snapshot, cam, rgb=False)  # back to the measured view
     # the denoised mode, where the denoiser is built: the fewest spp that reach 16 spp's PSNR
     out["denoise"] = None
-    if denoise_supported():
-        target = np.mean([r["rgb16_psnr_db"] for r in out["views"].values()])
-        for spp in DENOISE_SPPS:
-            dn = RenderSession(dataclasses.replace(base, spp=spp, denoise=True))
-            results = []
-            for v in views:
-                dn.render(snapshot, cameras[v], rgb=True, seed=1)  # load and compile
-                f = dn.render(snapshot, cameras[v], rgb=True, seed=2)
-                results.append((rgb_seconds(f.seconds), psnr(f.rgb, out["views"][v]["reference"])))
-            del dn
-            seconds, db = float(np.mean([x[0] for x in results])), float(np.mean([x[1] for x in results]))
-            out["denoise"] = {"spp": spp, "rgb_s": seconds, "psnr_db": db, "reached_16spp": db >= target}
-            if db >= target:
-                break
+    target = np.mean([r["rgb16_psnr_db"] for r in out["views"].values()])
+    for spp in DENOISE_SPPS:
+        dn = RenderSession(dataclasses.replace(base, spp=spp, denoise=True))
+        results = []
+        for v in views:
+            dn.render(snapshot, cameras[v], rgb=True, seed=1)  # load and compile
+            f = dn.render(snapshot, cameras[v], rgb=True, seed=2)
+            results.append((rgb_seconds(f.seconds), psnr(f.rgb, out["views"][v]["reference"])))
+        del dn
+        seconds, db = float(np.mean([x[0] for x in results])), float(np.mean([x[1] for x in results]))
+        out["denoise"] = {"spp": spp, "rgb_s": seconds, "psnr_db": db, "reached_16spp": db >= target}
+        if db >= target:
+            break
     out["snapshot"], out["cameras"] = snapshot, cameras
     return out
 
@@ -228,9 +195,8 @@ def measure_pipeline(args, views, spp: int, denoise: bool) -> dict:
     from synthua_usd.pipeline.generate import GenerateRequest, generate
 
     seeds = list(range(max(1, -(-args.pipeline_images // len(views)))))
-    render = {"width": args.width, "height": args.height, "spp": spp, "max_depth": MAX_DEPTH, "pixel_filter": "box"}
-    if denoise:
-        render["denoise"] = True
+    render = {"width": args.width, "height": args.height, "spp": spp, "max_depth": MAX_DEPTH, "pixel_filter": "box",
+              "denoise": denoise}
     doc = {"name": "bench-targets", "images": args.pipeline_images, "render": render, "cameras": list(views),
            "time_codes": [args.time_code], "seeds": seeds, "sampling_seed": 0,
            "quotas": {"aid_users": None, "per_condition": None, "per_rig_type": None},
@@ -458,8 +424,6 @@ def main(argv: list[str] | None = None) -> int:
     mode_db = dn["psnr_db"] if dn else float(np.mean([v["rgb16_psnr_db"] for v in session_out["views"].values()]))
     pipeline, pipeline_note = None, "skipped (--skip-pipeline)"
     if not args.skip_pipeline:
-        if mode_denoise and not denoise_supported(settings=True):
-            mode_spp, mode_denoise = RGB_SPP, False  # generation configs cannot ask for the denoiser yet
         try:
             pipeline = measure_pipeline(args, args.views, mode_spp, mode_denoise)
         except Exception as exc:  # noqa: BLE001 - the rest of the table is still worth printing
