@@ -145,7 +145,7 @@ def measure_session(args, stage, reader, views, psnr) -> dict:
                                for _ in range(args.repeat))
         # RGB: a converged reference, then 16 spp (after a warm-up render that compiles its kernels)
         ref_config = dataclasses.replace(base, spp=args.reference_spp, seed=7)
-        r["reference_s"], reference = timed(lambda: render_rgb(mi, scene, ref_config, show_progress=args.progress))
+        r["reference_s"], reference = timed(lambda: render_rgb(mi, scene, ref_config, show_progress=args.progress).rgb)
         session.render(snapshot, cam, rgb=True, seed=1)
         frame = session.render(snapshot, cam, rgb=True, seed=2)
         r["rgb16_s"] = rgb_seconds(frame.seconds)
