@@ -34,3 +34,22 @@ def test_markdown_table_has_one_line_per_row_and_escapes_pipes(bench):
     assert lines[2] == "| label pass | 0.060 s | raw bound 0.050 s | 1.20x | <= 1.5x | met |"
     assert lines[3] == "| a\\|b | x |  |  |  |  |"
     assert bench.verdict(False, "0.6x") == "NOT met (0.6x)" and bench.verdict(None) == "n/a"
+
+
+@pytest.mark.slow
+def test_a_tiny_run_measures_every_mitsuba_row(tmp_path):
+    """The benchmark end to end at 64x48 without Cycles and the pipeline: every Mitsuba row is measured (a
+    change of the render API it calls shows here, not only in the next full run)."""
+    import json
+    import subprocess
+
+    out = tmp_path / "bench.json"
+    proc = subprocess.run([sys.executable, str(REPO / "tools" / "bench_targets.py"), "--width", "64", "--height", "48",
+                           "--reference-spp", "8", "--repeat", "1", "--skip-cycles", "--skip-pipeline",
+                           "--json", str(out)], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    rows = {row["measure"].split(" (")[0]: row for row in json.loads(out.read_text())["rows"]}
+    for measure in ("label pass", "RGB 16 spp", "first load", "per-frame update, next time code",
+                    "per-frame update, another camera"):
+        assert measure in rows and rows[measure]["value"] not in ("", "-"), (measure, sorted(rows))
+    assert any(name.startswith("RGB denoised") and "dB" in row["value"] for name, row in rows.items())

@@ -83,8 +83,8 @@ def read_interchange(folder: str | Path) -> tuple[dict, list[tuple[np.ndarray, n
 
 
 def _not_exported(material) -> list[str]:
-    """Names of the material's fields beyond the constants exported here (e.g. textures, once materials
-    carry them), so the comparison says what Cycles did not get."""
+    """Names of the material's fields beyond the constants exported here (its textures, opacity), so the
+    comparison says what Cycles did not get."""
     exported = {"key", "base_color", "roughness", "metallic", "emissive_color"}
     return sorted(f.name for f in fields(material) if f.name not in exported and getattr(material, f.name))
 
