@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
+from synthua_usd import srgb
+
 SIZE = 512
 #: Image name → function of (rng, size) → (size, size, 3) linear values around 1.
 TEXTURES: dict = {}
@@ -102,14 +104,13 @@ def asphalt(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
 def encode_srgb8(linear: np.ndarray) -> np.ndarray:
     """(H, W, 3) linear values in [0, 1] → 8-bit sRGB."""
     c = np.clip(linear, 0.0, 1.0)
-    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1 / 2.4) - 0.055)
-    return np.round(srgb * 255.0).astype(np.uint8)
+    return np.round(srgb.from_linear(c) * 255.0).astype(np.uint8)
 
 
 def decode_srgb8(pixels: np.ndarray) -> np.ndarray:
     """8-bit sRGB → linear float64 (what a renderer decodes)."""
     c = pixels / 255.0
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return srgb.to_linear(c)
 
 
 def district_images(seed: int, size: int = SIZE) -> dict[str, np.ndarray]:

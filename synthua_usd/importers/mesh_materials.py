@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
+from synthua_usd import srgb
 from synthua_usd.scene import Material, Texture
 from synthua_usd.texture_images import texture_path
 from synthua_usd.twin import prim_name
@@ -25,7 +26,7 @@ def srgb8_to_linear(rgb8) -> tuple[float, float, float]:
     """An 8-bit sRGB colour (first three of ``rgb8``) as linear Rec.709."""
     # Colours come from the file: anything but 0..255 (NaN included) is clipped into it.
     c = np.clip(np.nan_to_num(np.asarray(rgb8[:3], float), nan=0.0), 0.0, 255.0) / 255.0
-    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    lin = srgb.to_linear(c)
     return tuple(float(v) for v in lin)
 
 

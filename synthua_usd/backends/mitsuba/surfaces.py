@@ -17,6 +17,7 @@ from typing import Callable
 
 import numpy as np
 
+from synthua_usd import srgb
 from synthua_usd.errors import InputError, echo
 from synthua_usd.scene import Material, Texture
 
@@ -32,7 +33,7 @@ MAX_TEXELS = 8192 * 8192
 def srgb_to_linear(values: np.ndarray) -> np.ndarray:
     """The sRGB transfer function's inverse (IEC 61966-2-1), elementwise on values in [0, 1]."""
     v = np.asarray(values, np.float32)
-    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4).astype(np.float32)
+    return srgb.to_linear(v).astype(np.float32)
 
 
 def mitsuba_uvs(uvs: np.ndarray) -> np.ndarray:

@@ -1,0 +1,20 @@
+"""The sRGB transfer function (IEC 61966-2-1), elementwise: the one copy its decoders and encoders use.
+
+Plain numpy: values keep the caller's float dtype, so a float32 texture decodes in float32 and an 8-bit
+colour divided by 255 in float64. Images meant for display go through OCIO instead
+(:func:`synthua_usd.backends.images.linear_to_display`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def to_linear(values: np.ndarray) -> np.ndarray:
+    """sRGB-encoded values in [0, 1] → linear."""
+    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+
+
+def from_linear(values: np.ndarray) -> np.ndarray:
+    """Linear values in [0, 1] → sRGB-encoded."""
+    return np.where(values <= 0.0031308, 12.92 * values, 1.055 * values ** (1 / 2.4) - 0.055)
