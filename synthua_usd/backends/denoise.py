@@ -85,6 +85,27 @@ def suppress_fireflies(rgb: np.ndarray, ratio: float = FIREFLY_RATIO) -> tuple[n
     return out, report
 
 
+def _import_pyoidn():
+    """``pyoidn``, imported without torch.
+
+    pyoidn imports torch at import time whenever it is installed (only its tensor interop uses it). We pass
+    NumPy arrays, so that costs every render process torch's start-up, and torch's exit handlers make
+    OpenImageIO's bindings print "nanobind: leaked ..." after our last line. Hiding torch while pyoidn loads
+    makes it take its no-torch path; torch stays importable afterwards for whoever needs it."""
+    import sys
+
+    if "pyoidn" in sys.modules or "torch" in sys.modules:
+        import pyoidn
+
+        return pyoidn
+    sys.modules["torch"] = None  # a None entry makes `import torch` raise ImportError
+    try:
+        import pyoidn
+    finally:
+        del sys.modules["torch"]
+    return pyoidn
+
+
 class Denoiser:
     """Intel Open Image Denoise's ``RT`` filter on the CPU, guided by albedo and normal.
 
@@ -94,7 +115,7 @@ class Denoiser:
 
     def __init__(self, num_threads: int | None = None) -> None:
         try:
-            import pyoidn
+            pyoidn = _import_pyoidn()
         except ImportError as exc:  # an optional-looking import, but a core dependency: say how to fix it
             raise DenoiserError(f"denoising needs the pyoidn package ({exc}); install it with "
                                 f"`pip install -c constraints.txt pyoidn` or render with denoise off") from None

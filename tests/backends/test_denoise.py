@@ -70,3 +70,22 @@ def test_refuses_guides_of_another_shape():
     with Denoiser() as denoise:
         with pytest.raises(ValueError, match=r"denoiser normal: shape \(48, 63, 3\)"):
             denoise(colour, albedo, normal[:, :63])
+
+
+def test_the_denoiser_does_not_load_torch_and_leaves_it_importable():
+    """pyoidn imports torch whenever it is installed; the denoiser hides it (start-up time, and torch's exit
+    handlers made OpenImageIO print leak reports after a command's last line)."""
+    import subprocess
+    import sys
+
+    code = ("import importlib.util, sys\n"
+            "from synthua_usd.backends.denoise import Denoiser\n"
+            "Denoiser(num_threads=1).close()\n"
+            "assert 'torch' not in sys.modules, 'torch was loaded'\n"
+            "if importlib.util.find_spec('torch') is not None:\n"
+            "    import torch\n"
+            "    print('torch', torch.__version__)\n"
+            "print('ok')\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip().endswith("ok")
