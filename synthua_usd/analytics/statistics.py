@@ -25,6 +25,8 @@ import numpy as np
 from synthua_usd.analytics import measures as m
 from synthua_usd.analytics.dataset_index import DatasetIndex
 from synthua_usd.assets.devices import DEVICES
+from synthua_usd.errors import InputError
+from synthua_usd.input_files import shown
 from synthua_usd.taxonomy import SemanticClass
 
 #: Occlusion buckets of aid users (the same edges as coverage.json's).
@@ -93,7 +95,11 @@ def _distribution(values) -> dict:
 
 
 def compute(index: DatasetIndex) -> DatasetStatistics:
-    """The statistics of the images of ``index`` (QA-rejected images are not in it)."""
+    """The statistics of the images of ``index`` (QA-rejected images are not in it); a dataset without images
+    raises :class:`InputError`."""
+    if not index.images:
+        raise InputError(f"{shown(index.root)}: no images ({index.rejected} rejected by QA, left out); expected a "
+                         f"dataset with at least one image to describe")
     classes = [c for c in index.class_map.classes if c.id != 0]
     position = {c.id: k for k, c in enumerate(classes)}
     images = index.images

@@ -110,3 +110,15 @@ def test_a_broken_record_is_one_error(tmp_path):
     (root / "records" / f"{tiny_dataset.NAMES[0]}.json").write_text('{"id": 1}')
     with pytest.raises(InputError, match="expected an image record written by `synthua generate`"):
         load_index(root)
+
+
+def test_a_dataset_without_images_is_refused(tmp_path):
+    import json
+
+    root = tiny_dataset.write(tmp_path / "ds")
+    manifest = json.loads((root / "manifest.json").read_text())
+    for entry in manifest["images"]:
+        entry["qa"] = "rejected"
+    (root / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(InputError, match=r"no images \(3 rejected by QA, left out\); expected a dataset"):
+        compute(load_index(root))
