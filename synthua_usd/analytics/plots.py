@@ -131,7 +131,7 @@ def aid_users(occlusion_hist: dict, size_hist: dict, path: Path) -> Path:
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
     for ax, hist, label in ((a, occlusion_hist, "occlusion"), (b, size_hist, "visible pixels (person + device)")):
         e = hist["edges"]
-        ticks = [f"{e[i]:g}–{e[i + 1]:g}" for i in range(len(e) - 1)]
+        ticks = [f"{e[i]:g}–{e[i + 1]:g}" if e[i + 1] < 1e9 else f"≥ {e[i]:g}" for i in range(len(e) - 1)]
         ax.bar(np.arange(len(ticks)), hist["counts"], color="#aa3377")
         ax.set_xticks(np.arange(len(ticks)), ticks, rotation=45, ha="right", fontsize=8)
         ax.set_xlabel(label)

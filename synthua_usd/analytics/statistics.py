@@ -31,6 +31,8 @@ from synthua_usd.taxonomy import SemanticClass
 
 #: Occlusion buckets of aid users (the same edges as coverage.json's).
 OCCLUSION_EDGES = (0.0, 0.25, 0.5, 0.75, 1.0)
+#: Visible-pixel buckets of aid users (person + device); the last is open-ended in practice.
+SIZE_EDGES = (0, 50, 100, 250, 500, 1000, 2500, 5000, 10000, 50000, 10**9)
 #: Coverage asked of the "classes covering the area" figure.
 COVERAGE = 0.8
 
@@ -87,6 +89,14 @@ def _histogram(values, edges) -> dict:
     return {"edges": [float(e) for e in edges], "counts": [int(c) for c in counts]}
 
 
+def _count_edges(top: int, bins: int = 30) -> np.ndarray:
+    """Histogram edges for counts 0..top: one bin per integer (edges at k - 0.5) up to ``bins`` integers, else
+    ``bins`` equal bins over [0, top + 1]."""
+    if top + 1 <= bins:
+        return np.arange(top + 2) - 0.5
+    return np.linspace(0, top + 1, bins + 1)
+
+
 def _distribution(values) -> dict:
     v = np.asarray(values, np.float64)
     if v.size == 0:
@@ -135,7 +145,7 @@ def compute(index: DatasetIndex) -> DatasetStatistics:
     occlusions = [u.occlusion for u in users if u.occlusion is not None]
     sizes = [u.visible_pixels for u in users]
     ipi = np.asarray(per_image, np.int64)
-    top = max(int(ipi.max()) if ipi.size else 0, 1)
+    top = int(ipi.max()) if ipi.size else 0
 
     summary = {
         "images": n_img, "rejected_images_left_out": index.rejected,
@@ -148,7 +158,7 @@ def compute(index: DatasetIndex) -> DatasetStatistics:
         "coverage": COVERAGE, "classes_for_coverage": m.classes_for_coverage(pixels, COVERAGE),
         "coverage_curve": [float(v) for v in m.coverage_curve(pixels)],
         "instances_per_image": _distribution(ipi) | {
-            "histogram": _histogram(ipi, np.linspace(0, top + 1, min(top + 1, 30) + 1)),
+            "histogram": _histogram(ipi, _count_edges(top)),
             "density_buckets": m.density_buckets(ipi)},
         "images_per_split": dict(sorted(Counter(i.split for i in images).items())),
         "images_per_condition": dict(sorted(Counter(i.condition for i in images).items())),
@@ -164,7 +174,7 @@ def compute(index: DatasetIndex) -> DatasetStatistics:
             "per_aid_type": dict(sorted(Counter(u.aid_type for u in users).items())),
             "occlusion": _distribution(occlusions) | {"histogram": _histogram(occlusions, OCCLUSION_EDGES)},
             "visible_pixels": _distribution(sizes) | {
-                "histogram": _histogram(sizes, [0, 50, 100, 250, 500, 1000, 2500, 5000, 10000, 50000, 10**9])}},
+                "histogram": _histogram(sizes, SIZE_EDGES)}},
     }
     return DatasetStatistics(classes=rows, areas=areas, instances_per_image=[int(v) for v in ipi],
                              cooccurrence=m.cooccurrence(presence), summary=summary)

@@ -72,6 +72,9 @@ def test_per_image_and_cooccurrence(tiny_stats):
     assert (s["instances_per_image"]["mean"], s["instances_per_image"]["median"], s["instances_per_image"]["max"]) \
         == (4.0, 4.0, 4.0)
     assert s["instances_per_image"]["density_buckets"] == {"<=100": 2, "101-500": 0, ">500": 0}
+    # one bin per count 0..4, centred on the integers: both images have 4 objects
+    assert s["instances_per_image"]["histogram"] == {"edges": [-0.5, 0.5, 1.5, 2.5, 3.5, 4.5],
+                                                     "counts": [0, 0, 0, 0, 2]}
     names = [c.name for c in tiny_stats.classes]
     co = tiny_stats.cooccurrence
     pair = lambda a, b: co[names.index(a), names.index(b)]  # noqa: E731
