@@ -20,7 +20,7 @@ import numpy as np
 
 from synthua_usd.analytics import segmentation_metrics as sm
 from synthua_usd.analytics.dataset_index import load_class_map, manifest_images
-from synthua_usd.dataset.layout import SPLITS, Layout
+from synthua_usd.dataset.layout import SPLITS, Layout, inside
 from synthua_usd.errors import InputError
 from synthua_usd.input_files import check_input_file, shown
 from synthua_usd.schemas import read_json
@@ -118,7 +118,8 @@ def evaluate_semantic(gt_dir: Path, pred_dir: Path, split: str | None = None) ->
     if not pred_dir.is_dir():
         raise InputError(f"{shown(pred_dir)}: not a folder; expected a folder of {{image name}}.png predictions "
                          f"(or a COCO results .json file)")
-    missing = [g.name for g in images if not (pred_dir / f"{g.name}.png").is_file()]
+    pred_paths = {g.name: inside(pred_dir, f"{g.name}.png") for g in images}   # names from the manifest: checked
+    missing = [g.name for g in images if not pred_paths[g.name].is_file()]
     if missing:
         raise InputError(f"{shown(pred_dir / (missing[0] + '.png'))}: file not found; expected a prediction for each "
                          f"of the {len(images)} images evaluated ({len(missing)} missing)")
@@ -128,7 +129,7 @@ def evaluate_semantic(gt_dir: Path, pred_dir: Path, split: str | None = None) ->
     for g in images:
         gt_path = layout.path(g.class_png)
         gt = _read_png(gt_path, "a class-id map")[..., 0].astype(np.int64)
-        pred_path = pred_dir / f"{g.name}.png"
+        pred_path = pred_paths[g.name]
         pred = prediction_ids(_read_png(pred_path, "a prediction PNG"), class_map, shown(pred_path))
         if pred.shape != gt.shape:
             raise InputError(f"{shown(pred_path)}: {pred.shape[1]}x{pred.shape[0]} pixels; expected "
