@@ -13,7 +13,7 @@ DISTRICT := stages/district/scenario.usda
 
 ## Validate the shipped scenarios, render the demo street's CCTV and pedestrian-eye cameras and the
 ## Largo da Ordem district's largo CCTV into out/demo/, then generate and verify a small dataset of the
-## demo street (configs/demo.json) in out/demo/dataset/.
+## demo street (configs/demo.json) in out/demo/dataset/ and write its statistics report to out/demo/dataset_report/.
 demo: setup
 	$(BIN)/synthua validate stage $(SCENARIO)
 	$(BIN)/synthua inspect $(SCENARIO)
@@ -23,7 +23,8 @@ demo: setup
 	$(BIN)/synthua render $(DISTRICT) --camera /World/Cameras/CCTV_Largo --time-code 24 --out $(DEMO_OUT)/district_cctv_largo
 	$(BIN)/synthua generate $(SCENARIO) --config configs/demo.json --out $(DEMO_OUT)/dataset
 	$(BIN)/synthua verify $(DEMO_OUT)/dataset
-	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}; a dataset (COCO, panoptic, Cityscapes, YOLO) in $(DEMO_OUT)/dataset"
+	$(BIN)/synthua stats $(DEMO_OUT)/dataset --out $(DEMO_OUT)/dataset_report
+	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}; a dataset (COCO, panoptic, Cityscapes, YOLO) in $(DEMO_OUT)/dataset, its statistics in $(DEMO_OUT)/dataset_report/report.html"
 
 ## The whole test suite (slow tests included).
 test: setup

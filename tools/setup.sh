@@ -2,7 +2,8 @@
 # Set up synthua-usd on a fresh Debian 12 machine (or any Linux with Python >= 3.11):
 #   1. system libraries, when apt is available and we may use it: libllvm19 (Mitsuba's llvm_ad_rgb
 #      variant needs LLVM >= 19; with only 14/15 it aborts) and python3-venv;
-#   2. a virtual environment in .venv with the package and its test extras, pinned by constraints.txt.
+#   2. chromium, when apt may be used (the HTML report tests; they skip without it);
+#   3. a virtual environment in .venv with the package and its test and torch extras, pinned by constraints.txt.
 # Safe to run again: it only does what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -31,6 +32,13 @@ if ! compgen -G "/usr/lib/*/libLLVM*.so.19*" >/dev/null && ! compgen -G "/usr/li
   apt_install libllvm19 || echo "setup: warning: could not install libllvm19; rendering will use the slower scalar_rgb variant" >&2
 fi
 
+# Chromium (optional): the tests open the HTML report of `synthua stats` in a real headless browser; without it
+# those tests skip with a reason.
+if ! command -v chromium >/dev/null 2>&1 && ! command -v chromium-browser >/dev/null 2>&1; then
+  echo "setup: installing chromium (headless browser for the report tests)"
+  apt_install chromium || echo "setup: warning: could not install chromium; the HTML report tests will be skipped" >&2
+fi
+
 # 2. Python >= 3.11.
 if [ -z "$PYTHON" ]; then
   for candidate in python3.11 python3.12 python3.13 python3; do
@@ -57,7 +65,8 @@ stamp="$VENV/.installed"
 if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ constraints.txt -nt "$stamp" ]; then
   echo "setup: installing synthua-usd and its dependencies into $VENV"
   "$VENV/bin/python" -m pip install -q --upgrade pip
-  "$VENV/bin/python" -m pip install -q -c constraints.txt -e '.[test]'
+  # The torch extra: torch==2.13.0 from PyPI (constraints.txt) is the CPU build on Linux x86-64.
+  "$VENV/bin/python" -m pip install -q -c constraints.txt -e '.[test,torch]'
   # panopticapi (the COCO panoptic reader of the tests): its PyPI wheel, panopticapi-lite, is the
   # cocodataset/panopticapi code but declares numpy<2, which the rest of the stack cannot meet; its code runs
   # on NumPy 2, and what it needs (numpy, pillow) comes with the test extra.

@@ -16,6 +16,7 @@ import click
 
 from synthua_usd import __version__
 from synthua_usd.cli.agents_commands import agents
+from synthua_usd.cli.analytics_commands import evaluate, stats
 from synthua_usd.cli.cameras_commands import cameras
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
 from synthua_usd.cli.common import parse_time_codes as _time_codes
@@ -252,7 +253,7 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     return EXIT_OK
 
 
-for _group in (twin, agents, cameras, survey, contact_sheet, generate, verify, replay):
+for _group in (twin, agents, cameras, survey, contact_sheet, generate, verify, replay, stats, evaluate):
     cli.add_command(_group)
 
 

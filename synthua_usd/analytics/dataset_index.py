@@ -1,0 +1,113 @@
+"""What analytics reads of a generated dataset: the manifest (which images, their split and QA verdict),
+the dataset's class map and each image's record (``records/{name}.json``: condition, camera rig, class pixel
+counts, instances with areas, occlusion and relations, panoptic segments). No image file is opened here: the
+records hold every count the statistics need. Images rejected by QA are left out, as every training format
+leaves them out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from synthua_usd.dataset.layout import Layout
+from synthua_usd.dataset.qa import AidUser, aid_users
+from synthua_usd.errors import InputError
+from synthua_usd.input_files import shown
+from synthua_usd.schemas import read_json
+from synthua_usd.taxonomy import ClassMap
+
+
+@dataclass(frozen=True)
+class ImageSummary:
+    """One image as the statistics see it.
+
+    ``class_pixels``: class name -> visible pixels (``unlabelled`` included); ``segments``: (class id, area in
+    pixels) of each panoptic segment (one per thing instance, one per stuff class present);
+    ``aid_users``: the image's mobility-aid users (:func:`synthua_usd.dataset.qa.aid_users`)."""
+
+    id: int
+    name: str
+    split: str
+    condition: str
+    rig_type: str
+    width: int
+    height: int
+    verdict: str
+    class_pixels: dict[str, int]
+    segments: tuple[tuple[int, int], ...]
+    aid_users: tuple[AidUser, ...] = field(default=())
+
+    @property
+    def rgb(self) -> str:
+        """Relative path of the RGB image."""
+        return Layout.rgb_png(self.split, self.name)
+
+    @property
+    def class_png(self) -> str:
+        """Relative path of the 8-bit class-id map."""
+        return Layout.frame_file(self.name, "class.png")
+
+
+@dataclass(frozen=True)
+class DatasetIndex:
+    root: Path
+    class_map: ClassMap
+    images: tuple[ImageSummary, ...]
+    rejected: int
+
+
+def load_class_map(root: Path) -> ClassMap:
+    """The dataset's own class map (``class_map.json``): the ids its label maps use."""
+    return ClassMap.load(Layout(root).path(Layout.CLASS_MAP))
+
+
+def manifest_images(root: Path) -> list[dict]:
+    """The manifest's image entries (``id``, ``name``, ``split``, ``qa``, ...); a folder without a manifest is
+    refused (the manifest is written last: without it the dataset is incomplete)."""
+    root = Path(root)
+    if not root.is_dir():
+        raise InputError(f"{shown(root)}: not a folder; expected a dataset folder written by `synthua generate`")
+    manifest_path = root / Layout.MANIFEST
+    if not manifest_path.exists():
+        raise InputError(f"{shown(manifest_path)}: file not found; expected a complete dataset written by "
+                         f"`synthua generate` (the manifest is written last)")
+    manifest = read_json(manifest_path, "a dataset manifest")
+    images = manifest.get("images") if isinstance(manifest, dict) else None
+    if not isinstance(images, list) or not all(isinstance(i, dict) and "name" in i and "split" in i for i in images):
+        raise InputError(f"{shown(manifest_path)}: images: not a list of image entries with name and split; "
+                         f"expected a manifest written by `synthua generate`")
+    return images
+
+
+def _summary(record: dict, verdict: str, where: str) -> ImageSummary:
+    try:
+        camera = record.get("camera") or {}
+        condition = (record.get("condition") or {}).get("name") or "stage"
+        return ImageSummary(
+            id=int(record["id"]), name=str(record["name"]), split=str(record["split"]), condition=str(condition),
+            rig_type=str(camera.get("rig_type") or "none"), width=int(record["width"]), height=int(record["height"]),
+            verdict=verdict, class_pixels={str(k): int(v) for k, v in record["class_pixel_counts"].items()},
+            segments=tuple((int(s["category_id"]), int(s["area"])) for s in record["panoptic_segments"]),
+            aid_users=tuple(aid_users(record.get("instances", ()))))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"{where}: {type(exc).__name__} {exc}; expected an image record written by "
+                         f"`synthua generate`") from None
+
+
+def load_index(root: str | Path) -> DatasetIndex:
+    """Manifest, class map and the records of every image not rejected by QA, by image id."""
+    root = Path(root)
+    layout = Layout(root)
+    entries = manifest_images(root)
+    class_map = load_class_map(root)
+    images, rejected = [], 0
+    for entry in entries:
+        verdict = str(entry.get("qa", "accepted"))
+        if verdict == "rejected":
+            rejected += 1
+            continue
+        path = layout.path(Layout.record(str(entry["name"])))
+        images.append(_summary(read_json(path, "an image record"), verdict, shown(path)))
+    images.sort(key=lambda i: i.id)
+    return DatasetIndex(root=root, class_map=class_map, images=tuple(images), rejected=rejected)

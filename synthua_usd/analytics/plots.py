@@ -1,0 +1,159 @@
+"""The statistics as figures (matplotlib, Agg backend, PNG at 100 dpi): one function per figure, each taking
+plain data and writing one file. Class colours are the class map's."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from synthua_usd.atomic import atomic_path
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path: Path) -> Path:
+    plt = _pyplot()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=100, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def _rgb(color) -> tuple[float, float, float]:
+    return tuple(v / 255.0 for v in color)
+
+
+def class_distribution(names, counts, pixel_shares, colors, path: Path) -> Path:
+    """Bar charts of objects per class (log scale) and pixel share per class, classes by object count."""
+    plt = _pyplot()
+    order = np.argsort(-np.asarray(counts), kind="stable")
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(12, 7), sharex=True)
+    x = np.arange(len(order))
+    c = [_rgb(colors[i]) for i in order]
+    top.bar(x, [max(counts[i], 0) for i in order], color=c, edgecolor="black", linewidth=0.4)
+    top.set_yscale("symlog", linthresh=1)
+    top.set_ylabel("objects (log)")
+    top.set_title("Objects and pixel share per class")
+    bottom.bar(x, [100 * pixel_shares[i] for i in order], color=c, edgecolor="black", linewidth=0.4)
+    bottom.set_ylabel("pixel share (%)")
+    bottom.set_xticks(x, [names[i] for i in order], rotation=75, ha="right", fontsize=8)
+    return _save(fig, path)
+
+
+def area_boxplots(areas: dict[str, list[int]], colors: dict[str, tuple], path: Path) -> Path:
+    """Box plots of object areas per class on a log scale (classes with objects only, by median area)."""
+    plt = _pyplot()
+    names = sorted((n for n, a in areas.items() if a), key=lambda n: float(np.median(areas[n])))
+    fig, ax = plt.subplots(figsize=(12, 5))
+    if names:
+        box = ax.boxplot([areas[n] for n in names], patch_artist=True, whis=1.5, flierprops={"markersize": 3})
+        for patch, n in zip(box["boxes"], names):
+            patch.set_facecolor(_rgb(colors[n]))
+        ax.set_xticks(np.arange(1, len(names) + 1), names, rotation=75, ha="right", fontsize=8)
+    ax.set_yscale("log")
+    ax.set_ylabel("object area (px², log)")
+    ax.set_title("Object areas per class")
+    return _save(fig, path)
+
+
+def cooccurrence_heatmap(names, matrix: np.ndarray, path: Path) -> Path:
+    """Heatmap of images showing both classes (classes present in at least one image only)."""
+    plt = _pyplot()
+    keep = np.flatnonzero(np.diag(matrix) > 0)
+    sub = matrix[np.ix_(keep, keep)]
+    fig, ax = plt.subplots(figsize=(9, 8))
+    im = ax.imshow(sub, cmap="viridis")
+    ax.set_xticks(np.arange(len(keep)), [names[i] for i in keep], rotation=75, ha="right", fontsize=7)
+    ax.set_yticks(np.arange(len(keep)), [names[i] for i in keep], fontsize=7)
+    fig.colorbar(im, ax=ax, label="images with both classes")
+    ax.set_title("Class co-occurrence")
+    return _save(fig, path)
+
+
+def coverage_cdf(curve, coverage: float, needed: int, path: Path) -> Path:
+    """Cumulative pixel share of classes sorted by area, with the coverage line and the classes needed."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4))
+    k = np.arange(1, len(curve) + 1)
+    ax.step(k, 100 * np.asarray(curve), where="post")
+    ax.axhline(100 * coverage, color="red", linestyle="--", label=f"{100 * coverage:g} %")
+    if needed:
+        ax.axvline(needed, color="grey", linestyle=":", label=f"{needed} classes")
+    ax.set_xlabel("classes, largest area first")
+    ax.set_ylabel("cumulative pixel share (%)")
+    ax.set_ylim(0, 101)
+    ax.legend()
+    ax.set_title("Coverage of the labelled area")
+    return _save(fig, path)
+
+
+def instances_histogram(per_image, edges, path: Path) -> Path:
+    """Histogram of objects per image with its mean and median."""
+    plt = _pyplot()
+    v = np.asarray(per_image, np.float64)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.hist(v, bins=np.asarray(edges), color="#4477aa", edgecolor="white")
+    if v.size:
+        ax.axvline(v.mean(), color="red", linestyle="--", label=f"mean {v.mean():.1f}")
+        ax.axvline(np.median(v), color="green", linestyle="--", label=f"median {np.median(v):g}")
+        ax.legend()
+    ax.set_xlabel("objects per image")
+    ax.set_ylabel("images")
+    ax.set_title("Objects per image")
+    return _save(fig, path)
+
+
+def aid_area(names, pixels, colors, path: Path) -> Path:
+    """Share of the mobility-aid area per device class (horizontal bars, all device classes shown)."""
+    plt = _pyplot()
+    total = float(sum(pixels)) or 1.0
+    fig, ax = plt.subplots(figsize=(7, 4))
+    y = np.arange(len(names))
+    ax.barh(y, [100 * p / total for p in pixels], color=[_rgb(c) for c in colors], edgecolor="black", linewidth=0.4)
+    ax.set_yticks(y, names)
+    ax.invert_yaxis()
+    ax.set_xlabel("share of mobility-aid pixels (%)")
+    ax.set_title("Mobility-aid area")
+    return _save(fig, path)
+
+
+def aid_users(occlusion_hist: dict, size_hist: dict, path: Path) -> Path:
+    """Two bar charts: aid users per occlusion bucket and per visible-pixel bucket."""
+    plt = _pyplot()
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
+    for ax, hist, label in ((a, occlusion_hist, "occlusion"), (b, size_hist, "visible pixels (person + device)")):
+        e = hist["edges"]
+        ticks = [f"{e[i]:g}–{e[i + 1]:g}" if e[i + 1] < 1e9 else f"≥ {e[i]:g}" for i in range(len(e) - 1)]
+        ax.bar(np.arange(len(ticks)), hist["counts"], color="#aa3377")
+        ax.set_xticks(np.arange(len(ticks)), ticks, rotation=45, ha="right", fontsize=8)
+        ax.set_xlabel(label)
+        ax.set_ylabel("aid users")
+    fig.suptitle("Mobility-aid users: occlusion and size")
+    return _save(fig, path)
+
+
+def confusion_heatmap(names, matrix: np.ndarray, path: Path) -> Path:
+    """Row-normalised confusion matrix (ground truth rows, predictions columns) of the classes that occur."""
+    plt = _pyplot()
+    m = np.asarray(matrix, np.float64)
+    keep = np.flatnonzero((m.sum(axis=0) + m.sum(axis=1)) > 0)
+    sub = m[np.ix_(keep, keep)]
+    rows = sub.sum(axis=1, keepdims=True)
+    norm = np.divide(sub, rows, out=np.zeros_like(sub), where=rows > 0)
+    fig, ax = plt.subplots(figsize=(9, 8))
+    im = ax.imshow(norm, cmap="Blues", vmin=0, vmax=1)
+    ax.set_xticks(np.arange(len(keep)), [names[i] for i in keep], rotation=75, ha="right", fontsize=7)
+    ax.set_yticks(np.arange(len(keep)), [names[i] for i in keep], fontsize=7)
+    ax.set_xlabel("predicted")
+    ax.set_ylabel("ground truth")
+    fig.colorbar(im, ax=ax, label="share of the ground-truth class's pixels")
+    ax.set_title("Confusion matrix")
+    return _save(fig, path)

@@ -1,0 +1,117 @@
+"""A hand-made dataset folder of three 8x6 images for the analytics tests, written with PIL and
+pycocotools (not with synthua's writers), holding what analytics reads: manifest, class map, records,
+RGB images, class maps and COCO instances. Image 3 is rejected by QA and must be left out everywhere.
+
+Image 1 (train, clear_day, cctv)        Image 2 (val, day_fog, pedestrian_eye)
+  rows 0-2, cols 0-3: building #1 (12)    rows 0-1, cols 0-2: building #1 (6)
+  row 3, cols 0-1: person #2 (2),         rows 0-1, cols 4-5: building #2 (4)
+     uses the wheelchair #3               row 3, cols 6-7: walker #3 (2), standing alone
+  row 3, cols 2-4: manual_wheelchair #3   row 5: road (8)
+     (3 visible of 4 amodal pixels)       unlabelled: 28
+  rows 4-5: road (16); unlabelled: 15
+Image 3 (test, rejected): road everywhere.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+from pycocotools import mask as mask_utils
+
+from synthua_usd.taxonomy import ClassMap
+
+H, W = 6, 8
+ROAD, BUILDING, PERSON, WHEELCHAIR, WALKER = 1, 6, 18, 29, 31
+NAMES = ("000001_CCTV_t0001_clear-day_s0", "000002_Ped_t0001_day-fog_s0", "000003_CCTV_t0002_clear-day_s0")
+
+
+def label_maps() -> list[tuple[np.ndarray, np.ndarray]]:
+    """(class ids, instance ids) per image, (H, W) each."""
+    c1, i1 = np.zeros((H, W), np.uint8), np.zeros((H, W), np.uint16)
+    c1[4:6, :] = ROAD
+    c1[0:3, 0:4], i1[0:3, 0:4] = BUILDING, 1
+    c1[3, 0:2], i1[3, 0:2] = PERSON, 2
+    c1[3, 2:5], i1[3, 2:5] = WHEELCHAIR, 3
+    c2, i2 = np.zeros((H, W), np.uint8), np.zeros((H, W), np.uint16)
+    c2[5, :] = ROAD
+    c2[0:2, 0:3], i2[0:2, 0:3] = BUILDING, 1
+    c2[0:2, 4:6], i2[0:2, 4:6] = BUILDING, 2
+    c2[3, 6:8], i2[3, 6:8] = WALKER, 3
+    c3, i3 = np.full((H, W), ROAD, np.uint8), np.zeros((H, W), np.uint16)
+    return [(c1, i1), (c2, i2), (c3, i3)]
+
+
+def _rle(mask: np.ndarray) -> dict:
+    rle = mask_utils.encode(np.asfortranarray(mask.astype(np.uint8)))
+    return {"size": [int(v) for v in rle["size"]], "counts": rle["counts"].decode("ascii")}
+
+
+def _bbox(mask: np.ndarray) -> list[int]:
+    ys, xs = np.nonzero(mask)
+    return [int(xs.min()), int(ys.min()), int(xs.max() - xs.min() + 1), int(ys.max() - ys.min() + 1)]
+
+
+def write(root: Path) -> Path:
+    cmap = ClassMap.default()
+    splits = ("train", "val", "test")
+    conditions = ("clear_day", "day_fog", "clear_day")
+    rigs = ("cctv", "pedestrian_eye", "cctv")
+    verdicts = ("accepted", "flagged", "rejected")
+    (root / "records").mkdir(parents=True)
+    (root / "annotations").mkdir()
+    (root / "class_map.json").write_text(json.dumps(cmap.document()))
+    manifest = {"$schema": "manifest", "provenance": {}, "images": [], "dataset_files": []}
+    coco = {s: {"images": [], "annotations": [], "categories": [
+        {"id": c.id, "name": c.name, "supercategory": c.group} for c in cmap.classes if c.isthing]} for s in splits}
+    ann_id = 0
+    for k, ((cls, inst), name, split) in enumerate(zip(label_maps(), NAMES, splits)):
+        image_id = k + 1
+        for folder in (root / "images" / split, root / "frames" / name):
+            folder.mkdir(parents=True, exist_ok=True)
+        c16 = cls.astype(np.int64)
+        rgb = np.stack([(c16 * 7) % 256, (c16 * 3) % 256, np.full_like(c16, 90)], axis=-1).astype(np.uint8)
+        Image.fromarray(rgb).save(root / "images" / split / f"{name}.png")
+        Image.fromarray(cls).save(root / "frames" / name / "class.png")
+        instances, segments = [], []
+        for iid in sorted(set(np.unique(inst).tolist()) - {0}):
+            mask = inst == iid
+            cid = int(cls[mask][0])
+            c = cmap.by_id(cid)
+            amodal = int(mask.sum()) + (1 if cid == WHEELCHAIR else 0)
+            relations = {"uses": "/World/Agents/A1/Wheelchair", "uses_class": "manual_wheelchair"} \
+                if cid == PERSON else {}
+            prim = {PERSON: "/World/Agents/A1/Person", WHEELCHAIR: "/World/Agents/A1/Wheelchair"}.get(
+                cid, f"/World/Twin/Thing_{image_id}_{iid}")
+            entry = {"id": iid, "category_id": cid, "class_name": c.name, "isthing": True, "area": int(mask.sum()),
+                     "amodal_area": amodal, "occlusion": 1 - int(mask.sum()) / amodal, "bbox": _bbox(mask),
+                     "segmentation": _rle(mask), "prim_path": prim, "relations": relations}
+            instances.append(entry)
+            segments.append({"id": iid, "category_id": cid, "area": int(mask.sum()), "bbox": _bbox(mask), "iscrowd": 0})
+            ann_id += 1
+            coco[split]["annotations"].append({"id": ann_id, "image_id": image_id, "category_id": cid,
+                                               "segmentation": _rle(mask), "area": int(mask.sum()),
+                                               "bbox": [float(v) for v in _bbox(mask)], "iscrowd": 0})
+        for cid in sorted(set(np.unique(cls).tolist()) - {0}):
+            if not cmap.by_id(cid).isthing:
+                mask = cls == cid
+                segments.append({"id": 65536 + cid, "category_id": cid, "area": int(mask.sum()),
+                                 "bbox": _bbox(mask), "iscrowd": 0})
+        pixels = {cmap.by_id(int(v)).name: int((cls == v).sum()) for v in np.unique(cls)}
+        record = {"id": image_id, "name": name, "split": split, "width": W, "height": H, "seed": 0,
+                  "time_code": 1.0, "camera": {"name": name.split("_")[1], "rig_type": rigs[k]},
+                  "condition": {"name": conditions[k]}, "class_pixel_counts": pixels, "instances": instances,
+                  "panoptic_segments": segments, "qa": {"verdict": verdicts[k], "reasons": [], "measures": {}}}
+        (root / "records" / f"{name}.json").write_text(json.dumps(record))
+        manifest["images"].append({"id": image_id, "name": name, "split": split, "seed": 0, "qa": verdicts[k],
+                                   "files": []})
+        if verdicts[k] != "rejected":
+            coco[split]["images"].append({"id": image_id, "file_name": f"{name}.png", "width": W, "height": H})
+        else:
+            coco[split]["annotations"] = [a for a in coco[split]["annotations"] if a["image_id"] != image_id]
+    for split in splits:
+        (root / "annotations" / f"instances_{split}.json").write_text(json.dumps(coco[split]))
+    (root / "manifest.json").write_text(json.dumps(manifest))
+    return root
