@@ -25,7 +25,7 @@ def twin() -> None:
 KIND_OPTIONS = {
     "rules": ("mesh", "cityjson", "pointcloud"),
     "up_axis": ("mesh",), "scale": ("mesh",),
-    "lod": ("cityjson",),
+    "lod": ("cityjson",), "crs": ("cityjson", "pointcloud"), "units": ("cityjson", "pointcloud"),
     "max_deviation_m": ("pointcloud",), "plane_threshold_m": ("pointcloud",),
     "storey_height_m": ("footprints",),
 }
@@ -56,6 +56,12 @@ def _refuse_foreign_options(ctx: click.Context, kind: str) -> None:
               help="mesh: file units to metres.")
 @click.option("--lod", help="cityjson: level of detail to import, one the file has [default: the highest each object "
                             "has].")
+@click.option("--crs", help="cityjson, pointcloud: the CRS of the coordinates (EPSG:2263, 2263, a CRS URL or WKT); "
+                            "replaces the file's own, and serves files that have none. Its linear units convert "
+                            "the coordinates to metres.")
+@click.option("--units", type=click.Choice(["m", "ft", "us-ft"]),
+              help="cityjson, pointcloud: the linear unit of a file without a CRS (us-ft: US survey foot, "
+                   "1200/3937 m). Files whose unit is unknown are refused without --crs or --units.")
 @click.option("--max-deviation-m", type=InRange(importer_limits.MAX_DEVIATION), default=0.005, show_default=True,
               help="pointcloud: largest Hausdorff distance simplification may introduce (metres).")
 @click.option("--plane-threshold-m", type=InRange(importer_limits.PLANE_THRESHOLD), default=0.02, show_default=True,
@@ -64,15 +70,17 @@ def _refuse_foreign_options(ctx: click.Context, kind: str) -> None:
               help="footprints: metres per level when a footprint gives levels, not height.")
 @click.pass_context
 def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, rules: Path | None,
-                class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, max_deviation_m: float,
+                class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, crs: str | None,
+                units: str | None, max_deviation_m: float,
                 plane_threshold_m: float, storey_height_m: float) -> int:
     """Import real city data of KIND from INPUT as labelled twin layers plus a renderable scenario.
 
     \b
     KIND       INPUT
     mesh       .obj .ply .glb .gltf .stl (trimesh); classes from --rules (object/material/group regex)
-    cityjson   CityJSON 1.1 or 2.0 (needs metadata.referenceSystem in metres)
-    pointcloud .las .laz .ply; LAS classes, RANSAC planes, TIN, simplification within --max-deviation-m
+    cityjson   CityJSON 1.1 or 2.0 (units from metadata.referenceSystem, --crs or --units)
+    pointcloud .las .laz .ply; units from the LAS CRS (WKT or GeoTIFF keys), --crs or --units;
+               LAS classes, RANSAC planes, TIN, simplification within --max-deviation-m
     footprints GeoJSON polygons with 'height' or 'levels' -> extruded LoD1 buildings
 
     Geometry no rule matches is labelled 'unlabelled' (class 0) and listed in import_report.json.
@@ -89,7 +97,8 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     cmap = load_class_map(class_map)
     loaded_rules = AssignmentRules.load(rules, cmap) if rules else None
     t0 = time.perf_counter()
-    model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod,
+    model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod, crs=crs,
+                              units=units,
                               max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
                               storey_height_m=storey_height_m, show_progress=sys.stderr.isatty())
     seconds = time.perf_counter() - t0

@@ -28,6 +28,8 @@ from tqdm import tqdm
 
 from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.errors import InputError, echo
+from synthua_usd.importers.crs import (PROJECTED_CRS, USER_DEFINED, LinearUnits, crs_units, geotiff_units,
+                                       resolve_units)
 from synthua_usd.importers.limits import (MAX_DEVIATION, MAX_EXTENT_M, MAX_POINTCLOUD_BYTES, MAX_POINTS,
                                           PLANE_THRESHOLD)
 from synthua_usd.input_files import check_input_file, shown
@@ -100,8 +102,9 @@ def _check_las_header(header, size: int, where: str) -> None:
                          f"±{COORDINATE.high:g} m")
 
 
-def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None]:
-    """(n, 3) float64 coordinates, (n,) uint8 LAS classification or None, CRS text or None."""
+def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None, LinearUnits | None]:
+    """(n, 3) float64 coordinates in the file's units, (n,) uint8 LAS classification or None, CRS text or None,
+    and the linear units the file states (LAS: WKT or GeoTIFF keys) or None (PLY never states any)."""
     where = shown(path)
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
@@ -117,7 +120,7 @@ def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None]:
         vertices = np.asarray(getattr(cloud, "vertices", np.zeros((0, 3))), float).reshape(-1, 3)
         if len(vertices) > MAX_POINTS:
             raise InputError(f"{where}: {len(vertices)} points; expected at most {MAX_POINTS}")
-        return vertices, None, None
+        return vertices, None, None, None
     import laspy
 
     try:
@@ -133,12 +136,35 @@ def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None]:
                          f"could be read; expected a complete file")
     xyz = np.column_stack([np.asarray(las.x, float), np.asarray(las.y, float), np.asarray(las.z, float)])
     classes = np.asarray(las.classification, np.uint8)
-    try:
-        with _quiet("laspy"):
-            crs = las.header.parse_crs()
-    except Exception:  # a CRS record laspy cannot parse leaves the CRS unknown, as a file without one
-        crs = None
-    return xyz, (classes if np.any(classes > 1) else None), (crs.to_string() if crs is not None else None)
+    crs_text, units = las_crs_units(las.header, where)
+    return xyz, (classes if np.any(classes > 1) else None), crs_text, units
+
+
+def las_crs_units(header, where: str) -> tuple[str | None, LinearUnits | None]:
+    """(CRS text, linear units) of a LAS header: its OGC WKT (VLR or EVLR) when it has one, else its GeoTIFF
+    keys; (None, None) when it has neither."""
+    from pyproj.exceptions import CRSError
+
+    records = list(header.vlrs) + list(getattr(header, "evlrs", None) or [])
+    for vlr in records:
+        wkt = getattr(vlr, "string", None)
+        if type(vlr).__name__ == "WktCoordinateSystemVlr" and wkt and wkt.strip("\x00 "):
+            text = wkt.strip("\x00 ")
+            try:
+                from pyproj import CRS
+
+                crs = CRS.from_wkt(text)
+            except CRSError as exc:
+                raise InputError(f"{where}: the WKT CRS record cannot be read ({echo(str(exc)[:160])}); expected OGC "
+                                 f"WKT (or give --crs)") from None
+            return crs.to_string(), crs_units(crs, "WKT", where)
+    for vlr in records:
+        if type(vlr).__name__ == "GeoKeyDirectoryVlr":
+            keys = {int(k.id): int(k.value_offset) for k in vlr.geo_keys if int(k.tiff_tag_location) == 0}
+            units = geotiff_units(keys, where)
+            code = keys.get(PROJECTED_CRS)
+            return (f"EPSG:{code}" if code and code != USER_DEFINED else "GeoTIFF keys (user-defined CRS)"), units
+    return None, None
 
 
 def fit_plane(points: np.ndarray) -> tuple[np.ndarray, float]:
@@ -265,18 +291,26 @@ def simplify_within(points: np.ndarray, triangles: np.ndarray, cloud: np.ndarray
 
 def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, max_deviation_m: float = 0.005,
                       plane_threshold_m: float = 0.02, min_plane_points: int = 50, seed: int = 0,
-                      show_progress: bool = False, **_ignored) -> TwinModel:
-    """Segment, reconstruct and simplify a point cloud; the report holds the measured deviations."""
+                      crs: str | None = None, units: str | None = None, show_progress: bool = False,
+                      **_ignored) -> TwinModel:
+    """Segment, reconstruct and simplify a point cloud; the report holds the measured deviations.
+
+    Coordinates are converted to metres before anything is measured: by ``crs`` (EPSG code or WKT; it
+    replaces the file's), else ``units`` ('m', 'ft', 'us-ft'), else the file's own CRS (LAS WKT or GeoTIFF
+    keys). A file whose unit none of these gives is refused."""
     path = Path(path)
     where = shown(path)
     MAX_DEVIATION.check(max_deviation_m, "max_deviation_m")
     PLANE_THRESHOLD.check(plane_threshold_m, "plane_threshold_m")
-    xyz, classes, crs = read_points(path)
+    xyz, classes, file_crs, found_units = read_points(path)
     if len(xyz) == 0:
         raise InputError(f"{where}: the point cloud has no points; expected at least 3")
     if not np.all(np.isfinite(xyz)):
         raise InputError(f"{where}: {int((~np.isfinite(xyz)).any(axis=1).sum())} points have NaN or infinite "
                          f"coordinates; expected finite coordinates")
+    linear = resolve_units(found_units, crs, units, where,
+                           "the file states no CRS" if file_crs is None else f"its CRS {echo(file_crs)} names no unit")
+    xyz = xyz * linear.scale
     if np.abs(xyz).max() > COORDINATE.high:
         raise InputError(f"{where}: coordinates up to {np.abs(xyz).max():.3g} m; expected coordinates within "
                          f"±{COORDINATE.high:g} m")
@@ -308,7 +342,8 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
         rest = pts[~used]
         if len(rest) >= 3:
             segments.append(Segment("Unsegmented", _rule_or(rules, {"type": "unsegmented"}, "unlabelled"), rest, "rest"))
-    objects, report = [], {"points": int(len(xyz)), "max_deviation_m": max_deviation_m, "segments": []}
+    objects, report = [], {"points": int(len(xyz)), "units": linear.as_report(), "file_crs": file_crs,
+                           "max_deviation_m": max_deviation_m, "segments": []}
     for seg in tqdm(segments, desc="surfaces", unit="segment", disable=not show_progress):
         surface = seg.surface_points()
         tris = triangulate_height_field(surface)
@@ -331,7 +366,7 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
                          f"sample surfaces (at least 3 not on one line)")
     return TwinModel(objects=tuple(objects), materials=subset(p.material for o in objects for p in o.parts),
                      source=str(path),
-                     origin_offset_m=tuple(float(v) for v in origin), crs=crs, report=report)
+                     origin_offset_m=tuple(float(v) for v in origin), crs=crs or file_crs, report=report)
 
 
 def _rule_or(rules: AssignmentRules | None, fields: dict, default: str) -> str:

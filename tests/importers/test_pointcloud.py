@@ -8,12 +8,24 @@ from synthua_usd.errors import InputError
 from synthua_usd.importers.pointcloud import fit_plane, import_pointcloud
 
 
-def write_las(path, xyz, classes=None):
+def write_las(path, xyz, classes=None, crs="EPSG:32633", geokeys=None, wkt=False):
+    """A LAS 1.2 file of ``xyz`` (file units); its CRS as GeoTIFF keys (``crs`` by EPSG code through laspy,
+    or ``geokeys``: key id -> value, written as given), or as a WKT record (LAS 1.4, ``wkt=True``); none
+    with ``crs=None``."""
     import laspy
+    from laspy.vlrs.known import GeoKeyDirectoryVlr, GeoKeyEntryStruct
+    from pyproj import CRS
 
-    header = laspy.LasHeader(point_format=3, version="1.2")
+    header = laspy.LasHeader(point_format=6 if wkt else 3, version="1.4" if wkt else "1.2")
     header.scales = np.array([0.001, 0.001, 0.001])
     header.offsets = xyz.min(axis=0) if len(xyz) else np.zeros(3)
+    if geokeys is not None:
+        vlr = GeoKeyDirectoryVlr()
+        vlr.geo_keys = [GeoKeyEntryStruct(k, 0, 1, v) for k, v in geokeys.items()]
+        vlr.geo_keys_header.number_of_keys = len(vlr.geo_keys)
+        header.vlrs.append(vlr)
+    elif crs is not None:
+        header.add_crs(CRS.from_user_input(crs))
     las = laspy.LasData(header)
     las.x, las.y, las.z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
     if classes is not None:
@@ -89,7 +101,7 @@ def test_third_party_las_and_laz():
     big = max(flat.report["segments"], key=lambda s: s["points"])
     assert big["label"] == "road" and big["simplification_deviation_m"] <= 0.005
     assert big["faces"] < big["faces_reconstructed"]
-    simple = import_pointcloud(third_party("las", "simple.las"))
+    simple = import_pointcloud(third_party("las", "simple.las"), units="m")  # the file states no CRS
     assert any(s["source"] == "las:2" and s["label"] == "road" for s in simple.report["segments"])
     assert all(s["simplification_deviation_m"] <= 0.005 for s in simple.report["segments"])
 
@@ -110,3 +122,67 @@ def test_bad_point_clouds(tmp_path):
     broken.write_bytes(b"LASF" + b"\x00" * 20)
     with pytest.raises(InputError, match="cannot read as LAS/LAZ"):
         import_pointcloud(broken)
+
+
+# --- units -----------------------------------------------------------------------------------------------------
+
+US_FT = 1200 / 3937
+
+
+def box_cloud(rng, size_m=10.0, n=3000):
+    """A flat 10 x 10 m ground plus a 4 m wall (metres), for unit tests."""
+    g = np.column_stack([rng.uniform(0, size_m, n), rng.uniform(0, size_m, n), rng.normal(0, 0.001, n)])
+    w = np.column_stack([np.full(n // 2, size_m) + rng.normal(0, 0.001, n // 2), rng.uniform(0, size_m, n // 2),
+                         rng.uniform(0.5, 4, n // 2)])
+    return np.concatenate([g, w]) + [300000.0, 60000.0, 20.0]
+
+
+def extent_m(model):
+    pts = np.concatenate([p.points for o in model.objects for p in o.parts])
+    return pts.max(axis=0) - pts.min(axis=0)
+
+
+@pytest.mark.parametrize("how", ["epsg-geokeys", "user-defined-geokeys", "wkt-compound"])
+def test_las_in_us_survey_feet_imports_at_true_size(tmp_path, how):
+    rng = np.random.default_rng(5)
+    metres = box_cloud(rng)
+    feet = metres / US_FT
+    if how == "epsg-geokeys":  # NAD83 / New York Long Island (ftUS)
+        path = write_las(tmp_path / "ft.las", feet, crs="EPSG:2263")
+    elif how == "user-defined-geokeys":  # GTModelType projected, user-defined CRS, ProjLinearUnits 9003
+        path = write_las(tmp_path / "ft.las", feet, geokeys={1024: 1, 3072: 32767, 3076: 9003})
+    else:  # WKT of a compound CRS: NAD83(2011) / Washington South (ftUS) + NAVD88 height (ftUS)
+        path = write_las(tmp_path / "ft.las", feet, crs="EPSG:6599+6360", wkt=True)
+    model = import_pointcloud(path, max_deviation_m=0.005, plane_threshold_m=0.01)
+    assert extent_m(model) == pytest.approx([10.0, 10.0, 4.0], abs=0.05)
+    units = model.report["units"]
+    assert units["horizontal"] == "US survey foot" and units["horizontal_m_per_unit"] == pytest.approx(US_FT)
+    assert units["vertical_m_per_unit"] == pytest.approx(US_FT)
+    # Thresholds are metres: the 1 cm plane threshold holds the 1 mm-noise ground in one plane.
+    ground = max(model.report["segments"], key=lambda s: s["points"])
+    assert ground["points"] >= 2900
+
+
+def test_vertical_unit_from_its_own_key(tmp_path):
+    """Horizontal metres, vertical US survey feet (VerticalUnitsGeoKey 4099 = 9003)."""
+    rng = np.random.default_rng(6)
+    pts = box_cloud(rng)
+    pts[:, 2] /= US_FT
+    model = import_pointcloud(write_las(tmp_path / "v.las", pts, geokeys={1024: 1, 3072: 32767, 3076: 9001,
+                                                                         4099: 9003}))
+    assert extent_m(model) == pytest.approx([10.0, 10.0, 4.0], abs=0.05)
+    assert model.report["units"]["vertical"] == "US survey foot"
+
+
+def test_unknown_unit_is_refused_unless_given(tmp_path):
+    path = write_las(tmp_path / "nocrs.las", box_cloud(np.random.default_rng(2)), crs=None)
+    with pytest.raises(InputError, match=r"nocrs.las: the unit of the coordinates cannot be determined \(the file "
+                                         r"states no CRS\); expected a CRS in the file, or --crs"):
+        import_pointcloud(path)
+    assert extent_m(import_pointcloud(path, units="ft"))[0] == pytest.approx(10.0 * 0.3048, abs=0.02)
+    assert extent_m(import_pointcloud(path, crs="EPSG:2263"))[0] == pytest.approx(10.0 * US_FT, abs=0.02)
+    assert extent_m(import_pointcloud(path, crs="EPSG:32633"))[0] == pytest.approx(10.0, abs=0.02)
+    with pytest.raises(InputError, match="is geographic"):
+        import_pointcloud(path, crs="EPSG:4326")
+    with pytest.raises(InputError, match="--crs: unknown CRS 'nonsense'"):
+        import_pointcloud(path, crs="nonsense")

@@ -64,3 +64,22 @@ def test_import_bad_input_exit_2_nothing_written(run_cli, tmp_path):
     assert code == 2 and "metadata.referenceSystem is missing" in err
     assert len(err.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
+
+
+def test_cli_crs_serves_a_cityjson_without_one_and_unknown_units_are_refused(run_cli, tmp_path):
+    import json
+
+    from conftest import DATA
+
+    doc = json.loads((DATA / "invalid" / "cityjson_no_crs.city.json").read_text())
+    src = tmp_path / "nocrs.city.json"
+    src.write_text(json.dumps(doc))
+    code, _, err = run_cli("twin", "import", "cityjson", src, "--out", tmp_path / "a", "--crs", "EPSG:31982")
+    assert code == 0, err
+    report = json.loads((tmp_path / "a" / REPORT_FILE).read_text())
+    assert report["crs"] == "EPSG:31982" and report["units"]["source"] == "--crs"
+    code, _, err = run_cli("twin", "import", "cityjson", src, "--out", tmp_path / "b")
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "cannot be determined (metadata.referenceSystem is missing); expected a CRS in the file, or --crs" in err
+    code, _, err = run_cli("twin", "import", "footprints", src, "--out", tmp_path / "c", "--units", "m")
+    assert code == 2 and "--units: given for a footprints import" in err
