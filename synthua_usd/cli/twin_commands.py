@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_OK, load_class_map
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map
 from synthua_usd.cli.options import InRange
 from synthua_usd.errors import echo
 from synthua_usd.importers import limits as importer_limits
@@ -26,7 +26,7 @@ KIND_OPTIONS = {
     "rules": ("mesh", "cityjson", "pointcloud"),
     "up_axis": ("mesh",), "scale": ("mesh",),
     "lod": ("cityjson",), "crs": ("cityjson", "pointcloud"), "units": ("cityjson", "pointcloud"),
-    "max_deviation_m": ("pointcloud",), "plane_threshold_m": ("pointcloud",),
+    "max_deviation_m": ("pointcloud",), "plane_threshold_m": ("pointcloud",), "max_residual_m": ("pointcloud",),
     "storey_height_m": ("footprints",),
 }
 
@@ -66,13 +66,18 @@ def _refuse_foreign_options(ctx: click.Context, kind: str) -> None:
               help="pointcloud: largest Hausdorff distance simplification may introduce (metres).")
 @click.option("--plane-threshold-m", type=InRange(importer_limits.PLANE_THRESHOLD), default=0.02, show_default=True,
               help="pointcloud: RANSAC inlier distance (metres).")
+@click.option("--max-residual-m", type=InRange(importer_limits.MAX_RESIDUAL), default=0.10, show_default=True,
+              help="pointcloud: a segment whose 95th-percentile point-to-surface distance exceeds this (metres) is "
+                   "reported as a finding.")
+@click.option("--strict", is_flag=True, help="Exit 1 when the import has findings (residuals over their bound, "
+                                             "automatic cameras that see too few labelled pixels).")
 @click.option("--storey-height-m", type=InRange(importer_limits.STOREY_HEIGHT), default=3.0, show_default=True,
               help="footprints: metres per level when a footprint gives levels, not height.")
 @click.pass_context
 def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, rules: Path | None,
                 class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, crs: str | None,
-                units: str | None, max_deviation_m: float,
-                plane_threshold_m: float, storey_height_m: float) -> int:
+                units: str | None, max_deviation_m: float, plane_threshold_m: float, max_residual_m: float,
+                strict: bool, storey_height_m: float) -> int:
     """Import real city data of KIND from INPUT as labelled twin layers plus a renderable scenario.
 
     \b
@@ -98,8 +103,8 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     loaded_rules = AssignmentRules.load(rules, cmap) if rules else None
     t0 = time.perf_counter()
     model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod, crs=crs,
-                              units=units,
-                              max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
+                              units=units, max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
+                              max_residual_m=max_residual_m,
                               storey_height_m=storey_height_m, show_progress=sys.stderr.isatty())
     seconds = time.perf_counter() - t0
     from synthua_usd.pipeline.twin_import import write_import  # USD and the writers: only once the input is good
@@ -113,14 +118,18 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     for seg in model.report.get("segments", []):
         if not seg.get("skipped"):
             click.echo(f"  {seg['name']}: {seg['points']} points -> {seg['faces']} faces, simplification deviation "
-                       f"{seg['simplification_deviation_m'] * 1000:.3f} mm, point residual max "
-                       f"{seg['residual_max_m'] * 1000:.1f} mm / rms {seg['residual_rms_m'] * 1000:.1f} mm")
+                       f"{seg['simplification_deviation_m'] * 1000:.3f} mm, point-to-surface distance p50 "
+                       f"{seg['residual_p50_m'] * 1000:.1f} / p95 {seg['residual_p95_m'] * 1000:.1f} / max "
+                       f"{seg['residual_max_m'] * 1000:.1f} mm")
     unmatched = model.report.get("unmatched") or model.report.get("unlabelled_types")
     if unmatched:
         click.echo(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
     click.echo(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "
                f"--out OUT")
-    return EXIT_OK
+    findings = report.get("findings", [])
+    for f in findings:
+        click.echo(f"{f['severity']}: {f['where']}: {f['message']} ({f['rule']})", err=True)
+    return EXIT_FINDINGS if strict and findings else EXIT_OK
 
 
 @twin.command("demo")

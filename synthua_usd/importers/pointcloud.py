@@ -28,10 +28,11 @@ from tqdm import tqdm
 
 from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.errors import InputError, echo
+from synthua_usd.findings import Finding, Severity
 from synthua_usd.importers.crs import (PROJECTED_CRS, USER_DEFINED, LinearUnits, crs_units, geotiff_units,
                                        resolve_units)
 from synthua_usd.importers.limits import (MAX_DEVIATION, MAX_EXTENT_M, MAX_POINTCLOUD_BYTES, MAX_POINTS,
-                                          PLANE_THRESHOLD)
+                                          MAX_RESIDUAL, PLANE_THRESHOLD)
 from synthua_usd.input_files import check_input_file, shown
 from synthua_usd.materials import class_material, subset
 from synthua_usd.ranges import COORDINATE
@@ -248,9 +249,7 @@ class Simplified:
     triangles: np.ndarray
     faces_before: int
     deviation_m: float          # symmetric Hausdorff, reconstructed ↔ simplified
-    residual_max_m: float       # input points → simplified mesh
-    residual_mean_m: float
-    residual_rms_m: float
+    residuals_m: np.ndarray     # (n,) float64: distance of every input point to the simplified mesh
 
 
 def simplify_within(points: np.ndarray, triangles: np.ndarray, cloud: np.ndarray, max_deviation_m: float) -> Simplified:
@@ -282,26 +281,42 @@ def simplify_within(points: np.ndarray, triangles: np.ndarray, cloud: np.ndarray
         if dev > max_deviation_m:
             break
         best_id, best_dev = trial, dev
-    residual = hausdorff(0, best_id, False)
+    # Every input point is sampled (MeshLab keeps the per-sample distances in a mesh of its own).
+    ms.get_hausdorff_distance(sampledmesh=0, targetmesh=best_id, samplevert=True, sampleface=False,
+                              samplenum=len(cloud), maxdist=pymeshlab.PercentageValue(100), savesample=True)
+    residuals = np.abs(np.asarray(ms.mesh(ms.mesh_number() - 1).vertex_scalar_array(), float))
     mesh = ms.mesh(best_id)
     return Simplified(np.asarray(mesh.vertex_matrix(), float), np.asarray(mesh.face_matrix(), np.int64),
-                      len(triangles), float(best_dev), float(residual["max"]), float(residual["mean"]),
-                      float(residual["RMS"]))
+                      len(triangles), float(best_dev), residuals)
+
+
+def residual_summary(residuals_m: np.ndarray, bound_m: float) -> dict:
+    """The distribution of point-to-surface distances (metres): mean, RMS, percentiles 50/90/95/99, max, and
+    how many points lie farther than ``bound_m``."""
+    r = np.asarray(residuals_m, float)
+    p50, p90, p95, p99 = (float(v) for v in np.percentile(r, [50, 90, 95, 99]))
+    return {"residual_mean_m": float(r.mean()), "residual_rms_m": float(np.sqrt(np.mean(r * r))),
+            "residual_p50_m": p50, "residual_p90_m": p90, "residual_p95_m": p95, "residual_p99_m": p99,
+            "residual_max_m": float(r.max()), "points_beyond_bound": int((r > bound_m).sum())}
 
 
 def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, max_deviation_m: float = 0.005,
                       plane_threshold_m: float = 0.02, min_plane_points: int = 50, seed: int = 0,
-                      crs: str | None = None, units: str | None = None, show_progress: bool = False,
-                      **_ignored) -> TwinModel:
+                      max_residual_m: float = 0.10, crs: str | None = None, units: str | None = None,
+                      show_progress: bool = False, **_ignored) -> TwinModel:
     """Segment, reconstruct and simplify a point cloud; the report holds the measured deviations.
 
     Coordinates are converted to metres before anything is measured: by ``crs`` (EPSG code or WKT; it
     replaces the file's), else ``units`` ('m', 'ft', 'us-ft'), else the file's own CRS (LAS WKT or GeoTIFF
-    keys). A file whose unit none of these gives is refused."""
+    keys). A file whose unit none of these gives is refused.
+
+    Every segment's point-to-surface distances are summarised in the report; a segment whose 95th percentile
+    exceeds ``max_residual_m`` is a finding (``report['findings']``)."""
     path = Path(path)
     where = shown(path)
     MAX_DEVIATION.check(max_deviation_m, "max_deviation_m")
     PLANE_THRESHOLD.check(plane_threshold_m, "plane_threshold_m")
+    MAX_RESIDUAL.check(max_residual_m, "max_residual_m")
     xyz, classes, file_crs, found_units = read_points(path)
     if len(xyz) == 0:
         raise InputError(f"{where}: the point cloud has no points; expected at least 3")
@@ -342,8 +357,10 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
         rest = pts[~used]
         if len(rest) >= 3:
             segments.append(Segment("Unsegmented", _rule_or(rules, {"type": "unsegmented"}, "unlabelled"), rest, "rest"))
-    objects, report = [], {"points": int(len(xyz)), "units": linear.as_report(), "file_crs": file_crs,
-                           "max_deviation_m": max_deviation_m, "segments": []}
+    objects, findings = [], []
+    report = {"points": int(len(xyz)), "units": linear.as_report(), "file_crs": file_crs,
+              "max_deviation_m": max_deviation_m, "max_residual_m": max_residual_m, "segments": [],
+              "findings": findings}
     for seg in tqdm(segments, desc="surfaces", unit="segment", disable=not show_progress):
         surface = seg.surface_points()
         tris = triangulate_height_field(surface)
@@ -353,14 +370,20 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
             continue
         simple = simplify_within(surface, tris, seg.points, max_deviation_m)
         material = class_material(seg.label).key
+        residual = residual_summary(simple.residuals_m, max_residual_m)
         objects.append(TwinObject(seg.name, seg.label, (TwinPart("Surface", simple.points, simple.triangles, material),),
                                   {"segment_source": seg.source, "simplification_deviation_m": simple.deviation_m,
-                                   "residual_max_m": simple.residual_max_m}))
+                                   "residual_p95_m": residual["residual_p95_m"]}))
         report["segments"].append({"name": seg.name, "label": seg.label, "source": seg.source,
                                    "points": int(len(seg.points)), "faces_reconstructed": simple.faces_before,
                                    "faces": int(len(simple.triangles)), "simplification_deviation_m": simple.deviation_m,
-                                   "residual_max_m": simple.residual_max_m, "residual_mean_m": simple.residual_mean_m,
-                                   "residual_rms_m": simple.residual_rms_m})
+                                   **residual})
+        if residual["residual_p95_m"] > max_residual_m:
+            findings.append(Finding("residual-bound", f"{where}: segment {seg.name}",
+                                    f"95 % of its {len(seg.points)} points lie within {residual['residual_p95_m']:.3f} m "
+                                    f"of its surface (max {residual['residual_max_m']:.3f} m); expected within "
+                                    f"{max_residual_m:g} m (--max-residual-m): the surface does not explain these "
+                                    f"points", Severity.WARNING).to_dict())
     if not objects:
         raise InputError(f"{where}: no surface could be reconstructed from {len(xyz)} points; expected points that "
                          f"sample surfaces (at least 3 not on one line)")

@@ -37,7 +37,7 @@ def test_footprint_materials_are_palette_entries():
 
 
 def test_pointcloud_materials_are_palette_entries():
-    model = import_pointcloud(third_party("las", "simple.las"))
+    model = import_pointcloud(third_party("las", "simple.las"), units="m")
     _check_palette(model)
     assert {o.label for o in model.objects} == {"road", "unlabelled"}
     assert [len(o.parts[0].triangles) for o in model.objects] == [532, 1550]

@@ -4,34 +4,9 @@ import pytest
 import trimesh
 
 from conftest import third_party
+from las_files import write_las
 from synthua_usd.errors import InputError
 from synthua_usd.importers.pointcloud import fit_plane, import_pointcloud
-
-
-def write_las(path, xyz, classes=None, crs="EPSG:32633", geokeys=None, wkt=False):
-    """A LAS 1.2 file of ``xyz`` (file units); its CRS as GeoTIFF keys (``crs`` by EPSG code through laspy,
-    or ``geokeys``: key id -> value, written as given), or as a WKT record (LAS 1.4, ``wkt=True``); none
-    with ``crs=None``."""
-    import laspy
-    from laspy.vlrs.known import GeoKeyDirectoryVlr, GeoKeyEntryStruct
-    from pyproj import CRS
-
-    header = laspy.LasHeader(point_format=6 if wkt else 3, version="1.4" if wkt else "1.2")
-    header.scales = np.array([0.001, 0.001, 0.001])
-    header.offsets = xyz.min(axis=0) if len(xyz) else np.zeros(3)
-    if geokeys is not None:
-        vlr = GeoKeyDirectoryVlr()
-        vlr.geo_keys = [GeoKeyEntryStruct(k, 0, 1, v) for k, v in geokeys.items()]
-        vlr.geo_keys_header.number_of_keys = len(vlr.geo_keys)
-        header.vlrs.append(vlr)
-    elif crs is not None:
-        header.add_crs(CRS.from_user_input(crs))
-    las = laspy.LasData(header)
-    las.x, las.y, las.z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
-    if classes is not None:
-        las.classification = classes
-    las.write(str(path))
-    return path
 
 
 def street_corner(rng, n_ground=3000, n_wall=2000, noise=0.002):
@@ -186,3 +161,27 @@ def test_unknown_unit_is_refused_unless_given(tmp_path):
         import_pointcloud(path, crs="EPSG:4326")
     with pytest.raises(InputError, match="--crs: unknown CRS 'nonsense'"):
         import_pointcloud(path, crs="nonsense")
+
+
+# --- residuals -------------------------------------------------------------------------------------------------
+
+def test_residual_distribution_is_reported_and_a_segment_over_its_bound_is_a_finding(tmp_path):
+    """A rough ground (sigma 0.2 m) fitted by a plane with a 1 m inlier threshold: the plane explains the
+    points only to ~0.4 m (p95), over a 0.1 m bound; the distribution agrees with trimesh's distances."""
+    rng = np.random.default_rng(9)
+    n = 4000
+    g = np.column_stack([rng.uniform(0, 30, n), rng.uniform(0, 30, n), rng.normal(0, 0.2, n)]) + [500, 500, 10]
+    path = write_las(tmp_path / "rough.las", g)
+    model = import_pointcloud(path, plane_threshold_m=1.0, max_residual_m=0.1)
+    seg = model.report["segments"][0]
+    surface = model.objects[0].parts[0]
+    mesh = trimesh.Trimesh(surface.points, surface.triangles, process=False)
+    assert seg["points"] == n
+    _, dist, _ = trimesh.proximity.closest_point(mesh, g - model.origin_offset_m)
+    assert seg["residual_p95_m"] == pytest.approx(np.percentile(dist, 95), abs=0.01)
+    assert seg["residual_p50_m"] == pytest.approx(np.percentile(dist, 50), abs=0.01)
+    assert seg["residual_max_m"] == pytest.approx(dist.max(), abs=0.01)
+    assert seg["points_beyond_bound"] == pytest.approx(int((dist > 0.1).sum()), abs=n * 0.005)
+    findings = model.report["findings"]
+    assert [f["rule"] for f in findings] == ["residual-bound"] and seg["name"] in findings[0]["where"]
+    assert not import_pointcloud(path, plane_threshold_m=1.0, max_residual_m=1.0).report["findings"]

@@ -83,3 +83,16 @@ def test_cli_crs_serves_a_cityjson_without_one_and_unknown_units_are_refused(run
     assert "cannot be determined (metadata.referenceSystem is missing); expected a CRS in the file, or --crs" in err
     code, _, err = run_cli("twin", "import", "footprints", src, "--out", tmp_path / "c", "--units", "m")
     assert code == 2 and "--units: given for a footprints import" in err
+
+
+def test_cli_strict_exits_1_on_a_residual_finding(run_cli, tmp_path):
+    from las_files import write_las
+
+    rng = np.random.default_rng(9)
+    g = np.column_stack([rng.uniform(0, 30, 3000), rng.uniform(0, 30, 3000), rng.normal(0, 0.2, 3000)]) + 500
+    src = write_las(tmp_path / "rough.las", g)
+    args = ("twin", "import", "pointcloud", src, "--plane-threshold-m", "1", "--max-residual-m", "0.1")
+    code, stdout, err = run_cli(*args, "--out", tmp_path / "a")
+    assert code == 0 and "warning: " in err and "(residual-bound)" in err and "p95" in stdout
+    code, _, err = run_cli(*args, "--out", tmp_path / "b", "--strict")
+    assert code == 1 and (tmp_path / "b" / REPORT_FILE).exists()
