@@ -89,6 +89,9 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     footprints GeoJSON polygons with 'height' or 'levels' -> extruded LoD1 buildings
 
     Geometry no rule matches is labelled 'unlabelled' (class 0) and listed in import_report.json.
+    The scenario stands on a generated ground (unlabelled, 20 km out) and has automatic Overview (densest
+    cluster) and Street (1.6 m above a road) cameras; each camera's label pass must show the twin in 10 %
+    of its pixels, else a finding is printed (exit 1 with --strict).
     Options of one kind (--lod, --scale, ...) are refused for the others. Nothing in --out changes
     unless the whole import is written.
     """
@@ -112,7 +115,7 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     report = {"kind": kind, "input": str(input_path), "seconds": round(seconds, 3), "objects": len(model.objects),
               "triangles": model.triangle_count(), "classes": model.label_counts(), "crs": model.crs,
               "origin_offset_m": list(model.origin_offset_m), **model.report}
-    written = write_import(model, out_dir, cmap, report)
+    written, report = write_import(model, out_dir, cmap, report)
     click.echo(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
                f"{model.triangle_count()} triangles, classes {model.label_counts()}")
     for seg in model.report.get("segments", []):
@@ -124,6 +127,8 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     unmatched = model.report.get("unmatched") or model.report.get("unlabelled_types")
     if unmatched:
         click.echo(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
+    for name, cam in report["cameras"].items():
+        click.echo(f"  camera {name}: label pass shows the twin in {cam['labelled_share']:.1%} of its pixels")
     click.echo(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "
                f"--out OUT")
     findings = report.get("findings", [])
