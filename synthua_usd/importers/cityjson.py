@@ -330,8 +330,10 @@ def import_cityjson(path: str | Path, rules: AssignmentRules | None = None, lod:
         log.warning("%s: %d city objects have no LoD %s; their highest LoD was imported", where, fallback, echo(lod))
     materials = subset(p.material for o in objects for p in o.parts)
     return TwinModel(objects=tuple(unique_paths(objects)), materials=materials, source=str(path),
+                     double_sided=True,
                      origin_offset_m=tuple(float(v) for v in origin), crs=crs or crs_text,
-                     report={"units": linear.as_report(), "file_crs": crs_text, "city_objects": len(city_objects), "objects": len(objects), "lods_present": present,
+                     report={"units": linear.as_report(), "file_crs": crs_text, "city_objects": len(city_objects),
+                             "objects": len(objects), "lods_present": present,
                              "lod_fallbacks": fallback, "unlabelled_types": dict(unlabelled_types),
                              "version": version})
 

@@ -105,7 +105,8 @@ def crs_units(crs, source: str, where: str) -> LinearUnits:
     leaves z in the horizontal unit (stated: ``vertical_assumed``)."""
     horizontal = crs.sub_crs_list[0] if crs.is_compound else crs
     if not horizontal.is_projected:
-        raise InputError(f"{where}: CRS '{echo(crs.name)}' is {'geographic (degrees)' if horizontal.is_geographic else 'not projected'}; "
+        kind = "geographic (degrees)" if horizontal.is_geographic else "not projected"
+        raise InputError(f"{where}: CRS '{echo(crs.name)}' is {kind}; "
                          f"expected a projected CRS (reproject the file first, or give --crs)")
     h_axis = horizontal.axis_info[0]
     vertical_axes = [a for a in crs.axis_info if a.direction in ("up", "down")]

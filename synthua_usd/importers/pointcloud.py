@@ -380,7 +380,8 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
                                    **residual})
         if residual["residual_p95_m"] > max_residual_m:
             findings.append(Finding("residual-bound", f"{where}: segment {seg.name}",
-                                    f"95 % of its {len(seg.points)} points lie within {residual['residual_p95_m']:.3f} m "
+                                    f"95 % of its {len(seg.points)} points lie within "
+                                    f"{residual['residual_p95_m']:.3f} m "
                                     f"of its surface (max {residual['residual_max_m']:.3f} m); expected within "
                                     f"{max_residual_m:g} m (--max-residual-m): the surface does not explain these "
                                     f"points", Severity.WARNING).to_dict())
@@ -388,7 +389,7 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
         raise InputError(f"{where}: no surface could be reconstructed from {len(xyz)} points; expected points that "
                          f"sample surfaces (at least 3 not on one line)")
     return TwinModel(objects=tuple(objects), materials=subset(p.material for o in objects for p in o.parts),
-                     source=str(path),
+                     source=str(path), double_sided=True,
                      origin_offset_m=tuple(float(v) for v in origin), crs=crs or file_crs, report=report)
 
 

@@ -238,7 +238,8 @@ class StageReader:
         inst = self.instances.get(sites[0].prim_path) if sites else None
         return MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
                         material_key=material.key, instance_id=inst.id if inst else 0,
-                        class_id=inst.class_id if inst else 0, lamp=_lamp_role(prim), uvs=uvs)
+                        class_id=inst.class_id if inst else 0, lamp=_lamp_role(prim), uvs=uvs,
+                        double_sided=bool(UsdGeom.Gprim(prim).GetDoubleSidedAttr().Get()))
 
     def _geometry(self, prim: Usd.Prim, t: Usd.TimeCode, material: Material
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:

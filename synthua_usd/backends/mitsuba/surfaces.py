@@ -161,6 +161,12 @@ def wrapped(bsdf: dict, material: Material, images: TextureImages | None = None)
     return node
 
 
+def sided(bsdf: dict, double_sided: bool) -> dict:
+    """``bsdf`` as is, or for a ``doubleSided`` gprim wrapped in Mitsuba's ``twosided`` (the same BSDF on the
+    back, mirrored; Mitsuba's BSDFs are black seen from behind)."""
+    return {"type": "twosided", "bsdf": bsdf} if double_sided else bsdf
+
+
 def _encoded_normals(values: np.ndarray) -> np.ndarray:
     n = values / np.maximum(np.linalg.norm(values, axis=2, keepdims=True), 1e-6)
     return (0.5 * n + 0.5).astype(np.float32)
