@@ -85,7 +85,7 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     mesh       .obj .ply .glb .gltf .stl (trimesh); classes from --rules (object/material/group regex)
     cityjson   CityJSON 1.1 or 2.0 (units from metadata.referenceSystem, --crs or --units)
     pointcloud .las .laz .ply; units from the LAS CRS (WKT or GeoTIFF keys), --crs or --units;
-               LAS classes, RANSAC planes, TIN, simplification within --max-deviation-m
+               ground, connected planes, tree hulls; simplification within --max-deviation-m
     footprints GeoJSON polygons with 'height' or 'levels' -> extruded LoD1 buildings
 
     Geometry no rule matches is labelled 'unlabelled' (class 0) and listed in import_report.json.
