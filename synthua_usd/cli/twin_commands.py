@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map
-from synthua_usd.cli.options import InRange
+from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
 from synthua_usd.errors import echo
 from synthua_usd.importers import limits as importer_limits
 
@@ -39,6 +39,15 @@ def _refuse_foreign_options(ctx: click.Context, kind: str) -> None:
             option = "--" + name.replace("_", "-")
             raise click.UsageError(f"{option}: given for a {kind} import; expected only with "
                                    f"{' or '.join(kinds)} imports", ctx)
+
+
+def _refuse_population_options(ctx: click.Context, populate: bool) -> None:
+    from click.core import ParameterSource
+
+    for name in ("density", "aid_share", "frames"):
+        if not populate and ctx.get_parameter_source(name) is ParameterSource.COMMANDLINE:
+            raise click.UsageError(f"--{name.replace('_', '-')}: given without --populate; expected only with it",
+                                   ctx)
 
 
 @twin.command("import")
@@ -71,13 +80,23 @@ def _refuse_foreign_options(ctx: click.Context, kind: str) -> None:
                    "reported as a finding.")
 @click.option("--strict", is_flag=True, help="Exit 1 when the import has findings (residuals over their bound, "
                                              "automatic cameras that see too few labelled pixels).")
+@click.option("--populate", is_flag=True,
+              help="Also write an agents layer: people walking (and using mobility aids) on the twin's roads, "
+                   "sidewalks, crosswalks and curb ramps, composed into the scenario.")
+@click.option("--density", type=InRange(DENSITY), default=0.03,
+              show_default=True, help="With --populate: persons per m² of walkable area (realistic: up to ~1).")
+@click.option("--aid-share", type=InRange(AID_SHARE), default=0.3, show_default=True,
+              help="With --populate: share of people using a mobility aid.")
+@click.option("--frames", type=click.IntRange(1, 10_000), default=48, show_default=True,
+              help="With --populate: time codes of the animation (24 per second).")
 @click.option("--storey-height-m", type=InRange(importer_limits.STOREY_HEIGHT), default=3.0, show_default=True,
               help="footprints: metres per level when a footprint gives levels, not height.")
 @click.pass_context
 def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, rules: Path | None,
                 class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, crs: str | None,
                 units: str | None, max_deviation_m: float, plane_threshold_m: float, max_residual_m: float,
-                strict: bool, storey_height_m: float) -> int:
+                strict: bool, populate: bool, density: float, aid_share: float, frames: int,
+                storey_height_m: float) -> int:
     """Import real city data of KIND from INPUT as labelled twin layers plus a renderable scenario.
 
     \b
@@ -99,6 +118,7 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     from synthua_usd.importers import importers
 
     _refuse_foreign_options(ctx, kind)
+    _refuse_population_options(ctx, populate)
     if kind == "mesh" and rules is None:
         raise click.UsageError("--rules: missing; mesh import needs --rules FILE (meshes carry no classes of their "
                                "own; see schemas/semantic_rules.schema.json)", ctx)
@@ -115,7 +135,13 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     report = {"kind": kind, "input": str(input_path), "seconds": round(seconds, 3), "objects": len(model.objects),
               "triangles": model.triangle_count(), "classes": model.label_counts(), "crs": model.crs,
               "origin_offset_m": list(model.origin_offset_m), **model.report}
-    written, report = write_import(model, out_dir, cmap, report)
+    crowd = None
+    if populate:
+        from synthua_usd.agents.crowd import CrowdParams
+        from synthua_usd.pipeline.twin_import import IMPORT_WALKABLE
+
+        crowd = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=frames, walkable=IMPORT_WALKABLE)
+    written, report = write_import(model, out_dir, cmap, report, crowd)
     click.echo(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
                f"{model.triangle_count()} triangles, classes {model.label_counts()}")
     for seg in model.report.get("segments", []):
@@ -127,6 +153,10 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     unmatched = model.report.get("unmatched") or model.report.get("unlabelled_types")
     if unmatched:
         click.echo(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
+    if "population" in report:
+        p = report["population"]
+        click.echo(f"  people: {p['placed']} placed ({p['aid_users']} with mobility aids) on "
+                   f"{p['walkable_area_m2']:.0f} m² walkable, {frames} time codes")
     for name, cam in report["cameras"].items():
         click.echo(f"  camera {name}: label pass shows the twin in {cam['labelled_share']:.1%} of its pixels")
     click.echo(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "

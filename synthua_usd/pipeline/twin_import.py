@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
 from synthua_usd.atomic import output_set, write_json_atomic
 from synthua_usd.findings import Finding, Severity
 from synthua_usd.framing import Framing, automatic_cameras
@@ -40,13 +41,35 @@ def with_ground(model: TwinModel) -> TwinModel:
     return dataclasses.replace(model, objects=objects, materials=materials)
 
 
-def import_scenario(model: TwinModel) -> tuple[ScenarioSpec, Framing]:
+#: Where imported twins' people walk by default: CityJSON and photogrammetry roads often include their
+#: sidewalks, so roads count.
+IMPORT_WALKABLE = ("sidewalk", "crosswalk", "curb_ramp", "street_road", "road")
+
+
+def populated(model: TwinModel, params: CrowdParams) -> Crowd:
+    """A crowd on ``model``'s walkable surfaces (its objects' triangles and classes; the generated ground is
+    unlabelled, so nobody walks there)."""
+    verts, faces, names, n = [], [], [], 0
+    for obj in model.objects:
+        for part in obj.parts:
+            verts.append(part.points)
+            faces.append(part.triangles + n)
+            names += [obj.label] * len(part.triangles)
+            n += len(part.points)
+    return populate_crowd(np.concatenate(verts), np.concatenate(faces), np.array(names, object), params)
+
+
+def import_scenario(model: TwinModel, crowd: CrowdParams | None = None) -> tuple[ScenarioSpec, Framing]:
     """The twin on its generated ground with automatic ``Overview`` and ``Street`` cameras, a clear day and
-    default render settings; and how the cameras were framed."""
+    default render settings, and with ``crowd`` people walking on it (time codes 1 to ``crowd.time_codes``);
+    and how the cameras were framed."""
     grounded = with_ground(model)
     framing = automatic_cameras(model, grounded.objects[-1])
-    spec = ScenarioSpec(doc=f"synthua twin imported from {model.source}", metadata=IMPORT_METADATA, twin=grounded,
-                        cameras=framing.cameras, render_camera="Overview")
+    people = populated(grounded, crowd) if crowd is not None else None
+    metadata = IMPORT_METADATA if crowd is None else StageMetadata(
+        start_time_code=1, end_time_code=crowd.time_codes, time_codes_per_second=crowd.time_codes_per_second)
+    spec = ScenarioSpec(doc=f"synthua twin imported from {model.source}", metadata=metadata, twin=grounded,
+                        cameras=framing.cameras, render_camera="Overview", crowd=people)
     return spec, framing
 
 
@@ -72,11 +95,13 @@ def labelled_shares(scenario: Path, class_map: ClassMap, cameras: list[str]) -> 
     return shares
 
 
-def write_import(model: TwinModel, out_dir: str | Path, class_map: ClassMap, report: dict) -> tuple[list[Path], dict]:
-    """Write the scenario of ``model`` and ``report`` (completed with the ground, the cameras' framing and
-    label-pass shares, and their findings) into ``out_dir``; returns the final paths and the report."""
+def write_import(model: TwinModel, out_dir: str | Path, class_map: ClassMap, report: dict,
+                 crowd: CrowdParams | None = None) -> tuple[list[Path], dict]:
+    """Write the scenario of ``model`` (with ``crowd`` people when given) and ``report`` (completed with the
+    ground, the cameras' framing and label-pass shares, the population, and their findings) into
+    ``out_dir``; returns the final paths and the report."""
     out_dir = Path(out_dir)
-    spec, framing = import_scenario(model)
+    spec, framing = import_scenario(model, crowd)
     with output_set(out_dir) as staging:
         written = write_scenario(spec, staging, class_map)
         shares = labelled_shares(staging / ROOT_FILE, class_map, [c.name for c in spec.cameras])
@@ -93,5 +118,8 @@ def write_import(model: TwinModel, out_dir: str | Path, class_map: ClassMap, rep
                   "cameras": {name: {**framing.report[name.lower()], "labelled_share": share,
                                      "min_labelled_share": MIN_LABELLED_SHARE} for name, share in shares.items()},
                   "findings": findings}
+        if spec.crowd is not None:
+            report["population"] = {k: v if isinstance(v, (dict, int)) else float(v)
+                                    for k, v in spec.crowd.report.items()}
         write_json_atomic(staging / REPORT_FILE, report)
     return [out_dir / p.relative_to(staging) for p in written] + [out_dir / REPORT_FILE], report

@@ -96,3 +96,26 @@ def test_cli_strict_exits_1_on_a_residual_finding(run_cli, tmp_path):
     assert code == 0 and "warning: " in err and "(residual-bound)" in err and "p95" in stdout
     code, _, err = run_cli(*args, "--out", tmp_path / "b", "--strict")
     assert code == 1 and (tmp_path / "b" / REPORT_FILE).exists()
+
+
+def test_import_and_populate_in_one_go(run_cli, tmp_path):
+    import json
+
+    from conftest import DATA
+    from synthua_usd.usd.stage_io import open_stage
+
+    src = DATA / "valid" / "lod2_house.city.json"
+    code, _, err = run_cli("twin", "import", "cityjson", src, "--out", tmp_path / "a", "--density", "0.1")
+    assert code == 2 and "--density: given without --populate" in err
+    code, stdout, err = run_cli("twin", "import", "cityjson", src, "--out", tmp_path / "b", "--populate",
+                                "--density", "0.05", "--aid-share", "1", "--frames", "6")
+    assert code in (0, 1), err
+    report = json.loads((tmp_path / "b" / REPORT_FILE).read_text())
+    people = report["population"]
+    assert people["placed"] >= 1 and people["aid_users"] == people["placed"]
+    assert people["walkable_area_m2"] == pytest.approx(134, abs=2)  # the 20 x 7 m road less its 2 x 3 m hole
+    stage = open_stage(tmp_path / "b" / "scenario.usda")
+    assert (stage.GetStartTimeCode(), stage.GetEndTimeCode()) == (1, 6)
+    agents = [p for p in stage.Traverse() if str(p.GetPath()).startswith("/World/Agents/Agent_")
+              and p.GetParent().GetPath().pathString == "/World/Agents"]
+    assert len(agents) == people["placed"]
