@@ -150,6 +150,27 @@ def _warn_convention(path: str, strength: float, rule: str, value: float) -> Non
 DEFAULT_SKY = Light("/synthua:defaultSky", "dome", (0.75, 0.85, 1.0), radiance=0.08)
 
 
+def animated_skins(stage: Usd.Stage) -> list[tuple[str, str, list[str]]]:
+    """(SkelRoot path, animation path, skinned mesh paths) for every skeleton whose animation varies in time:
+    meshes the reader can only show in their bind pose (it does not apply UsdSkel skinning)."""
+    from pxr import UsdSkel
+
+    found = []
+    cache = UsdSkel.Cache()
+    for prim in stage.Traverse():
+        if not prim.IsA(UsdSkel.Root):
+            continue
+        root = UsdSkel.Root(prim)
+        cache.Populate(root, Usd.PrimDefaultPredicate)
+        for binding in cache.ComputeSkelBindings(root, Usd.PrimDefaultPredicate):
+            anim = cache.GetSkelQuery(binding.GetSkeleton()).GetAnimQuery()
+            if anim and anim.JointTransformsMightBeTimeVarying():
+                targets = [str(t.GetPrim().GetPath()) for t in binding.GetSkinningTargets()]
+                if targets:
+                    found.append((str(prim.GetPath()), str(anim.GetPrim().GetPath()), targets))
+    return found
+
+
 def _lamp_role(prim: Usd.Prim) -> str:
     """The gprim's ``synthua:lamp`` value ('' when unauthored); an unknown role is a :class:`StageError`."""
     attr = prim.GetAttribute(LAMP_ATTRIBUTE)
@@ -233,6 +254,7 @@ class StageReader:
         self._xform_memo: dict[str, bool] = {}
         self._warned_unlabelled = False
         self._warned_unlit = False
+        self._warned_skinned = False
         self._last: SceneSnapshot | None = None
 
     def _is_varying(self, prim: Usd.Prim) -> bool:
@@ -286,6 +308,12 @@ class StageReader:
         check_time_code(self.stage, time_code)
         if self._last is not None and self._last.time_code == time_code:
             return self._last
+        if not self._warned_skinned:
+            self._warned_skinned = True
+            for root, anim, targets in animated_skins(self.stage):
+                log.warning("%s: %d skinned meshes (e.g. %s) are animated by %s, and synthua cannot pose skinned "
+                            "meshes: they render in their bind pose, not as animated", root, len(targets),
+                            targets[0], anim)
         previous = {m.prim_path: m for m in self._last.meshes} if self._last is not None else {}
         t = Usd.TimeCode(time_code)
         xcache = UsdGeom.XformCache(t)
