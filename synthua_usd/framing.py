@@ -100,7 +100,7 @@ def fit_view(points: np.ndarray, forward: np.ndarray, tan_half: float = FIT_TAN)
 
 #: Overview directions tried: 8 azimuths at 45 and 60 degrees down; the one that frames the cluster from
 #: the least distance (the largest on screen) wins.
-OVERVIEW_DIRECTIONS = tuple((az, pitch) for pitch in (45.0, 60.0) for az in range(45, 360, 45))
+OVERVIEW_DIRECTIONS = tuple((az, pitch) for pitch in (45.0, 60.0) for az in range(0, 360, 45))
 
 
 def overview_view(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
