@@ -1,66 +1,232 @@
-"""Automatic cameras for a twin that comes without any (imports): an oblique overview of the whole extent
-and an eye-level street view, as :class:`CameraSpec` values."""
+"""Automatic cameras for a twin that comes without any (imports), framed on what is there.
+
+* ``Overview``: 45 or 60 degrees down, from the side (of 8) and at the least distance from which the boxes of
+  the densest cluster of objects fit the frame, heights included (:func:`densest_cluster`,
+  :func:`overview_view`). A sparse model spread over kilometres is framed on its biggest cluster, not on
+  its whole extent.
+* ``Street``: 1.6 m above a walkable or road surface found by casting rays down onto the twin (the first
+  surface hit from above must be a street surface, so never under a roof, a tree or a bridge), near the
+  cluster's centre, looking along the street there (the main axis of the street surfaces within
+  :data:`STREET_RADIUS_M`) in the direction with the longer free view. Without street surfaces it stands on
+  the generated ground (:mod:`synthua_usd.ground`) and looks at the cluster.
+
+Whether each camera's label pass sees enough of the twin is checked by the import pipeline
+(:mod:`synthua_usd.pipeline.twin_import`), which renders it.
+"""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from synthua_usd.cameras import CameraSpec
 from synthua_usd.errors import InputError
-from synthua_usd.twin import TwinModel
+from synthua_usd.ground import REACH_M, is_ground
+from synthua_usd.twin import TwinModel, TwinObject
 
 #: Classes a street-level camera may stand on.
-STREET_CLASSES = ("road", "street_road", "sidewalk")
+STREET_CLASSES = ("road", "street_road", "sidewalk", "crosswalk", "curb_ramp")
+#: Full-frame 24 mm: (focal length, horizontal and vertical aperture), millimetres.
+LENS_MM = (24.0, 36.0, 24.0)
+#: Half the frame's height over the focal length (12 / 24 mm), less a 5 % margin: the tangent every
+#: corner of the framed box must stay within, horizontally and vertically (whatever the image's aspect,
+#: between 3:2 and 4:3 the conformed frame is at least this wide and high).
+FIT_TAN = 0.5 * 0.95
+#: Eye height of the street camera above the surface it stands on (metres).
+EYE_HEIGHT_M = 1.6
+#: Street surfaces within this distance of the camera set the street's direction (metres).
+STREET_RADIUS_M = 20.0
+#: A street view whose free line of sight reaches this far is taken at once (metres).
+GOOD_VIEW_M = 20.0
+#: Street spots tried, nearest the cluster's centre first.
+MAX_SPOTS = 64
 
 
-def automatic_cameras(model: TwinModel) -> tuple[CameraSpec, ...]:
-    """``Overview`` (45 degrees down, the whole horizontal extent in view) and ``Street`` (1.6 m above the
-    road or sidewalk point nearest the twin's centre, looking along the road there); full-frame 24 mm."""
-    points = [p.points for o in model.objects for p in o.parts if len(p.points)]
-    if not points:
-        raise InputError(f"{model.source}: the import produced no geometry")
-    allp = np.concatenate(points)
-    lo, hi = allp.min(axis=0), allp.max(axis=0)
-    centre = (lo + hi) / 2
-    radius = max(float(np.linalg.norm(hi[:2] - lo[:2])) / 2, 1.0)
-    # 24 mm on 36 x 24 mm sees ~74 x 53 degrees; 1.4 radii away the extent's circle fits at 45 degrees.
-    dist = 1.4 * radius
-    eye = centre + np.array([-dist * 0.5, -dist * 0.5, dist * 0.7071])
-    far = float(4 * dist + 1000)
-    point, direction = _street_view(model, centre)
-    ground = point if point is not None else np.array([centre[0], centre[1], lo[2]])
-    street_eye = ground + [0.0, 0.0, 1.6]
-    d = np.asarray(direction, float)
-    d = d / (np.linalg.norm(d) or 1.0)
-    return (
-        CameraSpec("Overview", tuple(eye), tuple(centre), 24.0, 36.0, 24.0, "Oblique overview of the whole twin.",
-                   clip_near_m=0.5, clip_far_m=far),
-        CameraSpec("Street", tuple(street_eye), tuple(street_eye + [10 * d[0], 10 * d[1], -0.5]), 24.0, 36.0, 24.0,
-                   "Eye level at the twin's centre.", clip_near_m=0.05, clip_far_m=far),
-    )
+@dataclass(frozen=True)
+class Framing:
+    """The automatic cameras and what they were framed on (for the import report)."""
+
+    cameras: tuple[CameraSpec, ...]
+    report: dict
 
 
-def _street_view(model: TwinModel, centre: np.ndarray):
-    """A ground point on the road (or sidewalk) part nearest the twin's centre, and the road's main
-    direction there; (None, (1, 0)) when the twin has no road."""
+def object_boxes(objects: list[TwinObject]) -> np.ndarray:
+    """(n, 2, 3) float64: each object's axis-aligned box (min, max corner), local metres."""
+    return np.array([[np.min([p.points.min(axis=0) for p in o.parts], axis=0),
+                      np.max([p.points.max(axis=0) for p in o.parts], axis=0)] for o in objects])
+
+
+def densest_cluster(boxes: np.ndarray) -> np.ndarray:
+    """Indices of the boxes in the biggest cluster: boxes whose centres lie within a link distance of one
+    another, chained (single linkage). The link distance is 3x the median distance from a box centre to its
+    nearest neighbour, at least 10 m: neighbours in a block join, a village 1 km away does not."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    centres = boxes.mean(axis=1)[:, :2]
+    if len(centres) < 3:
+        return np.arange(len(centres))
+    tree = cKDTree(centres)
+    nearest = tree.query(centres, k=2)[0][:, 1]
+    link = max(3.0 * float(np.median(nearest)), 10.0)
+    pairs = tree.query_pairs(link, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(centres),) * 2)
+    _, labels = connected_components(graph, directed=False)
+    return np.flatnonzero(labels == np.bincount(labels).argmax())
+
+
+def view_axes(forward: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(forward, right, up) unit vectors of a camera looking along ``forward`` with Z up."""
+    f = forward / np.linalg.norm(forward)
+    r = np.cross(f, [0.0, 0.0, 1.0])
+    r /= np.linalg.norm(r)
+    return f, r, np.cross(r, f)
+
+
+def fit_view(points: np.ndarray, forward: np.ndarray, tan_half: float = FIT_TAN) -> tuple[np.ndarray, float]:
+    """(target, distance): the point the camera looks at and the least distance back along ``forward`` from
+    it at which all ``points`` (n, 3) lie within ``tan_half`` of the optical axis horizontally and vertically.
+    The target centres the points' extent across the view (right and up axes)."""
+    f, r, u = view_axes(forward)
+    x, y = points @ r, points @ u
+    target = points.mean(axis=0)
+    target = target + r * ((x.max() + x.min()) / 2 - target @ r) + u * ((y.max() + y.min()) / 2 - target @ u)
+    rel = points - target
+    need = np.maximum(np.abs(rel @ r), np.abs(rel @ u)) / tan_half - rel @ f
+    return target, float(max(need.max(), 1.0))
+
+
+#: Overview directions tried: 8 azimuths at 45 and 60 degrees down; the one that frames the cluster from
+#: the least distance (the largest on screen) wins.
+OVERVIEW_DIRECTIONS = tuple((az, pitch) for pitch in (45.0, 60.0) for az in range(0, 360, 45))
+
+
+def overview_view(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """(eye, target, distance) of the tightest overview of ``points`` (n, 3) among :data:`OVERVIEW_DIRECTIONS`."""
     best = None
-    for obj in model.objects:
-        if obj.label not in STREET_CLASSES:
-            continue
+    for az, pitch in OVERVIEW_DIRECTIONS:
+        a, p = np.radians(az), np.radians(pitch)
+        forward = np.array([np.cos(p) * np.cos(a), np.cos(p) * np.sin(a), -np.sin(p)])
+        target, dist = fit_view(points, forward)
+        if best is None or dist < best[2] - 1e-9:
+            best = (target - forward * dist, target, dist)
+    return best
+
+
+def automatic_cameras(model: TwinModel, ground: TwinObject) -> Framing:
+    """``Overview`` and ``Street`` cameras for ``model`` standing on ``ground`` (full-frame 24 mm)."""
+    objects = [o for o in model.objects if any(len(p.points) for p in o.parts)]
+    if not objects:
+        raise InputError(f"{model.source}: the import produced no geometry")
+    # Framed: labelled objects that stand on the ground (buildings, trees, furniture); unlabelled ones (water,
+    # generic objects) are not what the labels are about, and ground surfaces are everywhere.
+    standing = ([o for o in objects if not is_ground(o) and o.label != "unlabelled"]
+                or [o for o in objects if not is_ground(o)] or objects)
+    boxes = object_boxes(standing)
+    members = densest_cluster(boxes)
+    lo, hi = boxes[members, 0].min(axis=0), boxes[members, 1].max(axis=0)
+    corners = np.array([[b[i, 0], b[j, 1], b[k, 2]] for b in boxes[members] for i in (0, 1) for j in (0, 1)
+                        for k in (0, 1)])
+    eye, target, dist = overview_view(corners)
+    overview = CameraSpec("Overview", tuple(eye), tuple(target), *LENS_MM,
+                          f"Oblique overview of the densest cluster of objects ({len(members)} of {len(standing)}).",
+                          clip_near_m=max(0.05, dist / 1000), clip_far_m=REACH_M * 1.5)
+    street, street_report = _street_camera(model, ground, lo, hi)
+    report = {"overview": {"cluster_objects": int(len(members)), "objects": len(standing),
+                           "cluster_box_m": [lo.tolist(), hi.tolist()], "distance_m": dist},
+              "street": street_report}
+    return Framing((overview, street), report)
+
+
+def _scene(model: TwinModel, ground: TwinObject):
+    """The twin and its ground as one trimesh, and per face: whether it is a street surface, its object path."""
+    import trimesh
+
+    pts, tris, street, paths, n = [], [], [], [], 0
+    for obj in (*model.objects, ground):
         for part in obj.parts:
-            if len(part.triangles) == 0:
-                continue
-            tris = part.points[part.triangles]
-            centroids = tris.mean(axis=1)
-            up = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])[:, 2] > 0
-            if not up.any():
-                continue
-            d = np.linalg.norm(centroids[up, :2] - centre[:2], axis=1)
-            k = int(np.argmin(d))
-            if best is None or d[k] < best[0]:
-                best = (d[k], centroids[up][k], part.points)
-    if best is None:
-        return None, (1.0, 0.0)
-    xy = best[2][:, :2] - best[2][:, :2].mean(axis=0)
-    direction = np.linalg.svd(xy, full_matrices=False)[2][0] if len(xy) > 1 else np.array([1.0, 0.0])
-    return best[1], tuple(direction)
+            pts.append(part.points)
+            tris.append(part.triangles + n)
+            n += len(part.points)
+            street.append(np.full(len(part.triangles), obj.label in STREET_CLASSES))
+            paths += [obj.path] * len(part.triangles)
+    mesh = trimesh.Trimesh(np.concatenate(pts), np.concatenate(tris), process=False)
+    return mesh, np.concatenate(street), np.array(paths, dtype=object)
+
+
+def _first_hits(mesh, origins: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) distance to the first hit along each ray (inf for none) and (n,) face index (-1 for none)."""
+    dist = np.full(len(origins), np.inf)
+    face = np.full(len(origins), -1)
+    if not len(origins):
+        return dist, face
+    locations, ray_idx, tri_idx = mesh.ray.intersects_location(origins, directions, multiple_hits=False)
+    d = np.linalg.norm(locations - origins[ray_idx], axis=1)
+    dist[ray_idx], face[ray_idx] = d, tri_idx
+    return dist, face
+
+
+def _street_camera(model: TwinModel, ground: TwinObject, lo: np.ndarray, hi: np.ndarray):
+    mesh, street, paths = _scene(model, ground)
+    centre = (lo + hi) / 2
+    tris = mesh.triangles
+    normals = mesh.face_normals
+    candidates = np.flatnonzero(street & (normals[:, 2] > 0.7))
+    on_street = len(candidates) > 0
+    if not on_street:  # no street surfaces: stand on the generated ground (its last faces) inside the cluster
+        candidates = np.flatnonzero(paths == ground.path)
+    spots = tris[candidates].mean(axis=1)
+    near = np.linalg.norm(spots[:, :2] - centre[:2], axis=1)
+    order = np.argsort(near, kind="stable")[:MAX_SPOTS]
+    top = float(mesh.bounds[1][2]) + 10.0
+    origins = np.column_stack([spots[order, :2], np.full(len(order), top)])
+    down, face = _first_hits(mesh, origins, np.tile([0.0, 0.0, -1.0], (len(order), 1)))
+    standing = street[face] if on_street else paths[face] == ground.path
+    best = None
+    for k in np.flatnonzero((face >= 0) & standing):
+        foot = origins[k] - [0.0, 0.0, down[k]]
+        eye = foot + [0.0, 0.0, EYE_HEIGHT_M]
+        if on_street:
+            same = candidates[paths[candidates] == paths[face[k]]]
+            local = tris[same].mean(axis=1)
+            local = local[np.linalg.norm(local[:, :2] - foot[:2], axis=1) <= STREET_RADIUS_M][:, :2]
+            axis = (np.linalg.svd(local - local.mean(axis=0), full_matrices=False)[2][0] if len(local) > 2
+                    else np.array([1.0, 0.0]))
+        else:
+            axis = centre[:2] - foot[:2]
+            axis = axis / (np.linalg.norm(axis) or 1.0)
+        dirs = np.array([[axis[0], axis[1], 0.0], [-axis[0], -axis[1], 0.0]])
+        free, _ = _first_hits(mesh, np.tile(eye, (2, 1)), dirs)
+        if not on_street:
+            free = np.array([free[0], -1.0])  # look at the cluster, not away from it
+        j = int(np.argmax(free))
+        if best is None or min(free[j], 1e6) > best[2]:
+            best = (eye, dirs[j], min(free[j], 1e6), paths[face[k]], foot)
+        if best[2] >= GOOD_VIEW_M:
+            break
+    if best is None:  # nothing found by ray casting: the ground under the cluster's centre
+        from synthua_usd.ground import height_at
+
+        foot = np.array([centre[0], centre[1], float(height_at(ground, centre[None, :2])[0])])
+        best = (foot + [0.0, 0.0, EYE_HEIGHT_M], np.array([1.0, 0.0, 0.0]), 0.0, ground.path, foot)
+    eye, d, free, path, foot = best
+    target = eye + 10.0 * d - [0.0, 0.0, 0.5]
+    if np.linalg.norm(hi[:2] - lo[:2]) < 2 * GOOD_VIEW_M:
+        # A small model: at eye level on it one sees over it. Step back along the view until its box fits
+        # (at most 10 degrees down), stand on the surface there and look at its centre.
+        from synthua_usd.ground import height_at
+
+        horizontal = np.array([d[0], d[1], 0.0]) / (np.linalg.norm(d[:2]) or 1.0)
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        aim, dist = fit_view(corners, horizontal - [0.0, 0.0, np.tan(np.radians(10.0))])
+        back = aim[:2] - horizontal[:2] * dist
+        stand = max(float(height_at(ground, back[None])[0]), float(lo[2]))
+        eye = np.array([back[0], back[1], stand + EYE_HEIGHT_M])
+        target, path, foot = aim, ground.path, np.array([back[0], back[1], stand])
+    camera = CameraSpec("Street", tuple(float(v) for v in eye), tuple(float(v) for v in target), *LENS_MM,
+                        f"Eye level ({EYE_HEIGHT_M} m) on {path}, looking along it.", clip_near_m=0.05,
+                        clip_far_m=REACH_M * 1.5)
+    return camera, {"stands_on": str(path), "surface_z_m": float(foot[2]), "free_view_m": float(free),
+                    "on_street_surface": bool(on_street)}

@@ -44,3 +44,41 @@ def radiance_rgb(luminance_cd_m2: float, color: tuple[float, float, float]) -> t
     """The renderer RGB radiance of a surface of ``luminance_cd_m2`` with a unit-luminance ``color``."""
     scale = luminance_cd_m2 / CD_PER_M2_PER_UNIT
     return tuple(float(c * scale) for c in color)
+
+
+# --- UsdLux light strengths from other conventions -------------------------------------------------------------
+
+#: The brightest light strength read as renderer units (irradiance of a distant light, radiance of a dome): 20
+#: units is 1.46 Mlx or 1.46 Mcd/m², 11x the brightest clear-noon sun (~130 klx) and ~100x a bright sky. Our
+#: own stages author sun 1.2 and sky 0.08. A stronger authored value means the stage follows another convention.
+MAX_RENDERER_UNITS = 20.0
+
+
+def solid_angle_sr(angle_deg: float) -> float:
+    """Solid angle (sr) of a disk of apparent diameter ``angle_deg`` (UsdLux DistantLight ``inputs:angle``)."""
+    import math
+
+    return 2.0 * math.pi * (1.0 - math.cos(math.radians(angle_deg) / 2.0))
+
+
+def distant_irradiance(strength: float, angle_deg: float, normalize: bool) -> tuple[float, str]:
+    """(irradiance in renderer units, the rule used) of a UsdLux DistantLight whose ``intensity x 2^exposure``
+    is ``strength``. Our convention: renderer units (1 = 72,983 lx). A strength above
+    :data:`MAX_RENDERER_UNITS` follows another: UsdLux's radiance of the sun's disk (not normalised:
+    irradiance = strength x the disk's solid angle; the schema's default 50,000 at 0.53 degrees gives 3.36 units,
+    245 klx), or, when that is implausible too or the light is normalised, lux."""
+    if strength <= MAX_RENDERER_UNITS:
+        return strength, "renderer units"
+    if not normalize:
+        disk = strength * solid_angle_sr(angle_deg)
+        if disk <= MAX_RENDERER_UNITS:
+            return disk, f"UsdLux radiance of a {angle_deg:g} degree disk (x {solid_angle_sr(angle_deg):.3g} sr)"
+    return strength / CD_PER_M2_PER_UNIT, "lux"
+
+
+def dome_radiance(strength: float) -> tuple[float, str]:
+    """(radiance in renderer units, the rule used) of a UsdLux DomeLight of ``intensity x 2^exposure`` =
+    ``strength``: renderer units up to :data:`MAX_RENDERER_UNITS`, nits (cd/m²) above."""
+    if strength <= MAX_RENDERER_UNITS:
+        return strength, "renderer units"
+    return strength / CD_PER_M2_PER_UNIT, "nits (cd/m²)"

@@ -138,6 +138,8 @@ class MeshItem:
     class_id: int
     lamp: str = ""
     uvs: np.ndarray | None = field(default=None, repr=False)
+    #: The gprim's ``doubleSided``: its back faces are shaded like its front faces.
+    double_sided: bool = False
 
 
 @dataclass(frozen=True)

@@ -117,6 +117,10 @@ class TwinModel:
     crs: str | None = None
     report: dict = field(default_factory=dict)
     images: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    #: True when the source does not guarantee closed, outward-facing shells (meshes, CityJSON, point-cloud
+    #: surfaces): every mesh is authored ``doubleSided`` and renders lit from both sides. False when the
+    #: builder closes its shells itself, facing out (footprint extrusions, the demo district).
+    double_sided: bool = False
 
     def triangle_count(self) -> int:
         return int(sum(len(p.triangles) for o in self.objects for p in o.parts))

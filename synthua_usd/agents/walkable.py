@@ -79,7 +79,12 @@ def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, 
     if len(faces) == 0:
         raise InputError("the twin has no geometry to walk on")
     mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
-    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    # The grid spans the labelled geometry: an imported twin's generated ground (unlabelled) reaches kilometres
+    # past it, and nobody walks there.
+    labelled = np.asarray(face_class, object) != "unlabelled"
+    spanned = vertices[np.unique(faces[labelled])] if labelled.any() else vertices
+    lo, hi = spanned.min(axis=0), spanned.max(axis=0)
+    hi[2] = vertices[:, 2].max()  # rays start above everything
     if not (math.isfinite(cell_m) and cell_m > 0):
         raise InputError(f"cell size: {cell_m!r}; expected a finite number of metres > 0")
     nx_, ny_ = int(math.ceil((hi[0] - lo[0]) / cell_m)), int(math.ceil((hi[1] - lo[1]) / cell_m))

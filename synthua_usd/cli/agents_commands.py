@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK
-from synthua_usd.cli.options import InRange
+from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
 from synthua_usd.ranges import Range
 
 # --- agents -----------------------------------------------------------------------------------------------
@@ -19,10 +19,10 @@ def agents() -> None:
 
 @agents.command("populate")
 @click.argument("stage", metavar="TWIN_OR_SCENARIO", type=click.Path(path_type=Path))
-@click.option("--density", type=InRange(Range(0.0, 1e6, "persons/m²", low_open=True)), default=0.03, show_default=True,
+@click.option("--density", type=InRange(DENSITY), default=0.03, show_default=True,
               help="Persons per m² of walkable area (Poisson mean = density x area). Refused above 5 (crowd "
                    "crush); warned above 0.7 (level of service E).")
-@click.option("--aid-share", type=InRange(Range(0.0, 1.0)), default=0.3, show_default=True,
+@click.option("--aid-share", type=InRange(AID_SHARE), default=0.3, show_default=True,
               help="Fraction of agents using a mobility aid (wheelchairs, walker, crutches, canes).")
 @click.option("--time-codes", "--frames", "time_codes", type=click.IntRange(1, 10_000), default=48, show_default=True,
               help="Time codes to author, one sample each, from the stage's start time code (--frames is the same).")

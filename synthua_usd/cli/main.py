@@ -190,8 +190,9 @@ def create_district(out_dir: Path, seed: int) -> int:
 @cli.command()
 @click.argument("scenario", type=click.Path(path_type=Path))
 @click.option("--camera", "cameras", multiple=True,
-              help="Camera prim path, e.g. /World/Cameras/CCTV; repeat for several [default: the render "
-                   "settings' camera].")
+              help="Camera prim path, e.g. /World/Cameras/CCTV; repeat for several; 'auto': a camera framing the "
+                   "stage's bounds, authored in its session layer only (for stages without one) [default: the "
+                   "render settings' camera].")
 @click.option("--time-code", "--frame", "time_codes", multiple=True, callback=_time_codes,
               help="Time code(s) to render: 24, 1,12,24 or 1:48:8 (START:END:STEP); repeatable; --frame is "
                    "the same option [default: the stage's start time code].")

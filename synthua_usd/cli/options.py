@@ -40,3 +40,8 @@ class InRange(click.ParamType):
             shown = f"{number:g}" if isinstance(number, float) else str(number)
             self.fail(f"{echo(shown)}; expected {self.allowed}", param, ctx)
         return int(number) if self.allowed.integer else float(number)
+
+
+#: Crowd options shared by ``agents populate`` and ``twin import --populate`` (defaults: CrowdParams's).
+DENSITY = Range(0.0, 1e6, "persons/m²", low_open=True)
+AID_SHARE = Range(0.0, 1.0)

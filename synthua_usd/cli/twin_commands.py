@@ -8,8 +8,8 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_OK, load_class_map
-from synthua_usd.cli.options import InRange
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map
+from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
 from synthua_usd.errors import echo
 from synthua_usd.importers import limits as importer_limits
 
@@ -25,8 +25,8 @@ def twin() -> None:
 KIND_OPTIONS = {
     "rules": ("mesh", "cityjson", "pointcloud"),
     "up_axis": ("mesh",), "scale": ("mesh",),
-    "lod": ("cityjson",),
-    "max_deviation_m": ("pointcloud",), "plane_threshold_m": ("pointcloud",),
+    "lod": ("cityjson",), "crs": ("cityjson", "pointcloud"), "units": ("cityjson", "pointcloud"),
+    "max_deviation_m": ("pointcloud",), "plane_threshold_m": ("pointcloud",), "max_residual_m": ("pointcloud",),
     "storey_height_m": ("footprints",),
 }
 
@@ -39,6 +39,15 @@ def _refuse_foreign_options(ctx: click.Context, kind: str) -> None:
             option = "--" + name.replace("_", "-")
             raise click.UsageError(f"{option}: given for a {kind} import; expected only with "
                                    f"{' or '.join(kinds)} imports", ctx)
+
+
+def _refuse_population_options(ctx: click.Context, populate: bool) -> None:
+    from click.core import ParameterSource
+
+    for name in ("density", "aid_share", "frames"):
+        if not populate and ctx.get_parameter_source(name) is ParameterSource.COMMANDLINE:
+            raise click.UsageError(f"--{name.replace('_', '-')}: given without --populate; expected only with it",
+                                   ctx)
 
 
 @twin.command("import")
@@ -56,26 +65,52 @@ def _refuse_foreign_options(ctx: click.Context, kind: str) -> None:
               help="mesh: file units to metres.")
 @click.option("--lod", help="cityjson: level of detail to import, one the file has [default: the highest each object "
                             "has].")
+@click.option("--crs", help="cityjson, pointcloud: the CRS of the coordinates (EPSG:2263, 2263, a CRS URL or WKT); "
+                            "replaces the file's own, and serves files that have none. Its linear units convert "
+                            "the coordinates to metres.")
+@click.option("--units", type=click.Choice(["m", "ft", "us-ft"]),
+              help="cityjson, pointcloud: the linear unit of a file without a CRS (us-ft: US survey foot, "
+                   "1200/3937 m). Files whose unit is unknown are refused without --crs or --units.")
 @click.option("--max-deviation-m", type=InRange(importer_limits.MAX_DEVIATION), default=0.005, show_default=True,
               help="pointcloud: largest Hausdorff distance simplification may introduce (metres).")
 @click.option("--plane-threshold-m", type=InRange(importer_limits.PLANE_THRESHOLD), default=0.02, show_default=True,
               help="pointcloud: RANSAC inlier distance (metres).")
+@click.option("--max-residual-m", type=InRange(importer_limits.MAX_RESIDUAL), default=0.10, show_default=True,
+              help="pointcloud: a segment whose 95th-percentile point-to-surface distance exceeds this (metres) is "
+                   "reported as a finding.")
+@click.option("--strict", is_flag=True, help="Exit 1 when the import has findings (residuals over their bound, "
+                                             "automatic cameras that see too few labelled pixels).")
+@click.option("--populate", is_flag=True,
+              help="Also write an agents layer: people walking (and using mobility aids) on the twin's roads, "
+                   "sidewalks, crosswalks and curb ramps, composed into the scenario.")
+@click.option("--density", type=InRange(DENSITY), default=0.03,
+              show_default=True, help="With --populate: persons per m² of walkable area (realistic: up to ~1).")
+@click.option("--aid-share", type=InRange(AID_SHARE), default=0.3, show_default=True,
+              help="With --populate: share of people using a mobility aid.")
+@click.option("--frames", type=click.IntRange(1, 10_000), default=48, show_default=True,
+              help="With --populate: time codes of the animation (24 per second).")
 @click.option("--storey-height-m", type=InRange(importer_limits.STOREY_HEIGHT), default=3.0, show_default=True,
               help="footprints: metres per level when a footprint gives levels, not height.")
 @click.pass_context
 def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, rules: Path | None,
-                class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, max_deviation_m: float,
-                plane_threshold_m: float, storey_height_m: float) -> int:
+                class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, crs: str | None,
+                units: str | None, max_deviation_m: float, plane_threshold_m: float, max_residual_m: float,
+                strict: bool, populate: bool, density: float, aid_share: float, frames: int,
+                storey_height_m: float) -> int:
     """Import real city data of KIND from INPUT as labelled twin layers plus a renderable scenario.
 
     \b
     KIND       INPUT
     mesh       .obj .ply .glb .gltf .stl (trimesh); classes from --rules (object/material/group regex)
-    cityjson   CityJSON 1.1 or 2.0 (needs metadata.referenceSystem in metres)
-    pointcloud .las .laz .ply; LAS classes, RANSAC planes, TIN, simplification within --max-deviation-m
+    cityjson   CityJSON 1.1 or 2.0 (units from metadata.referenceSystem, --crs or --units)
+    pointcloud .las .laz .ply; units from the LAS CRS (WKT or GeoTIFF keys), --crs or --units;
+               ground, connected planes, tree hulls; simplification within --max-deviation-m
     footprints GeoJSON polygons with 'height' or 'levels' -> extruded LoD1 buildings
 
     Geometry no rule matches is labelled 'unlabelled' (class 0) and listed in import_report.json.
+    The scenario stands on a generated ground (unlabelled, 20 km out) and has automatic Overview (densest
+    cluster) and Street (1.6 m above a road) cameras; each camera's label pass must show the twin in 10 %
+    of its pixels, else a finding is printed (exit 1 with --strict).
     Options of one kind (--lod, --scale, ...) are refused for the others. Nothing in --out changes
     unless the whole import is written.
     """
@@ -83,14 +118,16 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     from synthua_usd.importers import importers
 
     _refuse_foreign_options(ctx, kind)
+    _refuse_population_options(ctx, populate)
     if kind == "mesh" and rules is None:
         raise click.UsageError("--rules: missing; mesh import needs --rules FILE (meshes carry no classes of their "
                                "own; see schemas/semantic_rules.schema.json)", ctx)
     cmap = load_class_map(class_map)
     loaded_rules = AssignmentRules.load(rules, cmap) if rules else None
     t0 = time.perf_counter()
-    model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod,
-                              max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
+    model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod, crs=crs,
+                              units=units, max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
+                              max_residual_m=max_residual_m,
                               storey_height_m=storey_height_m, show_progress=sys.stderr.isatty())
     seconds = time.perf_counter() - t0
     from synthua_usd.pipeline.twin_import import write_import  # USD and the writers: only once the input is good
@@ -98,20 +135,36 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     report = {"kind": kind, "input": str(input_path), "seconds": round(seconds, 3), "objects": len(model.objects),
               "triangles": model.triangle_count(), "classes": model.label_counts(), "crs": model.crs,
               "origin_offset_m": list(model.origin_offset_m), **model.report}
-    written = write_import(model, out_dir, cmap, report)
+    crowd = None
+    if populate:
+        from synthua_usd.agents.crowd import CrowdParams
+        from synthua_usd.pipeline.twin_import import IMPORT_WALKABLE
+
+        crowd = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=frames, walkable=IMPORT_WALKABLE)
+    written, report = write_import(model, out_dir, cmap, report, crowd)
     click.echo(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
                f"{model.triangle_count()} triangles, classes {model.label_counts()}")
     for seg in model.report.get("segments", []):
         if not seg.get("skipped"):
             click.echo(f"  {seg['name']}: {seg['points']} points -> {seg['faces']} faces, simplification deviation "
-                       f"{seg['simplification_deviation_m'] * 1000:.3f} mm, point residual max "
-                       f"{seg['residual_max_m'] * 1000:.1f} mm / rms {seg['residual_rms_m'] * 1000:.1f} mm")
+                       f"{seg['simplification_deviation_m'] * 1000:.3f} mm, point-to-surface distance p50 "
+                       f"{seg['residual_p50_m'] * 1000:.1f} / p95 {seg['residual_p95_m'] * 1000:.1f} / max "
+                       f"{seg['residual_max_m'] * 1000:.1f} mm")
     unmatched = model.report.get("unmatched") or model.report.get("unlabelled_types")
     if unmatched:
         click.echo(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
+    if "population" in report:
+        p = report["population"]
+        click.echo(f"  people: {p['placed']} placed ({p['aid_users']} with mobility aids) on "
+                   f"{p['walkable_area_m2']:.0f} m² walkable, {frames} time codes")
+    for name, cam in report["cameras"].items():
+        click.echo(f"  camera {name}: label pass shows the twin in {cam['labelled_share']:.1%} of its pixels")
     click.echo(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "
                f"--out OUT")
-    return EXIT_OK
+    findings = report.get("findings", [])
+    for f in findings:
+        click.echo(f"{f['severity']}: {f['where']}: {f['message']} ({f['rule']})", err=True)
+    return EXIT_FINDINGS if strict and findings else EXIT_OK
 
 
 @twin.command("demo")

@@ -18,7 +18,7 @@ from tqdm import tqdm
 
 from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.errors import InputError, echo
-from synthua_usd.importers.crs import require_projected_metres
+from synthua_usd.importers.crs import crs_units, parse_crs, resolve_units
 from synthua_usd.importers.limits import MAX_EXTENT_M, TRANSFORM_SCALE
 from synthua_usd.input_files import shown
 from synthua_usd.materials import class_material, subset
@@ -234,8 +234,13 @@ def _lod_number(text) -> float:
 
 
 def import_cityjson(path: str | Path, rules: AssignmentRules | None = None, lod: str | None = None,
-                    show_progress: bool = False, **_ignored) -> TwinModel:
-    """Read a CityJSON file into labelled objects grouped by city object type."""
+                    crs: str | None = None, units: str | None = None, show_progress: bool = False,
+                    **_ignored) -> TwinModel:
+    """Read a CityJSON file into labelled objects grouped by city object type.
+
+    Vertices are converted to metres by the linear units of ``crs`` (EPSG code or WKT; it replaces the
+    file's), else of ``units`` ('m', 'ft', 'us-ft'), else of ``metadata.referenceSystem``; a file with none
+    of these is refused."""
     path = Path(path)
     where = shown(path)
     doc = read_json(path, "a CityJSON document")
@@ -250,14 +255,13 @@ def import_cityjson(path: str | Path, rules: AssignmentRules | None = None, lod:
     if not isinstance(metadata, dict):
         raise InputError(f"{where}: metadata: {_value(metadata)}; expected an object with a referenceSystem")
     crs_text = metadata.get("referenceSystem")
-    if not crs_text:
-        raise InputError(f"{where}: metadata.referenceSystem is missing; a CRS is needed to place the model in metres")
-    if not isinstance(crs_text, str):
+    if crs_text is not None and not isinstance(crs_text, str):
         raise InputError(f"{where}: metadata.referenceSystem: {_value(crs_text)}; expected a CRS URL such as "
                          f"https://www.opengis.net/def/crs/EPSG/0/7415")
-    require_projected_metres(crs_text, where)
+    found = crs_units(parse_crs(crs_text, f"{where}: metadata.referenceSystem"), "CRS", where) if crs_text else None
+    linear = resolve_units(found, crs, units, where, "metadata.referenceSystem is missing")
     scale, translate = _transform(doc.get("transform"), where, version)
-    world = _vertices(doc.get("vertices"), scale, translate, where)
+    world = _vertices(doc.get("vertices"), scale * linear.scale, translate * linear.scale, where)
     lo, hi = world.min(axis=0), world.max(axis=0)
     origin = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]])
     local = world - origin
@@ -326,8 +330,10 @@ def import_cityjson(path: str | Path, rules: AssignmentRules | None = None, lod:
         log.warning("%s: %d city objects have no LoD %s; their highest LoD was imported", where, fallback, echo(lod))
     materials = subset(p.material for o in objects for p in o.parts)
     return TwinModel(objects=tuple(unique_paths(objects)), materials=materials, source=str(path),
-                     origin_offset_m=tuple(float(v) for v in origin), crs=crs_text,
-                     report={"city_objects": len(city_objects), "objects": len(objects), "lods_present": present,
+                     double_sided=True,
+                     origin_offset_m=tuple(float(v) for v in origin), crs=crs or crs_text,
+                     report={"units": linear.as_report(), "file_crs": crs_text, "city_objects": len(city_objects),
+                             "objects": len(objects), "lods_present": present,
                              "lod_fallbacks": fallback, "unlabelled_types": dict(unlabelled_types),
                              "version": version})
 

@@ -18,6 +18,9 @@ MAX_DEVIATION = Range(1e-5, 10, "m")
 #: pointcloud: RANSAC inlier distance; below 0.1 mm no plane of a real scan has inliers, above 10 m
 #: everything is one plane.
 PLANE_THRESHOLD = Range(1e-4, 10, "m")
+#: pointcloud: bound on the 95th percentile of a segment's point-to-surface distances before it is a finding;
+#: 1 mm is below any scanner's noise, 100 m explains nothing.
+MAX_RESIDUAL = Range(1e-3, 100, "m")
 #: footprints: metres per level when a footprint gives levels.
 STOREY_HEIGHT = Range(1, 20, "m")
 

@@ -113,6 +113,7 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
         log.warning("%s: %d of %d meshes matched no rule and are labelled '%s': %s", where, len(unmatched),
                     len(meshes), rules.default, echo(", ".join(unmatched[:5]) + (" ..." if len(unmatched) > 5 else "")))
     model = TwinModel(objects=tuple(unique_paths(objects)), materials=materials, source=str(path),
+                      double_sided=True,
                       report={"meshes": len(meshes), "unmatched": unmatched, "matched_by": dict(matched_by),
                               "rules": rules.source, "textures": sorted(images)}, images=images)
     return model

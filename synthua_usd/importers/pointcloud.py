@@ -1,24 +1,25 @@
 """Point clouds (LAS, LAZ, PLY) → labelled, simplified surface meshes.
 
-1. Segments: the LAS classification when the file has one (ground, vegetation, building, ...); the
-   points it leaves unclassified go through RANSAC plane detection, each plane refitted by least
-   squares (min Σ(n·Xᵢ + d)², the smallest singular vector of the centred inliers) and named by its
-   normal: ground (horizontal, lowest), roof (horizontal above ground, or sloped) or façade (vertical).
-2. Surfaces: a plane's inliers are projected onto it (the model is the fitted plane, bounded by its
-   points); other segments (LAS ground, trees, what no plane explains) keep their points. Either way the
-   points are triangulated as a height field over the segment's least-squares plane (2-D Delaunay in
-   plane coordinates, long edges dropped).
+0. Units: coordinates are converted to metres first (:mod:`synthua_usd.importers.crs`).
+1. Segments (:mod:`synthua_usd.importers.segmentation`): ground (LAS classes or a morphological ground
+   filter), connected planar regions named by normal and height above the local ground (roof, façade,
+   ground-level plane), trees as connected clusters, and the points that fit nothing (reported).
+2. Surfaces: a plane's points are projected onto it and the ground's smoothed (moving least squares), then
+   triangulated as a height field over their least-squares plane (2-D Delaunay in plane coordinates, long
+   edges dropped); a tree is its convex hull.
 3. Simplification: MeshLab's quadric edge collapse (pymeshlab), halving the face count while the
    symmetric Hausdorff distance between the reconstructed and the simplified mesh (MeshLab's own
-   sampling filter, both ways) stays within ``max_deviation_m`` (default 5 mm, the paper's ε).
-   Reported per segment: that simplification deviation, and the residual from the input points to the
-   final mesh (max, mean, RMS), which also holds the sensor noise the plane fit removed.
+   sampling filter, both ways) stays within ``max_deviation_m`` (default 5 mm, the paper's ε); faces
+   before and after are reported, and why when nothing could be collapsed.
+4. Residuals: every input point's distance to its segment's final surface, summarised per segment; over
+   ``max_residual_m`` (95th percentile) a finding. A tree's hull encloses its points: no bound there.
 """
 
 from __future__ import annotations
 
 import contextlib
 import logging
+from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
@@ -28,8 +29,12 @@ from tqdm import tqdm
 
 from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.errors import InputError, echo
+from synthua_usd.findings import Finding, Severity
+from synthua_usd.importers.crs import (PROJECTED_CRS, USER_DEFINED, LinearUnits, crs_units, geotiff_units,
+                                       resolve_units)
 from synthua_usd.importers.limits import (MAX_DEVIATION, MAX_EXTENT_M, MAX_POINTCLOUD_BYTES, MAX_POINTS,
-                                          PLANE_THRESHOLD)
+                                          MAX_RESIDUAL, PLANE_THRESHOLD)
+from synthua_usd.importers.segmentation import Region, Segmentation, fit_plane, segment, smoothed_heights
 from synthua_usd.input_files import check_input_file, shown
 from synthua_usd.materials import class_material, subset
 from synthua_usd.ranges import COORDINATE
@@ -39,31 +44,8 @@ log = logging.getLogger(__name__)
 
 SUFFIXES = (".las", ".laz", ".ply")
 
-#: ASPRS LAS 1.4 classification codes → classes. 1 (unclassified) and 0 (never classified) go through
-#: plane detection instead.
-LAS_CLASSES = {2: "road", 3: "vegetation", 4: "vegetation", 5: "vegetation", 6: "building", 9: "unlabelled",
-               11: "road", 17: "road"}
-LAS_NAMES = {0: "never_classified", 1: "unclassified", 2: "ground", 3: "low_vegetation", 4: "medium_vegetation",
-             5: "high_vegetation", 6: "building", 7: "noise", 9: "water", 11: "road_surface", 17: "bridge_deck"}
-PLANE_CLASSES = {"ground": "road", "roof": "building", "facade": "building"}
 #: Largest point data a LAS/LAZ header may announce (points x record length), decompressed in memory.
 MAX_POINT_DATA_BYTES = 2 * 2**30
-
-
-@dataclass(frozen=True)
-class Segment:
-    name: str
-    label: str
-    points: np.ndarray  # (n, 3) local metres
-    source: str         # "las:<code>", "plane" or "rest"
-    plane: tuple[np.ndarray, float] | None = None  # (unit normal, d) of a detected plane
-
-    def surface_points(self) -> np.ndarray:
-        """The points the surface goes through: projected onto the plane for plane segments."""
-        if self.plane is None:
-            return self.points
-        normal, d = self.plane
-        return self.points - np.outer(self.points @ normal + d, normal)
 
 
 @contextlib.contextmanager
@@ -100,8 +82,9 @@ def _check_las_header(header, size: int, where: str) -> None:
                          f"±{COORDINATE.high:g} m")
 
 
-def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None]:
-    """(n, 3) float64 coordinates, (n,) uint8 LAS classification or None, CRS text or None."""
+def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None, LinearUnits | None]:
+    """(n, 3) float64 coordinates in the file's units, (n,) uint8 LAS classification or None, CRS text or None,
+    and the linear units the file states (LAS: WKT or GeoTIFF keys) or None (PLY never states any)."""
     where = shown(path)
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
@@ -117,7 +100,7 @@ def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None]:
         vertices = np.asarray(getattr(cloud, "vertices", np.zeros((0, 3))), float).reshape(-1, 3)
         if len(vertices) > MAX_POINTS:
             raise InputError(f"{where}: {len(vertices)} points; expected at most {MAX_POINTS}")
-        return vertices, None, None
+        return vertices, None, None, None
     import laspy
 
     try:
@@ -133,59 +116,35 @@ def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None]:
                          f"could be read; expected a complete file")
     xyz = np.column_stack([np.asarray(las.x, float), np.asarray(las.y, float), np.asarray(las.z, float)])
     classes = np.asarray(las.classification, np.uint8)
-    try:
-        with _quiet("laspy"):
-            crs = las.header.parse_crs()
-    except Exception:  # a CRS record laspy cannot parse leaves the CRS unknown, as a file without one
-        crs = None
-    return xyz, (classes if np.any(classes > 1) else None), (crs.to_string() if crs is not None else None)
+    crs_text, units = las_crs_units(las.header, where)
+    return xyz, (classes if np.any(classes > 1) else None), crs_text, units
 
 
-def fit_plane(points: np.ndarray) -> tuple[np.ndarray, float]:
-    """Least-squares plane: unit normal n and offset d minimising Σ(n·Xᵢ + d)²."""
-    centroid = points.mean(axis=0)
-    normal = np.linalg.svd(points - centroid, full_matrices=False)[2][-1]
-    if normal[2] < 0:
-        normal = -normal
-    return normal, -float(normal @ centroid)
+def las_crs_units(header, where: str) -> tuple[str | None, LinearUnits | None]:
+    """(CRS text, linear units) of a LAS header: its OGC WKT (VLR or EVLR) when it has one, else its GeoTIFF
+    keys; (None, None) when it has neither."""
+    from pyproj.exceptions import CRSError
 
+    records = list(header.vlrs) + list(getattr(header, "evlrs", None) or [])
+    for vlr in records:
+        wkt = getattr(vlr, "string", None)
+        if type(vlr).__name__ == "WktCoordinateSystemVlr" and wkt and wkt.strip("\x00 "):
+            text = wkt.strip("\x00 ")
+            try:
+                from pyproj import CRS
 
-def ransac_planes(points: np.ndarray, rng: np.random.Generator, threshold_m: float, min_points: int,
-                  max_planes: int = 8, iterations: int = 300) -> list[tuple[np.ndarray, np.ndarray, float]]:
-    """Planes as (inlier indices, normal, d), biggest first. Each RANSAC winner is refitted by least squares
-    on its inliers and its inliers recomputed."""
-    remaining = np.arange(len(points))
-    planes = []
-    while len(remaining) >= max(min_points, 3) and len(planes) < max_planes:
-        pts = points[remaining]
-        best = None
-        for _ in range(iterations):
-            a, b, c = pts[rng.choice(len(pts), 3, replace=False)]
-            n = np.cross(b - a, c - a)
-            norm = np.linalg.norm(n)
-            if norm < 1e-12:
-                continue
-            n /= norm
-            inliers = np.abs((pts - a) @ n) <= threshold_m
-            count = int(inliers.sum())
-            if best is None or count > best[0]:
-                best = (count, inliers)
-        if best is None or best[0] < min_points:
-            break
-        normal, d = fit_plane(pts[best[1]])
-        inliers = np.abs(pts @ normal + d) <= threshold_m
-        if inliers.sum() < min_points:
-            break
-        planes.append((remaining[inliers], normal, d))
-        remaining = remaining[~inliers]
-    return planes
-
-
-def _plane_kind(normal: np.ndarray, points: np.ndarray, ground_z: float) -> str:
-    nz = abs(normal[2])
-    if nz >= 0.9:
-        return "ground" if points[:, 2].mean() - ground_z < 1.0 else "roof"
-    return "facade" if nz < 0.3 else "roof"
+                crs = CRS.from_wkt(text)
+            except CRSError as exc:
+                raise InputError(f"{where}: the WKT CRS record cannot be read ({echo(str(exc)[:160])}); expected OGC "
+                                 f"WKT (or give --crs)") from None
+            return crs.to_string(), crs_units(crs, "WKT", where)
+    for vlr in records:
+        if type(vlr).__name__ == "GeoKeyDirectoryVlr":
+            keys = {int(k.id): int(k.value_offset) for k in vlr.geo_keys if int(k.tiff_tag_location) == 0}
+            units = geotiff_units(keys, where)
+            code = keys.get(PROJECTED_CRS)
+            return (f"EPSG:{code}" if code and code != USER_DEFINED else "GeoTIFF keys (user-defined CRS)"), units
+    return None, None
 
 
 def triangulate_height_field(points: np.ndarray, max_edge_factor: float = 8.0) -> np.ndarray:
@@ -222,9 +181,8 @@ class Simplified:
     triangles: np.ndarray
     faces_before: int
     deviation_m: float          # symmetric Hausdorff, reconstructed ↔ simplified
-    residual_max_m: float       # input points → simplified mesh
-    residual_mean_m: float
-    residual_rms_m: float
+    residuals_m: np.ndarray     # (n,) float64: distance of every input point to the simplified mesh
+    note: str = ""              # why it was not simplified, when it was not
 
 
 def simplify_within(points: np.ndarray, triangles: np.ndarray, cloud: np.ndarray, max_deviation_m: float) -> Simplified:
@@ -243,7 +201,7 @@ def simplify_within(points: np.ndarray, triangles: np.ndarray, cloud: np.ndarray
         return ms.get_hausdorff_distance(sampledmesh=a, targetmesh=b, samplevert=True, sampleface=faces,
                                          samplenum=samples, maxdist=pymeshlab.PercentageValue(100))
 
-    best_id, best_dev = 1, 0.0
+    best_id, best_dev, note = 1, 0.0, ""
     target = len(triangles)
     while target > 2:
         target //= 2
@@ -254,29 +212,56 @@ def simplify_within(points: np.ndarray, triangles: np.ndarray, cloud: np.ndarray
                                                     preservenormal=True, planarquadric=True, qualitythr=0.3)
         dev = max(hausdorff(1, trial, True)["max"], hausdorff(trial, 1, True)["max"])
         if dev > max_deviation_m:
+            if best_id == 1:
+                note = (f"not simplified: halving to {target} faces deviated {dev:.4g} m, more than "
+                        f"--max-deviation-m {max_deviation_m:g} m (the surface follows noisy points)")
             break
         best_id, best_dev = trial, dev
-    residual = hausdorff(0, best_id, False)
+    # Every input point is sampled (MeshLab keeps the per-sample distances in a mesh of its own).
+    ms.get_hausdorff_distance(sampledmesh=0, targetmesh=best_id, samplevert=True, sampleface=False,
+                              samplenum=len(cloud), maxdist=pymeshlab.PercentageValue(100), savesample=True)
+    residuals = np.abs(np.asarray(ms.mesh(ms.mesh_number() - 1).vertex_scalar_array(), float))
     mesh = ms.mesh(best_id)
     return Simplified(np.asarray(mesh.vertex_matrix(), float), np.asarray(mesh.face_matrix(), np.int64),
-                      len(triangles), float(best_dev), float(residual["max"]), float(residual["mean"]),
-                      float(residual["RMS"]))
+                      len(triangles), float(best_dev), residuals, note)
+
+
+def residual_summary(residuals_m: np.ndarray, bound_m: float) -> dict:
+    """The distribution of point-to-surface distances (metres): mean, RMS, percentiles 50/90/95/99, max, and
+    how many points lie farther than ``bound_m``."""
+    r = np.asarray(residuals_m, float)
+    p50, p90, p95, p99 = (float(v) for v in np.percentile(r, [50, 90, 95, 99]))
+    return {"residual_mean_m": float(r.mean()), "residual_rms_m": float(np.sqrt(np.mean(r * r))),
+            "residual_p50_m": p50, "residual_p90_m": p90, "residual_p95_m": p95, "residual_p99_m": p99,
+            "residual_max_m": float(r.max()), "points_beyond_bound": int((r > bound_m).sum())}
 
 
 def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, max_deviation_m: float = 0.005,
                       plane_threshold_m: float = 0.02, min_plane_points: int = 50, seed: int = 0,
+                      max_residual_m: float = 0.10, crs: str | None = None, units: str | None = None,
                       show_progress: bool = False, **_ignored) -> TwinModel:
-    """Segment, reconstruct and simplify a point cloud; the report holds the measured deviations."""
+    """Segment, reconstruct and simplify a point cloud; the report holds the measured deviations.
+
+    Coordinates are converted to metres before anything is measured: by ``crs`` (EPSG code or WKT; it
+    replaces the file's), else ``units`` ('m', 'ft', 'us-ft'), else the file's own CRS (LAS WKT or GeoTIFF
+    keys). A file whose unit none of these gives is refused.
+
+    Every segment's point-to-surface distances are summarised in the report; a segment whose 95th percentile
+    exceeds ``max_residual_m`` is a finding (``report['findings']``)."""
     path = Path(path)
     where = shown(path)
     MAX_DEVIATION.check(max_deviation_m, "max_deviation_m")
     PLANE_THRESHOLD.check(plane_threshold_m, "plane_threshold_m")
-    xyz, classes, crs = read_points(path)
+    MAX_RESIDUAL.check(max_residual_m, "max_residual_m")
+    xyz, classes, file_crs, found_units = read_points(path)
     if len(xyz) == 0:
         raise InputError(f"{where}: the point cloud has no points; expected at least 3")
     if not np.all(np.isfinite(xyz)):
         raise InputError(f"{where}: {int((~np.isfinite(xyz)).any(axis=1).sum())} points have NaN or infinite "
                          f"coordinates; expected finite coordinates")
+    linear = resolve_units(found_units, crs, units, where,
+                           "the file states no CRS" if file_crs is None else f"its CRS {echo(file_crs)} names no unit")
+    xyz = xyz * linear.scale
     if np.abs(xyz).max() > COORDINATE.high:
         raise InputError(f"{where}: coordinates up to {np.abs(xyz).max():.3g} m; expected coordinates within "
                          f"±{COORDINATE.high:g} m")
@@ -286,52 +271,86 @@ def import_pointcloud(path: str | Path, rules: AssignmentRules | None = None, ma
                          f"cloud)")
     origin = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]])
     local = xyz - origin
-    rng = np.random.default_rng(seed)
-
-    segments: list[Segment] = []
-    unclassified = np.arange(len(local))
-    if classes is not None:
-        unclassified = np.flatnonzero(classes <= 1)
-        for code in sorted(set(classes.tolist()) - {0, 1, 7}):
-            label = _rule_or(rules, {"las_class": str(code)}, LAS_CLASSES.get(code, "unlabelled"))
-            segments.append(Segment(f"LAS_{LAS_NAMES.get(code, code)}", label, local[classes == code], f"las:{code}"))
-    if len(unclassified) >= 3:
-        pts = local[unclassified]
-        ground_z = float(np.percentile(local[:, 2], 2))
-        planes = ransac_planes(pts, rng, plane_threshold_m, min_plane_points)
-        used = np.zeros(len(pts), bool)
-        for k, (idx, normal, d) in enumerate(planes):
-            kind = _plane_kind(normal, pts[idx], ground_z)
-            label = _rule_or(rules, {"type": kind}, PLANE_CLASSES[kind])
-            segments.append(Segment(f"Plane_{k:02d}_{kind}", label, pts[idx], "plane", (normal, d)))
-            used[idx] = True
-        rest = pts[~used]
-        if len(rest) >= 3:
-            segments.append(Segment("Unsegmented", _rule_or(rules, {"type": "unsegmented"}, "unlabelled"), rest, "rest"))
-    objects, report = [], {"points": int(len(xyz)), "max_deviation_m": max_deviation_m, "segments": []}
-    for seg in tqdm(segments, desc="surfaces", unit="segment", disable=not show_progress):
-        surface = seg.surface_points()
-        tris = triangulate_height_field(surface)
+    found = segment(local, classes, np.random.default_rng(seed), plane_threshold_m, min_plane_points)
+    objects, findings = [], []
+    report = {"points": int(len(xyz)), "units": linear.as_report(), "file_crs": file_crs,
+              "max_deviation_m": max_deviation_m, "max_residual_m": max_residual_m,
+              "segmentation": segmentation_report(found, len(xyz)), "segments": [], "findings": findings}
+    counts: dict[str, int] = defaultdict(int)
+    for region in tqdm(found.regions, desc="surfaces", unit="segment", disable=not show_progress):
+        counts[region.kind] += 1
+        name = f"{KIND_NAMES[region.kind]}_{counts[region.kind]:02d}"
+        fields = {"type": region.kind} if region.las_class is None else {"las_class": str(region.las_class)}
+        label = _rule_or(rules, fields, KIND_CLASSES[region.kind])
+        points = local[region.indices]
+        surface, tris = _surface(region, points)
+        source = f"las:{region.las_class}" if region.las_class is not None else region.kind
         if len(tris) == 0:
-            log.warning("%s: segment %s (%d points) could not be triangulated; skipped", where, seg.name, len(seg.points))
-            report["segments"].append({"name": seg.name, "points": int(len(seg.points)), "skipped": True})
+            log.warning("%s: segment %s (%d points) could not be triangulated; skipped", where, name, len(points))
+            report["segments"].append({"name": name, "points": int(len(points)), "skipped": True})
             continue
-        simple = simplify_within(surface, tris, seg.points, max_deviation_m)
-        material = class_material(seg.label).key
-        objects.append(TwinObject(seg.name, seg.label, (TwinPart("Surface", simple.points, simple.triangles, material),),
-                                  {"segment_source": seg.source, "simplification_deviation_m": simple.deviation_m,
-                                   "residual_max_m": simple.residual_max_m}))
-        report["segments"].append({"name": seg.name, "label": seg.label, "source": seg.source,
-                                   "points": int(len(seg.points)), "faces_reconstructed": simple.faces_before,
-                                   "faces": int(len(simple.triangles)), "simplification_deviation_m": simple.deviation_m,
-                                   "residual_max_m": simple.residual_max_m, "residual_mean_m": simple.residual_mean_m,
-                                   "residual_rms_m": simple.residual_rms_m})
+        simple = simplify_within(surface, tris, points, max_deviation_m)
+        material = class_material(label).key
+        residual = residual_summary(simple.residuals_m, max_residual_m)
+        hull = region.kind == "tree"
+        objects.append(TwinObject(name, label, (TwinPart("Surface", simple.points, simple.triangles, material),),
+                                  {"segment_source": source, "simplification_deviation_m": simple.deviation_m,
+                                   "residual_p95_m": residual["residual_p95_m"]}))
+        report["segments"].append({"name": name, "label": label, "source": source, "kind": region.kind,
+                                   "points": int(len(points)), "faces_reconstructed": simple.faces_before,
+                                   "faces": int(len(simple.triangles)),
+                                   "simplification_deviation_m": simple.deviation_m,
+                                   **({"simplification_note": simple.note} if simple.note else {}),
+                                   **residual, "residual_bound_applies": not hull})
+        if not hull and residual["residual_p95_m"] > max_residual_m:
+            findings.append(Finding("residual-bound", f"{where}: segment {name}",
+                                    f"95 % of its {len(points)} points lie within "
+                                    f"{residual['residual_p95_m']:.3f} m of its surface (max "
+                                    f"{residual['residual_max_m']:.3f} m); expected within {max_residual_m:g} m "
+                                    f"(--max-residual-m): the surface does not explain these points",
+                                    Severity.WARNING).to_dict())
     if not objects:
         raise InputError(f"{where}: no surface could be reconstructed from {len(xyz)} points; expected points that "
                          f"sample surfaces (at least 3 not on one line)")
     return TwinModel(objects=tuple(objects), materials=subset(p.material for o in objects for p in o.parts),
-                     source=str(path),
-                     origin_offset_m=tuple(float(v) for v in origin), crs=crs, report=report)
+                     source=str(path), double_sided=True,
+                     origin_offset_m=tuple(float(v) for v in origin), crs=crs or file_crs, report=report)
+
+
+#: Region kind → segment name and default class (a rules file may override by ``type`` or ``las_class``).
+KIND_NAMES = {"ground": "Ground", "ground_plane": "GroundPlane", "roof": "Roof", "facade": "Facade", "tree": "Tree"}
+KIND_CLASSES = {"ground": "road", "ground_plane": "road", "roof": "building", "facade": "building",
+                "tree": "vegetation"}
+
+
+def _surface(region: Region, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(points, triangles) of a region's surface: a tree's convex hull (outward faces); a plane's inliers
+    projected onto it, or the ground's points smoothed (moving least squares), triangulated as a height field."""
+    if region.kind == "tree":
+        import trimesh
+
+        try:
+            hull = trimesh.convex.convex_hull(points)
+        except Exception:  # qhull refuses flat or degenerate clusters  # noqa: BLE001
+            return points, np.zeros((0, 3), np.int64)
+        return np.asarray(hull.vertices, float), np.asarray(hull.faces, np.int64)
+    if region.plane is not None:
+        normal, d = region.plane
+        surface = points - np.outer(points @ normal + d, normal)
+    else:
+        surface = smoothed_heights(points)
+    return surface, triangulate_height_field(surface)
+
+
+def segmentation_report(found: Segmentation, total: int) -> dict:
+    """Counts of the segmentation: regions by kind, points by kind, the unfit points and their share."""
+    by_kind: dict[str, int] = defaultdict(int)
+    regions: dict[str, int] = defaultdict(int)
+    for region in found.regions:
+        by_kind[region.kind] += len(region.indices)
+        regions[region.kind] += 1
+    return {"ground_from": found.ground_source, "regions": dict(regions), "points_by_kind": dict(by_kind),
+            "unfit_points": int(len(found.unfit)), "unfit_share": len(found.unfit) / max(total, 1)}
 
 
 def _rule_or(rules: AssignmentRules | None, fields: dict, default: str) -> str:

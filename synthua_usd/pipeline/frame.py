@@ -31,7 +31,7 @@ from synthua_usd.render_config import RenderConfig
 from synthua_usd.resources import check_frame_memory
 from synthua_usd.scene import SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
-from synthua_usd.usd.cameras import read_camera
+from synthua_usd.usd.cameras import author_auto_camera, read_camera
 from synthua_usd.usd.conditions import read_condition
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.render_settings import render_defaults
@@ -41,6 +41,11 @@ log = logging.getLogger(__name__)
 
 #: Frames one ``synthua render`` call may hold (each is a folder of files).
 MAX_FRAMES = 10_000
+
+
+#: ``--camera auto``: a camera framing the stage, authored into its session layer
+#: (:func:`synthua_usd.usd.cameras.author_auto_camera`).
+AUTO_CAMERA = "auto"
 
 
 @dataclass(frozen=True)
@@ -111,7 +116,11 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
         check_time_code(stage, tc)
     camera_paths = request.camera_paths or ((defaults.camera_path,) if defaults.camera_path else ())
     if not camera_paths:
-        raise StageError(f"{request.stage_path}: no --camera given and no UsdRender settings name one")
+        raise StageError(f"{request.stage_path}: no --camera given and no UsdRender settings name one; expected "
+                         f"--camera PATH, or --camera auto for a camera framing the stage")
+    if AUTO_CAMERA in camera_paths:
+        auto = author_auto_camera(stage, time_codes[0])
+        camera_paths = tuple(auto if c == AUTO_CAMERA else c for c in camera_paths)
     frames = [(cam, tc) for cam in camera_paths for tc in time_codes]
     if len(frames) > MAX_FRAMES:
         raise InputError(f"{len(frames)} frames requested ({len(camera_paths)} cameras x {len(time_codes)} time "

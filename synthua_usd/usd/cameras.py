@@ -109,3 +109,39 @@ def camera_rig_type(stage: Usd.Stage, path: str) -> str | None:
     attr = stage.GetPrimAtPath(path).GetAttribute(RIG_TYPE_ATTRIBUTE)
     value = attr.Get() if attr and attr.HasAuthoredValue() else None
     return str(value) if value else None
+
+
+#: The path ``--camera auto`` authors its camera at, in the stage's session layer (never in the user's files).
+AUTO_CAMERA_PATH = "/SynthuaAutoCamera"
+
+
+def author_auto_camera(stage: Usd.Stage, time_code: float) -> str:
+    """Author a camera framing the stage's whole world bounds (the overview rule of
+    :func:`synthua_usd.framing.overview_view`: every corner inside a full-frame 24 mm view, from the tightest
+    of 16 directions) into the stage's session layer at :data:`AUTO_CAMERA_PATH`; returns the path. Y-up and
+    any ``metersPerUnit`` are honoured. Raises :class:`StageError` when the stage has no bounded geometry."""
+    from synthua_usd.framing import LENS_MM, overview_view
+    from synthua_usd.geometry import look_at
+
+    t = Usd.TimeCode(time_code)
+    bound = UsdGeom.BBoxCache(t, [UsdGeom.Tokens.default_, UsdGeom.Tokens.render]).ComputeWorldBound(
+        stage.GetPseudoRoot()).ComputeAlignedRange()
+    if bound.IsEmpty():
+        raise StageError(f"{stage.GetRootLayer().identifier}: --camera auto: the stage has no geometry with bounds; "
+                         f"expected gprims to frame")
+    mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    lo, hi = np.array(bound.GetMin(), float) * mpu, np.array(bound.GetMax(), float) * mpu
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    # Frame in a Z-up frame: a Y-up stage's (x, y, z) is (x, -z, y) there.
+    y_up = UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y
+    to_stage = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]]) if y_up else np.eye(3)
+    eye, target, dist = overview_view(corners @ to_stage)  # rows: (to_stage.T @ p).T = p @ to_stage
+    m = np.eye(4)
+    m[:3] = to_stage @ look_at(eye, target)[:3]
+    size = float(np.linalg.norm(hi - lo))
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        author_camera(stage, AUTO_CAMERA_PATH, m, focal_length_mm=LENS_MM[0], horizontal_aperture_mm=LENS_MM[1],
+                      vertical_aperture_mm=LENS_MM[2], clip_near_m=max(dist - size, dist / 1000),
+                      clip_far_m=dist + 2 * size, meters_per_unit=mpu,
+                      doc="--camera auto: frames the stage's bounds (session layer only).")
+    return AUTO_CAMERA_PATH

@@ -17,6 +17,7 @@ from pxr import Usd, UsdGeom, UsdLux
 from synthua_usd import geometry as geo
 from synthua_usd.errors import StageError, UnsupportedPrimError, echo
 from synthua_usd.lamps import KINDS as LAMP_KINDS
+from synthua_usd.photometry import CD_PER_M2_PER_UNIT, MAX_RENDERER_UNITS, distant_irradiance, dome_radiance
 from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error
@@ -111,22 +112,63 @@ def unsupported_light_message(prim: Usd.Prim) -> str | None:
 
 
 def _read_light(prim: Usd.Prim, t: Usd.TimeCode) -> Light:
+    """The light ``prim`` in renderer units (:mod:`synthua_usd.photometry`): UsdLux strength is
+    ``inputs:intensity x 2^inputs:exposure``; a strength too great for our convention is read in the
+    convention it must follow (:func:`photometry.distant_irradiance`, :func:`photometry.dome_radiance`), with
+    a warning naming the light, its value and the rule."""
     path = str(prim.GetPath())
     message = unsupported_light_message(prim)
     if message:
         raise UnsupportedPrimError(f"{path}: {message}")
-    power, color = _light_power(UsdLux.LightAPI(prim), t)
+    light = UsdLux.LightAPI(prim)
+    strength, color = _light_power(light, t)
     if prim.IsA(UsdLux.DistantLight):
         m = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(t), float).T
         d = m[:3, :3] @ np.array([0.0, 0.0, -1.0])
         d /= np.linalg.norm(d)
         angle = float(UsdLux.DistantLight(prim).GetAngleAttr().Get(t))
-        return Light(path, "distant", color, direction=tuple(d), angle_deg=angle, irradiance=power)
+        irradiance, rule = distant_irradiance(strength, angle, bool(light.GetNormalizeAttr().Get(t)))
+        _warn_convention(path, strength, rule, irradiance)
+        return Light(path, "distant", color, direction=tuple(d), angle_deg=angle, irradiance=irradiance)
     if prim.IsA(UsdLux.DomeLight):
         if UsdLux.DomeLight(prim).GetTextureFileAttr().Get(t):
             log.warning("%s: dome textures are not supported yet; using its colour and intensity", path)
-        return Light(path, "dome", color, radiance=power)
+        radiance, rule = dome_radiance(strength)
+        _warn_convention(path, strength, rule, radiance)
+        return Light(path, "dome", color, radiance=radiance)
     raise AssertionError(f"{path}: LIGHT_TYPES lists a type with no reader")
+
+
+def _warn_convention(path: str, strength: float, rule: str, value: float) -> None:
+    if rule != "renderer units":
+        log.warning("%s: intensity x 2^exposure = %g is beyond our renderer units (at most %g); read as %s: %.4g "
+                    "units (%.0f lx or cd/m²)", path, strength, MAX_RENDERER_UNITS, rule, value,
+                    value * CD_PER_M2_PER_UNIT)
+
+
+#: The light a stage without UsdLux lights is rendered with: a uniform sky of our own stages' daytime strength.
+DEFAULT_SKY = Light("/synthua:defaultSky", "dome", (0.75, 0.85, 1.0), radiance=0.08)
+
+
+def animated_skins(stage: Usd.Stage) -> list[tuple[str, str, list[str]]]:
+    """(SkelRoot path, animation path, skinned mesh paths) for every skeleton whose animation varies in time:
+    meshes the reader can only show in their bind pose (it does not apply UsdSkel skinning)."""
+    from pxr import UsdSkel
+
+    found = []
+    cache = UsdSkel.Cache()
+    for prim in stage.Traverse():
+        if not prim.IsA(UsdSkel.Root):
+            continue
+        root = UsdSkel.Root(prim)
+        cache.Populate(root, Usd.PrimDefaultPredicate)
+        for binding in cache.ComputeSkelBindings(root, Usd.PrimDefaultPredicate):
+            anim = cache.GetSkelQuery(binding.GetSkeleton()).GetAnimQuery()
+            if anim and anim.JointTransformsMightBeTimeVarying():
+                targets = [str(t.GetPrim().GetPath()) for t in binding.GetSkinningTargets()]
+                if targets:
+                    found.append((str(prim.GetPath()), str(anim.GetPrim().GetPath()), targets))
+    return found
 
 
 def _lamp_role(prim: Usd.Prim) -> str:
@@ -211,6 +253,8 @@ class StageReader:
         self._varying: dict[str, bool] = {}
         self._xform_memo: dict[str, bool] = {}
         self._warned_unlabelled = False
+        self._warned_unlit = False
+        self._warned_skinned = False
         self._last: SceneSnapshot | None = None
 
     def _is_varying(self, prim: Usd.Prim) -> bool:
@@ -238,7 +282,8 @@ class StageReader:
         inst = self.instances.get(sites[0].prim_path) if sites else None
         return MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
                         material_key=material.key, instance_id=inst.id if inst else 0,
-                        class_id=inst.class_id if inst else 0, lamp=_lamp_role(prim), uvs=uvs)
+                        class_id=inst.class_id if inst else 0, lamp=_lamp_role(prim), uvs=uvs,
+                        double_sided=bool(UsdGeom.Gprim(prim).GetDoubleSidedAttr().Get()))
 
     def _geometry(self, prim: Usd.Prim, t: Usd.TimeCode, material: Material
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -263,6 +308,12 @@ class StageReader:
         check_time_code(self.stage, time_code)
         if self._last is not None and self._last.time_code == time_code:
             return self._last
+        if not self._warned_skinned:
+            self._warned_skinned = True
+            for root, anim, targets in animated_skins(self.stage):
+                log.warning("%s: %d skinned meshes (e.g. %s) are animated by %s, and synthua cannot pose skinned "
+                            "meshes: they render in their bind pose, not as animated", root, len(targets),
+                            targets[0], anim)
         previous = {m.prim_path: m for m in self._last.meshes} if self._last is not None else {}
         t = Usd.TimeCode(time_code)
         xcache = UsdGeom.XformCache(t)
@@ -289,7 +340,12 @@ class StageReader:
                         len(unlabelled), self.class_map.taxonomy, unlabelled[0])
         lights = tuple(_read_light(p, t) for p in self.stage.Traverse() if p.HasAPI(UsdLux.LightAPI))
         if not lights:
-            log.warning("%s: no UsdLux lights; RGB will be black", self.stage.GetRootLayer().identifier)
+            lights = (DEFAULT_SKY,)
+            if not self._warned_unlit:
+                self._warned_unlit = True
+                log.warning("%s: no UsdLux lights; lit by a default uniform sky (%g units, %.0f cd/m²)",
+                            self.stage.GetRootLayer().identifier, DEFAULT_SKY.radiance,
+                            DEFAULT_SKY.radiance * CD_PER_M2_PER_UNIT)
         self._last = SceneSnapshot(time_code=time_code, up_axis=str(UsdGeom.GetStageUpAxis(self.stage)),
                                    meshes=tuple(meshes), materials=dict(self._materials.by_key), lights=lights,
                                    instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)))

@@ -59,6 +59,8 @@ def author_twin(model: TwinModel, class_map: ClassMap, meta: StageMetadata) -> t
             uvs = part.uvs if spec.textures else None
             mesh = define_mesh(twin, f"{path}/{part.name}", part.points, part.triangles, looks[part.material], uvs,
                                spec.uv_primvar)
+            if model.double_sided:
+                mesh.CreateDoubleSidedAttr(True)
             for key, value in sorted(part.attributes.items()):
                 _set_custom(mesh.GetPrim(), key, value)
         apply_label(semantics.OverridePrim(path), class_map.taxonomy, class_map.resolve(obj.label).name)

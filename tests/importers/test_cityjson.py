@@ -49,7 +49,7 @@ def test_rules_override_the_type_table(class_map):
 @pytest.mark.parametrize("name,text", [
     ("cityjson_v1_0", "CityJSON version 1.0 is not supported; expected one of 1.1, 2.0"),
     ("cityjson_no_crs", "metadata.referenceSystem is missing"),
-    ("cityjson_geographic_crs", "is geographic (degrees); expected a projected CRS in metres"),
+    ("cityjson_geographic_crs", "is geographic (degrees); expected a projected CRS"),
     ("cityjson_nan_vertex", "NaN is not JSON; expected finite numbers"),
     ("cityjson_bad_boundary", "CityObjects['road-1'].geometry[0].boundaries[0][0][2]: vertex index 999"),
 ])
@@ -76,3 +76,37 @@ def test_delft():
     assert model.origin_offset_m == pytest.approx(expected)
     pts = np.concatenate([p.points for o in model.objects for p in o.parts])
     assert np.abs(pts[:, :2]).max() < 300 and pts[:, 2].min() >= 0
+
+
+def _house_doc():
+    return json.loads((DATA / "valid" / "lod2_house.city.json").read_text())
+
+
+def _extent(model):
+    pts = np.concatenate([p.points for o in model.objects for p in o.parts])
+    return pts.max(axis=0) - pts.min(axis=0)
+
+
+def test_cityjson_without_crs_imports_with_crs_option(tmp_path):
+    doc = _house_doc()
+    del doc["metadata"]["referenceSystem"]
+    path = tmp_path / "nocrs.city.json"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match="metadata.referenceSystem is missing"):
+        import_cityjson(path)
+    metres = import_cityjson(path, crs="EPSG:31982")
+    assert metres.crs == "EPSG:31982" and metres.report["units"]["source"] == "--crs"
+    assert _extent(metres) == pytest.approx([30.0, 18.0, 6.0])
+    assert _extent(import_cityjson(path, units="m")) == pytest.approx([30.0, 18.0, 6.0])
+
+
+def test_cityjson_in_feet_is_converted_to_metres(tmp_path):
+    """A file in EPSG:2263 (US survey feet) with the same numbers is 0.3048006 times as large in metres."""
+    doc = _house_doc()
+    doc["metadata"]["referenceSystem"] = "https://www.opengis.net/def/crs/EPSG/0/2263"
+    path = tmp_path / "feet.city.json"
+    path.write_text(json.dumps(doc))
+    model = import_cityjson(path)
+    assert _extent(model) == pytest.approx(np.array([30.0, 18.0, 6.0]) * 1200 / 3937)
+    assert model.origin_offset_m == pytest.approx(np.array([676010.0, 7185999.0, 900.0]) * 1200 / 3937)
+    assert model.report["units"]["horizontal"] == "US survey foot"

@@ -3,6 +3,8 @@ layer, UsdUVTexture networks in it and ``primvars:st`` on its meshes, and render
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import OpenImageIO as oiio
 import pytest
@@ -55,7 +57,7 @@ def test_obj_mtl_texture_is_kept_written_and_rendered(tmp_path, rules, class_map
     assert part.uvs is not None and len(part.uvs) == len(part.points)
 
     out = tmp_path / "twin"
-    written = write_import(model, out, class_map, model.report)
+    written, _ = write_import(model, out, class_map, model.report)
     image = out / "textures" / "brick_base_color.png"
     assert image in written and image.is_file()
     assert np.array_equal(oiio.ImageBuf(str(image)).get_pixels(oiio.UINT8), TEXELS)
@@ -64,14 +66,16 @@ def test_obj_mtl_texture_is_kept_written_and_rendered(tmp_path, rules, class_map
     snap = read_snapshot(stage, 1.0, class_map)
     read = snap.materials["/World/Looks/brick"]
     assert read.base_color_texture.path == str(image.resolve()) and read.base_color_texture.color_space == "sRGB"
-    (mesh,) = snap.meshes
+    mesh, ground = snap.meshes  # the wall, and the generated ground (no texture coordinates)
+    assert ground.prim_path.startswith("/World/Twin/Ground") and ground.uvs is None
     # The OBJ's st at its corners, the texture upright on the wall.
     corner = {tuple(np.round(p, 6)): tuple(uv) for p, uv in zip(mesh.points, mesh.uvs)}
     assert corner[(0.0, 0.0, 0.0)] == (0.0, 0.0) and corner[(2.0, 0.0, 1.0)] == (1.0, 1.0)
     mi = variants.activate("scalar_rgb")
     cam = read_camera(stage, "/World/Cameras/Overview", 1.0)
-    expected, hit_ref = reference_albedo(snap, cam, srgb_decoded(TEXELS), 48, 32)
-    got, hit = mitsuba_albedo(mi, snap, cam, 48, 32)
+    wall = dataclasses.replace(snap, meshes=(mesh,))
+    expected, hit_ref = reference_albedo(wall, cam, srgb_decoded(TEXELS), 48, 32)
+    got, hit = mitsuba_albedo(mi, wall, cam, 48, 32)
     both = hit & hit_ref
     assert both.sum() > 50
     assert np.abs(got[both] - expected[both]).max() < 2e-3
@@ -103,7 +107,7 @@ def test_glb_pbr_textures_become_usd_textures(tmp_path, rules, class_map):
     assert m.roughness_texture.color_space == m.metallic_texture.color_space == m.normal_texture.color_space == "raw"
     assert m.normal_texture.scale == (2.0, 2.0, 2.0, 1.0) and m.normal_texture.bias == (-1.0, -1.0, -1.0, 0.0)
     assert (m.opacity_texture.channel, m.opacity_threshold) == ("a", pytest.approx(0.4))
-    (mesh,) = snap.meshes
+    mesh, _ = snap.meshes  # the box and the generated ground
     assert mesh.uvs is not None and mesh.triangles.shape == (12, 3)
     # glTF's v runs down the image; trimesh flips it on load, so the st that reach USD are the ones given.
     assert sorted(map(tuple, np.round(mesh.uvs, 5))) == sorted(map(tuple, np.round(uv.astype(np.float32), 5)))

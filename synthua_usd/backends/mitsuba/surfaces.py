@@ -161,6 +161,17 @@ def wrapped(bsdf: dict, material: Material, images: TextureImages | None = None)
     return node
 
 
+def sided(bsdf: dict, double_sided: bool) -> dict:
+    """``bsdf`` as is, or for a ``doubleSided`` gprim wrapped in Mitsuba's ``twosided`` (the same BSDF on the
+    back, mirrored; Mitsuba's BSDFs are black seen from behind). ``twosided`` refuses BSDFs that transmit,
+    so an opacity ``mask`` stays outside: the mask of a two-sided BSDF."""
+    if not double_sided:
+        return bsdf
+    if bsdf.get("type") == "mask":
+        return {**bsdf, "bsdf": sided(bsdf["bsdf"], True)}
+    return {"type": "twosided", "bsdf": bsdf}
+
+
 def _encoded_normals(values: np.ndarray) -> np.ndarray:
     n = values / np.maximum(np.linalg.norm(values, axis=2, keepdims=True), 1e-6)
     return (0.5 * n + 0.5).astype(np.float32)

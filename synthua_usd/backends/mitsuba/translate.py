@@ -159,15 +159,16 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
         if not textured:  # a mesh without texture coordinates renders its material's constants
             material = material.untextured()
         layers = frozenset(face_weights[i])
-        if (material.key, textured, layers) not in bsdfs:
-            bsdfs[(material.key, textured, layers)] = mi.load_dict(
-                weather_scene.surface_bsdf_dict(material, layers, images))
+        key_bsdf = (material.key, textured, layers, item.double_sided)
+        if key_bsdf not in bsdfs:
+            bsdfs[key_bsdf] = mi.load_dict(surfaces.sided(weather_scene.surface_bsdf_dict(material, layers, images),
+                                                          item.double_sided))
         emitter = None
         if i in lamp_indices:
             emitter = weather_scene.dark_area_emitter(mi)
         elif any(material.emissive_color):
             emitter = mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": list(material.emissive_color)}})
-        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[(material.key, textured, layers)], emitter,
+        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[key_bsdf], emitter,
                            face_weights[i], item.uvs if textured else None)
         shape_ids.append(key)
     for k, light in enumerate(weather_scene.own_lights(snapshot, condition)):
