@@ -62,6 +62,10 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ constraints.txt -nt
   # cocodataset/panopticapi code but declares numpy<2, which the rest of the stack cannot meet; its code runs
   # on NumPy 2, and what it needs (numpy, pillow) comes with the test extra.
   "$VENV/bin/python" -m pip install -q -c constraints.txt --no-deps panopticapi-lite
+  # The body model that rebuilds the shipped body bank (tools/build_body_bank.py): torch's CPU build first,
+  # then anny and warp-lang, pinned (the bodies extra).
+  "$VENV/bin/python" -m pip install -q -c constraints.txt torch==2.13.0
+  "$VENV/bin/python" -m pip install -q -c constraints.txt -e '.[bodies]'
   touch "$stamp"
 fi
 "$VENV/bin/synthua" --version
