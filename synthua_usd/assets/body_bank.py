@@ -28,6 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from synthua_usd.keypoint_classes import PERSON_KEYPOINTS
+
 log = logging.getLogger(__name__)
 
 BANK_PATH = Path(__file__).parent / "data" / "bodies.npz"
@@ -58,9 +60,7 @@ REDUCED_BONES = (
     ("hand.R", ("wrist.R",), "wrist.R"),
 )
 #: COCO's 17 person keypoints, in COCO's order (anny's regressor names them so too).
-COCO_KEYPOINTS = ("nose", "left_eye", "right_eye", "left_ear", "right_ear", "left_shoulder", "right_shoulder",
-                  "left_elbow", "right_elbow", "left_wrist", "right_wrist", "left_hip", "right_hip", "left_knee",
-                  "right_knee", "left_ankle", "right_ankle")
+COCO_KEYPOINTS = PERSON_KEYPOINTS
 
 
 def _reduced_index(labels: list[str], parents: list[int]) -> np.ndarray:

@@ -51,8 +51,9 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
     sampler picks images that meet the quotas (share of images with a visible mobility-aid user, images
     per condition and per rig type) and splits them train/val/test by camera. Per image: RGB, class ids,
     class colours, instance ids and a coloured preview, panoptic PNG, depth, amodal masks, occlusion and
-    truncation, QA verdicts. Per dataset: COCO instances and panoptic JSON, Cityscapes gtFine, YOLO
-    labels and data.yaml, metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
+    truncation, person keypoints and device contact points with visibility flags, QA verdicts. Per dataset:
+    COCO instances (with keypoints) and panoptic JSON, Cityscapes gtFine, YOLO labels and data.yaml,
+    metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
     \b
     Killed or failed runs resume: run the same command again; finished images are kept.
     The same config, scenario and variant give the same bytes (check one image: synthua replay).

@@ -14,18 +14,22 @@ agents reference prototypes from ``instanceable`` prims. Per agent, and therefor
 - each region's material (skin tone, garment colours), bound on the region's instance root;
 - each segment's motion from the base posture (walking swings, push strokes), a time-sampled translate and
   orientation on the segment's Xform; a segment that does not move has none;
-- the device prim, which is itself the instance root of its device prototype and carries the label.
+- the device prim, which is itself the instance root of its device prototype and carries the label;
+- keypoints (:mod:`synthua_usd.assets.agent_keypoints`): on the ``Person`` prim the 17 COCO body keypoints,
+  on the device prim its contact points, each as ``synthua:keypoints`` (point3f[], the prim's frame,
+  time-sampled when they move) with their names in ``synthua:keypointNames`` (token[], uniform; the order
+  of :data:`synthua_usd.keypoint_classes.KEYPOINT_CLASSES`).
 
 Layout of one agent (``*`` marks instance roots, ``->`` their prototype)::
 
     Agent_0007            translate, rotateZ (time-sampled)
-      Person              label person, synthua:uses -> ../ManualWheelchair
+      Person              label person, synthua:uses -> ../ManualWheelchair, synthua:keypoints (time-sampled)
         Torso             (static when seated)
           Skin*           material:binding -> Looks/Skin3       -> Prototypes/Body51ManualWheelchairTorsoSkin_0
           Upper*          material:binding -> Looks/Shirt1      -> ...
         ForearmL          translate, orient (time-sampled: the push stroke)
           ...
-      ManualWheelchair*   label manual_wheelchair               -> Prototypes/ManualWheelchair_85_47_46
+      ManualWheelchair*   label manual_wheelchair, synthua:keypoints -> Prototypes/ManualWheelchair_85_47_46
 """
 
 from __future__ import annotations
@@ -33,17 +37,20 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
-from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdShade
+from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdShade, Vt
 
 from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd
 from synthua_usd.assets import devices
+from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS, load_bank, skin
 from synthua_usd.assets.postures import AID_OFFSETS, SEATED, DeviceFit, fit_device, pose, segment_motion, step_length_m
+from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.materials import PALETTE
 from synthua_usd.scenario import StageMetadata
 from synthua_usd.usd.authoring import (apply_label, bind_material, define_mesh, define_preview_material, define_xform,
                                        new_layer, set_kind)
+from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR
 
 AGENTS_ROOT = "/World/Agents"
 #: Where the shared geometry lives: a ``class`` prim, so it is composed but never rendered itself.
@@ -157,6 +164,20 @@ def _quat(r: np.ndarray) -> Gf.Quatf:
     return Gf.Quatf(float(q.GetReal()), *map(float, q.GetImaginary()))
 
 
+def author_keypoints(prim: Usd.Prim, names, points: np.ndarray, times) -> None:
+    """``points`` (T, k, 3), the prim's frame, one row per time code of ``times``, as ``synthua:keypoints``
+    (a single default value when they never move) and ``names`` as ``synthua:keypointNames``."""
+    prim.CreateAttribute(KEYPOINT_NAMES_ATTR, Sdf.ValueTypeNames.TokenArray, custom=True,
+                         variability=Sdf.VariabilityUniform).Set(list(names))
+    attr = prim.CreateAttribute(KEYPOINTS_ATTR, Sdf.ValueTypeNames.Point3fArray, custom=True)
+    points = np.asarray(points, np.float32)
+    if len(points) and np.all(points == points[0]):
+        attr.Set(Vt.Vec3fArray.FromNumpy(points[0]))
+        return
+    for t, p in zip(times, points):
+        attr.Set(Vt.Vec3fArray.FromNumpy(p), t)
+
+
 def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.Stage:
     """The agents layer of ``crowd``: time samples from ``meta.start_time_code``, labels of ``taxonomy``."""
     trajectories, looks = crowd.trajectories, crowd.looks
@@ -193,6 +214,9 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
             amplitude = np.zeros_like(amplitude)
         motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, device, fit, p, a))
                    for p, a in zip(phase, amplitude)]
+        # Person and device prims have no transform of their own: the agent frame is their frame.
+        author_keypoints(person_xf.GetPrim(), KEYPOINT_CLASSES["person"].names,
+                         body_keypoints(bodies.bank, look.body, base, motions), times)
         for name in SEGMENTS:
             seg = define_xform(stage, f"{person_xf.GetPath()}/{name}")
             track = np.stack([m[name] for m in motions]) if motions else np.zeros((0, 3, 4))
@@ -212,4 +236,6 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
             set_kind(aid, Kind.Tokens.component)
             apply_label(aid, taxonomy, device)
             person_xf.GetPrim().CreateRelationship("synthua:uses", custom=True).SetTargets([aid.GetPath()])
+            author_keypoints(aid, KEYPOINT_CLASSES[device].names,
+                             contact_points(bodies.bank, look.body, device, fit, base, motions), times)
     return stage

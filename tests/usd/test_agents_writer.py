@@ -17,7 +17,10 @@ from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS
 from synthua_usd.assets.people import PersonLook
 from synthua_usd.demo.street import META, street_scenario
+from synthua_usd.errors import StageError
+from synthua_usd.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, PROTOTYPES, build_agents_layer
+from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.scenario_writer import write_scenario
 from synthua_usd.usd.semantics import renderable_gprims
@@ -230,3 +233,41 @@ def test_shipped_agents_layers_are_instanced(layer):
     assert instances > 0 and all(p.IsInstance() for p in stage.Traverse() if p.GetName() in ("Skin", "Upper"))
     if layer.startswith("district"):
         assert 0 < len(stage.GetPrototypes()) < instances / 1.5
+
+
+@pytest.mark.parametrize("time_code", [1.0, 24.0])
+def test_every_person_and_device_carries_keypoints_on_its_rendered_geometry(stage, crowd, class_map, time_code):
+    """The reader's world keypoints (the agent's time-sampled transform applied to the authored ones) lie
+    in the world box of the instance's rendered meshes, grown by 5 cm (a hand holds a grip from outside)."""
+    snapshot = StageReader(stage, class_map).snapshot(time_code)
+    by_path = {i.prim_path: i for i in snapshot.instances}
+    for prim, traj in zip(_agents(stage), crowd.trajectories):
+        device = traj.plan.profile.device
+        for path, cls in [(f"{prim.GetPath()}/Person", "person")] + (
+                [(f"{prim.GetPath()}/{''.join(p.title() for p in device.split('_'))}", device)] if device else []):
+            inst = by_path[path]
+            found = snapshot.keypoints[inst.id]
+            assert found.names == KEYPOINT_CLASSES[cls].names
+            points = np.concatenate([m.points for m in snapshot.meshes if m.instance_id == inst.id])
+            if cls == "person":
+                lo, hi = points.min(axis=0) - 0.05, points.max(axis=0) + 0.05
+            else:  # the device's contacts: its box joined with its user's
+                user = np.concatenate([m.points for m in snapshot.meshes if m.instance_id == by_path[f"{prim.GetPath()}/Person"].id])
+                lo, hi = np.minimum(points.min(0), user.min(0)) - 0.05, np.maximum(points.max(0), user.max(0)) + 0.05
+            assert ((found.points >= lo) & (found.points <= hi)).all(), path
+    assert len(snapshot.keypoints) == len(crowd.trajectories) + sum(1 for t in crowd.trajectories if t.plan.profile.device)
+
+
+def test_keypoints_named_otherwise_are_refused(scenario, class_map, tmp_path):
+    stage = open_stage(scenario)
+    person = stage.GetPrimAtPath(f"{AGENTS_ROOT}/Agent_0000/Person")
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        person.GetAttribute(KEYPOINT_NAMES_ATTR).Set(list(PERSON_KEYPOINTS[1:]) + ["nose"])
+    with pytest.raises(StageError, match="synthua:keypointNames is .* expected the keypoints of class person"):
+        StageReader(stage, class_map)
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        person.GetAttribute(KEYPOINT_NAMES_ATTR).Set(list(PERSON_KEYPOINTS))
+        person.GetAttribute(KEYPOINTS_ATTR).Set([(0.0, 0.0, 0.0)] * 16, Usd.TimeCode(3.0))
+    reader = StageReader(stage, class_map)
+    with pytest.raises(StageError, match="holds 16 points.*expected 17"):
+        reader.snapshot(3.0)
