@@ -8,7 +8,7 @@ import dataclasses
 import numpy as np
 import pytest
 from conftest import STAGES
-from pxr import Sdf, Usd, UsdShade
+from pxr import Sdf, Usd, UsdGeom, UsdShade
 
 from synthua_usd.agents.crowd import CrowdParams, scripted_crowd
 from synthua_usd.agents.motion import simulate
@@ -246,6 +246,8 @@ def test_every_person_and_device_carries_keypoints_on_its_rendered_geometry(stag
         for path, cls in [(f"{prim.GetPath()}/Person", "person")] + (
                 [(f"{prim.GetPath()}/{''.join(p.title() for p in device.split('_'))}", device)] if device else []):
             inst = by_path[path]
+            # the keypoints are computed in the agent's frame: the labelled prims must not move on their own
+            assert not UsdGeom.Xformable(stage.GetPrimAtPath(path)).GetOrderedXformOps(), path
             found = snapshot.keypoints[inst.id]
             assert found.names == KEYPOINT_CLASSES[cls].names
             points = np.concatenate([m.points for m in snapshot.meshes if m.instance_id == inst.id])
