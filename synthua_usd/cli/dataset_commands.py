@@ -83,8 +83,8 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
 @click.argument("dataset", type=click.Path(path_type=Path))
 def verify(dataset: Path) -> int:
     """Check DATASET against its manifest: every file present with its size and SHA-256, every planned
-    image complete, every COCO annotation equal to its instance's pixels, every panoptic segment equal to
-    its PNG, Cityscapes and YOLO files consistent. Exit 1 on any problem, listed one per line."""
+    image complete, every COCO annotation equal to its instance's pixels (a visible keypoint within 2
+    pixels of them), every panoptic segment equal to its PNG, Cityscapes and YOLO files consistent. Exit 1 on any problem, listed one per line."""
     from synthua_usd.pipeline.verify import MAX_LISTED, verify as run_verify
 
     result = run_verify(dataset, show_progress=sys.stderr.isatty())
