@@ -9,19 +9,27 @@ of each class from :data:`CLASS_MATERIAL`.
 
 from __future__ import annotations
 
+import numpy as np
+
 from synthua_usd.scene import Material
+from synthua_usd.srgb import to_linear
 
 WALL_COLOURS = [(0.62, 0.42, 0.2), (0.22, 0.35, 0.55), (0.6, 0.55, 0.45), (0.55, 0.2, 0.15), (0.35, 0.5, 0.3),
                 (0.7, 0.62, 0.35), (0.45, 0.3, 0.45), (0.75, 0.72, 0.66)]
 
-#: Skin tones across the Fitzpatrick range, lightest first.
-SKINS = tuple(Material(f"Skin{i}", c, 0.6) for i, c in enumerate(
-    [(0.62, 0.45, 0.36), (0.55, 0.37, 0.27), (0.45, 0.29, 0.2), (0.32, 0.2, 0.13), (0.2, 0.12, 0.08), (0.12, 0.07, 0.05)]))
+#: Skin tones: the ten swatches of the Monk Skin Tone scale (Monk 2019; Google 2022), lightest first, sRGB
+#: hex decoded to linear; skin is slightly rough and non-metallic.
+MONK_SKIN_TONES = ("f6ede4", "f3e7db", "f7ead0", "eadaba", "d7bd96", "a07e56", "825c43", "604134", "3a312a", "292420")
+SKINS = tuple(Material(f"Skin{i}", tuple(float(c) for c in to_linear(np.array([int(h[k:k + 2], 16) / 255 for k in (0, 2, 4)]))), 0.6)
+              for i, h in enumerate(MONK_SKIN_TONES))
 SHIRTS = tuple(Material(f"Shirt{i}", c, 0.85) for i, c in enumerate(
     [(0.5, 0.06, 0.05), (0.05, 0.15, 0.45), (0.12, 0.35, 0.15), (0.7, 0.6, 0.1), (0.6, 0.6, 0.6), (0.05, 0.05, 0.05),
      (0.45, 0.15, 0.4), (0.8, 0.35, 0.1)]))
 TROUSERS = tuple(Material(f"Trousers{i}", c, 0.85) for i, c in enumerate(
-    [(0.07, 0.08, 0.12), (0.15, 0.2, 0.35), (0.25, 0.2, 0.15), (0.3, 0.3, 0.3), (0.04, 0.04, 0.04)]))
+    [(0.07, 0.08, 0.12), (0.15, 0.2, 0.35), (0.25, 0.2, 0.15), (0.3, 0.3, 0.3), (0.04, 0.04, 0.04), (0.35, 0.28, 0.18),
+     (0.4, 0.08, 0.1)]))
+SHOES = tuple(Material(f"Shoes{i}", c, 0.5) for i, c in enumerate(
+    [(0.02, 0.02, 0.02), (0.15, 0.08, 0.04), (0.7, 0.7, 0.68), (0.05, 0.07, 0.15)]))
 
 PALETTE: dict[str, Material] = {m.key: m for m in [
     # Ground: roads, sidewalks, kerbs, ramps, paint, cobbles and pavers.
@@ -62,7 +70,7 @@ PALETTE: dict[str, Material] = {m.key: m for m in [
     # Imported geometry without materials of its own.
     Material("Roof", (0.35, 0.15, 0.1), 0.8), Material("Neutral", (0.3, 0.3, 0.3), 0.8),
     Material("Soil", (0.22, 0.18, 0.13), 0.95),
-] + [Material(f"Wall{i}", c, 0.9) for i, c in enumerate(WALL_COLOURS)] + list(SKINS + SHIRTS + TROUSERS)}
+] + [Material(f"Wall{i}", c, 0.9) for i, c in enumerate(WALL_COLOURS)] + list(SKINS + SHIRTS + TROUSERS + SHOES)}
 
 #: The palette key importers give each class when the input carries no material; classes not listed
 #: take ``Neutral``.

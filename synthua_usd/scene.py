@@ -160,6 +160,16 @@ class Light:
 
 
 @dataclass(frozen=True, eq=False)
+class Keypoints:
+    """The named keypoints of one instance at one time code: ``names`` and ``points`` (k, 3) float64 world
+    metres, one per name (a person's COCO body keypoints, a device's contact points)."""
+
+    instance_id: int
+    names: tuple[str, ...]
+    points: np.ndarray = field(repr=False)
+
+
+@dataclass(frozen=True, eq=False)
 class SceneSnapshot:
     """Everything renderable in a stage at one time code."""
 
@@ -169,6 +179,8 @@ class SceneSnapshot:
     materials: dict[str, Material]
     lights: tuple[Light, ...]
     instances: tuple[Instance, ...]
+    #: Instance id -> its keypoints, for instances whose prim authors them.
+    keypoints: dict[int, Keypoints] = field(default_factory=dict)
 
     def instance(self, instance_id: int) -> Instance:
         for inst in self.instances:

@@ -59,3 +59,30 @@ def coco_self_evaluation(gt, annotations: list[dict]) -> dict[str, list[float]]:
             ev.summarize()
             stats[kind] = [float(s) for s in ev.stats]
     return stats
+
+
+def coco_keypoint_self_evaluation(gt) -> dict[str, float]:
+    """COCOeval's keypoint AP (OKS) of ``gt`` (a pycocotools COCO) against its own keypoints as detections
+    with score 1, per category that has labelled keypoints, each with its own OKS sigmas
+    (:func:`synthua_usd.keypoint_classes.sigmas`: COCOeval takes one sigma array for all the categories it
+    evaluates); 1.0 for each when the format is right."""
+    from pycocotools.cocoeval import COCOeval
+
+    from synthua_usd.keypoint_classes import sigmas
+
+    dets = [{"image_id": a["image_id"], "category_id": a["category_id"], "keypoints": a["keypoints"], "score": 1.0}
+            for a in gt.dataset["annotations"] if a.get("num_keypoints")]
+    out = {}
+    with contextlib.redirect_stdout(io.StringIO()):
+        if not dets:
+            return out
+        dt = gt.loadRes(dets)
+        for cat in gt.loadCats(sorted({d["category_id"] for d in dets})):
+            ev = COCOeval(gt, dt, "keypoints")
+            ev.params.catIds = [cat["id"]]
+            ev.params.kpt_oks_sigmas = sigmas(cat["name"])
+            ev.evaluate()
+            ev.accumulate()
+            ev.summarize()
+            out[cat["name"]] = float(ev.stats[0])
+    return out

@@ -75,7 +75,7 @@ def populate_crowd(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarr
     count = sample_count(rng, params.density_per_m2, grid.area_m2())
     plans = plan_agents(rng, graph, grid, count, params.aid_share)
     trajectories, dropped = simulate(plans, params.time_codes, params.time_codes_per_second)
-    looks = [PersonLook.random(rng) for _ in trajectories]
+    looks = [PersonLook.random(rng, aid_user=t.plan.profile.device is not None) for t in trajectories]
     by_profile: dict[str, int] = {}
     for t in trajectories:
         by_profile[t.plan.profile.name] = by_profile.get(t.plan.profile.name, 0) + 1

@@ -51,8 +51,9 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
     sampler picks images that meet the quotas (share of images with a visible mobility-aid user, images
     per condition and per rig type) and splits them train/val/test by camera. Per image: RGB, class ids,
     class colours, instance ids and a coloured preview, panoptic PNG, depth, amodal masks, occlusion and
-    truncation, QA verdicts. Per dataset: COCO instances and panoptic JSON, Cityscapes gtFine, YOLO
-    labels and data.yaml, metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
+    truncation, person keypoints and device contact points with visibility flags, QA verdicts. Per dataset:
+    COCO instances (with keypoints) and panoptic JSON, Cityscapes gtFine, YOLO labels and data.yaml,
+    metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
     \b
     Killed or failed runs resume: run the same command again; finished images are kept.
     The same config, scenario and variant give the same bytes (check one image: synthua replay).
@@ -82,8 +83,8 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
 @click.argument("dataset", type=click.Path(path_type=Path))
 def verify(dataset: Path) -> int:
     """Check DATASET against its manifest: every file present with its size and SHA-256, every planned
-    image complete, every COCO annotation equal to its instance's pixels, every panoptic segment equal to
-    its PNG, Cityscapes and YOLO files consistent. Exit 1 on any problem, listed one per line."""
+    image complete, every COCO annotation equal to its instance's pixels (a visible keypoint within 2
+    pixels of them), every panoptic segment equal to its PNG, Cityscapes and YOLO files consistent. Exit 1 on any problem, listed one per line."""
     from synthua_usd.pipeline.verify import MAX_LISTED, verify as run_verify
 
     result = run_verify(dataset, show_progress=sys.stderr.isatty())

@@ -151,7 +151,7 @@ def street_crowd() -> Crowd:
     trajectories, dropped = simulate(plans, params.time_codes, params.time_codes_per_second)
     if dropped:  # fixed, far-apart routes: this would be a bug here, not bad input
         raise RuntimeError(f"demo street: {dropped} scripted agents collided")
-    looks = [PersonLook(1.75, 1.0, "Skin2", "Shirt0", "Trousers0"), PersonLook(1.7, 1.05, "Skin1", "Shirt2", "Trousers1")]
+    looks = [PersonLook(4, "Skin6", "Shirt0", "Trousers0", "Shoes1"), PersonLook(51, "Skin2", "Shirt2", "Trousers1", "Shoes0")]
     return scripted_crowd(trajectories, looks, params)
 
 

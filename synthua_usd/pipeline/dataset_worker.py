@@ -2,11 +2,12 @@
 
 A worker is made once per shard of a ``synthua generate`` run (:func:`init_worker`: open the stage, one
 :class:`RenderSession`, one scene load) and then renders its images in order (:func:`work`). Per image it
-renders RGB and exact labels, traces amodal masks, measures truncation, annotates every visible instance,
-runs the QA checks, and writes the image's files. Writing runs on a background thread while the next image
-renders (:class:`synthua_usd.pipeline.background.BackgroundWriter`, the mechanism ``synthua render`` uses
-too); the image's record (``records/{name}.json``) is written after all its files, so a record on disk
-means a complete image and a run killed at any moment resumes from the records it finds.
+renders RGB and exact labels, traces amodal masks, measures truncation, annotates every visible instance
+(keypoints too: :mod:`synthua_usd.dataset.keypoints`), runs the QA checks, and writes the image's files.
+Writing runs on a background thread while the next image renders
+(:class:`synthua_usd.pipeline.background.BackgroundWriter`, the mechanism ``synthua render`` uses too); the
+image's record (``records/{name}.json``) is written after all its files, so a record on disk means a complete
+image and a run killed at any moment resumes from the records it finds.
 
 Every file is written atomically (a temporary sibling renamed into place), and every path is made by
 :mod:`synthua_usd.dataset.layout` from safe names, so nothing outside the dataset folder is ever touched.
@@ -23,7 +24,7 @@ import numpy as np
 
 from synthua_usd.atomic import atomic_path, write_json_atomic, write_text_atomic
 from synthua_usd.backends import images
-from synthua_usd.dataset import annotations, qa, resample
+from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, onehot, previews, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
@@ -153,6 +154,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         amodal = {i: resample.resample_pixel_set(pixels, (height, width), index) for i, pixels in amodal.items()}
         width, height = out_w, out_h
     instances = annotations.annotate(class_ids, instance_ids, snapshot.instances, amodal, truncations)
+    keypoints.annotate_keypoints(instances, snapshot.keypoints, camera, (job.render.width, job.render.height),
+                                 instance_ids, depth)
     by_path = {inst.prim_path: inst for inst in snapshot.instances}
     for entry in instances:  # the class of what a person uses, also when it is out of view
         used = by_path.get(entry.get("relations", {}).get("uses", ""))

@@ -179,6 +179,8 @@ def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], pan
         box = [float(xs.min()), float(ys.min()), float(xs.max() - xs.min() + 1), float(ys.max() - ys.min() + 1)]
         if [float(v) for v in ann["bbox"]] != box:
             result.add(f"{where}: COCO annotation {ann['id']}: bbox {ann['bbox']}; the mask's box is {box}")
+        if "keypoints" in ann:
+            _check_keypoints(where, ann, truth, result)
         seen.add(inst)
     for missing in sorted(set(things) - seen):
         result.add(f"{where}: instance {missing} ({things[missing]['class_name']}) is visible but has no COCO "
@@ -203,6 +205,32 @@ def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], pan
         if len(lines) != expected:
             result.add(f"{where}: {files['yolo_label']} has {len(lines)} lines; the image has {expected} instances "
                        f"of YOLO classes")
+
+
+def _check_keypoints(where: str, ann: dict, truth: np.ndarray, result: Verification) -> None:
+    """A COCO annotation's keypoints against its instance's pixels ``truth`` (H, W) bool: ``num_keypoints``
+    counts the labelled ones, an unlabelled one is at 0, 0, a labelled one lies in the image, and a visible
+    one (v = 2) has its instance within :data:`WINDOW_PX` pixels (the rule of
+    :mod:`synthua_usd.dataset.keypoints`; its depth part needs the depth image, which is optional)."""
+    from synthua_usd.dataset.keypoints import WINDOW_PX
+
+    values = np.asarray(ann["keypoints"], float).reshape(-1, 3)
+    labelled = values[:, 2] > 0
+    if int(ann.get("num_keypoints", -1)) != int(labelled.sum()):
+        result.add(f"{where}: COCO annotation {ann['id']}: num_keypoints {ann.get('num_keypoints')}; "
+                   f"{int(labelled.sum())} keypoints are labelled")
+    height, width = truth.shape
+    for k, (x, y, v) in enumerate(values):
+        if v == 0:
+            bad = x != 0 or y != 0
+        else:
+            col, row = int(x), int(y)
+            bad = not (0 <= x < width and 0 <= y < height) or (v == 2 and not truth[
+                max(0, row - WINDOW_PX):row + WINDOW_PX + 1, max(0, col - WINDOW_PX):col + WINDOW_PX + 1].any())
+        if bad:
+            result.add(f"{where}: COCO annotation {ann['id']}: keypoint {k} at ({x:g}, {y:g}) with v = {v:g} "
+                       f"disagrees with the instance's pixels (v = 2 needs them within {WINDOW_PX} px)")
+            return
 
 
 @dataclass

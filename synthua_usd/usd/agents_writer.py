@@ -1,30 +1,35 @@
 """The agents layer: every agent an Xform with time-sampled translate and heading, holding a labelled
-``Person`` (swinging limbs when walking, seated in a wheelchair) and, for mobility-aid users, a
-separately labelled device linked from the person by a ``synthua:uses`` relationship.
+``Person`` (an articulated body from the body bank, :mod:`synthua_usd.assets.bodies`) and, for mobility-aid
+users, a separately labelled device sized to that body, linked from the person by a ``synthua:uses``
+relationship.
 
-Geometry is shared through USD scenegraph instancing. Each distinct part shape (a torso of one size, a
-leg, a head, ...) and each device is authored once as a prototype under :data:`PROTOTYPES`, a ``class``
-prim, which USD's default traversal (and so the reader and every validator rule) never visits; agents
-reference prototypes from ``instanceable`` prims. Per agent, and therefore never inside a prototype:
+A body is nine rigid segments (:data:`synthua_usd.assets.bodies.SEGMENTS`) cut from its base posture
+(standing, seated in its wheelchair, holding its walker, crutches or cane; :mod:`synthua_usd.assets.postures`),
+each split into garment regions. Geometry is shared through USD scenegraph instancing: each (body, posture,
+segment, region) mesh and each (device, fit) is authored once as a prototype under :data:`PROTOTYPES`, a
+``class`` prim, which USD's default traversal (and so the reader and every validator rule) never visits;
+agents reference prototypes from ``instanceable`` prims. Per agent, and therefore never inside a prototype:
 
-- the labelled ``Person`` prim (an ordinary Xform above its part instances) and its ``synthua:uses``
-  relationship, so instance ids stay one per agent;
-- each person part's material, bound on the part's instance root, so one shape takes every agent's colours;
-- each walking limb's pivot and time-sampled swing, authored on the limb's instance root;
-- the device prim, which is itself the instance root of its device prototype and carries the label
-  (a device's materials never vary, so they are bound inside the prototype).
+- the labelled ``Person`` prim and its ``synthua:uses`` relationship, so instance ids stay one per agent;
+- each region's material (skin tone, garment colours), bound on the region's instance root;
+- each segment's motion from the base posture (walking swings, push strokes), a time-sampled translate and
+  orientation on the segment's Xform; a segment that does not move has none;
+- the device prim, which is itself the instance root of its device prototype and carries the label;
+- keypoints (:mod:`synthua_usd.assets.agent_keypoints`): on the ``Person`` prim the 17 COCO body keypoints,
+  on the device prim its contact points, each as ``synthua:keypoints`` (point3f[], the prim's frame,
+  time-sampled when they move) with their names in ``synthua:keypointNames`` (token[], uniform; the order
+  of :data:`synthua_usd.keypoint_classes.KEYPOINT_CLASSES`).
 
 Layout of one agent (``*`` marks instance roots, ``->`` their prototype)::
 
     Agent_0007            translate, rotateZ (time-sampled)
-      Person              label person, synthua:uses -> ../ManualWheelchair
-        Torso*            material:binding -> Looks/Shirt3      -> Prototypes/SeatedTorso_2
-        Head*             material:binding -> Looks/Skin1       -> Prototypes/SeatedHead_1
-        ...
-      ManualWheelchair*   label manual_wheelchair               -> Prototypes/ManualWheelchair
-
-A walking person's limbs are ``LegL*``, ``LegR*``, ``ArmL*``, ``ArmR*`` with translate (the pivot) and
-rotateY (time-sampled); left and right share one prototype.
+      Person              label person, synthua:uses -> ../ManualWheelchair, synthua:keypoints (time-sampled)
+        Torso             (static when seated)
+          Skin*           material:binding -> Looks/Skin3       -> Prototypes/Body51ManualWheelchairTorsoSkin_0
+          Upper*          material:binding -> Looks/Shirt1      -> ...
+        ForearmL          translate, orient (time-sampled: the push stroke)
+          ...
+      ManualWheelchair*   label manual_wheelchair, synthua:keypoints -> Prototypes/ManualWheelchair_85_47_46
 """
 
 from __future__ import annotations
@@ -32,42 +37,36 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
-from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdShade
+from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdShade, Vt
 
 from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd
 from synthua_usd.assets import devices
-from synthua_usd.assets.people import person, swing_deg
+from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points
+from synthua_usd.assets.bodies import REGIONS, SEGMENTS, load_bank, skin
+from synthua_usd.assets.postures import AID_OFFSETS, SEATED, DeviceFit, fit_device, pose, segment_motion, step_length_m
+from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.materials import PALETTE
 from synthua_usd.scenario import StageMetadata
 from synthua_usd.usd.authoring import (apply_label, bind_material, define_mesh, define_preview_material, define_xform,
                                        new_layer, set_kind)
+from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR
 
 AGENTS_ROOT = "/World/Agents"
 #: Where the shared geometry lives: a ``class`` prim, so it is composed but never rendered itself.
 PROTOTYPES = f"{AGENTS_ROOT}/Prototypes"
 
-#: Where a device stands relative to its user (local frame: user faces +X): offsets per device.
-DEVICE_PLACEMENT = {"walker": [(0.42, 0.0)], "crutch": [(0.12, 0.3), (0.12, -0.3)],
-                    "smart_cane": [(0.3, -0.25)], "wooden_cane": [(0.12, -0.3)], "orthopedic_cane": [(0.12, -0.3)],
-                    "tripod_cane": [(0.12, -0.32)]}
-
-
 def _name(class_name: str) -> str:
     return "".join(part.title() for part in class_name.split("_"))
-
-
-def _side_less(limb: str) -> str:
-    """``LegL`` -> ``Leg``: left and right limbs are one shape."""
-    return limb[:-1] if limb[-1:] in ("L", "R") else limb
 
 
 class PrototypeLibrary:
     """The prototypes of one agents layer, authored on first use and shared by content.
 
     A person part's prototype is an Xform holding one unbound ``Mesh``; two parts with the same points and
-    triangles (left and right legs, two agents of the same size) get the same prototype. A device's
-    prototype holds its parts at every placement of :data:`DEVICE_PLACEMENT`, each bound to its material.
+    triangles (two agents of one body and posture) get the same prototype. A device's prototype (one per
+    class and fit) holds its parts at every placement of :data:`synthua_usd.assets.postures.AID_OFFSETS`,
+    each bound to its material.
     Names are the shape with a counter in order of first use, so the same crowd gives the same layer.
     """
 
@@ -92,14 +91,15 @@ class PrototypeLibrary:
             self._paths[key] = path
         return self._paths[key]
 
-    def device(self, class_name: str) -> Sdf.Path:
-        """The prototype of the device ``class_name`` (a key of :data:`synthua_usd.assets.devices.DEVICES`)."""
-        key = ("device", class_name)
+    def device(self, class_name: str, fit: DeviceFit) -> Sdf.Path:
+        """The prototype of the device ``class_name`` (a key of :data:`synthua_usd.assets.devices.DEVICES`)
+        sized by ``fit``."""
+        key = ("device", class_name, fit)
         if key not in self._paths:
-            path = Sdf.Path(f"{PROTOTYPES}/{_name(class_name)}")
+            path = Sdf.Path(f"{PROTOTYPES}/{_name(class_name)}_{fit.key()}")
             define_xform(self.stage, str(path))
-            pieces = devices.DEVICES[class_name]()
-            for k, (dx, dy) in enumerate(DEVICE_PLACEMENT.get(class_name, [(0.0, 0.0)])):
+            pieces = devices.DEVICES[class_name](fit)
+            for k, (dx, dy) in enumerate(AID_OFFSETS.get(class_name, [(0.0, 0.0)])):
                 for part in pieces:
                     define_mesh(self.stage, f"{path}/{part.name}{'' if k == 0 else f'_{k}'}",
                                 part.points + [dx, dy, 0.0], part.triangles, self.materials[part.material])
@@ -115,16 +115,80 @@ def _instance(stage: Usd.Stage, path: str, prototype: Sdf.Path, translate=None) 
     return prim
 
 
+def _phases(traj, height_m: float, fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per time code, the motion cycle's phase (radians) and amplitude (0 still .. 1 moving at the agent's
+    speed). Walking: one gait cycle per two steps of :func:`step_length_m` at the agent's speed; a manual
+    wheelchair: one push per 1.2 m. The amplitude follows the speed over the last time code, eased over
+    three time codes so a stop does not freeze a stride."""
+    d = np.asarray(traj.distance_m, float)
+    speed = np.diff(d, prepend=d[0]) * fps
+    if len(speed) > 1:
+        speed[0] = speed[1]
+    moving = np.clip(speed / max(traj.plan.speed_mps, 1e-6), 0.0, 1.0)
+    amplitude = np.convolve(np.pad(moving, 1, mode="edge"), np.ones(3) / 3, mode="valid")
+    cycle = 1.2 if traj.plan.profile.device == "manual_wheelchair" else 2 * step_length_m(traj.plan.speed_mps, height_m)
+    return 2 * np.pi * d / cycle, amplitude
+
+
+class _BodyParts:
+    """Base postures, fits and segment meshes per (body, device), computed once per layer."""
+
+    def __init__(self) -> None:
+        self.bank = load_bank()
+        self._cache: dict[tuple, tuple] = {}
+
+    def get(self, body: int, device: str | None):
+        key = (body, device)
+        if key not in self._cache:
+            fit = fit_device(self.bank, body, device)
+            base = pose(self.bank, body, device, fit, 0.0, 0.0)
+            pts = skin(self.bank.points[body], self.bank, base.skinning(self.bank.joints[body]))
+            region = self.bank.face_region(body)
+            parts = {}
+            for k, name in enumerate(SEGMENTS):
+                for r, region_name in enumerate(REGIONS):
+                    tris = self.bank.triangles[(self.bank.face_segment == k) & (region == r)]
+                    if len(tris):
+                        used, inverse = np.unique(tris, return_inverse=True)
+                        parts[(name, region_name)] = (pts[used], inverse.reshape(-1, 3))
+            self._cache[key] = (fit, base, parts)
+        return self._cache[key]
+
+
+def _posture_name(device: str | None) -> str:
+    return _name(device) if device else "Walk"
+
+
+def _quat(r: np.ndarray) -> Gf.Quatf:
+    q = Gf.Matrix3d(*r.T.ravel().tolist()).ExtractRotation().GetQuat()  # Gf matrices act on row vectors
+    return Gf.Quatf(float(q.GetReal()), *map(float, q.GetImaginary()))
+
+
+def author_keypoints(prim: Usd.Prim, names, points: np.ndarray, times) -> None:
+    """``points`` (T, k, 3), the prim's frame, one row per time code of ``times``, as ``synthua:keypoints``
+    (a single default value when they never move) and ``names`` as ``synthua:keypointNames``."""
+    prim.CreateAttribute(KEYPOINT_NAMES_ATTR, Sdf.ValueTypeNames.TokenArray, custom=True,
+                         variability=Sdf.VariabilityUniform).Set(list(names))
+    attr = prim.CreateAttribute(KEYPOINTS_ATTR, Sdf.ValueTypeNames.Point3fArray, custom=True)
+    points = np.asarray(points, np.float32)
+    if len(points) and np.all(points == points[0]):
+        attr.Set(Vt.Vec3fArray.FromNumpy(points[0]))
+        return
+    for t, p in zip(times, points):
+        attr.Set(Vt.Vec3fArray.FromNumpy(p), t)
+
+
 def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.Stage:
     """The agents layer of ``crowd``: time samples from ``meta.start_time_code``, labels of ``taxonomy``."""
     trajectories, looks = crowd.trajectories, crowd.looks
     stage = new_layer(meta, crowd.doc)
     stage.SetDefaultPrim(stage.OverridePrim("/World"))
     define_xform(stage, AGENTS_ROOT, kind=Kind.Tokens.group)
-    used = {look.skin for look in looks} | {look.shirt for look in looks} | {look.trousers for look in looks}
+    used = set().union(*(look.materials() for look in looks)) if looks else set()
     used |= {p.material for t in trajectories if t.plan.profile.device for p in devices.DEVICES[t.plan.profile.device]()}
     mats = {key: define_preview_material(stage, f"{AGENTS_ROOT}/Looks/{key}", PALETTE[key]) for key in sorted(used)}
     library = PrototypeLibrary(stage, mats)
+    bodies = _BodyParts()
     times = [Usd.TimeCode(meta.start_time_code + f) for f in range(len(trajectories[0].positions))] if trajectories else []
     for i, (traj, look) in enumerate(zip(trajectories, looks)):
         profile = traj.plan.profile
@@ -143,24 +207,35 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
         person_xf = define_xform(stage, f"{root.GetPath()}/Person")
         set_kind(person_xf.GetPrim(), Kind.Tokens.component)
         apply_label(person_xf.GetPrim(), taxonomy, "person")
-        geom = person(look, seated=profile.seated)
-        pose = "Seated" if profile.seated else ""
-        for name, (mesh, mat) in geom.body.items():
-            part = _instance(stage, f"{person_xf.GetPath()}/{name}", library.part(pose + name, mesh))
-            bind_material(part, mats[mat])
-        swing = swing_deg(traj.distance_m)
-        for name, limb in geom.limbs.items():
-            # The limb's own prim is the instance root: its pivot, swing and material are this agent's.
-            part = _instance(stage, f"{person_xf.GetPath()}/{name}", library.part(_side_less(name), limb.mesh),
-                             translate=limb.pivot)
-            bind_material(part, mats[limb.material])
-            op = UsdGeom.Xformable(part).AddRotateYOp()
-            sign = (1.0 if name in ("LegL", "ArmR") else -1.0) * (0.6 if name.startswith("Arm") else 1.0)
-            for t, a in zip(times, swing):
-                op.Set(float(sign * a), t)
+        device = profile.device
+        fit, base, parts = bodies.get(look.body, device)
+        phase, amplitude = _phases(traj, float(bodies.bank.height_m[look.body]), meta.time_codes_per_second)
+        if device == "electric_wheelchair":
+            amplitude = np.zeros_like(amplitude)
+        motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, device, fit, p, a))
+                   for p, a in zip(phase, amplitude)]
+        # Person and device prims have no transform of their own: the agent frame is their frame.
+        author_keypoints(person_xf.GetPrim(), KEYPOINT_CLASSES["person"].names,
+                         body_keypoints(bodies.bank, look.body, base, motions), times)
+        for name in SEGMENTS:
+            seg = define_xform(stage, f"{person_xf.GetPath()}/{name}")
+            track = np.stack([m[name] for m in motions]) if motions else np.zeros((0, 3, 4))
+            if len(track) and not np.allclose(track, np.eye(3, 4), atol=1e-6):
+                translate, orient = seg.AddTranslateOp(), seg.AddOrientOp()
+                for t, m in zip(times, track):
+                    translate.Set(Gf.Vec3d(*map(float, m[:, 3])), t)
+                    orient.Set(_quat(m[:, :3]), t)
+            for region in REGIONS:
+                if (name, region) not in parts:
+                    continue
+                shape = f"Body{look.body:02d}{_posture_name(device)}{name}{region.title()}"
+                part = _instance(stage, f"{seg.GetPath()}/{region.title()}", library.part(shape, parts[(name, region)]))
+                bind_material(part, mats[look.region_material(region)])
         if profile.device:
-            device = _instance(stage, f"{root.GetPath()}/{_name(profile.device)}", library.device(profile.device))
-            set_kind(device, Kind.Tokens.component)
-            apply_label(device, taxonomy, profile.device)
-            person_xf.GetPrim().CreateRelationship("synthua:uses", custom=True).SetTargets([device.GetPath()])
+            aid = _instance(stage, f"{root.GetPath()}/{_name(device)}", library.device(device, fit))
+            set_kind(aid, Kind.Tokens.component)
+            apply_label(aid, taxonomy, device)
+            person_xf.GetPrim().CreateRelationship("synthua:uses", custom=True).SetTargets([aid.GetPath()])
+            author_keypoints(aid, KEYPOINT_CLASSES[device].names,
+                             contact_points(bodies.bank, look.body, device, fit, base, motions), times)
     return stage

@@ -2,7 +2,8 @@
 
 Gprims are triangulated in world space (metres) by a handler registered per prim type; materials are
 UsdPreviewSurface constants and textures (:mod:`synthua_usd.usd.shading`); lights are UsdLux distant and dome lights. Each gprim gets the class and
-instance of the labelled prim above it (see :mod:`synthua_usd.usd.semantics`). What the reader refuses it
+instance of the labelled prim above it (see :mod:`synthua_usd.usd.semantics`); instances that author
+keypoints give them in world metres (:mod:`synthua_usd.usd.keypoints`). What the reader refuses it
 finds with the checks of :mod:`synthua_usd.usd.prim_checks`, which ``synthua validate stage`` runs too.
 """
 
@@ -20,6 +21,7 @@ from synthua_usd.lamps import KINDS as LAMP_KINDS
 from synthua_usd.photometry import CD_PER_M2_PER_UNIT, MAX_RENDERER_UNITS, distant_irradiance, dome_radiance
 from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
+from synthua_usd.usd.keypoints import keypoint_prims, read_keypoints
 from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
 from synthua_usd.usd.shading import Materials
@@ -248,6 +250,7 @@ class StageReader:
         self.class_map = class_map
         self.meters_per_unit = meters_per_unit(stage)
         self.instances = collect_instances(stage, class_map)
+        self._keypoint_prims = keypoint_prims(stage, self.instances)
         self._materials = Materials()
         self._static: dict[str, MeshItem | None] = {}
         self._varying: dict[str, bool] = {}
@@ -348,7 +351,9 @@ class StageReader:
                             DEFAULT_SKY.radiance * CD_PER_M2_PER_UNIT)
         self._last = SceneSnapshot(time_code=time_code, up_axis=str(UsdGeom.GetStageUpAxis(self.stage)),
                                    meshes=tuple(meshes), materials=dict(self._materials.by_key), lights=lights,
-                                   instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)))
+                                   instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)),
+                                   keypoints=read_keypoints(self._keypoint_prims, time_code, xcache,
+                                                            self.meters_per_unit))
         return self._last
 
 

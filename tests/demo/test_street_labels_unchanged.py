@@ -1,6 +1,8 @@
 """The shipped demo street, now binary crate layers with instanced agents, renders the very label maps the
 text layers of commit bb615bc rendered (class and instance ids at 320x240, every camera, time codes 1 and
-24; recorded from those layers before the change)."""
+24; recorded from those layers before the change). Since the mannequins gave way to articulated bodies the
+people and their devices look different: the comparison covers every pixel where neither map shows an agent
+(a person or a mobility aid), and the agents must still be there."""
 
 import numpy as np
 import pytest
@@ -14,6 +16,13 @@ from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.stage_io import open_stage
 
 REFERENCE = DATA / "refs" / "street_labels_bb615bc.npz"
+
+
+def AGENT_CLASSES(class_map) -> list[int]:  # noqa: N802 (a constant of the class map)
+    """Class ids of people and their mobility aids."""
+    from synthua_usd.agents.profiles import PROFILES
+    names = {"person"} | {p.device for p in PROFILES.values() if p.device}
+    return [class_map.resolve(n).id for n in names]
 
 
 @pytest.mark.slow
@@ -32,6 +41,10 @@ def test_crate_street_labels_are_byte_identical_to_the_text_layers(class_map):
         for path in camera_paths(stage):
             frame = session.render(snapshot, read_camera(stage, path, t), rgb=False)
             old = reference[f"street|{t:g}|{path}".replace("/", "_")]
-            assert np.array_equal(frame.class_ids, old[0]) and np.array_equal(frame.instance_ids, old[1]), (t, path)
+            agents = np.isin(frame.class_ids, AGENT_CLASSES(class_map)) | np.isin(old[0], AGENT_CLASSES(class_map))
+            assert agents.any() == np.isin(old[0], AGENT_CLASSES(class_map)).any(), (t, path)
+            keep = ~agents
+            assert np.array_equal(frame.class_ids[keep], old[0][keep]), (t, path)
+            assert np.array_equal(frame.instance_ids[keep], old[1][keep]), (t, path)
             checked += 1
     assert checked == len(reference.files) == 6

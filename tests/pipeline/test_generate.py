@@ -21,6 +21,7 @@ import pytest
 from conftest import SCENARIO, TINY_CONFIG, generate_dataset
 from hostile import assert_refused, run_synthua, tree_state
 from synthua_usd.backends.images import read_image
+from synthua_usd.dataset.layout import Layout
 from synthua_usd.pipeline.verify import verify
 
 
@@ -259,6 +260,27 @@ def test_verify_checks_annotations_against_masks(damaged):
     _rewrite_with_checksum(damaged, coco_path, json.dumps(coco).encode())
     result = verify(damaged)
     assert [p for p in result.problems if "bbox" in p], result.problems
+
+
+def test_verify_checks_visible_keypoints_against_their_instance(damaged):
+    """A visible keypoint moved to a pixel whose neighbourhood does not show its instance, the manifest
+    updated to match: verify reports it."""
+    from synthua_usd.dataset.keypoints import WINDOW_PX
+
+    coco_path = damaged / "annotations" / "instances_train.json"
+    coco = json.loads(coco_path.read_text())
+    names = {img["id"]: img["file_name"][:-4] for img in coco["images"]}
+    ann = next(a for a in coco["annotations"] if 2 in a.get("keypoints", [])[2::3])
+    ids = read_image(damaged / Layout.frame_file(names[ann["image_id"]], "instance.png"))[0][..., 0]
+    away = np.ones_like(ids, bool)
+    for y, x in zip(*np.nonzero(ids == ann["instance_id"])):
+        away[max(0, y - WINDOW_PX):y + WINDOW_PX + 1, max(0, x - WINDOW_PX):x + WINDOW_PX + 1] = False
+    y, x = np.argwhere(away)[0]
+    k = ann["keypoints"][2::3].index(2)
+    ann["keypoints"][3 * k:3 * k + 2] = [float(x) + 0.5, float(y) + 0.5]
+    _rewrite_with_checksum(damaged, coco_path, json.dumps(coco).encode())
+    result = verify(damaged)
+    assert [p for p in result.problems if f"keypoint {k} " in p], result.problems
 
 
 def test_verify_counts_yolo_lines_against_the_instances(damaged):

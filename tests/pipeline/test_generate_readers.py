@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from format_readers import cityscapes_evaluation, coco_self_evaluation
+from format_readers import cityscapes_evaluation, coco_keypoint_self_evaluation, coco_self_evaluation
 from synthua_usd.dataset.layout import SPLITS, Layout
 from synthua_usd.taxonomy import ClassMap
 
@@ -80,6 +80,41 @@ def test_pycocotools_loads_every_split_and_cocoeval_of_gt_against_itself_is_one(
             assert stats[1] == pytest.approx(1.0), (split, kind, stats[:3])
         evaluated += 1
     assert evaluated >= 1, "no split has COCO annotations"
+
+
+def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_instance_maps(generated):
+    """OKS AP of the keypoints against themselves is 1.0 for every category with labelled keypoints (people
+    and the street's manual wheelchair); a visible keypoint (v = 2) has its instance's id in the written
+    instance map within WINDOW_PX pixels, a labelled one lies inside the image, an unlabelled one is 0, 0."""
+    from pycocotools.coco import COCO
+
+    from synthua_usd.dataset.keypoints import WINDOW_PX
+
+    names = {m["id"]: m["name"] for m in manifest_images(generated)}
+    evaluated, flags = set(), Counter()
+    for split in splits_with_images(generated):
+        with quiet():
+            gt = COCO(str(generated / Layout.coco_instances(split)))
+        for category, ap in coco_keypoint_self_evaluation(gt).items():
+            assert ap == pytest.approx(1.0), (split, category)
+            evaluated.add(category)
+        for ann in gt.dataset["annotations"]:
+            if "keypoints" not in ann:
+                continue
+            image = gt.imgs[ann["image_id"]]
+            ids = read_png(generated / Layout.frame_file(names[ann["image_id"]], "instance.png"))
+            for x, y, v in np.array(ann["keypoints"], float).reshape(-1, 3):
+                flags[int(v)] += 1
+                if v == 0:
+                    assert x == y == 0
+                    continue
+                assert 0 <= x < image["width"] and 0 <= y < image["height"]
+                if v == 2:
+                    col, row = int(x), int(y)
+                    window = ids[max(0, row - WINDOW_PX):row + WINDOW_PX + 1, max(0, col - WINDOW_PX):col + WINDOW_PX + 1]
+                    assert (window == ann["instance_id"]).any(), (ann["prim_path"], x, y)
+    assert {"person", "manual_wheelchair"} <= evaluated
+    assert flags[2] > 0
 
 
 def test_coco_ids_categories_and_images_agree_with_the_manifest_and_class_map(generated):

@@ -8,24 +8,28 @@ import dataclasses
 import numpy as np
 import pytest
 from conftest import STAGES
-from pxr import Sdf, Usd, UsdShade
+from pxr import Sdf, Usd, UsdGeom, UsdShade
 
 from synthua_usd.agents.crowd import CrowdParams, scripted_crowd
 from synthua_usd.agents.motion import simulate
 from synthua_usd.agents.population import Plan
 from synthua_usd.agents.profiles import PROFILES
-from synthua_usd.assets.people import BUILD_STEP, HEIGHT_STEP_M, PersonLook
+from synthua_usd.assets.bodies import REGIONS, SEGMENTS
+from synthua_usd.assets.people import PersonLook
 from synthua_usd.demo.street import META, street_scenario
+from synthua_usd.errors import StageError
+from synthua_usd.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, PROTOTYPES, build_agents_layer
+from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.scenario_writer import write_scenario
 from synthua_usd.usd.semantics import renderable_gprims
 from synthua_usd.usd.stage_checks import validate_stage
 from synthua_usd.usd.stage_io import open_stage
 
-# Two of one size in different colours (shared shapes, own materials) and one of another size.
-LOOKS = (PersonLook(1.75, 1.0, "Skin2", "Shirt0", "Trousers0"), PersonLook(1.75, 1.0, "Skin4", "Shirt3", "Trousers2"),
-         PersonLook(1.6, 1.1, "Skin1", "Shirt2", "Trousers1"))
+# Two of one body in different colours (shared shapes, own materials) and one of another body.
+LOOKS = (PersonLook(4, "Skin2", "Shirt0", "Trousers0"), PersonLook(4, "Skin8", "Shirt3", "Trousers2", "Shoes2", False),
+         PersonLook(60, "Skin1", "Shirt2", "Trousers1", "Shoes1", True, False))
 
 
 @pytest.fixture(scope="module")
@@ -74,9 +78,9 @@ def _agents(stage):
     return [p for p in stage.GetPrimAtPath(AGENTS_ROOT).GetChildren() if p.GetName().startswith("Agent_")]
 
 
-def _part_count(crowd) -> int:
-    """Person parts of ``crowd``: torso, head and four limbs walking; torso, head, legs and arms seated."""
-    return sum(4 if t.plan.profile.seated else 6 for t in crowd.trajectories)
+def _part_count(stage) -> int:
+    """Person parts: one instance per (segment, garment region) of every agent's body."""
+    return sum(1 for p in stage.Traverse() if p.IsInstance() and "/Person/" in str(p.GetPath()))
 
 
 def _meshes(snapshot) -> dict:
@@ -91,17 +95,20 @@ def test_agents_layer_is_a_crate_and_the_scenario_validates_clean(scenario, stag
 
 def test_prototypes_are_shared_between_agents(stage, crowd):
     instances = [p for p in stage.Traverse() if p.IsInstance()]
-    assert len(instances) == _part_count(crowd) + 8  # and one per device
-    assert len(stage.GetPrototypes()) < len(instances) / 2
-    person = {p.GetName(): p for p in _agents(stage)[0].GetChild("Person").GetChildren()}
-    assert person["LegL"].GetPrototype() == person["LegR"].GetPrototype()
-    assert person["ArmL"].GetPrototype() == person["ArmR"].GetPrototype()
+    assert len(instances) == _part_count(stage) + 8  # and one per device
+    # Agents 9, 10 and 11 walk with bodies 4, 4 and 60: the first two share every part.
+    assert len(stage.GetPrototypes()) < len(instances)
+    nine, ten = ([p.GetPrototype() for p in Usd.PrimRange(_agents(stage)[k]) if p.IsInstance()] for k in (9, 10))
+    assert nine == ten and len(nine) >= 12
+    person = _agents(stage)[0].GetChild("Person")
+    assert [p.GetName() for p in person.GetChildren()] == list(SEGMENTS)
+    assert {p.GetName() for p in person.GetChild("Torso").GetChildren()} <= {r.title() for r in REGIONS}
 
 
 def test_one_shape_takes_each_agents_own_material(stage, crowd):
-    """Agents 9 and 10 are pedestrians of one size in different clothes (LOOKS[0] and LOOKS[1])."""
-    a, b = (_agents(stage)[k].GetChild("Person").GetChild("Torso") for k in (9, 10))
-    assert crowd.looks[9].height_m == crowd.looks[10].height_m and crowd.looks[9].shirt != crowd.looks[10].shirt
+    """Agents 9 and 10 are pedestrians of one body in different clothes (LOOKS[0] and LOOKS[1])."""
+    a, b = (_agents(stage)[k].GetChild("Person").GetChild("Torso").GetChild("Upper") for k in (9, 10))
+    assert crowd.looks[9].body == crowd.looks[10].body and crowd.looks[9].shirt != crowd.looks[10].shirt
     assert a.GetPrototype() == b.GetPrototype()
     for root, shirt in ((a, crowd.looks[9].shirt), (b, crowd.looks[10].shirt)):
         proxy = root.GetChild("Mesh")
@@ -145,7 +152,7 @@ def test_instanced_and_deinstanced_snapshots_are_identical(stage, deinstanced, c
     b = _meshes(StageReader(deinstanced, class_map).snapshot(time_code))
     assert a.keys() == b.keys()
     # Device meshes: wheelchairs 4 each, walker 2, crutches 2 x 2, smart cane 3, three canes 1, 1, 2.
-    assert sum(1 for p in a if p.startswith(AGENTS_ROOT)) == _part_count(crowd) + 4 + 4 + 2 + 4 + 3 + 1 + 1 + 2
+    assert sum(1 for p in a if p.startswith(AGENTS_ROOT)) == _part_count(stage) + 4 + 4 + 2 + 4 + 3 + 1 + 1 + 2
     for path, m in a.items():
         n = b[path]
         assert (m.instance_id, m.class_id, m.material_key) == (n.instance_id, n.class_id, n.material_key), path
@@ -181,13 +188,13 @@ def test_instance_proxies_under_animated_roots_move_between_time_codes(stage, de
     reader = StageReader(stage, class_map)
     first, later, again = (_meshes(reader.snapshot(t)) for t in (1.0, 24.0, 1.0))
     agent = str(_agents(stage)[0].GetPath())  # a pedestrian: walks and swings its limbs
-    for part in ("Person/Torso/Mesh", "Person/LegL/Mesh", "Person/ArmR/Mesh"):
+    for part in ("Person/Torso/Upper/Mesh", "Person/ThighL/Lower/Mesh", "Person/UpperArmR/Upper/Mesh"):
         path = f"{agent}/{part}"
         assert not np.allclose(first[path].points, later[path].points)
         assert np.array_equal(first[path].points, again[path].points)
-    # The leg's swing (its instance root's rotateY) is applied, not only the agent's translation.
-    leg = f"{agent}/Person/LegL/Mesh"
-    body = f"{agent}/Person/Torso/Mesh"
+    # The thigh's swing (its segment's time-sampled orientation) is applied, not only the agent's translation.
+    leg = f"{agent}/Person/ThighL/Lower/Mesh"
+    body = f"{agent}/Person/Torso/Upper/Mesh"
     shift = later[body].points.mean(0) - first[body].points.mean(0)
     assert not np.allclose(later[leg].points - first[leg].points, shift, atol=1e-3)
     device = f"{_agents(stage)[1].GetPath()}/ManualWheelchair/Seat"
@@ -206,21 +213,63 @@ def test_same_crowd_gives_byte_identical_crate(crowd, tmp_path, class_map):
     assert paths[0].read_bytes() == paths[1].read_bytes()
 
 
-def test_random_looks_come_in_steps_and_draw_as_before():
-    """Rounding to the steps draws nothing extra: the generator ends where the unrounded draws leave it."""
-    rng, twin = np.random.default_rng(5), np.random.default_rng(5)
-    looks = [PersonLook.random(rng) for _ in range(200)]
-    for _ in range(200):
-        twin.normal(1.70, 0.09), twin.uniform(0.85, 1.25), twin.integers(6), twin.integers(8), twin.integers(5)
-    assert rng.bit_generator.state == twin.bit_generator.state
-    for look in looks:
-        assert abs(look.height_m / HEIGHT_STEP_M - round(look.height_m / HEIGHT_STEP_M)) < 1e-9
-        assert abs(look.build / BUILD_STEP - round(look.build / BUILD_STEP)) < 1e-9
-    assert len({(l.height_m, l.build) for l in looks}) < 80
+def test_random_looks_draw_bodies_of_their_stratum_and_every_skin_tone():
+    from synthua_usd.assets.bodies import load_bank
+    from synthua_usd.materials import SKINS
+    bank = load_bank()
+    rng = np.random.default_rng(5)
+    walkers = [PersonLook.random(rng) for _ in range(400)]
+    users = [PersonLook.random(rng, aid_user=True) for _ in range(100)]
+    assert not any(bank.aid_stratum[l.body] for l in walkers) and all(bank.aid_stratum[l.body] for l in users)
+    assert {l.skin for l in walkers} == {m.key for m in SKINS}
+    assert min(bank.years[l.body] for l in users) >= 50
 
 
 @pytest.mark.parametrize("layer", ["agents.usdc", "district/agents.usdc"])
 def test_shipped_agents_layers_are_instanced(layer):
+    """The street's two agents have bodies of their own (nothing to share); the district's crowd shares."""
     stage = Usd.Stage.Open(str(STAGES / layer))
     instances = sum(1 for p in stage.Traverse() if p.IsInstance())
-    assert 0 < len(stage.GetPrototypes()) < instances
+    assert instances > 0 and all(p.IsInstance() for p in stage.Traverse() if p.GetName() in ("Skin", "Upper"))
+    if layer.startswith("district"):
+        assert 0 < len(stage.GetPrototypes()) < instances / 1.5
+
+
+@pytest.mark.parametrize("time_code", [1.0, 24.0])
+def test_every_person_and_device_carries_keypoints_on_its_rendered_geometry(stage, crowd, class_map, time_code):
+    """The reader's world keypoints (the agent's time-sampled transform applied to the authored ones) lie
+    in the world box of the instance's rendered meshes, grown by 5 cm (a hand holds a grip from outside)."""
+    snapshot = StageReader(stage, class_map).snapshot(time_code)
+    by_path = {i.prim_path: i for i in snapshot.instances}
+    for prim, traj in zip(_agents(stage), crowd.trajectories):
+        device = traj.plan.profile.device
+        for path, cls in [(f"{prim.GetPath()}/Person", "person")] + (
+                [(f"{prim.GetPath()}/{''.join(p.title() for p in device.split('_'))}", device)] if device else []):
+            inst = by_path[path]
+            # the keypoints are computed in the agent's frame: the labelled prims must not move on their own
+            assert not UsdGeom.Xformable(stage.GetPrimAtPath(path)).GetOrderedXformOps(), path
+            found = snapshot.keypoints[inst.id]
+            assert found.names == KEYPOINT_CLASSES[cls].names
+            points = np.concatenate([m.points for m in snapshot.meshes if m.instance_id == inst.id])
+            if cls == "person":
+                lo, hi = points.min(axis=0) - 0.05, points.max(axis=0) + 0.05
+            else:  # the device's contacts: its box joined with its user's
+                user = np.concatenate([m.points for m in snapshot.meshes if m.instance_id == by_path[f"{prim.GetPath()}/Person"].id])
+                lo, hi = np.minimum(points.min(0), user.min(0)) - 0.05, np.maximum(points.max(0), user.max(0)) + 0.05
+            assert ((found.points >= lo) & (found.points <= hi)).all(), path
+    assert len(snapshot.keypoints) == len(crowd.trajectories) + sum(1 for t in crowd.trajectories if t.plan.profile.device)
+
+
+def test_keypoints_named_otherwise_are_refused(scenario, class_map, tmp_path):
+    stage = open_stage(scenario)
+    person = stage.GetPrimAtPath(f"{AGENTS_ROOT}/Agent_0000/Person")
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        person.GetAttribute(KEYPOINT_NAMES_ATTR).Set(list(PERSON_KEYPOINTS[1:]) + ["nose"])
+    with pytest.raises(StageError, match="synthua:keypointNames is .* expected the keypoints of class person"):
+        StageReader(stage, class_map)
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        person.GetAttribute(KEYPOINT_NAMES_ATTR).Set(list(PERSON_KEYPOINTS))
+        person.GetAttribute(KEYPOINTS_ATTR).Set([(0.0, 0.0, 0.0)] * 16, Usd.TimeCode(3.0))
+    reader = StageReader(stage, class_map)
+    with pytest.raises(StageError, match="holds 16 points.*expected 17"):
+        reader.snapshot(3.0)

@@ -6,6 +6,12 @@ the panoptic and Cityscapes formats. Extra fields per annotation, which COCO rea
 ``amodal_segmentation``, ``amodal_bbox``, ``amodal_area``, ``occlusion``, ``truncation``, ``prim_path``,
 ``instance_id`` (the pixel value in the image's instance map) and ``relations`` (``{"uses": prim path,
 "uses_annotation_id": id}``; the id only when the used device or person is annotated in the same image).
+
+Keypoints (COCO's person-keypoints fields): a category with keypoints (:mod:`synthua_usd.keypoint_classes`:
+the person's 17 COCO body keypoints, a mobility aid's contact points) lists their ``keypoints`` names and
+``skeleton``; each of its annotations has ``keypoints`` (flat ``[x, y, v, ...]``, pixel coordinates of the
+written image, v 0/1/2 as :mod:`synthua_usd.dataset.keypoints` defines them) and ``num_keypoints`` (how
+many have v > 0). An instance of such a category whose stage authors no keypoints gets all ``0, 0, 0``.
 """
 
 from __future__ import annotations
@@ -14,13 +20,34 @@ from typing import Iterable
 
 from synthua_usd.dataset.formats.records import image_entry, is_rejected, ordered
 from synthua_usd.errors import InputError
+from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.taxonomy import ClassMap
 
 
 def categories(class_map: ClassMap) -> list[dict]:
-    """COCO ``categories``: every thing class with id >= 1; ``supercategory`` is the class's group."""
-    return [{"id": c.id, "name": c.name, "supercategory": c.group} for c in class_map.classes
-            if c.isthing and c.id >= 1]
+    """COCO ``categories``: every thing class with id >= 1; ``supercategory`` is the class's group; classes
+    with keypoints add their ``keypoints`` names and ``skeleton``."""
+    out = []
+    for c in class_map.classes:
+        if c.isthing and c.id >= 1:
+            entry = {"id": c.id, "name": c.name, "supercategory": c.group}
+            if c.name in KEYPOINT_CLASSES:
+                entry.update(KEYPOINT_CLASSES[c.name].coco_category_fields())
+            out.append(entry)
+    return out
+
+
+def _keypoint_fields(record: dict, inst: dict, class_name: str) -> dict:
+    """``keypoints`` and ``num_keypoints`` of an instance of ``class_name``, a class with keypoints (module
+    docstring)."""
+    names = KEYPOINT_CLASSES[class_name].names
+    found = inst.get("keypoints")
+    if found is None:
+        return {"keypoints": [0] * (3 * len(names)), "num_keypoints": 0}
+    if tuple(found["names"]) != names or len(found["keypoints"]) != 3 * len(names):
+        raise InputError(f"record {record['name']!r}: instance {inst['id']} has keypoints {found['names']} "
+                         f"({len(found['keypoints'])} values); expected {list(names)}, 3 values each")
+    return {"keypoints": list(found["keypoints"]), "num_keypoints": int(found["num_keypoints"])}
 
 
 def annotation_ids(records: Iterable[dict], class_map: ClassMap) -> dict[tuple[int, int], int]:
@@ -67,6 +94,7 @@ def coco_instances(records: Iterable[dict], class_map: ClassMap, split: str) -> 
             ann_id = ids.get((record["id"], inst["id"]))
             if ann_id is None:
                 continue
+            name = class_map.by_id(int(inst["category_id"])).name
             relations = dict(inst.get("relations") or {})
             used = by_path.get(relations.get("uses"))
             if used is not None:
@@ -79,6 +107,7 @@ def coco_instances(records: Iterable[dict], class_map: ClassMap, split: str) -> 
                 "amodal_bbox": [float(v) for v in inst["amodal_bbox"]],
                 "occlusion": float(inst["occlusion"]), "truncation": float(inst["truncation"]),
                 "prim_path": inst["prim_path"], "instance_id": int(inst["id"]), "relations": relations,
+                **(_keypoint_fields(record, inst, name) if name in KEYPOINT_CLASSES else {}),
             })
     return {"info": {"description": f"synthua-usd synthetic street scenes, {split} split",
                      "version": "1.0"},

@@ -1,0 +1,193 @@
+"""Postures and motion of a bank body with its mobility aid, and the aid's size fitted to that body.
+
+A posture is a function of the body, its device fit and a cycle phase: walking (stride and cadence from
+the speed), walking with a walker (both hands on its handles), with forearm crutches (hands on the grips),
+with a cane (cane hand on its grip), seated in a manual wheelchair (hands on the push rims, a push cycle),
+seated in an electric wheelchair (left hand on the joystick). Frames as in :mod:`bodies`: feet on z = 0
+(standing), facing +X; a seated body sits on the seat its :class:`DeviceFit` gives.
+
+Fitting follows clinical practice: cane, crutch and walker grips at the wrist crease of the standing user
+with the arms hanging; the wheelchair seat at the user's seated lower-leg drop plus the footrest's ground
+clearance, as wide as the hips plus 2 cm a side.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from synthua_usd.assets.bodies import (BONES, SEGMENTS, Bank, Pose, forward_kinematics, rot_y, rotation_between, skin,
+                                       two_bone_aims)
+
+#: Walk ratio (step length / cadence) of adults, m per (steps/min), for a 1.7 m person (Sekiya & Nagasaki 1998).
+WALK_RATIO = 0.0064
+FOOTREST_CLEARANCE_M = 0.08
+#: Wheelchair rear wheels: centre behind the seat's origin, radius of the push rim.
+REAR_WHEEL_X = -0.1
+RIM_RADIUS_M = 0.27
+#: Where each walking aid stands relative to its user (user faces +X): offsets per device.
+AID_OFFSETS = {"walker": [(0.42, 0.0)], "crutch": [(0.14, 0.3), (0.14, -0.3)], "smart_cane": [(0.3, -0.25)],
+               "wooden_cane": [(0.14, -0.3)], "orthopedic_cane": [(0.14, -0.3)], "tripod_cane": [(0.14, -0.32)]}
+SEATED = ("manual_wheelchair", "electric_wheelchair")
+CANES = ("smart_cane", "wooden_cane", "orthopedic_cane", "tripod_cane")
+
+
+@dataclass(frozen=True)
+class DeviceFit:
+    """Sizes of a device fitted to its user, metres (rounded to 1 cm so users of one size share a device)."""
+
+    grip_height_m: float = 0.85
+    seat_height_m: float = 0.45
+    seat_width_m: float = 0.46
+
+    def key(self) -> str:
+        return f"{round(self.grip_height_m * 100)}_{round(self.seat_height_m * 100)}_{round(self.seat_width_m * 100)}"
+
+
+def _arms_down(rest: np.ndarray) -> dict[str, np.ndarray]:
+    """Upper arms from the bank's A pose to hanging 7 degrees out from the body, forearms 10 degrees forward."""
+    out = {}
+    for side, sign in (("L", 1.0), ("R", -1.0)):
+        up, low, hand = (BONES.index(f"{b}.{side}") for b in ("upperarm", "lowerarm", "hand"))
+        ru = rotation_between(rest[low] - rest[up], np.array([0.0, sign * 0.12, -1.0]))
+        out[f"upperarm.{side}"] = ru
+        out[f"lowerarm.{side}"] = rot_y(-10.0) @ rotation_between(ru @ (rest[hand] - rest[low]), np.array([0.0, sign * 0.05, -1.0])) @ ru
+    return out
+
+
+def _standing(bank: Bank, body: int) -> Pose:
+    rest = bank.joints[body]
+    return forward_kinematics(rest, _arms_down(rest))
+
+
+def fit_device(bank: Bank, body: int, device: str | None) -> DeviceFit:
+    """The device of class ``device`` sized to ``body``."""
+    if device is None:
+        return DeviceFit()
+    rest = bank.joints[body]
+    if device in SEATED:
+        pose = _seated_legs(bank, body, 0.0)
+        pts = skin(bank.points[body], bank, pose.skinning(rest))
+        hips = _hip_vertices(bank, pts, pose)
+        drop = float(pts[hips, 2].min() - pts[_segment_vertices(bank, ("ShankL", "ShankR")), 2].min())
+        width = float(np.ptp(pts[hips, 1]))
+        return DeviceFit(seat_height_m=round(float(np.clip(drop + FOOTREST_CLEARANCE_M, 0.3, 0.62)), 2),
+                         seat_width_m=round(width + 0.04, 2))
+    wrist = _standing(bank, body).joints[BONES.index("hand.R"), 2]
+    return DeviceFit(grip_height_m=round(float(wrist), 2))
+
+
+def _segment_vertices(bank: Bank, names) -> np.ndarray:
+    seg = [list(SEGMENTS).index(n) for n in names]
+    return np.unique(bank.triangles[np.isin(bank.face_segment, seg)])
+
+
+def _hip_vertices(bank: Bank, pts: np.ndarray, pose: Pose) -> np.ndarray:
+    """Vertices of the torso and thighs within 0.15 m (along X) of the hip joints: what sits on a seat."""
+    cand = _segment_vertices(bank, ("Torso", "ThighL", "ThighR"))
+    hip_x = pose.joints[BONES.index("upperleg.L"), 0]
+    return cand[np.abs(pts[cand, 0] - hip_x) < 0.15]
+
+
+def _seated_legs(bank: Bank, body: int, root_z: float) -> Pose:
+    rest = bank.joints[body]
+    aims = _arms_down(rest)
+    for side in ("L", "R"):
+        aims[f"upperleg.{side}"] = rot_y(-86.0)
+        aims[f"lowerleg.{side}"] = rot_y(-12.0)
+        aims[f"foot.{side}"] = rot_y(-12.0)
+    root = rest[0] + np.array([0.0, 0.0, root_z])
+    return forward_kinematics(rest, aims, root)
+
+
+def _with_arms(bank: Bank, body: int, pose: Pose, targets: dict[str, np.ndarray], aims: dict) -> Pose:
+    """``pose`` with the named hands ("L", "R") on ``targets`` (body frame) by two-bone IK."""
+    rest = bank.joints[body]
+    aims = dict(aims)
+    for side, target in targets.items():
+        sign = 1.0 if side == "L" else -1.0
+        shoulder = pose.joints[BONES.index(f"upperarm.{side}")]
+        aims.update(two_bone_aims(rest, f"upperarm.{side}", f"lowerarm.{side}", f"hand.{side}", shoulder, target,
+                                  np.array([-1.0, sign * 0.6, 0.0]), pose.rotations[0]))
+    root = pose.joints[0]
+    return forward_kinematics(rest, aims, root)
+
+
+def step_length_m(speed_mps: float, height_m: float) -> float:
+    """Step length from speed: cadence c (steps/min) and step length W c (W the walk ratio, scaled by height)
+    give speed W c² / 60."""
+    w = WALK_RATIO * height_m / 1.7
+    cadence = np.sqrt(60.0 * max(speed_mps, 0.05) / w)
+    return float(w * cadence)
+
+
+def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float, amplitude: float) -> Pose:
+    """The body's pose at cycle ``phase`` (radians; gait cycle walking, push cycle in a manual chair) with
+    the motion scaled by ``amplitude`` (0 still, 1 full stride)."""
+    rest = bank.joints[body]
+    if device in SEATED:
+        base = _seated_legs(bank, body, 0.0)
+        pts = skin(bank.points[body], bank, base.skinning(rest))
+        seat_bottom = pts[_hip_vertices(bank, pts, base), 2].min()
+        back = pts[_segment_vertices(bank, ("Torso",)), 0].min()
+        # Sit on the seat (its top at seat height), the back 3 cm in front of the backrest (x = -0.18).
+        shift = np.array([-0.15 - back, 0.0, fit.seat_height_m - seat_bottom])
+        seated = forward_kinematics(rest, {b: base.rotations[k] for k, b in enumerate(BONES)}, rest[0] + shift)
+        aims = {b: seated.rotations[k] for k, b in enumerate(BONES) if not b.startswith(("upperarm", "lowerarm", "hand"))}
+        half = fit.seat_width_m / 2
+        if device == "manual_wheelchair":
+            targets = {}
+            for side, sign in (("L", 1.0), ("R", -1.0)):
+                angle = np.radians(20.0 + 35.0 * amplitude * np.sin(phase))
+                targets[side] = np.array([REAR_WHEEL_X + (RIM_RADIUS_M + 0.02) * np.sin(angle), sign * (half + 0.07),
+                                          0.3 + (RIM_RADIUS_M + 0.02) * np.cos(angle)])
+        else:
+            targets = {"L": np.array([0.22, half + 0.03, fit.seat_height_m + 0.3]),
+                       "R": np.array([shift[0] + rest[0, 0] + 0.32, -0.1, fit.seat_height_m + 0.2])}
+        return _with_arms(bank, body, seated, targets, aims)
+    height = float(bank.height_m[body])
+    step = step_length_m(1.0, height)
+    leg = float(np.linalg.norm(rest[BONES.index("foot.L")] - rest[BONES.index("upperleg.L")]))
+    hip_amp = np.degrees(np.arctan2(0.5 * step, leg)) * amplitude
+    aims = _arms_down(rest)
+    for side, sign in (("L", 1.0), ("R", -1.0)):
+        swing = sign * np.sin(phase)
+        swinging = max(0.0, sign * np.cos(phase))  # the leg moving forward bends its knee
+        hip = hip_amp * swing
+        knee = amplitude * (5.0 + 40.0 * swinging ** 2)
+        aims[f"upperleg.{side}"] = rot_y(-hip)
+        aims[f"lowerleg.{side}"] = rot_y(-(hip - knee))
+        aims[f"foot.{side}"] = rot_y(-(hip - knee) * 0.5)
+        arm = -0.7 * hip
+        aims[f"upperarm.{side}"] = rot_y(-arm) @ aims[f"upperarm.{side}"]
+        aims[f"lowerarm.{side}"] = rot_y(-arm) @ aims[f"lowerarm.{side}"]
+    walking = forward_kinematics(rest, aims)
+    targets = {}
+    if device == "walker":
+        targets = {s: np.array([0.3, sign * 0.26, fit.grip_height_m + 0.03]) for s, sign in (("L", 1.0), ("R", -1.0))}
+    elif device == "crutch":
+        targets = {s: np.array([AID_OFFSETS["crutch"][k][0] + 0.08, AID_OFFSETS["crutch"][k][1], fit.grip_height_m + 0.03])
+                   for k, s in enumerate(("L", "R"))}
+    elif device in CANES:
+        x, y = AID_OFFSETS[device][0]
+        targets = {"R": np.array([x - 0.03, y, fit.grip_height_m + 0.04])}
+    posed = _with_arms(bank, body, walking, targets, aims) if targets else walking
+    # Keep the lower foot on the ground.
+    pts = skin(bank.points[body], bank, posed.skinning(rest))
+    low = pts[_segment_vertices(bank, ("ShankL", "ShankR")), 2].min()
+    return forward_kinematics(rest, {b: posed.rotations[k] for k, b in enumerate(BONES)},
+                              posed.joints[0] - np.array([0.0, 0.0, low]))
+
+
+def segment_motion(bank: Bank, body: int, base: Pose, now: Pose) -> dict[str, np.ndarray]:
+    """Per segment, the rigid motion (3, 4) taking it from ``base`` to ``now``: ``now``'s primary bone
+    matrix times the inverse of ``base``'s."""
+    rest = bank.joints[body]
+    a, b = base.skinning(rest), now.skinning(rest)
+    out = {}
+    for name, (_, primary) in SEGMENTS.items():
+        k = BONES.index(primary)
+        r = b[k, :, :3] @ a[k, :, :3].T
+        out[name] = np.concatenate([r, (b[k, :, 3] - r @ a[k, :, 3])[:, None]], axis=1)
+    return out

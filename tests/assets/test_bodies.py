@@ -1,0 +1,117 @@
+"""Bodies from the body bank: topology and triangle count, phenotypes against their stated distributions,
+walking on the ground with a stride that follows speed, seated users on their seats, and no body part inside
+its own device beyond a stated tolerance at sampled times."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+from scipy import stats
+
+from synthua_usd.assets import body_bank, devices
+from synthua_usd.assets.bodies import load_bank, skin
+from synthua_usd.assets.postures import AID_OFFSETS, SEATED, fit_device, pose, step_length_m
+
+#: How deep a body vertex may sit inside its own device: hands close round grips and push rims, whose
+#: boxes and cylinders are solid here.
+DEVICE_TOLERANCE_M = 0.04
+SEAT_TOLERANCE_M = 0.02
+
+
+@pytest.fixture(scope="module")
+def bank():
+    return load_bank()
+
+
+def test_bank_shares_one_topology_of_3000_triangles(bank):
+    assert bank.triangles.shape == (body_bank.TARGET_TRIANGLES, 3)
+    assert bank.points.shape[1] == bank.skin_bones.shape[0] == int(bank.triangles.max()) + 1
+    assert np.allclose(bank.skin_weights.sum(axis=1), 1.0, atol=1e-5)
+    # Every body stands on z = 0 and is as tall as its stated height.
+    # (The decimated mesh keeps a subset of the full mesh's vertices: its lowest may sit 2 mm up.)
+    assert np.all(np.abs(bank.points[:, :, 2].min(axis=1)) < 2e-3)
+    assert np.allclose(np.ptp(bank.points[:, :, 2], axis=1), bank.height_m, atol=4e-3)
+
+
+def test_phenotypes_follow_their_stated_distributions(bank):
+    general = bank.years[~bank.aid_stratum]
+    counts = [np.sum((general >= lo) & (general < hi)) for lo, hi, _ in body_bank.AGE_BANDS]
+    expected = np.array([share for _, _, share in body_bank.AGE_BANDS]) * len(general)
+    assert stats.chisquare(counts, expected).pvalue > 0.01
+    aid = bank.years[bank.aid_stratum]
+    assert aid.min() >= body_bank.AID_AGE_RANGE[0] and aid.max() <= body_bank.AID_AGE_RANGE[1]
+    assert stats.kstest(aid, "uniform", args=(50.0, 40.0)).pvalue > 0.01
+    assert 0.3 < bank.female.mean() < 0.7
+    # Adults: heights in the human range, men taller than women on average (WHO-calibrated model).
+    adult = bank.years >= 20
+    men, women = bank.height_m[adult & ~bank.female], bank.height_m[adult & bank.female]
+    assert 1.70 < men.mean() < 1.90 and 1.52 < women.mean() < 1.72 and men.mean() - women.mean() > 0.08
+    children = bank.years < 12
+    assert bank.height_m[children].max() < 1.6
+
+
+def test_stride_and_cadence_follow_speed():
+    step = step_length_m(1.34, 1.7)
+    assert 0.68 < step < 0.76  # adults at free speed: ~0.72 m at ~110 steps/min
+    assert 100 < 60 * 1.34 / step < 120
+    assert step_length_m(0.8, 1.7) < step < step_length_m(1.8, 1.7)
+
+
+@pytest.mark.parametrize("body", [4, 15, 50])
+def test_walking_keeps_a_foot_on_the_ground(bank, body):
+    for phase in np.linspace(0, 2 * np.pi, 9):
+        posed = pose(bank, body, None, fit_device(bank, body, None), phase, 1.0)
+        pts = skin(bank.points[body], bank, posed.skinning(bank.joints[body]))
+        assert abs(pts[:, 2].min()) < 1e-6
+
+
+def _device_solids(device: str, fit) -> list[trimesh.Trimesh]:
+    """The convex pieces (boxes, cylinders) of the device as placed beside its user."""
+    out = []
+    for dx, dy in AID_OFFSETS.get(device, [(0.0, 0.0)]):
+        for part in devices.DEVICES[device](fit):
+            mesh = trimesh.Trimesh(part.points + [dx, dy, 0.0], part.triangles, process=True)
+            out += [piece.convex_hull for piece in mesh.split(only_watertight=False)]
+    return out
+
+
+def _penetration(points: np.ndarray, solids: list[trimesh.Trimesh]) -> float:
+    """Deepest any point lies inside any solid (0 if none), metres: the least plane distance of the hull."""
+    deepest = 0.0
+    for solid in solids:
+        normals, origins = solid.face_normals, solid.triangles[:, 0]
+        d = np.einsum("pfk,fk->pf", points[:, None, :] - origins[None], normals)
+        inside = d.max(axis=1)
+        deepest = max(deepest, float(-inside.min()) if (inside < 0).any() else 0.0)
+    return deepest
+
+
+@pytest.mark.parametrize("device", ["manual_wheelchair", "electric_wheelchair"])
+@pytest.mark.parametrize("body", [48, 56, 66])
+def test_seated_pelvis_rests_on_the_seat(bank, body, device):
+    fit = fit_device(bank, body, device)
+    seat = [p for p in devices.DEVICES[device](fit) if p.name == "Seat"][0]
+    pieces = trimesh.Trimesh(seat.points, seat.triangles).split(only_watertight=False)
+    cushion = max(pieces, key=lambda m: np.prod(np.ptp(m.vertices[:, :2], axis=0)))  # the seat, not the backrest
+    top = cushion.vertices[:, 2].max()
+    lo, hi = cushion.vertices[:, :2].min(axis=0), cushion.vertices[:, :2].max(axis=0)
+    posed = pose(bank, body, device, fit, 0.0, 0.0)
+    pts = skin(bank.points[body], bank, posed.skinning(bank.joints[body]))
+    # What sits: the torso and thighs (segments 0-2), over the cushion.
+    sitting = np.unique(bank.triangles[bank.face_segment <= 2])
+    pts = pts[sitting]
+    above = pts[np.all((pts[:, :2] > lo) & (pts[:, :2] < hi), axis=1)]
+    assert abs(above[:, 2].min() - top) < SEAT_TOLERANCE_M
+
+
+@pytest.mark.parametrize("device", ["manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane",
+                                    "wooden_cane", "orthopedic_cane", "tripod_cane"])
+def test_no_body_part_inside_its_own_device(bank, device):
+    body = 60
+    fit = fit_device(bank, body, device)
+    solids = _device_solids(device, fit)
+    for phase in np.linspace(0, 2 * np.pi, 6, endpoint=False):
+        posed = pose(bank, body, device, fit, phase, 0.0 if device in SEATED and device != "manual_wheelchair" else 1.0)
+        pts = skin(bank.points[body], bank, posed.skinning(bank.joints[body]))
+        assert _penetration(pts, solids) <= DEVICE_TOLERANCE_M, (device, phase)
