@@ -31,6 +31,16 @@ AID_OFFSETS = {"walker": [(0.42, 0.0)], "crutch": [(0.14, 0.3), (0.14, -0.3)], "
                "wooden_cane": [(0.14, -0.3)], "orthopedic_cane": [(0.14, -0.3)], "tripod_cane": [(0.14, -0.32)]}
 SEATED = ("manual_wheelchair", "electric_wheelchair")
 CANES = ("smart_cane", "wooden_cane", "orthopedic_cane", "tripod_cane")
+#: Aids whose tips step with the gait (:func:`aid_shift_m`): planted on the ground in the middle of the left
+#: foot's stance (phase pi/2 .. 3 pi/2), swung forward while the left leg swings. A cane in the right hand
+#: moves with the left leg; forearm crutches move together with it (three-point gait, the left leg taken
+#: as the affected one). Planted for AID_STANCE of the cycle: shorter than the foot's half, so that the
+#: hand reaches the grip at both ends of the stroke.
+STEPPING_AIDS = ("crutch",) + CANES
+AID_STANCE = 0.4
+AID_STANCE_START = np.pi - AID_STANCE * np.pi
+#: Where the hand holds a stepping aid: its grip's distance ahead of the aid's origin, m.
+GRIP_DX = {"crutch": 0.08, **{cane: -0.03 for cane in CANES}}
 
 
 @dataclass(frozen=True)
@@ -122,9 +132,30 @@ def step_length_m(speed_mps: float, height_m: float) -> float:
     return float(w * cadence)
 
 
-def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float, amplitude: float) -> Pose:
+def aid_shift_m(device: str | None, phase: float, amplitude: float, cycle_m: float) -> float:
+    """How far (m, along the user's heading) a stepping aid (:data:`STEPPING_AIDS`) stands ahead of its
+    place in :data:`AID_OFFSETS` at gait ``phase``, for a gait cycle of ``cycle_m`` metres travelled (phase
+    2 pi per cycle). Planted for :data:`AID_STANCE` of the cycle from :data:`AID_STANCE_START`: the shift
+    falls by exactly the distance the user travels, so the tip stays put on the ground; then it swings
+    forward again (smoothstep, the tip gliding along the ground). The stroke, ``amplitude * AID_STANCE *
+    cycle_m`` long, is centred so that the grip passes under the shoulder (x = 0), where the hand reaches
+    furthest both ways. 0 for other devices."""
+    if device not in STEPPING_AIDS:
+        return 0.0
+    travel = amplitude * AID_STANCE * cycle_m  # while planted
+    centre = -amplitude * (AID_OFFSETS[device][0][0] + GRIP_DX[device])
+    u = ((phase - AID_STANCE_START) / (2 * np.pi)) % 1.0
+    if u < AID_STANCE:
+        return centre + travel * (0.5 - u / AID_STANCE)
+    v = (u - AID_STANCE) / (1.0 - AID_STANCE)
+    return centre + travel * (v * v * (3 - 2 * v) - 0.5)
+
+
+def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float, amplitude: float,
+         aid_shift: float = 0.0) -> Pose:
     """The body's pose at cycle ``phase`` (radians; gait cycle walking, push cycle in a manual chair) with
-    the motion scaled by ``amplitude`` (0 still, 1 full stride)."""
+    the motion scaled by ``amplitude`` (0 still, 1 full stride); a walking aid moved ``aid_shift`` metres
+    forward (:func:`aid_shift_m`) takes the hands on it along."""
     rest = bank.joints[body]
     if device in SEATED:
         base = _seated_legs(bank, body, 0.0)
@@ -167,17 +198,16 @@ def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float
     if device == "walker":
         targets = {s: np.array([0.3, sign * 0.26, fit.grip_height_m + 0.03]) for s, sign in (("L", 1.0), ("R", -1.0))}
     elif device == "crutch":
-        targets = {s: np.array([AID_OFFSETS["crutch"][k][0] + 0.08, AID_OFFSETS["crutch"][k][1], fit.grip_height_m + 0.03])
-                   for k, s in enumerate(("L", "R"))}
+        targets = {s: np.array([AID_OFFSETS["crutch"][k][0] + GRIP_DX["crutch"] + aid_shift, AID_OFFSETS["crutch"][k][1],
+                                fit.grip_height_m + 0.03]) for k, s in enumerate(("L", "R"))}
     elif device in CANES:
         x, y = AID_OFFSETS[device][0]
-        targets = {"R": np.array([x - 0.03, y, fit.grip_height_m + 0.04])}
-    posed = _with_arms(bank, body, walking, targets, aims) if targets else walking
-    # Keep the lower foot on the ground.
-    pts = skin(bank.points[body], bank, posed.skinning(rest))
+        targets = {"R": np.array([x + GRIP_DX[device] + aid_shift, y, fit.grip_height_m + 0.04])}
+    # Keep the lower foot on the ground, then put the hands on the aid (whose grips do not bob with the body).
+    pts = skin(bank.points[body], bank, walking.skinning(rest))
     low = pts[_segment_vertices(bank, ("ShankL", "ShankR")), 2].min()
-    return forward_kinematics(rest, {b: posed.rotations[k] for k, b in enumerate(BONES)},
-                              posed.joints[0] - np.array([0.0, 0.0, low]))
+    walking = forward_kinematics(rest, aims, walking.joints[0] - np.array([0.0, 0.0, low]))
+    return _with_arms(bank, body, walking, targets, aims) if targets else walking
 
 
 def segment_motion(bank: Bank, body: int, base: Pose, now: Pose) -> dict[str, np.ndarray]:

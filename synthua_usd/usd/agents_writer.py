@@ -14,7 +14,9 @@ agents reference prototypes from ``instanceable`` prims. Per agent, and therefor
 - each region's material (skin tone, garment colours), bound on the region's instance root;
 - each segment's motion from the base posture (walking swings, push strokes), a time-sampled translate and
   orientation on the segment's Xform; a segment that does not move has none;
-- the device prim, which is itself the instance root of its device prototype and carries the label.
+- the device prim, which is itself the instance root of its device prototype and carries the label; crutches
+  and canes step with the gait (:func:`synthua_usd.assets.postures.aid_shift_m`), a time-sampled translate
+  on the device prim.
 
 Layout of one agent (``*`` marks instance roots, ``->`` their prototype)::
 
@@ -39,7 +41,8 @@ from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd
 from synthua_usd.assets import devices
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS, load_bank, skin
-from synthua_usd.assets.postures import AID_OFFSETS, SEATED, DeviceFit, fit_device, pose, segment_motion, step_length_m
+from synthua_usd.assets.postures import (AID_OFFSETS, STEPPING_AIDS, DeviceFit, aid_shift_m, fit_device, pose,
+                                       segment_motion, step_length_m)
 from synthua_usd.materials import PALETTE
 from synthua_usd.scenario import StageMetadata
 from synthua_usd.usd.authoring import (apply_label, bind_material, define_mesh, define_preview_material, define_xform,
@@ -108,9 +111,9 @@ def _instance(stage: Usd.Stage, path: str, prototype: Sdf.Path, translate=None) 
     return prim
 
 
-def _phases(traj, height_m: float, fps: float) -> tuple[np.ndarray, np.ndarray]:
+def _phases(traj, height_m: float, fps: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Per time code, the motion cycle's phase (radians) and amplitude (0 still .. 1 moving at the agent's
-    speed). Walking: one gait cycle per two steps of :func:`step_length_m` at the agent's speed; a manual
+    speed); and the cycle's length in metres travelled. Walking: one gait cycle per two steps of :func:`step_length_m` at the agent's speed; a manual
     wheelchair: one push per 1.2 m. The amplitude follows the speed over the last time code, eased over
     three time codes so a stop does not freeze a stride."""
     d = np.asarray(traj.distance_m, float)
@@ -120,7 +123,7 @@ def _phases(traj, height_m: float, fps: float) -> tuple[np.ndarray, np.ndarray]:
     moving = np.clip(speed / max(traj.plan.speed_mps, 1e-6), 0.0, 1.0)
     amplitude = np.convolve(np.pad(moving, 1, mode="edge"), np.ones(3) / 3, mode="valid")
     cycle = 1.2 if traj.plan.profile.device == "manual_wheelchair" else 2 * step_length_m(traj.plan.speed_mps, height_m)
-    return 2 * np.pi * d / cycle, amplitude
+    return 2 * np.pi * d / cycle, amplitude, cycle
 
 
 class _BodyParts:
@@ -140,7 +143,7 @@ class _BodyParts:
             parts = {}
             for k, name in enumerate(SEGMENTS):
                 for r, region_name in enumerate(REGIONS):
-                    tris = self.bank.triangles[(self.bank.face_segment == k) & (region == r)]
+                    tris = self.bank.triangles[self.bank.segment_faces[k] & (region == r)]
                     if len(tris):
                         used, inverse = np.unique(tris, return_inverse=True)
                         parts[(name, region_name)] = (pts[used], inverse.reshape(-1, 3))
@@ -188,11 +191,12 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
         apply_label(person_xf.GetPrim(), taxonomy, "person")
         device = profile.device
         fit, base, parts = bodies.get(look.body, device)
-        phase, amplitude = _phases(traj, float(bodies.bank.height_m[look.body]), meta.time_codes_per_second)
+        phase, amplitude, cycle = _phases(traj, float(bodies.bank.height_m[look.body]), meta.time_codes_per_second)
         if device == "electric_wheelchair":
             amplitude = np.zeros_like(amplitude)
-        motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, device, fit, p, a))
-                   for p, a in zip(phase, amplitude)]
+        shifts = [aid_shift_m(device, p, a, cycle) for p, a in zip(phase, amplitude)]
+        motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, device, fit, p, a, x))
+                   for p, a, x in zip(phase, amplitude, shifts)]
         for name in SEGMENTS:
             seg = define_xform(stage, f"{person_xf.GetPath()}/{name}")
             track = np.stack([m[name] for m in motions]) if motions else np.zeros((0, 3, 4))
@@ -209,6 +213,10 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
                 bind_material(part, mats[look.region_material(region)])
         if profile.device:
             aid = _instance(stage, f"{root.GetPath()}/{_name(device)}", library.device(device, fit))
+            if device in STEPPING_AIDS and times:  # the tips step with the gait
+                aid_translate = UsdGeom.Xformable(aid).AddTranslateOp()
+                for t, x in zip(times, shifts):
+                    aid_translate.Set(Gf.Vec3d(x, 0.0, 0.0), t)
             set_kind(aid, Kind.Tokens.component)
             apply_label(aid, taxonomy, device)
             person_xf.GetPrim().CreateRelationship("synthua:uses", custom=True).SetTargets([aid.GetPath()])
