@@ -3,8 +3,9 @@
 A posture is a function of the body, its device fit and a cycle phase: walking (stride and cadence from
 the speed), walking with a walker (both hands on its handles), with forearm crutches (hands on the grips),
 with a cane (cane hand on its grip), seated in a manual wheelchair (hands on the push rims, a push cycle),
-seated in an electric wheelchair (left hand on the joystick). Frames as in :mod:`bodies`: feet on z = 0
-(standing), facing +X; a seated body sits on the seat its :class:`DeviceFit` gives.
+seated in an electric wheelchair (left hand on the joystick), seated on a bench (hands on the thighs, feet on
+the ground). Frames as in :mod:`bodies`: feet on z = 0 (standing), facing +X; a seated body sits on the seat
+its :class:`DeviceFit` gives, its back at x = -0.15.
 
 Fitting follows clinical practice: cane, crutch and walker grips at the wrist crease of the standing user
 with the arms hanging; the wheelchair seat at the user's seated lower-leg drop plus the footrest's ground
@@ -30,6 +31,8 @@ RIM_RADIUS_M = 0.27
 AID_OFFSETS = {"walker": [(0.42, 0.0)], "crutch": [(0.14, 0.3), (0.14, -0.3)], "smart_cane": [(0.3, -0.25)],
                "wooden_cane": [(0.14, -0.3)], "orthopedic_cane": [(0.14, -0.3)], "tripod_cane": [(0.14, -0.32)]}
 SEATED = ("manual_wheelchair", "electric_wheelchair")
+#: The posture of a pedestrian seated on a bench (not a device: no device prim; :func:`bench_fit` sizes it).
+BENCH = "bench"
 CANES = ("smart_cane", "wooden_cane", "orthopedic_cane", "tripod_cane")
 #: Aids whose tips step with the gait (:func:`aid_shift_m`): planted on the ground in the middle of the left
 #: foot's stance (phase pi/2 .. 3 pi/2), swung forward while the left leg swings. A cane in the right hand
@@ -100,15 +103,40 @@ def _hip_vertices(bank: Bank, pts: np.ndarray, pose: Pose) -> np.ndarray:
     return cand[np.abs(pts[cand, 0] - hip_x) < 0.15]
 
 
-def _seated_legs(bank: Bank, body: int, root_z: float) -> Pose:
+def _seated_legs(bank: Bank, body: int, root_z: float, shank_deg: float = 12.0) -> Pose:
+    """Thighs level, shanks ``shank_deg`` forward of vertical, arms hanging."""
     rest = bank.joints[body]
     aims = _arms_down(rest)
     for side in ("L", "R"):
         aims[f"upperleg.{side}"] = rot_y(-86.0)
-        aims[f"lowerleg.{side}"] = rot_y(-12.0)
+        aims[f"lowerleg.{side}"] = rot_y(-shank_deg)
         aims[f"foot.{side}"] = rot_y(-12.0)
     root = rest[0] + np.array([0.0, 0.0, root_z])
     return forward_kinematics(rest, aims, root)
+
+
+def _seat_drop(bank: Bank, body: int, shank_deg: float) -> float:
+    """Seated with shanks ``shank_deg`` forward: how far the feet reach below what sits on the seat, m."""
+    pose = _seated_legs(bank, body, 0.0, shank_deg)
+    pts = skin(bank.points[body], bank, pose.skinning(bank.joints[body]))
+    return float(pts[_hip_vertices(bank, pts, pose), 2].min() - pts[_segment_vertices(bank, ("ShankL", "ShankR")), 2].min())
+
+
+def _bench_shank_deg(bank: Bank, body: int, seat_height_m: float) -> float:
+    """The shank angle (12-70 degrees forward) that puts the feet on the ground below a seat ``seat_height_m``
+    high; 12 when they do not reach it (a child's feet dangle)."""
+    lo, hi = 12.0, 70.0
+    if _seat_drop(bank, body, lo) <= seat_height_m:
+        return lo
+    for _ in range(20):  # the drop falls as the shanks tilt forward
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if _seat_drop(bank, body, mid) > seat_height_m else (lo, mid)
+    return hi
+
+
+def bench_fit(seat_height_m: float) -> DeviceFit:
+    """The fit of a bench posture: the seat's top above the ground the sitter's feet stand on."""
+    return DeviceFit(seat_height_m=round(float(seat_height_m), 2))
 
 
 def _with_arms(bank: Bank, body: int, pose: Pose, targets: dict[str, np.ndarray], aims: dict) -> Pose:
@@ -157,8 +185,8 @@ def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float
     the motion scaled by ``amplitude`` (0 still, 1 full stride); a walking aid moved ``aid_shift`` metres
     forward (:func:`aid_shift_m`) takes the hands on it along."""
     rest = bank.joints[body]
-    if device in SEATED:
-        base = _seated_legs(bank, body, 0.0)
+    if device in SEATED or device == BENCH:
+        base = _seated_legs(bank, body, 0.0, _bench_shank_deg(bank, body, fit.seat_height_m) if device == BENCH else 12.0)
         pts = skin(bank.points[body], bank, base.skinning(rest))
         seat_bottom = pts[_hip_vertices(bank, pts, base), 2].min()
         back = pts[_segment_vertices(bank, ("Torso",)), 0].min()
@@ -167,7 +195,11 @@ def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float
         seated = forward_kinematics(rest, {b: base.rotations[k] for k, b in enumerate(BONES)}, rest[0] + shift)
         aims = {b: seated.rotations[k] for k, b in enumerate(BONES) if not b.startswith(("upperarm", "lowerarm", "hand"))}
         half = fit.seat_width_m / 2
-        if device == "manual_wheelchair":
+        if device == BENCH:  # hands resting on the thighs
+            hip = seated.joints[BONES.index("upperleg.L")]
+            targets = {side: np.array([hip[0] + 0.24, sign * 0.12, fit.seat_height_m + 0.17])
+                       for side, sign in (("L", 1.0), ("R", -1.0))}
+        elif device == "manual_wheelchair":
             targets = {}
             for side, sign in (("L", 1.0), ("R", -1.0)):
                 angle = np.radians(20.0 + 35.0 * amplitude * np.sin(phase))

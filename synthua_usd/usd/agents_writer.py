@@ -4,7 +4,7 @@ users, a separately labelled device sized to that body, linked from the person b
 relationship.
 
 A body is nine rigid segments (:data:`synthua_usd.assets.bodies.SEGMENTS`) cut from its base posture
-(standing, seated in its wheelchair, holding its walker, crutches or cane; :mod:`synthua_usd.assets.postures`),
+(standing, seated in its wheelchair or on a bench, holding its walker, crutches or cane; :mod:`synthua_usd.assets.postures`),
 each split into garment regions. Geometry is shared through USD scenegraph instancing: each (body, posture,
 segment, region) mesh and each (device, fit) is authored once as a prototype under :data:`PROTOTYPES`, a
 ``class`` prim, which USD's default traversal (and so the reader and every validator rule) never visits;
@@ -41,8 +41,8 @@ from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd
 from synthua_usd.assets import devices
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS, load_bank, skin
-from synthua_usd.assets.postures import (AID_OFFSETS, STEPPING_AIDS, DeviceFit, aid_shift_m, fit_device, pose,
-                                       segment_motion, step_length_m)
+from synthua_usd.assets.postures import (AID_OFFSETS, BENCH, STEPPING_AIDS, DeviceFit, aid_shift_m, bench_fit,
+                                       fit_device, pose, segment_motion, step_length_m)
 from synthua_usd.materials import PALETTE
 from synthua_usd.scenario import StageMetadata
 from synthua_usd.usd.authoring import (apply_label, bind_material, define_mesh, define_preview_material, define_xform,
@@ -133,11 +133,12 @@ class _BodyParts:
         self.bank = load_bank()
         self._cache: dict[tuple, tuple] = {}
 
-    def get(self, body: int, device: str | None):
-        key = (body, device)
+    def get(self, body: int, posture: str | None, fit: DeviceFit | None = None):
+        """``posture`` a device class, :data:`BENCH` or None (walking); ``fit`` None: the device fitted to the body."""
+        key = (body, posture, fit)
         if key not in self._cache:
-            fit = fit_device(self.bank, body, device)
-            base = pose(self.bank, body, device, fit, 0.0, 0.0)
+            fit = fit or fit_device(self.bank, body, posture)
+            base = pose(self.bank, body, posture, fit, 0.0, 0.0)
             pts = skin(self.bank.points[body], self.bank, base.skinning(self.bank.joints[body]))
             region = self.bank.face_region(body)
             parts = {}
@@ -183,19 +184,21 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
         prim.CreateAttribute("synthua:profile", Sdf.ValueTypeNames.String, custom=True).Set(profile.name)
         prim.CreateAttribute("synthua:speed_mps", Sdf.ValueTypeNames.Double, custom=True).Set(traj.plan.speed_mps)
         if traj.plan.rests:
-            prim.CreateAttribute("synthua:behaviour", Sdf.ValueTypeNames.String, custom=True).Set("rests_at_bench")
+            prim.CreateAttribute("synthua:behaviour", Sdf.ValueTypeNames.String, custom=True).Set(
+                "sits_on_bench" if traj.plan.seat is not None else "rests_at_bench")
         if traj.plan.group is not None:
             prim.CreateAttribute("synthua:group", Sdf.ValueTypeNames.Int, custom=True).Set(traj.plan.group)
         person_xf = define_xform(stage, f"{root.GetPath()}/Person")
         set_kind(person_xf.GetPrim(), Kind.Tokens.component)
         apply_label(person_xf.GetPrim(), taxonomy, "person")
         device = profile.device
-        fit, base, parts = bodies.get(look.body, device)
+        posture = BENCH if traj.plan.seat is not None else device
+        fit, base, parts = bodies.get(look.body, posture, bench_fit(traj.plan.seat.seat_height_m) if posture == BENCH else None)
         phase, amplitude, cycle = _phases(traj, float(bodies.bank.height_m[look.body]), meta.time_codes_per_second)
         if device == "electric_wheelchair":
             amplitude = np.zeros_like(amplitude)
         shifts = [aid_shift_m(device, p, a, cycle) for p, a in zip(phase, amplitude)]
-        motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, device, fit, p, a, x))
+        motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, posture, fit, p, a, x))
                    for p, a, x in zip(phase, amplitude, shifts)]
         for name in SEGMENTS:
             seg = define_xform(stage, f"{person_xf.GetPath()}/{name}")
@@ -208,7 +211,7 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
             for region in REGIONS:
                 if (name, region) not in parts:
                     continue
-                shape = f"Body{look.body:02d}{_posture_name(device)}{name}{region.title()}"
+                shape = f"Body{look.body:02d}{_posture_name(posture)}{name}{region.title()}"
                 part = _instance(stage, f"{seg.GetPath()}/{region.title()}", library.part(shape, parts[(name, region)]))
                 bind_material(part, mats[look.region_material(region)])
         if profile.device:

@@ -176,3 +176,34 @@ def test_hands_stay_on_the_grips_of_stepping_aids(bank, body, device):
         hand = pose(bank, body, device, fit, phase, 1.0, shift).joints[BONES.index("hand.R")]
         grip = np.array([x + GRIP_DX[device] + shift, y, fit.grip_height_m])
         assert np.linalg.norm(hand[:2] - grip[:2]) < 0.04 and abs(hand[2] - grip[2]) < 0.08, (phase, hand - grip)
+
+
+@pytest.mark.parametrize("body", [15, 2, 47, 60, 67])
+def test_seated_on_a_bench_the_pelvis_rests_on_the_seat_and_the_feet_on_the_ground(bank, body):
+    """The street bench (synthua_usd.assets.street.bench: seat top 0.47 m, 0.44 m deep centred on x = 0,
+    backrest behind x = -0.22) placed where :mod:`synthua_usd.agents.seats` puts a sitter's origin (0.17 m in
+    front of the seat's back edge): what sits rests on the cushion within the seat tolerance, nothing is
+    inside the bench beyond the device tolerance, and the feet stand on the ground unless too short to reach
+    it (a child's dangle)."""
+    from synthua_usd.agents.seats import ORIGIN_FROM_BACK_M
+    from synthua_usd.assets import street
+    from synthua_usd.assets.postures import BENCH, bench_fit
+
+    dx = 0.22 - ORIGIN_FROM_BACK_M  # the bench's centre in the sitter's frame
+    solids = []
+    for part in street.bench():
+        mesh = trimesh.Trimesh(part.points + [dx, 0.0, 0.0], part.triangles, process=True)
+        solids += [piece.convex_hull for piece in mesh.split(only_watertight=False)]
+    seat = max(solids, key=lambda m: np.prod(np.ptp(m.vertices[:, :2], axis=0)))
+    top = seat.vertices[:, 2].max()
+    posed = pose(bank, body, BENCH, bench_fit(top), 0.0, 0.0)
+    pts = skin(bank.points[body], bank, posed.skinning(bank.joints[body]))
+    sitting = pts[np.unique(bank.triangles[bank.face_segment <= 2])]
+    lo, hi = seat.vertices[:, :2].min(axis=0), seat.vertices[:, :2].max(axis=0)
+    above = sitting[np.all((sitting[:, :2] > lo) & (sitting[:, :2] < hi), axis=1)]
+    assert abs(above[:, 2].min() - top) < SEAT_TOLERANCE_M
+    assert _penetration(pts, solids) <= DEVICE_TOLERANCE_M
+    feet = pts[:, 2].min()
+    assert feet > -SEAT_TOLERANCE_M
+    if bank.height_m[body] > 1.6:
+        assert feet < 0.04
