@@ -59,6 +59,7 @@ def summary(run: dict) -> dict[str, float]:
     first, later = run["frames"][0], run["frames"][1:] or run["frames"]
     mean = lambda key: statistics.fmean(f.get(key, 0.0) for f in later)  # noqa: E731
     return {"first load s": first["read"] + first["load"], "update s": mean("read") + mean("update"),
+            "  of which read s": mean("read"),
             "labels s": mean("labels"), "rgb s": mean("rgb"),
             "frame s": statistics.fmean(f["read"] + f.get("update", 0.0) + f["labels"] + f["rgb"] for f in later),
             "frame cpu s": mean("cpu"), "peak RSS MiB": run["peak_rss_mib"]}

@@ -25,17 +25,17 @@ REPO = Path(__file__).resolve().parents[1]
 
 #: Per row (camera name, agents from left to right as (profile name, body index of the bank, look colours)).
 ROWS = (
-    ("Row1_children_and_young", [("pedestrian", 15, "Skin1", "Shirt3", "Trousers2"), ("pedestrian", 6, "Skin8", "Shirt5", "Trousers0"),
+    ("Young", [("pedestrian", 15, "Skin1", "Shirt3", "Trousers2"), ("pedestrian", 6, "Skin8", "Shirt5", "Trousers0"),
                                  ("pedestrian", 9, "Skin4", "Shirt1", "Trousers4"), ("pedestrian", 3, "Skin9", "Shirt6", "Trousers3"),
                                  ("pedestrian", 32, "Skin2", "Shirt0", "Trousers1")]),
-    ("Row2_adults_of_every_build", [("pedestrian", 45, "Skin6", "Shirt2", "Trousers5"), ("pedestrian", 36, "Skin3", "Shirt7", "Trousers0"),
+    ("Adults_bench", [("pedestrian", 45, "Skin6", "Shirt2", "Trousers5"), ("pedestrian", 36, "Skin3", "Shirt7", "Trousers0"),
                                     ("pedestrian", 37, "Skin7", "Shirt4", "Trousers6"), ("bench", 2, "Skin0", "Shirt1", "Trousers2"),
                                     ("pedestrian", 40, "Skin5", "Shirt3", "Trousers1")]),
-    ("Row3_elders_and_wheelchairs", [("pedestrian", 20, "Skin2", "Shirt5", "Trousers3"), ("pedestrian", 22, "Skin9", "Shirt0", "Trousers4"),
+    ("Elders_chairs", [("pedestrian", 20, "Skin2", "Shirt5", "Trousers3"), ("pedestrian", 22, "Skin9", "Shirt0", "Trousers4"),
                                      ("manual_wheelchair", 61, "Skin4", "Shirt6", "Trousers0"),
                                      ("electric_wheelchair", 67, "Skin1", "Shirt2", "Trousers5"),
                                      ("walker", 63, "Skin6", "Shirt4", "Trousers1")]),
-    ("Row4_crutches_and_canes", [("crutches", 58, "Skin8", "Shirt7", "Trousers2"), ("smart_cane", 59, "Skin3", "Shirt1", "Trousers6"),
+    ("Crutch_canes", [("crutches", 58, "Skin8", "Shirt7", "Trousers2"), ("smart_cane", 59, "Skin3", "Shirt1", "Trousers6"),
                                  ("wooden_cane", 53, "Skin0", "Shirt3", "Trousers3"), ("orthopedic_cane", 65, "Skin7", "Shirt5", "Trousers0"),
                                  ("tripod_cane", 60, "Skin5", "Shirt0", "Trousers4")]),
 )

@@ -89,16 +89,19 @@ class Bank:
         seg_of_bone = {b: k for k, (bones, _) in enumerate(SEGMENTS.values()) for b in bones}
         return np.array([seg_of_bone[BONES[b]] for b in self.face_bone])
 
-    @functools.cached_property
-    def segment_faces(self) -> np.ndarray:
-        """(9, F) bool: the triangles each segment of :data:`SEGMENTS` renders: its own, and the triangles of its
-        neighbours that its bones hold with at least :data:`OVERLAP_WEIGHT` at some corner. Those are drawn
-        by both segments (coinciding in the base posture), so that a joint that bends shows a segment's
-        copy instead of a gap into the hollow body."""
+    def segment_faces(self, body: int) -> np.ndarray:
+        """(9, F) bool: the triangles each segment of :data:`SEGMENTS` renders for ``body``: its own, and the
+        triangles of its neighbours that its bones hold with at least :data:`OVERLAP_WEIGHT` at some corner
+        and that lie in a garment region the segment already has (so it needs no mesh more). Those are drawn
+        by both segments (coinciding in the base posture), so that a bending hip or shoulder shows a
+        segment's copy instead of a gap into the hollow body."""
+        own = np.arange(len(SEGMENTS))[:, None] == self.face_segment[None]
         per_segment = np.stack([self.vertex_bone_weights[:, [BONES.index(b) for b in bones]].sum(axis=1)
                                 for bones, _ in SEGMENTS.values()])  # (9, V)
         held = per_segment[:, self.triangles].max(axis=2) >= OVERLAP_WEIGHT
-        return held | (np.arange(len(SEGMENTS))[:, None] == self.face_segment[None])
+        region = self.face_region(body)
+        has_region = np.stack([np.isin(region, region[own[k]]) for k in range(len(SEGMENTS))])
+        return own | (held & has_region)
 
     def face_region(self, body: int) -> np.ndarray:
         """(F,) index into :data:`REGIONS` of each triangle of ``body``: skin on head and hands, shoes on feet,

@@ -141,10 +141,11 @@ class _BodyParts:
             base = pose(self.bank, body, posture, fit, 0.0, 0.0)
             pts = skin(self.bank.points[body], self.bank, base.skinning(self.bank.joints[body]))
             region = self.bank.face_region(body)
+            segment_faces = self.bank.segment_faces(body)
             parts = {}
             for k, name in enumerate(SEGMENTS):
                 for r, region_name in enumerate(REGIONS):
-                    tris = self.bank.triangles[self.bank.segment_faces[k] & (region == r)]
+                    tris = self.bank.triangles[segment_faces[k] & (region == r)]
                     if len(tris):
                         used, inverse = np.unique(tris, return_inverse=True)
                         parts[(name, region_name)] = (pts[used], inverse.reshape(-1, 3))

@@ -125,7 +125,7 @@ def _animated(bank, body: int, device: str | None, fit, phase: float, amplitude:
     pts = skin(bank.points[body], bank, base.skinning(bank.joints[body]))
     out = []
     for k, name in enumerate(SEGMENTS):
-        v = pts[np.unique(bank.triangles[bank.segment_faces[k]])]
+        v = pts[np.unique(bank.triangles[bank.segment_faces(body)[k]])]
         out.append(v @ motion[name][:, :3].T + motion[name][:, 3])
     return np.concatenate(out)
 
