@@ -1,7 +1,7 @@
 """A crowd: agents placed, routed and animated on the walkable surfaces of a twin, with their looks.
 
 :func:`populate_crowd` is the whole chain from triangles to trajectories: walkable grid → graph →
-Poisson population → routes (A*) → collision-free motion → looks. It takes plain arrays, so a twin
+Poisson population → routes (A*) and places on benches → collision-free motion → looks. It takes plain arrays, so a twin
 model (the demos) and a stage read through USD (``synthua agents populate``) populate the same way.
 """
 
@@ -14,6 +14,7 @@ import numpy as np
 
 from synthua_usd.agents.motion import Trajectory, min_separation, simulate
 from synthua_usd.agents.population import DEFAULT_AID_SHARE, check_density, plan_agents, sample_count
+from synthua_usd.agents.seats import find_seat_places
 from synthua_usd.agents.walkable import WALKABLE, build_grid, walkable_graph
 from synthua_usd.assets.people import PersonLook
 from synthua_usd.errors import InputError
@@ -73,7 +74,8 @@ def populate_crowd(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarr
     graph = walkable_graph(grid)
     rng = np.random.default_rng(params.seed)
     count = sample_count(rng, params.density_per_m2, grid.area_m2())
-    plans = plan_agents(rng, graph, grid, count, params.aid_share)
+    seats = tuple(find_seat_places(vertices, faces, face_class, grid))
+    plans = plan_agents(rng, graph, grid, count, params.aid_share, seats=seats)
     trajectories, dropped = simulate(plans, params.time_codes, params.time_codes_per_second)
     looks = [PersonLook.random(rng, aid_user=t.plan.profile.device is not None) for t in trajectories]
     by_profile: dict[str, int] = {}
@@ -82,6 +84,7 @@ def populate_crowd(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarr
     report = {"walkable_area_m2": grid.area_m2(), "expected": params.density_per_m2 * grid.area_m2(),
               "sampled": count, "placed": len(trajectories), "dropped": dropped,
               "aid_users": sum(1 for t in trajectories if t.plan.profile.device),
+              "seated": sum(1 for t in trajectories if t.plan.seat is not None),
               "by_profile": dict(sorted(by_profile.items())), "min_separation_m": min_separation(trajectories)}
     return Crowd(tuple(trajectories), tuple(looks), params, report)
 

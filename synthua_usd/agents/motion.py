@@ -78,7 +78,8 @@ def _simulate_one(plan: Plan, time_codes: int, dt: float, placed: list[Trajector
     p = point
     if _conflicts(p, r, 0, placed):
         return None
-    positions, headings, travelled = [p], [np.degrees(np.arctan2(direction[1], direction[0]))], [0.0]
+    heading = plan.seat.heading_deg if plan.seat is not None else np.degrees(np.arctan2(direction[1], direction[0]))
+    positions, headings, travelled = [p], [heading], [0.0]
     waited = 0.0
     entered_crossing = plan.surfaces[k] == "crosswalk"
     for f in range(1, time_codes):

@@ -14,6 +14,7 @@ import networkx as nx
 import numpy as np
 
 from synthua_usd.agents.profiles import AID_PROFILES, PROFILES, AgentProfile
+from synthua_usd.agents.seats import SeatPlace
 from synthua_usd.agents.walkable import WalkableGrid, shortest_path
 from synthua_usd.errors import InputError
 
@@ -58,16 +59,19 @@ class Plan:
     pause_before_crossing_s: float
     group: int | None = None
     rests: bool = False  # walks to a bench and stays there
+    seat: SeatPlace | None = None  # sits there (on a bench) all the time
 
 
 def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, count: int, aid_share: float,
-                min_route_m: float = 15.0, rest_share: float = 0.15) -> list[Plan]:
+                min_route_m: float = 15.0, rest_share: float = 0.15, seats: tuple[SeatPlace, ...] = ()) -> list[Plan]:
     """Routes for ``count`` agents: ``aid_share`` of them (rounded stochastically) use mobility aids.
 
     Each agent walks between two random reachable cells at least ``min_route_m`` apart, starting at a
     random point along its route; about a third of pedestrians come in groups of two or three, who share
     a route and walk 0.9 m apart. ``rest_share`` of single agents head for a bench (a cell beside street
-    furniture) and arrive within the first seconds, then stay there.
+    furniture) and arrive within the first seconds, then stay there; of the pedestrians among them, every
+    other one is instead seated the whole time at the free place of ``seats`` nearest its route's end
+    (while places are free).
     """
     if not 0.0 <= aid_share <= 1.0:
         raise InputError(f"aid share should be a fraction in [0, 1], but was {aid_share}")
@@ -78,6 +82,8 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
     pos = np.array([graph.nodes[n]["pos"] for n in nodes])
     benches = sorted(set(grid.cells_beside("furniture")) & set(graph.nodes))
     plans: list[Plan] = []
+    free = list(seats)
+    resting_pedestrians = 0
     group_id = 0
     misses = 0
     while len(plans) < count:
@@ -105,8 +111,15 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
         size = min(size, count - len(plans))
         gid = group_id if size > 1 else None
         group_id += size > 1
+        place = None
+        if rests and profile.device is None:
+            resting_pedestrians += 1
+            if free and resting_pedestrians % 2 == 0:
+                place = min(free, key=lambda q: float(np.linalg.norm(np.subtract(q.origin[:2], waypoints[-1][:2]))))
+                free.remove(place)
+                waypoints, surfaces, offset = np.array([place.origin, place.origin]), ("seat", "seat"), 0.0
         for k in range(size):
-            plans.append(Plan(profile, speed, waypoints, surfaces, max(offset - 0.9 * k, 0.0), pause, gid, rests))
+            plans.append(Plan(profile, speed, waypoints, surfaces, max(offset - 0.9 * k, 0.0), pause, gid, rests, place))
     return plans
 
 

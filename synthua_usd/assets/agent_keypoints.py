@@ -75,9 +75,11 @@ def _tips(device: str, fit: DeviceFit) -> list[np.ndarray]:
 
 
 def contact_points(bank: Bank, body: int, device: str, fit: DeviceFit, base: Pose,
-                   motions: list[dict[str, np.ndarray]]) -> np.ndarray:
+                   motions: list[dict[str, np.ndarray]], shifts=None) -> np.ndarray:
     """(T, k, 3) contact points of ``device`` used by ``body``, in the order of
-    ``KEYPOINT_CLASSES[device].names``, agent frame."""
+    ``KEYPOINT_CLASSES[device].names``, agent frame. ``shifts`` (T,): a stepping aid's forward shift along the
+    agent's +x at each time (:func:`synthua_usd.assets.postures.aid_shift_m`), which moves its tips; the
+    hands' motions already include it."""
     names = KEYPOINT_CLASSES[device].names
     hands = {side: _hand_centroid(bank, body, base, side) for side in ("L", "R")}
     hips = base.joints[[BONES.index("upperleg.L"), BONES.index("upperleg.R")]].mean(axis=0)
@@ -90,6 +92,8 @@ def contact_points(bank: Bank, body: int, device: str, fit: DeviceFit, base: Pos
                 out[t, k] = [pelvis[0], pelvis[1], fit.seat_height_m]
             elif name.endswith("tip"):
                 out[t, k] = tips[1 if name == "right_tip" else 0]  # crutches: left placement first
+                if shifts is not None:
+                    out[t, k, 0] += shifts[t]
             else:
                 side = "L" if name.startswith(("left", "joystick")) else "R"
                 out[t, k] = _apply(motion[f"Forearm{side}"], hands[side][None])[0]

@@ -40,6 +40,9 @@ SEGMENTS = {
 #: Garment regions: which look colour each region takes (skin, upper garment, lower garment, shoes); the
 #: forearm and shin regions take the skin or the garment by the look's sleeve and leg length.
 REGIONS = ("skin", "upper", "forearm", "lower", "shin", "shoes")
+#: A segment also draws its neighbours' triangles whose corners its bones hold with at least this weight
+#: (:attr:`Bank.segment_faces`).
+OVERLAP_WEIGHT = 0.3
 
 # anny faces -Y with +X to its left; ours face +X with +Y to the left: a quarter turn about Z.
 _TO_OURS = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
@@ -69,17 +72,36 @@ class Bank:
         return len(self.points)
 
     @functools.cached_property
-    def face_bone(self) -> np.ndarray:
-        """(F,) index into :data:`BONES` of the bone that dominates each triangle."""
+    def vertex_bone_weights(self) -> np.ndarray:
+        """(V, 14) skin weight of every bone of :data:`BONES` at each vertex."""
         dense = np.zeros((self.points.shape[1], len(BONES)))
         np.add.at(dense, (np.repeat(np.arange(len(dense)), 4), self.skin_bones.ravel()), self.skin_weights.ravel())
-        return dense[self.triangles].sum(axis=1).argmax(axis=1)
+        return dense
+
+    @functools.cached_property
+    def face_bone(self) -> np.ndarray:
+        """(F,) index into :data:`BONES` of the bone that dominates each triangle."""
+        return self.vertex_bone_weights[self.triangles].sum(axis=1).argmax(axis=1)
 
     @functools.cached_property
     def face_segment(self) -> np.ndarray:
         """(F,) index into :data:`SEGMENTS` of each triangle."""
         seg_of_bone = {b: k for k, (bones, _) in enumerate(SEGMENTS.values()) for b in bones}
         return np.array([seg_of_bone[BONES[b]] for b in self.face_bone])
+
+    def segment_faces(self, body: int) -> np.ndarray:
+        """(9, F) bool: the triangles each segment of :data:`SEGMENTS` renders for ``body``: its own, and the
+        triangles of its neighbours that its bones hold with at least :data:`OVERLAP_WEIGHT` at some corner
+        and that lie in a garment region the segment already has (so it needs no mesh more). Those are drawn
+        by both segments (coinciding in the base posture), so that a bending hip or shoulder shows a
+        segment's copy instead of a gap into the hollow body."""
+        own = np.arange(len(SEGMENTS))[:, None] == self.face_segment[None]
+        per_segment = np.stack([self.vertex_bone_weights[:, [BONES.index(b) for b in bones]].sum(axis=1)
+                                for bones, _ in SEGMENTS.values()])  # (9, V)
+        held = per_segment[:, self.triangles].max(axis=2) >= OVERLAP_WEIGHT
+        region = self.face_region(body)
+        has_region = np.stack([np.isin(region, region[own[k]]) for k in range(len(SEGMENTS))])
+        return own | (held & has_region)
 
     def face_region(self, body: int) -> np.ndarray:
         """(F,) index into :data:`REGIONS` of each triangle of ``body``: skin on head and hands, shoes on feet,

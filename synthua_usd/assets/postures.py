@@ -3,8 +3,9 @@
 A posture is a function of the body, its device fit and a cycle phase: walking (stride and cadence from
 the speed), walking with a walker (both hands on its handles), with forearm crutches (hands on the grips),
 with a cane (cane hand on its grip), seated in a manual wheelchair (hands on the push rims, a push cycle),
-seated in an electric wheelchair (left hand on the joystick). Frames as in :mod:`bodies`: feet on z = 0
-(standing), facing +X; a seated body sits on the seat its :class:`DeviceFit` gives.
+seated in an electric wheelchair (left hand on the joystick), seated on a bench (hands on the thighs, feet on
+the ground). Frames as in :mod:`bodies`: feet on z = 0 (standing), facing +X; a seated body sits on the seat
+its :class:`DeviceFit` gives, its back at x = -0.15.
 
 Fitting follows clinical practice: cane, crutch and walker grips at the wrist crease of the standing user
 with the arms hanging; the wheelchair seat at the user's seated lower-leg drop plus the footrest's ground
@@ -30,7 +31,19 @@ RIM_RADIUS_M = 0.27
 AID_OFFSETS = {"walker": [(0.42, 0.0)], "crutch": [(0.14, 0.3), (0.14, -0.3)], "smart_cane": [(0.3, -0.25)],
                "wooden_cane": [(0.14, -0.3)], "orthopedic_cane": [(0.14, -0.3)], "tripod_cane": [(0.14, -0.32)]}
 SEATED = ("manual_wheelchair", "electric_wheelchair")
+#: The posture of a pedestrian seated on a bench (not a device: no device prim; :func:`bench_fit` sizes it).
+BENCH = "bench"
 CANES = ("smart_cane", "wooden_cane", "orthopedic_cane", "tripod_cane")
+#: Aids whose tips step with the gait (:func:`aid_shift_m`): planted on the ground in the middle of the left
+#: foot's stance (phase pi/2 .. 3 pi/2), swung forward while the left leg swings. A cane in the right hand
+#: moves with the left leg; forearm crutches move together with it (three-point gait, the left leg taken
+#: as the affected one). Planted for AID_STANCE of the cycle: shorter than the foot's half, so that the
+#: hand reaches the grip at both ends of the stroke.
+STEPPING_AIDS = ("crutch",) + CANES
+AID_STANCE = 0.4
+AID_STANCE_START = np.pi - AID_STANCE * np.pi
+#: Where the hand holds a stepping aid: its grip's distance ahead of the aid's origin, m.
+GRIP_DX = {"crutch": 0.08, **{cane: -0.03 for cane in CANES}}
 
 
 @dataclass(frozen=True)
@@ -90,15 +103,40 @@ def _hip_vertices(bank: Bank, pts: np.ndarray, pose: Pose) -> np.ndarray:
     return cand[np.abs(pts[cand, 0] - hip_x) < 0.15]
 
 
-def _seated_legs(bank: Bank, body: int, root_z: float) -> Pose:
+def _seated_legs(bank: Bank, body: int, root_z: float, shank_deg: float = 12.0) -> Pose:
+    """Thighs level, shanks ``shank_deg`` forward of vertical, arms hanging."""
     rest = bank.joints[body]
     aims = _arms_down(rest)
     for side in ("L", "R"):
         aims[f"upperleg.{side}"] = rot_y(-86.0)
-        aims[f"lowerleg.{side}"] = rot_y(-12.0)
+        aims[f"lowerleg.{side}"] = rot_y(-shank_deg)
         aims[f"foot.{side}"] = rot_y(-12.0)
     root = rest[0] + np.array([0.0, 0.0, root_z])
     return forward_kinematics(rest, aims, root)
+
+
+def _seat_drop(bank: Bank, body: int, shank_deg: float) -> float:
+    """Seated with shanks ``shank_deg`` forward: how far the feet reach below what sits on the seat, m."""
+    pose = _seated_legs(bank, body, 0.0, shank_deg)
+    pts = skin(bank.points[body], bank, pose.skinning(bank.joints[body]))
+    return float(pts[_hip_vertices(bank, pts, pose), 2].min() - pts[_segment_vertices(bank, ("ShankL", "ShankR")), 2].min())
+
+
+def _bench_shank_deg(bank: Bank, body: int, seat_height_m: float) -> float:
+    """The shank angle (12-70 degrees forward) that puts the feet on the ground below a seat ``seat_height_m``
+    high; 12 when they do not reach it (a child's feet dangle)."""
+    lo, hi = 12.0, 70.0
+    if _seat_drop(bank, body, lo) <= seat_height_m:
+        return lo
+    for _ in range(20):  # the drop falls as the shanks tilt forward
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if _seat_drop(bank, body, mid) > seat_height_m else (lo, mid)
+    return hi
+
+
+def bench_fit(seat_height_m: float) -> DeviceFit:
+    """The fit of a bench posture: the seat's top above the ground the sitter's feet stand on."""
+    return DeviceFit(seat_height_m=round(float(seat_height_m), 2))
 
 
 def _with_arms(bank: Bank, body: int, pose: Pose, targets: dict[str, np.ndarray], aims: dict) -> Pose:
@@ -122,12 +160,33 @@ def step_length_m(speed_mps: float, height_m: float) -> float:
     return float(w * cadence)
 
 
-def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float, amplitude: float) -> Pose:
+def aid_shift_m(device: str | None, phase: float, amplitude: float, cycle_m: float) -> float:
+    """How far (m, along the user's heading) a stepping aid (:data:`STEPPING_AIDS`) stands ahead of its
+    place in :data:`AID_OFFSETS` at gait ``phase``, for a gait cycle of ``cycle_m`` metres travelled (phase
+    2 pi per cycle). Planted for :data:`AID_STANCE` of the cycle from :data:`AID_STANCE_START`: the shift
+    falls by exactly the distance the user travels, so the tip stays put on the ground; then it swings
+    forward again (smoothstep, the tip gliding along the ground). The stroke, ``amplitude * AID_STANCE *
+    cycle_m`` long, is centred so that the grip passes under the shoulder (x = 0), where the hand reaches
+    furthest both ways. 0 for other devices."""
+    if device not in STEPPING_AIDS:
+        return 0.0
+    travel = amplitude * AID_STANCE * cycle_m  # while planted
+    centre = -amplitude * (AID_OFFSETS[device][0][0] + GRIP_DX[device])
+    u = ((phase - AID_STANCE_START) / (2 * np.pi)) % 1.0
+    if u < AID_STANCE:
+        return centre + travel * (0.5 - u / AID_STANCE)
+    v = (u - AID_STANCE) / (1.0 - AID_STANCE)
+    return centre + travel * (v * v * (3 - 2 * v) - 0.5)
+
+
+def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float, amplitude: float,
+         aid_shift: float = 0.0) -> Pose:
     """The body's pose at cycle ``phase`` (radians; gait cycle walking, push cycle in a manual chair) with
-    the motion scaled by ``amplitude`` (0 still, 1 full stride)."""
+    the motion scaled by ``amplitude`` (0 still, 1 full stride); a walking aid moved ``aid_shift`` metres
+    forward (:func:`aid_shift_m`) takes the hands on it along."""
     rest = bank.joints[body]
-    if device in SEATED:
-        base = _seated_legs(bank, body, 0.0)
+    if device in SEATED or device == BENCH:
+        base = _seated_legs(bank, body, 0.0, _bench_shank_deg(bank, body, fit.seat_height_m) if device == BENCH else 12.0)
         pts = skin(bank.points[body], bank, base.skinning(rest))
         seat_bottom = pts[_hip_vertices(bank, pts, base), 2].min()
         back = pts[_segment_vertices(bank, ("Torso",)), 0].min()
@@ -136,7 +195,11 @@ def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float
         seated = forward_kinematics(rest, {b: base.rotations[k] for k, b in enumerate(BONES)}, rest[0] + shift)
         aims = {b: seated.rotations[k] for k, b in enumerate(BONES) if not b.startswith(("upperarm", "lowerarm", "hand"))}
         half = fit.seat_width_m / 2
-        if device == "manual_wheelchair":
+        if device == BENCH:  # hands resting on the thighs
+            hip = seated.joints[BONES.index("upperleg.L")]
+            targets = {side: np.array([hip[0] + 0.24, sign * 0.12, fit.seat_height_m + 0.17])
+                       for side, sign in (("L", 1.0), ("R", -1.0))}
+        elif device == "manual_wheelchair":
             targets = {}
             for side, sign in (("L", 1.0), ("R", -1.0)):
                 angle = np.radians(20.0 + 35.0 * amplitude * np.sin(phase))
@@ -167,17 +230,16 @@ def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float
     if device == "walker":
         targets = {s: np.array([0.3, sign * 0.26, fit.grip_height_m + 0.03]) for s, sign in (("L", 1.0), ("R", -1.0))}
     elif device == "crutch":
-        targets = {s: np.array([AID_OFFSETS["crutch"][k][0] + 0.08, AID_OFFSETS["crutch"][k][1], fit.grip_height_m + 0.03])
-                   for k, s in enumerate(("L", "R"))}
+        targets = {s: np.array([AID_OFFSETS["crutch"][k][0] + GRIP_DX["crutch"] + aid_shift, AID_OFFSETS["crutch"][k][1],
+                                fit.grip_height_m + 0.03]) for k, s in enumerate(("L", "R"))}
     elif device in CANES:
         x, y = AID_OFFSETS[device][0]
-        targets = {"R": np.array([x - 0.03, y, fit.grip_height_m + 0.04])}
-    posed = _with_arms(bank, body, walking, targets, aims) if targets else walking
-    # Keep the lower foot on the ground.
-    pts = skin(bank.points[body], bank, posed.skinning(rest))
+        targets = {"R": np.array([x + GRIP_DX[device] + aid_shift, y, fit.grip_height_m + 0.04])}
+    # Keep the lower foot on the ground, then put the hands on the aid (whose grips do not bob with the body).
+    pts = skin(bank.points[body], bank, walking.skinning(rest))
     low = pts[_segment_vertices(bank, ("ShankL", "ShankR")), 2].min()
-    return forward_kinematics(rest, {b: posed.rotations[k] for k, b in enumerate(BONES)},
-                              posed.joints[0] - np.array([0.0, 0.0, low]))
+    walking = forward_kinematics(rest, aims, walking.joints[0] - np.array([0.0, 0.0, low]))
+    return _with_arms(bank, body, walking, targets, aims) if targets else walking
 
 
 def segment_motion(bank: Bank, body: int, base: Pose, now: Pose) -> dict[str, np.ndarray]:

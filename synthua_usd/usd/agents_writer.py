@@ -4,7 +4,7 @@ users, a separately labelled device sized to that body, linked from the person b
 relationship.
 
 A body is nine rigid segments (:data:`synthua_usd.assets.bodies.SEGMENTS`) cut from its base posture
-(standing, seated in its wheelchair, holding its walker, crutches or cane; :mod:`synthua_usd.assets.postures`),
+(standing, seated in its wheelchair or on a bench, holding its walker, crutches or cane; :mod:`synthua_usd.assets.postures`),
 each split into garment regions. Geometry is shared through USD scenegraph instancing: each (body, posture,
 segment, region) mesh and each (device, fit) is authored once as a prototype under :data:`PROTOTYPES`, a
 ``class`` prim, which USD's default traversal (and so the reader and every validator rule) never visits;
@@ -14,7 +14,9 @@ agents reference prototypes from ``instanceable`` prims. Per agent, and therefor
 - each region's material (skin tone, garment colours), bound on the region's instance root;
 - each segment's motion from the base posture (walking swings, push strokes), a time-sampled translate and
   orientation on the segment's Xform; a segment that does not move has none;
-- the device prim, which is itself the instance root of its device prototype and carries the label;
+- the device prim, which is itself the instance root of its device prototype and carries the label; crutches
+  and canes step with the gait (:func:`synthua_usd.assets.postures.aid_shift_m`), a time-sampled translate
+  on the device prim;
 - keypoints (:mod:`synthua_usd.assets.agent_keypoints`): on the ``Person`` prim the 17 COCO body keypoints,
   on the device prim its contact points, each as ``synthua:keypoints`` (point3f[], the prim's frame,
   time-sampled when they move) with their names in ``synthua:keypointNames`` (token[], uniform; the order
@@ -44,7 +46,8 @@ from synthua_usd.agents.crowd import Crowd
 from synthua_usd.assets import devices
 from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS, load_bank, skin
-from synthua_usd.assets.postures import AID_OFFSETS, SEATED, DeviceFit, fit_device, pose, segment_motion, step_length_m
+from synthua_usd.assets.postures import (AID_OFFSETS, BENCH, STEPPING_AIDS, DeviceFit, aid_shift_m, bench_fit,
+                                       fit_device, pose, segment_motion, step_length_m)
 from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.materials import PALETTE
 from synthua_usd.scenario import StageMetadata
@@ -115,9 +118,9 @@ def _instance(stage: Usd.Stage, path: str, prototype: Sdf.Path, translate=None) 
     return prim
 
 
-def _phases(traj, height_m: float, fps: float) -> tuple[np.ndarray, np.ndarray]:
+def _phases(traj, height_m: float, fps: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Per time code, the motion cycle's phase (radians) and amplitude (0 still .. 1 moving at the agent's
-    speed). Walking: one gait cycle per two steps of :func:`step_length_m` at the agent's speed; a manual
+    speed); and the cycle's length in metres travelled. Walking: one gait cycle per two steps of :func:`step_length_m` at the agent's speed; a manual
     wheelchair: one push per 1.2 m. The amplitude follows the speed over the last time code, eased over
     three time codes so a stop does not freeze a stride."""
     d = np.asarray(traj.distance_m, float)
@@ -127,7 +130,7 @@ def _phases(traj, height_m: float, fps: float) -> tuple[np.ndarray, np.ndarray]:
     moving = np.clip(speed / max(traj.plan.speed_mps, 1e-6), 0.0, 1.0)
     amplitude = np.convolve(np.pad(moving, 1, mode="edge"), np.ones(3) / 3, mode="valid")
     cycle = 1.2 if traj.plan.profile.device == "manual_wheelchair" else 2 * step_length_m(traj.plan.speed_mps, height_m)
-    return 2 * np.pi * d / cycle, amplitude
+    return 2 * np.pi * d / cycle, amplitude, cycle
 
 
 class _BodyParts:
@@ -137,17 +140,19 @@ class _BodyParts:
         self.bank = load_bank()
         self._cache: dict[tuple, tuple] = {}
 
-    def get(self, body: int, device: str | None):
-        key = (body, device)
+    def get(self, body: int, posture: str | None, fit: DeviceFit | None = None):
+        """``posture`` a device class, :data:`BENCH` or None (walking); ``fit`` None: the device fitted to the body."""
+        key = (body, posture, fit)
         if key not in self._cache:
-            fit = fit_device(self.bank, body, device)
-            base = pose(self.bank, body, device, fit, 0.0, 0.0)
+            fit = fit or fit_device(self.bank, body, posture)
+            base = pose(self.bank, body, posture, fit, 0.0, 0.0)
             pts = skin(self.bank.points[body], self.bank, base.skinning(self.bank.joints[body]))
             region = self.bank.face_region(body)
+            segment_faces = self.bank.segment_faces(body)
             parts = {}
             for k, name in enumerate(SEGMENTS):
                 for r, region_name in enumerate(REGIONS):
-                    tris = self.bank.triangles[(self.bank.face_segment == k) & (region == r)]
+                    tris = self.bank.triangles[segment_faces[k] & (region == r)]
                     if len(tris):
                         used, inverse = np.unique(tris, return_inverse=True)
                         parts[(name, region_name)] = (pts[used], inverse.reshape(-1, 3))
@@ -201,20 +206,23 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
         prim.CreateAttribute("synthua:profile", Sdf.ValueTypeNames.String, custom=True).Set(profile.name)
         prim.CreateAttribute("synthua:speed_mps", Sdf.ValueTypeNames.Double, custom=True).Set(traj.plan.speed_mps)
         if traj.plan.rests:
-            prim.CreateAttribute("synthua:behaviour", Sdf.ValueTypeNames.String, custom=True).Set("rests_at_bench")
+            prim.CreateAttribute("synthua:behaviour", Sdf.ValueTypeNames.String, custom=True).Set(
+                "sits_on_bench" if traj.plan.seat is not None else "rests_at_bench")
         if traj.plan.group is not None:
             prim.CreateAttribute("synthua:group", Sdf.ValueTypeNames.Int, custom=True).Set(traj.plan.group)
         person_xf = define_xform(stage, f"{root.GetPath()}/Person")
         set_kind(person_xf.GetPrim(), Kind.Tokens.component)
         apply_label(person_xf.GetPrim(), taxonomy, "person")
         device = profile.device
-        fit, base, parts = bodies.get(look.body, device)
-        phase, amplitude = _phases(traj, float(bodies.bank.height_m[look.body]), meta.time_codes_per_second)
+        posture = BENCH if traj.plan.seat is not None else device
+        fit, base, parts = bodies.get(look.body, posture, bench_fit(traj.plan.seat.seat_height_m) if posture == BENCH else None)
+        phase, amplitude, cycle = _phases(traj, float(bodies.bank.height_m[look.body]), meta.time_codes_per_second)
         if device == "electric_wheelchair":
             amplitude = np.zeros_like(amplitude)
-        motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, device, fit, p, a))
-                   for p, a in zip(phase, amplitude)]
-        # Person and device prims have no transform of their own: the agent frame is their frame.
+        shifts = [aid_shift_m(device, p, a, cycle) for p, a in zip(phase, amplitude)]
+        motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, posture, fit, p, a, x))
+                   for p, a, x in zip(phase, amplitude, shifts)]
+        # The Person prim has no transform of its own: the agent frame is its frame.
         author_keypoints(person_xf.GetPrim(), KEYPOINT_CLASSES["person"].names,
                          body_keypoints(bodies.bank, look.body, base, motions), times)
         for name in SEGMENTS:
@@ -228,14 +236,20 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
             for region in REGIONS:
                 if (name, region) not in parts:
                     continue
-                shape = f"Body{look.body:02d}{_posture_name(device)}{name}{region.title()}"
+                shape = f"Body{look.body:02d}{_posture_name(posture)}{name}{region.title()}"
                 part = _instance(stage, f"{seg.GetPath()}/{region.title()}", library.part(shape, parts[(name, region)]))
                 bind_material(part, mats[look.region_material(region)])
         if profile.device:
             aid = _instance(stage, f"{root.GetPath()}/{_name(device)}", library.device(device, fit))
+            if device in STEPPING_AIDS and times:  # the tips step with the gait
+                aid_translate = UsdGeom.Xformable(aid).AddTranslateOp()
+                for t, x in zip(times, shifts):
+                    aid_translate.Set(Gf.Vec3d(x, 0.0, 0.0), t)
             set_kind(aid, Kind.Tokens.component)
             apply_label(aid, taxonomy, device)
             person_xf.GetPrim().CreateRelationship("synthua:uses", custom=True).SetTargets([aid.GetPath()])
-            author_keypoints(aid, KEYPOINT_CLASSES[device].names,
-                             contact_points(bodies.bank, look.body, device, fit, base, motions), times)
+            contacts = contact_points(bodies.bank, look.body, device, fit, base, motions, shifts)
+            if device in STEPPING_AIDS and times:  # agent frame -> the stepping aid's own frame
+                contacts = contacts - np.asarray(shifts)[:, None, None] * np.array([1.0, 0.0, 0.0])
+            author_keypoints(aid, KEYPOINT_CLASSES[device].names, contacts, times)
     return stage

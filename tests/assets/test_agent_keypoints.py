@@ -87,3 +87,28 @@ def test_contact_points_touch_the_device(device):
             assert np.ptp(points[:, 0, 0]) > 0.1
         if device == "crutch":  # left and right as the user's
             assert points[0, names.index("left_tip"), 1] > 0 > points[0, names.index("right_tip"), 1]
+
+
+@pytest.mark.parametrize("device", ["crutch", "wooden_cane", "tripod_cane"])
+def test_contact_points_of_a_stepping_aid_follow_its_tips_and_grips(device):
+    """Crutches and canes step with the gait (a forward shift of the device, the hands going with it): the
+    tips and hand contacts lie on the device moved by that shift, at every phase."""
+    from synthua_usd.assets.postures import aid_shift_m
+
+    bank = load_bank()
+    names = KEYPOINT_CLASSES[device].names
+    cycle = 1.4
+    for body in _bodies(bank)[:2]:
+        fit = fit_device(bank, body, device)
+        base = pose(bank, body, device, fit, 0.0, 0.0)
+        shifts = [aid_shift_m(device, p, 1.0, cycle) for p in PHASES]
+        assert np.ptp(shifts) > 0.1
+        motions = [segment_motion(bank, body, base, pose(bank, body, device, fit, p, 1.0, x))
+                   for p, x in zip(PHASES, shifts)]
+        points = contact_points(bank, body, device, fit, base, motions, shifts)
+        mesh = _device_mesh(device, fit)
+        for t, shift in enumerate(shifts):
+            _, distance, _ = trimesh.proximity.closest_point(mesh, points[t] - [shift, 0.0, 0.0])
+            for k, name in enumerate(names):
+                limit = 1e-3 if name.endswith("tip") else MAX_HAND_M
+                assert distance[k] <= limit, f"{name} at phase {t}: {distance[k]:.3f} m from the moved device"

@@ -10,8 +10,10 @@ import trimesh
 from scipy import stats
 
 from synthua_usd.assets import body_bank, devices
-from synthua_usd.assets.bodies import load_bank, skin
-from synthua_usd.assets.postures import AID_OFFSETS, SEATED, fit_device, pose, step_length_m
+from synthua_usd.agents.profiles import PROFILES
+from synthua_usd.assets.bodies import BONES, SEGMENTS, load_bank, skin
+from synthua_usd.assets.postures import (AID_OFFSETS, AID_STANCE, AID_STANCE_START, GRIP_DX, SEATED, STEPPING_AIDS,
+                                         aid_shift_m, fit_device, pose, segment_motion, step_length_m)
 
 #: How deep a body vertex may sit inside its own device: hands close round grips and push rims, whose
 #: boxes and cylinders are solid here.
@@ -105,13 +107,103 @@ def test_seated_pelvis_rests_on_the_seat(bank, body, device):
     assert abs(above[:, 2].min() - top) < SEAT_TOLERANCE_M
 
 
-@pytest.mark.parametrize("device", ["manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane",
-                                    "wooden_cane", "orthopedic_cane", "tripod_cane"])
-def test_no_body_part_inside_its_own_device(bank, device):
-    body = 60
+DEVICES = ["manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
+           "orthopedic_cane", "tripod_cane"]
+
+
+def _cycle_m(bank, body: int, device: str) -> float:
+    """The gait cycle of ``body`` walking with ``device`` at its profile's mean speed (as the agents layer has it)."""
+    speed = next(p.speed_mps for p in PROFILES.values() if p.device == device)
+    return 2 * step_length_m(speed, float(bank.height_m[body]))
+
+
+def _animated(bank, body: int, device: str | None, fit, phase: float, amplitude: float, shift: float) -> np.ndarray:
+    """The body as the agents layer renders it at ``phase``: each segment of the base posture moved rigidly by
+    its motion (a segment's vertices counted once per segment)."""
+    base = pose(bank, body, device, fit, 0.0, 0.0)
+    motion = segment_motion(bank, body, base, pose(bank, body, device, fit, phase, amplitude, shift))
+    pts = skin(bank.points[body], bank, base.skinning(bank.joints[body]))
+    out = []
+    for k, name in enumerate(SEGMENTS):
+        v = pts[np.unique(bank.triangles[bank.segment_faces(body)[k]])]
+        out.append(v @ motion[name][:, :3].T + motion[name][:, 3])
+    return np.concatenate(out)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@pytest.mark.parametrize("body", [52, 60, 66])
+def test_no_body_part_inside_its_own_device(bank, body, device):
+    """At twelve phases of the cycle, the rendered (rigid-segment) body against its device where it stands then."""
     fit = fit_device(bank, body, device)
+    amplitude = 0.0 if device == "electric_wheelchair" else 1.0
     solids = _device_solids(device, fit)
-    for phase in np.linspace(0, 2 * np.pi, 6, endpoint=False):
-        posed = pose(bank, body, device, fit, phase, 0.0 if device in SEATED and device != "manual_wheelchair" else 1.0)
-        pts = skin(bank.points[body], bank, posed.skinning(bank.joints[body]))
+    for phase in np.linspace(0, 2 * np.pi, 12, endpoint=False):
+        shift = aid_shift_m(device, phase, amplitude, _cycle_m(bank, body, device))
+        pts = _animated(bank, body, device, fit, phase, amplitude, shift) - [shift, 0.0, 0.0]
         assert _penetration(pts, solids) <= DEVICE_TOLERANCE_M, (device, phase)
+
+
+@pytest.mark.parametrize("device", STEPPING_AIDS)
+def test_stepping_aid_tips_stay_planted_then_swing(bank, device):
+    """Walking d metres, the aid's tip is at d + shift along the way: constant while planted (a stance of
+    AID_STANCE of the cycle), moving forward while it swings, with no jump anywhere; on the ground throughout
+    (the aid only slides along its user's heading)."""
+    cycle = _cycle_m(bank, 60, device)
+    d = np.linspace(0.0, 2 * cycle, 4001)
+    phase = 2 * np.pi * d / cycle
+    tip = d + np.array([aid_shift_m(device, p, 1.0, cycle) for p in phase])
+    u = ((phase - AID_STANCE_START) / (2 * np.pi)) % 1.0
+    planted = u < AID_STANCE - 1e-3
+    step = np.diff(tip)
+    assert np.all(np.abs(step[planted[:-1] & planted[1:]]) < 1e-9)
+    assert np.all(step > -1e-9)  # never backwards
+    assert np.max(step) < 10 * (d[1] - d[0])  # no jump
+    assert np.ptp(tip[planted & (d < cycle)]) < 1e-9 and np.ptp(tip) > cycle  # it does move on
+    assert aid_shift_m(device, 1.0, 0.0, cycle) == 0.0  # standing still, the aid stands in its place
+    assert aid_shift_m("walker", 1.0, 1.0, cycle) == 0.0
+
+
+@pytest.mark.parametrize("device", STEPPING_AIDS)
+@pytest.mark.parametrize("body", [52, 60, 66])
+def test_hands_stay_on_the_grips_of_stepping_aids(bank, body, device):
+    """The holding hand's wrist joint within 4 cm of the grip at twelve phases (two-bone IK reaches it)."""
+    fit = fit_device(bank, body, device)
+    cycle = _cycle_m(bank, body, device)
+    k = 1 if device == "crutch" else 0  # the right hand's aid
+    x, y = AID_OFFSETS[device][k]
+    for phase in np.linspace(0, 2 * np.pi, 12, endpoint=False):
+        shift = aid_shift_m(device, phase, 1.0, cycle)
+        hand = pose(bank, body, device, fit, phase, 1.0, shift).joints[BONES.index("hand.R")]
+        grip = np.array([x + GRIP_DX[device] + shift, y, fit.grip_height_m])
+        assert np.linalg.norm(hand[:2] - grip[:2]) < 0.04 and abs(hand[2] - grip[2]) < 0.08, (phase, hand - grip)
+
+
+@pytest.mark.parametrize("body", [15, 2, 47, 60, 67])
+def test_seated_on_a_bench_the_pelvis_rests_on_the_seat_and_the_feet_on_the_ground(bank, body):
+    """The street bench (synthua_usd.assets.street.bench: seat top 0.47 m, 0.44 m deep centred on x = 0,
+    backrest behind x = -0.22) placed where :mod:`synthua_usd.agents.seats` puts a sitter's origin (0.17 m in
+    front of the seat's back edge): what sits rests on the cushion within the seat tolerance, nothing is
+    inside the bench beyond the device tolerance, and the feet stand on the ground unless too short to reach
+    it (a child's dangle)."""
+    from synthua_usd.agents.seats import ORIGIN_FROM_BACK_M
+    from synthua_usd.assets import street
+    from synthua_usd.assets.postures import BENCH, bench_fit
+
+    dx = 0.22 - ORIGIN_FROM_BACK_M  # the bench's centre in the sitter's frame
+    solids = []
+    for part in street.bench():
+        mesh = trimesh.Trimesh(part.points + [dx, 0.0, 0.0], part.triangles, process=True)
+        solids += [piece.convex_hull for piece in mesh.split(only_watertight=False)]
+    seat = max(solids, key=lambda m: np.prod(np.ptp(m.vertices[:, :2], axis=0)))
+    top = seat.vertices[:, 2].max()
+    posed = pose(bank, body, BENCH, bench_fit(top), 0.0, 0.0)
+    pts = skin(bank.points[body], bank, posed.skinning(bank.joints[body]))
+    sitting = pts[np.unique(bank.triangles[bank.face_segment <= 2])]
+    lo, hi = seat.vertices[:, :2].min(axis=0), seat.vertices[:, :2].max(axis=0)
+    above = sitting[np.all((sitting[:, :2] > lo) & (sitting[:, :2] < hi), axis=1)]
+    assert abs(above[:, 2].min() - top) < SEAT_TOLERANCE_M
+    assert _penetration(pts, solids) <= DEVICE_TOLERANCE_M
+    feet = pts[:, 2].min()
+    assert feet > -SEAT_TOLERANCE_M
+    if bank.height_m[body] > 1.6:
+        assert feet < 0.04

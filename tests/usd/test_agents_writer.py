@@ -14,8 +14,9 @@ from synthua_usd.agents.crowd import CrowdParams, scripted_crowd
 from synthua_usd.agents.motion import simulate
 from synthua_usd.agents.population import Plan
 from synthua_usd.agents.profiles import PROFILES
-from synthua_usd.assets.bodies import REGIONS, SEGMENTS
+from synthua_usd.assets.bodies import REGIONS, SEGMENTS, load_bank
 from synthua_usd.assets.people import PersonLook
+from synthua_usd.assets.postures import STEPPING_AIDS, aid_shift_m, step_length_m
 from synthua_usd.demo.street import META, street_scenario
 from synthua_usd.errors import StageError
 from synthua_usd.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
@@ -246,8 +247,10 @@ def test_every_person_and_device_carries_keypoints_on_its_rendered_geometry(stag
         for path, cls in [(f"{prim.GetPath()}/Person", "person")] + (
                 [(f"{prim.GetPath()}/{''.join(p.title() for p in device.split('_'))}", device)] if device else []):
             inst = by_path[path]
-            # the keypoints are computed in the agent's frame: the labelled prims must not move on their own
-            assert not UsdGeom.Xformable(stage.GetPrimAtPath(path)).GetOrderedXformOps(), path
+            # a person's keypoints are in the agent's frame: the Person prim must not move on its own (a stepping
+            # aid's prim does: its contact points are in its own frame, checked by their place in the world below)
+            if cls == "person":
+                assert not UsdGeom.Xformable(stage.GetPrimAtPath(path)).GetOrderedXformOps(), path
             found = snapshot.keypoints[inst.id]
             assert found.names == KEYPOINT_CLASSES[cls].names
             points = np.concatenate([m.points for m in snapshot.meshes if m.instance_id == inst.id])
@@ -273,3 +276,35 @@ def test_keypoints_named_otherwise_are_refused(scenario, class_map, tmp_path):
     reader = StageReader(stage, class_map)
     with pytest.raises(StageError, match="holds 16 points.*expected 17"):
         reader.snapshot(3.0)
+
+
+def test_crutches_and_canes_step_with_the_gait_and_the_hands_go_with_them(stage, crowd, class_map):
+    """A stepping aid's device prim has a forward translate per time code equal to :func:`aid_shift_m` of the
+    agent's gait (an independent recomputation from the agent's travelled distance), and the holding hand's
+    mesh moves with it: the world distance between the aid's grip and the hand stays within a few cm."""
+    reader = StageReader(stage, class_map)
+    checked = 0
+    for k, traj in enumerate(crowd.trajectories):
+        device = traj.plan.profile.device
+        if device not in STEPPING_AIDS:
+            continue
+        look = crowd.looks[k]
+        cycle = 2 * step_length_m(traj.plan.speed_mps, float(load_bank().height_m[look.body]))
+        aid = stage.GetPrimAtPath(f"{AGENTS_ROOT}/Agent_{k:04d}/{''.join(p.title() for p in device.split('_'))}")
+        translate = UsdGeom.Xformable(aid).GetOrderedXformOps()[0]
+        assert translate.GetNumTimeSamples() == len(traj.positions)
+        shifts = [translate.Get(Usd.TimeCode(META.start_time_code + f))[0] for f in range(len(traj.positions))]
+        # Walking at constant speed: the amplitude is 1 once moving.
+        expected = [aid_shift_m(device, 2 * np.pi * d / cycle, 1.0, cycle) for d in traj.distance_m]
+        assert np.allclose(shifts[2:], expected[2:], atol=1e-6)
+        assert np.ptp(shifts) > 0.1
+        gaps = []
+        for f in (5, 15, 30):
+            snap = _meshes(reader.snapshot(META.start_time_code + f))
+            hand = snap[f"{AGENTS_ROOT}/Agent_{k:04d}/Person/ForearmR/Skin/Mesh"].points
+            aid_pts = np.concatenate([m.points for p, m in snap.items() if p.startswith(str(aid.GetPath()) + "/")])
+            top = aid_pts[aid_pts[:, 2] > aid_pts[:, 2].max() - (0.3 if device == "crutch" else 0.05)]
+            gaps.append(float(np.min(np.linalg.norm(hand[:, None] - top[None], axis=-1))))
+        assert max(gaps) < 0.05, (device, gaps)
+        checked += 1
+    assert checked == 5  # crutches and four canes
