@@ -33,14 +33,23 @@ def test_person_and_wheelchair_are_distinct_instances_with_a_relation(snap):
 
 
 def test_world_transform_follows_the_animation(demo_stage, class_map):
-    def head_centre(t):
+    """The reader places a body segment by its world transform at the time code (agent root, then the
+    segment's gait motion): its points equal the prototype's points under USD's own XformCache, and the
+    agent root walks 1.3 m/s along +X (frames 1 -> 25: one second at 24 time codes per second)."""
+    path = "/World/Agents/Agent_0000/Person/Torso/Skin/Mesh"
+    proxy = demo_stage.GetPrimAtPath(path)
+    local = np.array(UsdGeom.Mesh(proxy).GetPointsAttr().Get(), float)
+    roots = []
+    for t in (1.0, 25.0):
         s = read_snapshot(demo_stage, t, class_map)
-        (head,) = [m for m in s.meshes if m.prim_path == "/World/Agents/Agent_0000/Person/Head/Mesh"]
-        return head.points.mean(axis=0)
-
-    a, b = head_centre(1.0), head_centre(25.0)
-    # 1.3 m/s along +X; frames 1 -> 25 are one second at 24 time codes per second.
-    assert b - a == pytest.approx([1.3, 0.0, 0.0], abs=1e-5)
+        (mesh,) = [m for m in s.meshes if m.prim_path == path]
+        world = np.array(UsdGeom.XformCache(t).GetLocalToWorldTransform(proxy), float)  # row vectors
+        expected = local @ world[:3, :3] + world[3, :3]
+        np.testing.assert_allclose(np.asarray(mesh.points, float), expected, atol=1e-4)
+        root = np.array(UsdGeom.XformCache(t).GetLocalToWorldTransform(proxy.GetParent().GetParent().GetParent()
+                                                                      .GetParent()), float)
+        roots.append(root[3, :3])
+    assert roots[1] - roots[0] == pytest.approx([1.3, 0.0, 0.0], abs=1e-5)
 
 
 def test_instance_ids_are_stable_across_frames(demo_stage, class_map):
