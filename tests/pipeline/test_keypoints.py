@@ -128,7 +128,7 @@ def test_frontal_person_keypoints_land_on_the_independently_projected_rig(scene,
     stage = Usd.Stage.Open(str(path))
     bank = load_bank()
     traj, look = crowd.trajectories[0], crowd.looks[0]
-    phase, amplitude = _phases(traj, float(bank.height_m[look.body]), META.time_codes_per_second)
+    phase, amplitude, _ = _phases(traj, float(bank.height_m[look.body]), META.time_codes_per_second)
     k = int(T - META.start_time_code)
     assert amplitude[k] > 0.9, "the pedestrian should be mid-stride"
     rest = bank.joints[look.body]
