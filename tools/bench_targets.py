@@ -16,8 +16,11 @@ Prints one markdown table with ratios, then where each target stands:
 * the whole annotated image through the dataset pipeline (``synthua generate`` on ``--views`` x seeds: RGB,
   labels, amodal masks, annotations, QA, every file written): images/min and seconds per image by part —
   target 15 images/min on 2 cores (300 on cuda_ad_rgb) with RGB at 40 dB or better;
-* the render session's first load and its per-frame update (next time code: moving agents; another
-  camera) against the frame time — target at most 5 %;
+* RGB at the default quality (``RenderConfig``'s spp, pixel filter and denoiser at max_depth 4): PSNR and SSIM
+  against the same reference — target 40 dB;
+* the render session's first load and its per-frame update (next time code: moving agents, best of --repeat
+  consecutive time codes; another camera) against the frame time, and the next time code against a
+  default-quality frame — target at most 5 %;
 * Blender Cycles (PyPI ``bpy``, in its own interpreter) rendering the same exported scene (meshes, material
   constants, the stage's UsdLux sun and dome, same camera) on the CPU with 2 threads, max_bounces 2 (Mitsuba
   max_depth 4), adaptive sampling with and without OpenImageDenoise, its fastest setting that reaches the Mitsuba

@@ -202,7 +202,8 @@ class StageReader:
     the very same :class:`MeshItem` objects for the rest (so a backend can tell what moved by identity).
     A gprim whose own attributes are all constant and only its transform varies (a rigidly moving agent
     part) keeps its local triangles, texture coordinates, material and labels from the first read: a later
-    time code only re-places them in the world. The list of renderable gprims is kept too while no prim in
+    time code only re-places them in the world (as for constant gprims, a colour primvar inherited from an
+    ancestor that varies over time is read once). The list of renderable gprims is kept too while no prim in
     the stage has a time-varying visibility.
     """
 
