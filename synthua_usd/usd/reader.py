@@ -10,6 +10,7 @@ finds with the checks of :mod:`synthua_usd.usd.prim_checks`, which ``synthua val
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -243,6 +244,11 @@ class StageReader:
     Instances, materials and the meshes of gprims that cannot change over time are read once; a snapshot
     at another time code re-reads only the gprims whose transform or geometry is time-varying and reuses
     the very same :class:`MeshItem` objects for the rest (so a backend can tell what moved by identity).
+    A gprim whose own attributes are all constant and only its transform varies (a rigidly moving agent
+    part) keeps its local triangles, texture coordinates, material and labels from the first read: a later
+    time code only re-places them in the world (as for constant gprims, a colour primvar inherited from an
+    ancestor that varies over time is read once). The list of renderable gprims is kept too while no prim in
+    the stage has a time-varying visibility.
     """
 
     def __init__(self, stage: Usd.Stage, class_map: ClassMap) -> None:
@@ -253,21 +259,39 @@ class StageReader:
         self._keypoint_prims = keypoint_prims(stage, self.instances)
         self._materials = Materials()
         self._static: dict[str, MeshItem | None] = {}
-        self._varying: dict[str, bool] = {}
+        self._varying: dict[str, str] = {}
         self._xform_memo: dict[str, bool] = {}
+        self._local: dict[str, _LocalGprim | None] = {}
+        self._gprims: list[Usd.Prim] | None = None
         self._warned_unlabelled = False
         self._warned_unlit = False
         self._warned_skinned = False
         self._last: SceneSnapshot | None = None
 
-    def _is_varying(self, prim: Usd.Prim) -> bool:
+    def _variation(self, prim: Usd.Prim) -> str:
+        """'geometry' when one of the gprim's own authored attributes may vary over time, else 'transform' when
+        its world transform may, else '' (constant)."""
         key = str(prim.GetPath())
         if key not in self._varying:
-            geometry = any(a.ValueMightBeTimeVarying() for a in prim.GetAttributes() if a.HasAuthoredValue())
-            self._varying[key] = geometry or _might_vary(prim, self._xform_memo)
+            if any(a.ValueMightBeTimeVarying() for a in prim.GetAttributes() if a.HasAuthoredValue()):
+                self._varying[key] = "geometry"
+            else:
+                self._varying[key] = "transform" if _might_vary(prim, self._xform_memo) else ""
         return self._varying[key]
 
-    def _mesh_item(self, prim: Usd.Prim, t: Usd.TimeCode, xcache: UsdGeom.XformCache) -> MeshItem | None:
+    def _renderable_gprims(self, t: Usd.TimeCode) -> list[Usd.Prim]:
+        """:func:`renderable_gprims` at ``t``; kept from the first call while no visibility in the stage varies."""
+        if self._gprims is not None:
+            return self._gprims
+        gprims = renderable_gprims(self.stage, t)
+        every = Usd.PrimRange.Stage(self.stage, Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate))
+        if not any(UsdGeom.Imageable(p).GetVisibilityAttr().ValueMightBeTimeVarying()
+                   for p in every if p.IsA(UsdGeom.Imageable)):
+            self._gprims = gprims
+        return gprims
+
+    def _local_gprim(self, prim: Usd.Prim, t: Usd.TimeCode) -> "_LocalGprim | None":
+        """The gprim in its own space at ``t`` with its material and labels; None when it has no triangles."""
         message = unsupported_gprim_message(prim)
         if message:
             raise UnsupportedPrimError(f"{prim.GetPath()}: {message}")
@@ -275,18 +299,36 @@ class StageReader:
         points, tris, uvs = self._geometry(prim, t, material)
         if len(tris) == 0:
             return None
+        sites = label_sites(prim, self.class_map.taxonomy)
+        inst = self.instances.get(sites[0].prim_path) if sites else None
+        return _LocalGprim(points=points, triangles=tris, uvs=uvs, material_key=material.key,
+                           instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0,
+                           lamp=_lamp_role(prim), double_sided=bool(UsdGeom.Gprim(prim).GetDoubleSidedAttr().Get()))
+
+    def _placed(self, prim: Usd.Prim, local: "_LocalGprim", t: Usd.TimeCode, xcache: UsdGeom.XformCache) -> MeshItem:
+        """``local`` in world metres with ``prim``'s transform at ``t``."""
         m = np.array(xcache.GetLocalToWorldTransform(prim), float)  # row-vector convention
-        world = (points @ m[:3, :3] + m[3, :3]) * self.meters_per_unit
+        world = (local.points @ m[:3, :3] + m[3, :3]) * self.meters_per_unit
+        tris = local.triangles
         if np.linalg.det(m[:3, :3]) < 0:  # a mirroring transform flips the winding
             tris = tris[:, ::-1]
         if not np.all(np.isfinite(world)):
             raise StageError(f"{prim.GetPath()}: has non-finite point coordinates at time {t.GetValue():g}")
-        sites = label_sites(prim, self.class_map.taxonomy)
-        inst = self.instances.get(sites[0].prim_path) if sites else None
         return MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
-                        material_key=material.key, instance_id=inst.id if inst else 0,
-                        class_id=inst.class_id if inst else 0, lamp=_lamp_role(prim), uvs=uvs,
-                        double_sided=bool(UsdGeom.Gprim(prim).GetDoubleSidedAttr().Get()))
+                        material_key=local.material_key, instance_id=local.instance_id, class_id=local.class_id,
+                        lamp=local.lamp, uvs=local.uvs, double_sided=local.double_sided)
+
+    def _mesh_item(self, prim: Usd.Prim, t: Usd.TimeCode, xcache: UsdGeom.XformCache) -> MeshItem | None:
+        """The gprim at ``t`` in world space (None without triangles); a gprim whose only variation is its
+        transform is read once in its own space and re-placed."""
+        key = str(prim.GetPath())
+        if self._variation(prim) == "transform":
+            if key not in self._local:
+                self._local[key] = self._local_gprim(prim, t)
+            local = self._local[key]
+        else:
+            local = self._local_gprim(prim, t)
+        return None if local is None else self._placed(prim, local, t, xcache)
 
     def _geometry(self, prim: Usd.Prim, t: Usd.TimeCode, material: Material
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -321,9 +363,9 @@ class StageReader:
         t = Usd.TimeCode(time_code)
         xcache = UsdGeom.XformCache(t)
         meshes = []
-        for prim in renderable_gprims(self.stage, t):
+        for prim in self._renderable_gprims(t):
             key = str(prim.GetPath())
-            if self._is_varying(prim):
+            if self._variation(prim):
                 item = self._mesh_item(prim, t, xcache)
                 before = previous.get(key)
                 if (item is not None and before is not None and np.array_equal(before.points, item.points)
@@ -355,6 +397,22 @@ class StageReader:
                                    keypoints=read_keypoints(self._keypoint_prims, time_code, xcache,
                                                             self.meters_per_unit))
         return self._last
+
+
+@dataclass(frozen=True, eq=False)
+class _LocalGprim:
+    """A gprim in its own space: ``points`` (n, 3) float64 in stage units, ``triangles`` (m, 3) int64 as authored
+    (winding not yet flipped for a mirroring transform), ``uvs`` as :attr:`MeshItem.uvs`, and the material key,
+    instance, class, lamp role and sidedness of the :class:`MeshItem` it becomes."""
+
+    points: np.ndarray
+    triangles: np.ndarray
+    uvs: np.ndarray | None
+    material_key: str
+    instance_id: int
+    class_id: int
+    lamp: str
+    double_sided: bool
 
 
 def _same_uvs(a: np.ndarray | None, b: np.ndarray | None) -> bool:

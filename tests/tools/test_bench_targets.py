@@ -53,3 +53,5 @@ def test_a_tiny_run_measures_every_mitsuba_row(tmp_path):
                     "per-frame update, another camera"):
         assert measure in rows and rows[measure]["value"] not in ("", "-"), (measure, sorted(rows))
     assert any(name.startswith("RGB denoised") and "dB" in row["value"] for name, row in rows.items())
+    assert "dB" in rows["RGB at the default quality"]["value"]
+    assert rows["per-frame update, next time code, against a default-quality frame"]["ratio"].endswith("%")

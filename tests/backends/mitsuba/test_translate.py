@@ -7,7 +7,7 @@ import pytest
 from pxr import UsdGeom
 
 from synthua_usd.backends.mitsuba import variants
-from synthua_usd.backends.mitsuba.translate import bsdf_dict, translate
+from synthua_usd.backends.mitsuba.translate import DOME_WEIGHT_SHARE, bsdf_dict, translate
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import Material
 from synthua_usd.usd.cameras import read_camera
@@ -30,7 +30,9 @@ def test_translation_without_rendering(tiny, variant):
     assert sensor["fov"] == pytest.approx(math.degrees(2 * math.atan(36 / 2 / 20)))  # 20 mm on 36 mm film
     assert (sensor["film"]["width"], sensor["film"]["height"]) == (64, 48)
     assert sensor["sampler"]["sample_count"] == 4
-    assert tr.scene["light_000"] == {"type": "constant", "radiance": {"type": "rgb", "value": [1.0, 1.0, 1.0]}}
+    # the only light: its weight does not matter to Mitsuba's choice, it is the dome's illuminance share
+    assert tr.scene["light_000"] == {"type": "constant", "radiance": {"type": "rgb", "value": [1.0, 1.0, 1.0]},
+                                     "sampling_weight": pytest.approx(math.pi * DOME_WEIGHT_SHARE)}
     # One shape per snapshot mesh, in the snapshot's order: labels look up prim paths and classes by it.
     assert [m.prim_path for m in snap.meshes] == ["/World/Ground", "/World/Box"]
     assert [m.class_id for m in snap.meshes] == [1, 18]
@@ -64,3 +66,25 @@ def test_preview_surface_to_principled():
     d = bsdf_dict(Material("m", (0.2, 0.3, 0.4), roughness=1.5, metallic=0.25))
     assert d == {"type": "principled", "base_color": {"type": "rgb", "value": [0.2, 0.3, 0.4]},
                  "roughness": 1.0, "metallic": 0.25}
+
+
+def test_sun_and_sky_are_sampled_by_the_illuminance_they_bring(class_map, variant):
+    """Without a condition each UsdLux light's emitter-sampling weight is the illuminance it brings to an up-facing
+    surface (the dome's scaled by DOME_WEIGHT_SHARE), computed here from the stage's authored values; with a
+    condition the stage's own sun and sky are left out and nothing is weighted here."""
+    from conftest import DATA
+    from synthua_usd.usd.stage_io import open_stage
+
+    stage = open_stage(DATA / "valid" / "tiny_lit_scene.usda")
+    snap = read_snapshot(stage, 1.0, class_map)
+    mi = variants.activate(variant)
+    tr = translate(mi, snap, read_camera(stage, "/World/Cam", 1.0), RenderConfig(width=8, height=6, spp=1))
+    emitters = {d["type"]: d for k, d in tr.scene.items() if k.startswith("light_")}
+    # authored: DistantLight intensity 3 rotated (35, 0, -30) from -Z; DomeLight intensity 0.6; both white
+    # (the reader's colours are checked elsewhere: take them from the snapshot)
+    sun, sky = (next(l for l in snap.lights if l.kind == kind) for kind in ("distant", "dome"))
+    cos_sun = math.cos(math.radians(35))  # rotateXYZ (35, 0, -30) tilts -Z by 35 degrees from the nadir
+    assert emitters["directional"]["sampling_weight"] == pytest.approx(3 * np.mean(sun.color) * cos_sun, rel=1e-5)
+    assert emitters["constant"]["sampling_weight"] == pytest.approx(
+        math.pi * 0.6 * np.mean(sky.color) * DOME_WEIGHT_SHARE, rel=1e-5)
+    assert emitters["directional"]["sampling_weight"] > 4 * emitters["constant"]["sampling_weight"]
