@@ -275,7 +275,10 @@ run_shards(shards, INIT, toy_work, print, ExecutorConfig("local", workers=2))
 @pytest.mark.parametrize("how", ["ctrl-c", "kill -9"])
 def test_no_worker_outlives_its_parent(tmp_path, how):
     script = textwrap.dedent(PARENT.format(here=str(HERE), folder=str(tmp_path)))
-    parent = subprocess.Popen([sys.executable, "-c", script], start_new_session=True, stderr=subprocess.PIPE)
+    # A foreground program in a terminal has Ctrl-C's default disposition; a test run started as a background job
+    # (`cmd &`, nohup) inherits SIGINT ignored, and Python then installs no KeyboardInterrupt handler: restore it.
+    parent = subprocess.Popen([sys.executable, "-c", script], start_new_session=True, stderr=subprocess.PIPE,
+                              preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + 60
         while len(list(tmp_path.iterdir())) < 2 and time.monotonic() < deadline and parent.poll() is None:
