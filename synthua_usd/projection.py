@@ -33,6 +33,11 @@ from synthua_usd.errors import InputError
 
 #: Points per side of the frame's border undistorted to outline the frame of a distorted camera.
 BORDER_SAMPLES = 64
+#: Points moved into the camera frame per matrix product. OpenBLAS runs a larger (n, 3) x (3, 3) product on
+#: all its threads, which on a busy machine (a render, the background writer) cost ten times more than one
+#: thread doing it (60 ms against 5 ms for a 166k-point ground); each row is its own three dot products, so
+#: the blocks give the same numbers.
+PRODUCT_ROWS = 8192
 
 
 def projected_box(points_world: np.ndarray, triangles: np.ndarray, camera: PinholeCamera, width: int,
@@ -41,42 +46,84 @@ def projected_box(points_world: np.ndarray, triangles: np.ndarray, camera: Pinho
     plane (module docstring), or None when nothing of them lies in front of it.
 
     ``points_world`` (n, 3) float, world metres; ``triangles`` (m, 3) int indices into it."""
-    points, triangles = _checked(points_world, triangles)
+    return projected_boxes([(points_world, triangles)], camera, width, height)[0]
+
+
+def projected_boxes(parts, camera: PinholeCamera, width: int, height: int) -> list[np.ndarray | None]:
+    """:func:`projected_box` of each ``(points_world, triangles)`` of ``parts``, computed together: the
+    per-part work is one matrix product, the rest runs once over all triangles (an image's 230 instances
+    one by one cost 0.3 s at 1280x960)."""
+    checked = [_checked(points, triangles) for points, triangles in parts]
     ext = camera.world_to_camera_opencv()
-    pc = points @ ext[:3, :3].T + ext[:3, 3]
     near = camera.clip_near_m
+    k = camera.intrinsics(width, height)
+    offsets = np.cumsum([0] + [len(points) for points, _ in checked])
+    pc = np.concatenate([_to_camera(points, ext) for points, _ in checked] + [np.zeros((0, 3))])
+    triangles = np.concatenate([tris + offset for (_, tris), offset in zip(checked, offsets)]
+                               + [np.zeros((0, 3), np.int64)])
+    owner = np.repeat(np.arange(len(checked)), [len(tris) for _, tris in checked])
     front = pc[:, 2] >= near
     used = np.zeros(len(pc), bool)
-    used[triangles.ravel()] = True
-    kept = [pc[used & front]]
-    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
-    a, b = pc[edges[:, 0]], pc[edges[:, 1]]
+    used[triangles.reshape(-1)] = True
+    # the points of the triangles in front of the near plane (a part's points follow the part before's)
+    kept = np.flatnonzero(used & front)
+    x, y, z = pc[kept, 0], pc[kept, 1], pc[kept, 2]
+    u, v = k[0, 0] * x / z + k[0, 2], k[1, 1] * y / z + k[1, 2]
+    bounds = np.searchsorted(kept, offsets)
+    found = np.diff(bounds) > 0
+    low = np.full((len(checked), 2), np.inf)
+    high = np.full((len(checked), 2), -np.inf)
+    if kept.size:
+        for axis, coord in ((0, u), (1, v)):  # each part with points: from its first to the next part's
+            low[found, axis] = np.minimum.reduceat(coord, bounds[:-1][found])
+            high[found, axis] = np.maximum.reduceat(coord, bounds[:-1][found])
+    sides = front[triangles]
+    # and where edges cross it: only a triangle with corners on both sides of the plane has such edges
+    straddling = np.flatnonzero(sides.any(axis=1) & ~sides.all(axis=1))
+    edges = np.concatenate([triangles[straddling][:, [0, 1]], triangles[straddling][:, [1, 2]],
+                            triangles[straddling][:, [2, 0]]])
+    edge_owner = np.tile(owner[straddling], 3)
     crossing = front[edges[:, 0]] != front[edges[:, 1]]
-    a, b = a[crossing], b[crossing]
+    a, b, edge_owner = pc[edges[crossing, 0]], pc[edges[crossing, 1]], edge_owner[crossing]
     t = (near - a[:, 2]) / (b[:, 2] - a[:, 2])
-    kept.append(a + t[:, None] * (b - a))
-    clipped = np.concatenate(kept)
-    if not len(clipped):
-        return None
-    k = camera.intrinsics(width, height)
-    u = k[0, 0] * clipped[:, 0] / clipped[:, 2] + k[0, 2]
-    v = k[1, 1] * clipped[:, 1] / clipped[:, 2] + k[1, 2]
-    return np.array([u.min(), v.min(), u.max(), v.max()])
+    clipped = a + t[:, None] * (b - a)
+    found[edge_owner] = True
+    for axis, f, c in ((0, k[0, 0], k[0, 2]), (1, k[1, 1], k[1, 2])):
+        coord = f * clipped[:, axis] / clipped[:, 2] + c
+        np.minimum.at(low[:, axis], edge_owner, coord)
+        np.maximum.at(high[:, axis], edge_owner, coord)
+    return [np.array([lo[0], lo[1], hi[0], hi[1]]) if any_found else None
+            for lo, hi, any_found in zip(low, high, found)]
 
 
 def truncation(points_world: np.ndarray, triangles: np.ndarray, camera: PinholeCamera, width: int,
                height: int) -> float:
     """Share 0..1 of the instance's projected box outside the frame (module docstring for the definition)."""
-    box = projected_box(points_world, triangles, camera, width, height)
+    return truncations([(points_world, triangles)], camera, width, height)[0]
+
+
+def truncations(parts, camera: PinholeCamera, width: int, height: int) -> list[float]:
+    """:func:`truncation` of each ``(points_world, triangles)`` of ``parts`` (one per instance)."""
+    frame = frame_outline(camera, width, height)
+    return [_box_truncation(box, frame) for box in projected_boxes(parts, camera, width, height)]
+
+
+def _box_truncation(box: np.ndarray | None, frame: np.ndarray) -> float:
     if box is None:
         return 1.0
-    frame = frame_outline(camera, width, height)
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     if box_area <= 0.0:
         lo, hi = frame.min(axis=0), frame.max(axis=0)
         return 0.0 if (box[0] >= lo[0] and box[1] >= lo[1] and box[2] <= hi[0] and box[3] <= hi[1]) else 1.0
     inside = _polygon_area(_clip_to_box(frame, box))
     return float(min(1.0, max(0.0, 1.0 - inside / box_area)))
+
+
+def _to_camera(points: np.ndarray, ext: np.ndarray) -> np.ndarray:
+    """(n, 3) world points in OpenCV camera coordinates, by blocks of :data:`PRODUCT_ROWS`."""
+    rotation = ext[:3, :3].T
+    return np.concatenate([points[i:i + PRODUCT_ROWS] @ rotation for i in range(0, len(points), PRODUCT_ROWS)]
+                          or [points @ rotation]) + ext[:3, 3]
 
 
 def frame_outline(camera: PinholeCamera, width: int, height: int) -> np.ndarray:

@@ -8,6 +8,7 @@ Class ids are the project's class map's (``schemas/classmap.json``): 1 road, 3 s
 from __future__ import annotations
 
 import numpy as np
+from scipy import ndimage
 
 from synthua_usd.dataset.annotations import annotate, panoptic
 from synthua_usd.scene import Instance
@@ -97,3 +98,55 @@ def record(image_id: int, split: str, class_map, flip: bool = False, verdict: st
                "measures": {"laplacian_var": 10.0 + image_id}},
     }
     return rec, (cls, ins, amodal)
+
+
+def crowded_scene(seed: int, height: int = 61, width: int = 83) -> tuple:
+    """A random scene of many overlapping instances, for comparisons with per-instance computations:
+    blobs and boxes (things and stuff) painted over each other, parts cut apart and pinched, instances on
+    every border (column-major runs that cross from one column's bottom to the next column's top), single
+    pixels, instances hidden entirely; random amodal pixel sets (some outside the visible mask, some empty)
+    and truncations. Returns (class ids, instance ids, instances, amodal, truncation)."""
+    rng = np.random.default_rng(seed)
+    cls = np.zeros((height, width), np.uint8)
+    ins = np.zeros((height, width), np.uint16)
+    kinds = [(1, "road", False), (3, "sidewalk", False), (6, "building", True), (18, "person", True),
+             (19, "car", True), (22, "bicycle", True), (29, "manual_wheelchair", True)]
+    instances = []
+    for k in range(60):
+        inst_id = 65535 - k if k % 7 == 0 else 100 + 3 * k  # ids up to the uint16 limit too
+        class_id, name, isthing = kinds[int(rng.integers(len(kinds)))]
+        instances.append(Instance(inst_id, f"/World/I{k}", class_id, name, isthing))
+        y0, x0 = int(rng.integers(-5, height)), int(rng.integers(-5, width))
+        y1, x1 = y0 + int(rng.integers(1, 25)), x0 + int(rng.integers(1, 25))
+        region = (slice(max(0, y0), max(0, y1)), slice(max(0, x0), max(0, x1)))
+        if k % 3 == 0:
+            painted = rng.random((height, width)) < 0.5  # a speckled blob: pinches, holes, many parts
+            keep = np.zeros((height, width), bool)
+            keep[region] = True
+            painted &= keep
+        else:
+            painted = np.zeros((height, width), bool)
+            painted[region] = True
+        if k == 5:  # a full column: runs that continue from one column into the next
+            painted[:, width // 2:width // 2 + 3] = True
+        if k == 6:  # one pixel on the last row
+            painted = np.zeros((height, width), bool)
+            painted[-1, -1] = True
+        cls[painted], ins[painted] = class_id, inst_id
+    stuff_only = rng.random((height, width)) < 0.05  # stuff and void pixels without instance
+    cls[stuff_only], ins[stuff_only] = 3, 0
+    hidden = Instance(7, "/World/Hidden", 18, "person", True)
+    instances.append(hidden)
+    visible = {int(i) for i in np.unique(ins) if i}
+    amodal, truncation = {}, {}
+    for inst in instances:
+        choice = int(rng.integers(4))
+        if choice == 0:
+            amodal[inst.id] = np.sort(rng.choice(height * width, int(rng.integers(1, 200)), replace=False))
+        elif choice == 1 and inst.id in visible:  # the visible pixels and a few more around them
+            around = np.flatnonzero(ndimage.binary_dilation(ins == inst.id))
+            amodal[inst.id] = around
+        elif choice == 2:
+            amodal[inst.id] = np.zeros(0, np.int64)
+        truncation[inst.id] = float(rng.random())
+    return cls, ins, tuple(instances), amodal, truncation

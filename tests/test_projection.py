@@ -11,7 +11,7 @@ import pytest
 from synthua_usd.cameras import PinholeCamera
 from synthua_usd.distortion import BrownConrady
 from synthua_usd.errors import InputError
-from synthua_usd.projection import frame_outline, projected_box, truncation
+from synthua_usd.projection import frame_outline, projected_box, projected_boxes, truncation, truncations
 
 W, H = 360, 240
 QUAD = np.array([[0, 1, 2], [0, 2, 3]])
@@ -101,3 +101,50 @@ def test_distorted_frame_outline_maps_back_onto_the_frame_border():
 def test_bad_input_is_refused(points, triangles):
     with pytest.raises(InputError, match="projection"):
         truncation(points, np.asarray(triangles), camera(), W, H)
+
+
+def box_of_one_mesh(points, triangles, cam, width, height):
+    """projected_box the straightforward way, one mesh at a time: project the used points in front of the
+    near plane and the points where triangle edges cross it."""
+    ext = cam.world_to_camera_opencv()
+    pc = points @ ext[:3, :3].T + ext[:3, 3]
+    front = pc[:, 2] >= cam.clip_near_m
+    used = np.zeros(len(pc), bool)
+    used[triangles.ravel()] = True
+    found = [pc[used & front]]
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        pa, pb = pc[triangles[:, a]], pc[triangles[:, b]]
+        cross = front[triangles[:, a]] != front[triangles[:, b]]
+        t = (cam.clip_near_m - pa[cross, 2]) / (pb[cross, 2] - pa[cross, 2])
+        found.append(pa[cross] + t[:, None] * (pb[cross] - pa[cross]))
+    found = np.concatenate(found)
+    if not len(found):
+        return None
+    k = cam.intrinsics(width, height)
+    u = k[0, 0] * found[:, 0] / found[:, 2] + k[0, 2]
+    v = k[1, 1] * found[:, 1] / found[:, 2] + k[1, 2]
+    return np.array([u.min(), v.min(), u.max(), v.max()])
+
+
+def test_boxes_of_many_meshes_at_once_equal_each_mesh_alone():
+    """truncations works on all of an image's instances together (and multiplies large meshes in blocks):
+    each box must be exactly the one of its mesh alone, also across the near plane, for empty meshes and
+    unused points."""
+    rng = np.random.default_rng(5)
+    cam = PinholeCamera("/Cam", 35.0, 36.0, 24.0, 0.05, 1000.0,
+                        np.array([[1, 0, 0, 0.3], [0, 0.8, -0.6, 1.5], [0, 0.6, 0.8, 2.0], [0, 0, 0, 1.0]]), None)
+    parts = [(np.zeros((0, 3)), np.zeros((0, 3), np.int64))]
+    for n in (3, 10, 40, 200, 20000):  # 20000 points: more than one block
+        for spread in (0.5, 30.0):  # 30 m around the camera: meshes across the near plane and behind it
+            points = rng.normal(0, spread, (n, 3)) + [0, 0, -8]
+            triangles = rng.integers(0, max(1, n - 2), (max(1, n // 2), 3))  # the last points unused
+            parts.append((points, triangles))
+    parts.append((square(-1, 1, -1, 1, -5), QUAD))  # wholly behind
+    boxes = projected_boxes(parts, cam, W, H)
+    crossing = 0
+    for (points, triangles), box in zip(parts, boxes):
+        expected = box_of_one_mesh(points, triangles, cam, W, H) if len(triangles) else None
+        assert (box is None and expected is None) or np.array_equal(box, expected)
+        crossing += expected is not None and (expected[2] - expected[0]) > 10 * W
+    assert boxes[0] is None and boxes[-1] is None and crossing >= 2
+    assert truncations(parts, cam, W, H) == [truncation(p, t, cam, W, H) for p, t in parts]

@@ -67,12 +67,14 @@ def write_linear_exr(path: Path, rgb: np.ndarray) -> Path:
 
 def linear_to_display(rgb: np.ndarray) -> np.ndarray:
     """(H, W, 3) float32 scene-linear Rec.709 → (H, W, 3) uint8 sRGB through OCIO (values clipped to 0..1)."""
-    buf = oiio.ImageBuf(np.ascontiguousarray(rgb.astype(np.float32)))
+    buf = oiio.ImageBuf(np.ascontiguousarray(rgb, dtype=np.float32))
     converted = oiio.ImageBufAlgo.colorconvert(buf, LINEAR_SPACE, DISPLAY_SPACE)
     if converted.has_error:
         raise RuntimeError(f"colour conversion {LINEAR_SPACE} -> {DISPLAY_SPACE} failed: {converted.geterror()}")
-    display = np.clip(converted.get_pixels(oiio.FLOAT), 0.0, 1.0)
-    return np.round(display * 255.0).astype(np.uint8)
+    display = converted.get_pixels(oiio.FLOAT)  # a new array: scaled and rounded in place
+    np.clip(display, 0.0, 1.0, out=display)
+    display *= 255.0
+    return np.round(display, out=display).astype(np.uint8)
 
 
 def write_display_png(path: Path, rgb: np.ndarray) -> Path:

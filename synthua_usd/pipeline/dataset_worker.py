@@ -111,7 +111,7 @@ class ImageBuffers:
 
 def render_image(state: WorkerState, planned) -> ImageBuffers:
     """Render, trace amodal masks, annotate and check one planned image (nothing is written here)."""
-    from synthua_usd.projection import truncation
+    from synthua_usd.projection import truncations
     from synthua_usd.usd.cameras import read_camera
 
     job, class_map = state.job, state.class_map
@@ -121,7 +121,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     condition = state.condition(planned.condition)
     rendered = state.session.render(snapshot, camera, rgb=True, condition=condition, seed=planned.seed)
     width, height = job.render.width, job.render.height
-    visible = [int(i) for i in np.unique(rendered.instance_ids) if i]
+    visible = [i for i in np.flatnonzero(np.bincount(rendered.instance_ids.reshape(-1))).tolist() if i]
     group_of = {c.id: c.group for c in class_map.classes}
     by_id = {inst.id: inst for inst in snapshot.instances}
     wanted = [i for i in visible if job.config.amodal_wanted(by_id[i].class_name, group_of.get(by_id[i].class_id))]
@@ -136,11 +136,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     for mesh in snapshot.meshes:
         if mesh.instance_id in by_id:
             meshes_of.setdefault(mesh.instance_id, []).append(mesh)
-    truncations = {}
-    for i in visible:
-        meshes = meshes_of.get(i, [])
-        points, triangles, _ = snapshot.world_triangles(meshes)
-        truncations[i] = truncation(points, triangles, camera, width, height)
+    parts = [snapshot.world_triangles(meshes_of.get(i, []))[:2] for i in visible]
+    truncated = dict(zip(visible, truncations(parts, camera, width, height)))
     rgb, class_ids, instance_ids, depth = (rendered.rgb, rendered.class_ids, rendered.instance_ids,
                                            rendered.hits.z_m)
     if job.output_size is not None:
@@ -153,7 +150,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         depth = resample.gather(depth, index)
         amodal = {i: resample.resample_pixel_set(pixels, (height, width), index) for i, pixels in amodal.items()}
         width, height = out_w, out_h
-    instances = annotations.annotate(class_ids, instance_ids, snapshot.instances, amodal, truncations)
+    instances = annotations.annotate(class_ids, instance_ids, snapshot.instances, amodal, truncated)
     keypoints.annotate_keypoints(instances, snapshot.keypoints, camera, (job.render.width, job.render.height),
                                  instance_ids, depth)
     by_path = {inst.prim_path: inst for inst in snapshot.instances}
@@ -188,7 +185,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
                       "yolo_label": Layout.yolo_label(split, name)})
         arrays.update({"panoptic": panoptic_png, "cs_labelIds": labels, "cs_instanceIds": instance_cs,
                        "cs_color": colour, "yolo_label": yolo.yolo_lines(instances, width, height,
-                                                                        job.yolo_classes)})
+                                                                        job.yolo_classes, instance_ids)})
         outputs = job.config.outputs
         if outputs.depth:
             files["depth"] = Layout.frame_file(name, "depth.exr")

@@ -262,7 +262,12 @@ class StageReader:
         self._varying: dict[str, str] = {}
         self._xform_memo: dict[str, bool] = {}
         self._local: dict[str, _LocalGprim | None] = {}
+        #: The rigidly moving gprims placed last: (their paths, local points of all (n, 3), owner per point (n,),
+        #: bounds (k + 1,) of each gprim's points), kept while the same gprims move.
+        self._rigid_layout: tuple | None = None
         self._gprims: list[Usd.Prim] | None = None
+        self._entries: tuple[list[Usd.Prim], list[tuple[Usd.Prim, str, str]]] | None = None
+        self._light_prims: list[Usd.Prim] | None = None
         self._warned_unlabelled = False
         self._warned_unlit = False
         self._warned_skinned = False
@@ -289,6 +294,13 @@ class StageReader:
                    for p in every if p.IsA(UsdGeom.Imageable)):
             self._gprims = gprims
         return gprims
+
+    def _gprim_entries(self, t: Usd.TimeCode) -> list[tuple[Usd.Prim, str, str]]:
+        """(prim, path, :meth:`_variation`) of each of :meth:`_renderable_gprims` at ``t``, kept with that list."""
+        gprims = self._renderable_gprims(t)
+        if self._entries is None or self._entries[0] is not gprims:
+            self._entries = (gprims, [(p, str(p.GetPath()), self._variation(p)) for p in gprims])
+        return self._entries[1]
 
     def _local_gprim(self, prim: Usd.Prim, t: Usd.TimeCode) -> "_LocalGprim | None":
         """The gprim in its own space at ``t`` with its material and labels; None when it has no triangles."""
@@ -319,16 +331,46 @@ class StageReader:
                         lamp=local.lamp, uvs=local.uvs, double_sided=local.double_sided)
 
     def _mesh_item(self, prim: Usd.Prim, t: Usd.TimeCode, xcache: UsdGeom.XformCache) -> MeshItem | None:
-        """The gprim at ``t`` in world space (None without triangles); a gprim whose only variation is its
-        transform is read once in its own space and re-placed."""
-        key = str(prim.GetPath())
-        if self._variation(prim) == "transform":
-            if key not in self._local:
-                self._local[key] = self._local_gprim(prim, t)
-            local = self._local[key]
-        else:
-            local = self._local_gprim(prim, t)
+        """The gprim at ``t`` read whole and placed in world space (None without triangles)."""
+        local = self._local_gprim(prim, t)
         return None if local is None else self._placed(prim, local, t, xcache)
+
+    def _placed_rigid(self, rigid: list, t: Usd.TimeCode, xcache: UsdGeom.XformCache,
+                      previous: dict[str, MeshItem]) -> list[MeshItem]:
+        """The :class:`MeshItem` of each (place, prim, path, local gprim) of ``rigid`` at ``t``: every local gprim
+        re-placed by its transform at once (the points of all of them in one array), as :meth:`_placed` places
+        one; a gprim whose points and winding are those of its item in ``previous`` keeps that item."""
+        if not rigid:
+            return []
+        layout = tuple(r[2] for r in rigid)
+        if self._rigid_layout is None or self._rigid_layout[0] != layout:
+            counts = np.array([len(r[3].points) for r in rigid], np.int64)
+            self._rigid_layout = (layout, np.concatenate([r[3].points for r in rigid]),
+                                  np.repeat(np.arange(len(rigid)), counts), np.concatenate([[0], np.cumsum(counts)]))
+        _, local, owner, bounds = self._rigid_layout
+        m = np.array([np.array(xcache.GetLocalToWorldTransform(r[1]), float) for r in rigid])  # (k, 4, 4), rows
+        rot = m[owner, :3, :3]
+        # a (1, 3) @ (3, 3) product per point: the same sums, in the same order, as one gprim's points @ its matrix
+        world = (np.matmul(local[:, None, :], rot)[:, 0] + m[owner, 3, :3]) * self.meters_per_unit
+        bad = ~np.isfinite(world).all(axis=1)
+        if bad.any():
+            prim = rigid[int(owner[np.argmax(bad)])][1]
+            raise StageError(f"{prim.GetPath()}: has non-finite point coordinates at time {t.GetValue():g}")
+        flip = np.linalg.det(m[:, :3, :3]) < 0  # a mirroring transform flips the winding
+        out = []
+        for k, (_, prim, key, gprim) in enumerate(rigid):
+            points = world[bounds[k]:bounds[k + 1]]
+            tris = gprim.triangles[:, ::-1] if flip[k] else gprim.triangles
+            before = previous.get(key)
+            if (before is not None and np.array_equal(before.points, points)
+                    and np.array_equal(before.triangles, tris)):
+                out.append(before)
+                continue
+            out.append(MeshItem(prim_path=key, points=points, triangles=np.ascontiguousarray(tris),
+                                material_key=gprim.material_key, instance_id=gprim.instance_id,
+                                class_id=gprim.class_id, lamp=gprim.lamp, uvs=gprim.uvs,
+                                double_sided=gprim.double_sided))
+        return out
 
     def _geometry(self, prim: Usd.Prim, t: Usd.TimeCode, material: Material
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -362,10 +404,17 @@ class StageReader:
         previous = {m.prim_path: m for m in self._last.meshes} if self._last is not None else {}
         t = Usd.TimeCode(time_code)
         xcache = UsdGeom.XformCache(t)
-        meshes = []
-        for prim in self._renderable_gprims(t):
-            key = str(prim.GetPath())
-            if self._variation(prim):
+        meshes: list[MeshItem | None] = []
+        rigid: list[tuple[int, Usd.Prim, str, _LocalGprim]] = []  # (place in meshes, prim, path, local gprim)
+        for prim, key, variation in self._gprim_entries(t):
+            if variation == "transform":  # placed below, all together
+                if key not in self._local:
+                    self._local[key] = self._local_gprim(prim, t)
+                if self._local[key] is not None:
+                    rigid.append((len(meshes), prim, key, self._local[key]))
+                    meshes.append(None)
+                continue
+            if variation:
                 item = self._mesh_item(prim, t, xcache)
                 before = previous.get(key)
                 if (item is not None and before is not None and np.array_equal(before.points, item.points)
@@ -378,12 +427,16 @@ class StageReader:
                 item = self._static[key]
             if item is not None:
                 meshes.append(item)
+        for slot, item in zip((r[0] for r in rigid), self._placed_rigid(rigid, t, xcache, previous)):
+            meshes[slot] = item
         unlabelled = [m.prim_path for m in meshes if m.instance_id == 0]
         if unlabelled and not self._warned_unlabelled:
             self._warned_unlabelled = True
             log.warning("%d gprims have no '%s' label and render as class 0 (unlabelled), e.g. %s",
                         len(unlabelled), self.class_map.taxonomy, unlabelled[0])
-        lights = tuple(_read_light(p, t) for p in self.stage.Traverse() if p.HasAPI(UsdLux.LightAPI))
+        if self._light_prims is None:  # which prims are lights does not change with time
+            self._light_prims = [p for p in self.stage.Traverse() if p.HasAPI(UsdLux.LightAPI)]
+        lights = tuple(_read_light(p, t) for p in self._light_prims)
         if not lights:
             lights = (DEFAULT_SKY,)
             if not self._warned_unlit:

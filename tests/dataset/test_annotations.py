@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from pycocotools import mask as mask_utils
 
-from label_scenes import INSTANCES, H, W, scene
+from label_scenes import INSTANCES, H, W, crowded_scene, scene
 from synthua_usd.dataset.annotations import STUFF_ID_BASE, annotate, panoptic
 from synthua_usd.errors import InputError
 from synthua_usd.scene import Instance
@@ -78,3 +78,51 @@ def test_bad_inputs_name_what_they_found():
         annotate(cls, ins, wrong)
     with pytest.raises(InputError, match="expected \\(H, W\\) uint16"):
         annotate(cls, ins.astype(np.int32), INSTANCES)
+
+
+def coco_rle(mask):
+    """pycocotools' own encoding of a full-size mask, the straightforward way."""
+    rle = mask_utils.encode(np.asfortranarray(mask.astype(np.uint8)))
+    return {"size": [int(v) for v in rle["size"]], "counts": rle["counts"].decode("ascii")}
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_crowded_scene_equals_one_full_mask_per_instance(seed, class_map):
+    """annotate and panoptic read the maps a few times in all; each entry must equal what one full-size mask
+    per instance and pycocotools' encode give, byte for byte."""
+    cls, ins, instances, amodal, trunc = crowded_scene(seed)
+    height, width = ins.shape
+    entries = annotate(cls, ins, instances, amodal, trunc)
+    expected_ids = [i.id for i in instances if np.any(ins == i.id)]
+    assert [e["id"] for e in entries] == expected_ids and 7 not in expected_ids
+    for e in entries:
+        mask = ins == e["id"]
+        full = mask.copy().reshape(-1)
+        full[np.asarray(amodal.get(e["id"], []), np.int64)] = True
+        full = full.reshape(height, width)
+        assert e["segmentation"] == coco_rle(mask) and e["amodal_segmentation"] == coco_rle(full)
+        assert e["area"] == mask.sum() and e["bbox"] == box(mask)
+        assert e["amodal_area"] == full.sum() and e["amodal_bbox"] == box(full)
+        assert e["occlusion"] == 1.0 - mask.sum() / full.sum() and e["truncation"] == trunc[e["id"]]
+    rgb, segments = panoptic(cls, ins, instances, class_map)
+    rgb = rgb.astype(np.int64)
+    ids = rgb[..., 0] + 256 * rgb[..., 1] + 65536 * rgb[..., 2]
+    assert [s["id"] for s in segments] == sorted(int(i) for i in np.unique(ids) if i)
+    for s in segments:
+        mask = ids == s["id"]
+        assert s["area"] == mask.sum() and s["bbox"] == box(mask) and np.all(cls[mask] == s["category_id"])
+
+
+def test_a_mixed_class_instance_is_named_in_instance_order(class_map):
+    cls, ins, instances, _, _ = crowded_scene(0)
+    things = [i for i in instances if np.any(ins == i.id) and i.isthing]
+    first, later = things[3], things[10]
+    for inst in (later, first):  # another thing class under one pixel of each
+        y, x = np.argwhere(ins == inst.id)[0]
+        cls[y, x] = 22 if inst.class_id != 22 else 19
+    # annotate names the first in instance order, panoptic the smallest segment id
+    with pytest.raises(InputError, match=f"instance {first.id} .*expected only its class {first.class_id}"):
+        annotate(cls, ins, instances)
+    low = min(first, later, key=lambda i: i.id)
+    with pytest.raises(InputError, match=f"instance {low.id} .*expected only its class {low.class_id}"):
+        panoptic(cls, ins, instances, class_map)

@@ -130,3 +130,27 @@ def test_reader_through_time_codes_equals_fresh_reads_of_animated_gprims(class_m
     assert not np.array_equal(seen[1.0]["/World/Flag"].points, seen[2.0]["/World/Flag"].points)
     mirrored = seen[1.0]["/World/Mirrored"].triangles, seen[2.0]["/World/Mirrored"].triangles
     assert np.array_equal(mirrored[0][:, ::-1], mirrored[1])
+
+
+def test_rigidly_moving_gprims_are_placed_by_their_own_world_transforms(class_map):
+    """The reader places all rigidly moving gprims at once: each one's points equal its authored points moved by
+    its own world transform (computed by UsdGeom per prim), and a Cube's corners (half its size around the origin)
+    likewise."""
+    from pxr import Usd
+
+    stage = open_stage(DATA / "valid" / "animated_gprims.usda")
+    reader = StageReader(stage, class_map)
+    for t in (1.0, 3.0, 2.0):
+        meshes = {m.prim_path: m for m in reader.snapshot(t).meshes}
+        for path in ("/World/Mirrored", "/World/Walker/Body"):
+            prim = stage.GetPrimAtPath(path)
+            m = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(Usd.TimeCode(t)), float)
+            if prim.GetTypeName() == "Mesh":
+                local = np.array(UsdGeom.Mesh(prim).GetPointsAttr().Get(t), float)
+                assert np.allclose(meshes[path].points, local @ m[:3, :3] + m[3, :3], atol=1e-12), (path, t)
+            else:  # a Cube: its points span its box moved by the transform
+                half = 0.5 * UsdGeom.Cube(prim).GetSizeAttr().Get()
+                corners = np.array([[x, y, z] for x in (-half, half) for y in (-half, half) for z in (-half, half)])
+                placed = corners @ m[:3, :3] + m[3, :3]
+                assert np.allclose(meshes[path].points.min(axis=0), placed.min(axis=0), atol=1e-12), (path, t)
+                assert np.allclose(meshes[path].points.max(axis=0), placed.max(axis=0), atol=1e-12), (path, t)

@@ -21,7 +21,6 @@ from typing import Sequence
 
 import numpy as np
 
-from synthua_usd.dataset.annotations import pixel_groups
 from synthua_usd.errors import InputError, OutputError
 from synthua_usd.scene import Instance
 from synthua_usd.taxonomy import ClassMap
@@ -52,9 +51,12 @@ def cityscapes_arrays(class_ids: np.ndarray, instance_ids: np.ndarray, instances
                          f"expected (H, W) uint8 and uint16 of the same shape")
     thing = {c.id for c in class_map.classes if c.isthing}
     by_id = {inst.id: inst for inst in instances}
-    out = class_ids.astype(np.uint16)
+    counts = np.bincount(instance_ids.reshape(-1))
+    # per instance id: its encoded id, on the pixels of its own class (one lookup over the map)
+    encoded = np.zeros(counts.size, np.uint16)
+    own_class = np.full(counts.size, -1, np.int32)
     counters: dict[int, int] = {}
-    for inst_id, idx in sorted(pixel_groups(instance_ids).items()):
+    for inst_id in np.flatnonzero(counts).tolist():
         if inst_id == 0:
             continue
         inst = by_id.get(inst_id)
@@ -69,8 +71,9 @@ def cityscapes_arrays(class_ids: np.ndarray, instance_ids: np.ndarray, instances
             raise OutputError(f"Cityscapes instanceIds: instance {inst_id} is number {k} of class {inst.class_id} "
                               f"in this image; expected at most {MAX_INSTANCES_PER_CLASS} instances of a class and "
                               f"class*1000+k within 16 bits")
-        flat = out.reshape(-1)
-        flat[idx[class_ids.reshape(-1)[idx] == inst.class_id]] = inst.class_id * 1000 + k
+        encoded[inst_id] = inst.class_id * 1000 + k
+        own_class[inst_id] = inst.class_id
+    out = np.where(class_ids == own_class[instance_ids], encoded[instance_ids], class_ids.astype(np.uint16))
     return class_ids.copy(), out, class_map.palette()[class_ids]
 
 

@@ -34,6 +34,12 @@ def instance_colors(ids: np.ndarray) -> np.ndarray:
 
 
 def instance_preview(instance_ids: np.ndarray) -> np.ndarray:
-    """(H, W) integer instance ids -> (H, W, 3) uint8 sRGB preview, black where the id is 0."""
-    values, inverse = np.unique(instance_ids, return_inverse=True)
-    return instance_colors(values)[inverse.reshape(instance_ids.shape)]
+    """(H, W) non-negative integer instance ids -> (H, W, 3) uint8 sRGB preview, black where the id is 0."""
+    ids = np.asarray(instance_ids)
+    if ids.size == 0:
+        return np.zeros(ids.shape + (3,), np.uint8)
+    # a colour table over the ids present, looked up once per pixel (no sort of the whole map)
+    present = np.flatnonzero(np.bincount(ids.reshape(-1)))
+    table = np.zeros((int(present[-1]) + 1, 3), np.uint8)
+    table[present] = instance_colors(present)
+    return table[ids]

@@ -169,3 +169,32 @@ def test_rays_stopped_at_the_layer_cap_are_counted_and_logged(occluded_person, v
         masks = session.amodal(snap, cam, [1, 2, 3])
     assert session._amodal.capped_rays > 0 and "still hit after 2 layers" in caplog.text
     assert len(masks[1]) == 100 and len(masks[2]) > 0
+
+
+def test_candidate_pixels_hold_every_pixel_whose_ray_meets_the_box(street):
+    """Each scene traces only the candidate pixels of its instances' boxes: every pixel whose ray (numpy's,
+    from the lens values) meets an instance's triangles is among them, and they are far fewer than the image."""
+    from synthua_usd.backends.mitsuba.amodal import _boxes, candidate_pixels
+
+    snap, _, cam, things = street
+    reference = reference_amodal(snap, cam, *STREET, things)
+    boxes = _boxes(snap, frozenset(things))
+    sizes = []
+    for inst in things:
+        candidates = candidate_pixels(cam, [boxes[inst]], *STREET)
+        assert np.isin(reference[inst], candidates).all(), inst
+        sizes.append(len(candidates))
+    assert np.mean(sizes) < 0.25 * STREET[0] * STREET[1]  # not vacuous: boxes cover a small share of the view
+    assert candidate_pixels(dataclasses.replace(cam, distortion=BrownConrady(k1=-0.3)), [boxes[things[0]]],
+                            *STREET) is None  # a distorted lens traces every pixel
+
+
+def test_candidate_pixels_of_a_box_around_and_behind_the_camera(occluded_person):
+    """A box the camera stands in sees every pixel; one wholly behind the camera none."""
+    from synthua_usd.backends.mitsuba.amodal import candidate_pixels
+
+    _, cam = occluded_person  # at the origin, looking down -Z
+    around = np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
+    behind = np.array([[-1.0, -1.0, 2.0], [1.0, 1.0, 3.0]])
+    assert len(candidate_pixels(cam, [around], 60, 40)) == 60 * 40
+    assert len(candidate_pixels(cam, [behind], 60, 40)) == 0

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from format_readers import cityscapes_evaluation
-from label_scenes import INSTANCES, scene
+from label_scenes import INSTANCES, crowded_scene, scene
 from synthua_usd.backends.images import write_color_png, write_id_png
 from synthua_usd.dataset.formats.cityscapes import cityscapes_arrays
 from synthua_usd.dataset.layout import CityscapesName, Layout, cityscapes_city
@@ -69,3 +69,18 @@ def test_cityscapes_scripts_pixel_evaluation_of_gt_against_itself_is_iou_one(tmp
     for name in present & {l.name for l in labels if l.hasInstances}:
         assert result["classInstScores"][name] == pytest.approx(1.0), name
     assert result["averageScoreClasses"] == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_instance_ids_of_a_crowded_scene_equal_one_mask_per_instance(seed, class_map):
+    cls, ins, instances, _, _ = crowded_scene(seed)
+    _, cs_ids, _ = cityscapes_arrays(cls, ins, instances, class_map)
+    expected = cls.astype(np.uint16)
+    by_id = {i.id: i for i in instances}
+    numbered: dict[int, int] = {}
+    for inst_id in sorted(int(i) for i in np.unique(ins) if i):
+        inst = by_id[inst_id]
+        if class_map.by_id(inst.class_id).isthing:
+            k = numbered[inst.class_id] = numbered.get(inst.class_id, -1) + 1
+            expected[(ins == inst_id) & (cls == inst.class_id)] = inst.class_id * 1000 + k
+    assert np.array_equal(cs_ids, expected) and len(numbered) >= 3

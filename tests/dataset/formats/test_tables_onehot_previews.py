@@ -11,9 +11,9 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from label_scenes import record, scene
+from label_scenes import crowded_scene, record, scene
 from synthua_usd.dataset.formats.onehot import onehot, write_onehot_npz
-from synthua_usd.dataset.formats.previews import instance_preview
+from synthua_usd.dataset.formats.previews import instance_colors, instance_preview
 from synthua_usd.dataset.formats.tables import metadata_rows, write_tables
 from synthua_usd.errors import InputError
 
@@ -70,3 +70,8 @@ def test_instance_preview_is_deterministic_black_on_zero_and_distinct():
     ids = np.arange(1, 2001)
     strip = instance_preview(ids.reshape(1, -1).astype(np.uint16))[0].astype(int)
     assert np.abs(np.diff(strip, axis=0)).sum(1).min() > 30  # consecutive ids are far apart
+
+
+def test_instance_preview_equals_each_pixels_own_colour():
+    ins = crowded_scene(1)[1]
+    assert np.array_equal(instance_preview(ins), instance_colors(ins.reshape(-1)).reshape(ins.shape + (3,)))

@@ -6,9 +6,11 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from label_scenes import W, H, record, scene
+from label_scenes import W, H, crowded_scene, record, scene
 from synthua_usd.backends.images import write_color_png
-from synthua_usd.dataset.formats.yolo import class_index, data_yaml, merge_parts, outer_outlines, yolo_lines
+from synthua_usd.dataset.annotations import annotate
+from synthua_usd.dataset.formats.yolo import (class_index, data_yaml, label_outlines, merge_parts, outer_outlines,
+                                             yolo_lines)
 from synthua_usd.dataset.layout import Layout
 
 
@@ -79,3 +81,64 @@ def test_data_yaml_lists_splits_and_names():
     assert "train: images/train\n" in text and "test: images/test\n" in text and "path:" not in text
     assert '  0: "curb_ramp"\n' in text
     assert "path: \"/data/x\"" in data_yaml(ClassMap.default(), path="/data/x")
+
+
+def walked_outlines(mask: np.ndarray) -> list[np.ndarray]:
+    """Outer outlines traced one edge at a time in Python (the tracer's first form), for comparison: from
+    each unused edge in raster order of its start corner, follow the edge leaving the corner reached, the
+    left turn where two leave it; keep clockwise loops, corners only."""
+    m = np.pad(mask, 1)
+    rows, cols = np.nonzero(m[1:-1, 1:-1])
+    start, end = [], []
+    for (dr, dc), (sx, sy), (ex, ey) in [((-1, 0), (0, 0), (1, 0)), ((0, 1), (1, 0), (1, 1)),
+                                         ((1, 0), (1, 1), (0, 1)), ((0, -1), (0, 1), (0, 0))]:
+        for r, c in zip(rows, cols):
+            if not m[1 + r + dr, 1 + c + dc]:
+                start.append((c + sx, r + sy))
+                end.append((c + ex, r + ey))
+    outgoing = {}
+    for e, corner in enumerate(start):
+        outgoing.setdefault(corner, []).append(e)
+    used, loops = set(), []
+    for first in sorted(range(len(start)), key=lambda e: (start[e][1], start[e][0], e)):
+        if first in used:
+            continue
+        loop, e = [], first
+        while e not in used:
+            used.add(e)
+            loop.append(start[e])
+            options = [o for o in outgoing[end[e]] if o not in used]
+            if not options:
+                break
+            dx, dy = end[e][0] - start[e][0], end[e][1] - start[e][1]
+            lefts = [o for o in options if (end[o][0] - start[o][0], end[o][1] - start[o][1]) == (dy, -dx)]
+            e = (lefts or options)[0]
+        poly = np.array(loop, np.int64)
+        nxt, prev = np.roll(poly, -1, axis=0), np.roll(poly, 1, axis=0)
+        if np.sum(poly[:, 0] * nxt[:, 1] - nxt[:, 0] * poly[:, 1]) > 0:
+            d_in, d_out = poly - prev, nxt - poly
+            loops.append(poly[d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0] != 0])
+    return loops
+
+
+def test_outlines_equal_an_edge_by_edge_walk_on_random_masks():
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        mask = rng.random(tuple(rng.integers(1, 16, 2))) < rng.uniform(0.2, 0.8)  # pinches, holes, parts
+        got, expected = outer_outlines(mask), walked_outlines(mask)
+        assert len(got) == len(expected) and all(np.array_equal(a, b) for a, b in zip(got, expected))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_outlines_of_all_instances_at_once_and_lines_from_the_map_equal_those_of_each_mask(seed, class_map):
+    cls, ins, instances, amodal, trunc = crowded_scene(seed)
+    outlines = label_outlines(ins)
+    assert sorted(outlines) == sorted(int(i) for i in np.unique(ins) if i)
+    for inst_id, parts in outlines.items():
+        expected = outer_outlines(ins == inst_id)
+        assert len(parts) == len(expected) and all(np.array_equal(a, b) for a, b in zip(parts, expected))
+    entries = annotate(cls, ins, instances, amodal, trunc)
+    index = class_index(class_map)
+    from_map = yolo_lines(entries, ins.shape[1], ins.shape[0], index, ins)
+    assert from_map == yolo_lines(entries, ins.shape[1], ins.shape[0], index)  # masks decoded from the RLEs
+    assert len(from_map.splitlines()) == sum(e["category_id"] in index for e in entries) > 10
