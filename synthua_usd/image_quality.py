@@ -70,6 +70,20 @@ def psnr_db(test: np.ndarray, reference: np.ndarray, scale: float | None = None)
     return math.inf if mse == 0.0 else 10.0 * math.log10(1.0 / mse)
 
 
+def reference_ceiling_db(half_a: np.ndarray, half_b: np.ndarray, scale: float | None = None) -> float:
+    """The PSNR a noise-free image would score against the reference ``(half_a + half_b) / 2``, where the halves
+    are renders of one view with the same settings and sample count but other seeds (independent noise).
+
+    Their difference holds the noise of two halves, four times the noise of their mean, so the ceiling is
+    ``PSNR(half_a, half_b) + 10 log10 4``; it holds for any sampler (the halves need not have noise falling as
+    1/spp) and, on display values, to first order in the noise. Display values at ``scale`` (default: the mean's
+    exposure). A measured PSNR near the ceiling measures the reference, not the test image."""
+    a, b = _checked(half_a, half_b)
+    if scale is None:
+        scale = reference_scale((a + b) / 2)
+    return psnr_db(a, b, scale) + 10.0 * math.log10(4.0)
+
+
 def ssim(test: np.ndarray, reference: np.ndarray, scale: float | None = None) -> float:
     """Mean SSIM of (H, W, 3) float32 scene-linear ``test`` against ``reference`` on display values (Wang et al.
     2004 settings; images smaller than the 7×7 window are refused by scikit-image)."""

@@ -40,3 +40,22 @@ def reference_z_depth(snapshot, camera, width: int, height: int):
     z = np.zeros(width * height)
     z[ray_index] = (locations - origins[ray_index]) @ forward
     return z.reshape(height, width)
+
+
+def edge_distance(snapshot, instance_id: int, origin: np.ndarray, direction: np.ndarray) -> float:
+    """Metres from the ray (origin, unit direction (3,)) to the nearest triangle edge of ``instance_id``'s
+    meshes; inf for instance 0 (nothing)."""
+    meshes = [m for m in snapshot.meshes if m.instance_id == instance_id]
+    if not meshes:
+        return np.inf
+    verts, faces, _ = snapshot.world_triangles(meshes)
+    best = np.inf
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        start = verts[faces[:, i]]
+        edge = verts[faces[:, j]] - start
+        w = start - origin
+        ee, ed, wd, ew = np.einsum("ij,ij->i", edge, edge), edge @ direction, w @ direction, np.einsum("ij,ij->i", edge, w)
+        s = np.clip((ed * wd - ew) / np.maximum(ee - ed * ed, 1e-18), 0.0, 1.0)   # along the edge
+        t = np.maximum(wd + s * ed, 0.0)                                            # along the ray
+        best = min(best, float(np.min(np.linalg.norm(origin + t[:, None] * direction - start - s[:, None] * edge, axis=1))))
+    return best

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from synthua_usd.backends.exposure import choose_exposure
-from synthua_usd.image_quality import display_values, psnr_db, ssim
+from synthua_usd.image_quality import display_values, psnr_db, reference_ceiling_db, ssim
 
 
 def srgb_decode(v: float) -> float:
@@ -77,3 +77,19 @@ def test_refuses_mismatched_or_non_finite_images():
         psnr_db(b, a)
     with pytest.raises(ValueError, match="exposure scale"):
         psnr_db(a, a, scale=0.0)
+
+
+def test_reference_ceiling_from_two_halves_matches_a_noise_free_image():
+    """Two half-references of a known truth with independent noise: a noise-free image (the truth) scores against
+    their mean what the ceiling says, within 0.1 dB (display values; noise small against the signal)."""
+    rng = np.random.default_rng(5)
+    truth = rng.uniform(0.05, 0.2, (240, 320, 3)).astype(np.float32)
+    a = truth + rng.normal(0.0, 0.004, truth.shape).astype(np.float32)
+    b = truth + rng.normal(0.0, 0.004, truth.shape).astype(np.float32)
+    reference = (a + b) / 2
+    scale = 2.0
+    assert reference_ceiling_db(a, b, scale) == pytest.approx(psnr_db(truth, reference, scale), abs=0.1)
+    # with less noise in the halves the ceiling rises by the ratio of the variances
+    a2 = truth + (a - truth) / 2
+    b2 = truth + (b - truth) / 2
+    assert reference_ceiling_db(a2, b2, scale) - reference_ceiling_db(a, b, scale) == pytest.approx(6.02, abs=0.1)

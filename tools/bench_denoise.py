@@ -3,12 +3,14 @@
 
 Usage: python tools/bench_denoise.py [--scenario stages/district/scenario.usda] [--views CAM ...]
        [--time-code 24] [--large (1280x960; default 640x480)] [--reference-spp 512] [--spp 1 2 4 8]
-       [--variant llvm_ad_rgb] [--cache out/bench_denoise] [--no-ablation]
+       [--variant llvm_ad_rgb] [--cache out/bench_denoise] [--no-ablation] [--no-plain]
 
 Per view (default: CCTV_Largo, CCTV_AidUser_1, PedestrianEye_Street, UAV_Oblique of the district at time
 code 24, under the stage's selected condition, as `synthua render` renders it) a reference is rendered at
---reference-spp with the box filter (the mean of each pixel's area, the quantity every setting estimates; cached
-as EXR under --cache, keyed by view, size, spp, seed and variant). Then every setting renders the same view:
+--reference-spp with the box filter (the mean of each pixel's area, the quantity every setting estimates), as the
+mean of two halves of --reference-spp / 2 samples with seeds 0 and 1000 (cached as EXR under --cache, keyed by view,
+size, spp, seed and variant). Then every setting renders the same view (--no-plain leaves out the rows without
+a denoiser):
 
   16 spp gaussian            the old default filter, no denoiser
   16 spp box                 no denoiser
@@ -19,12 +21,12 @@ as EXR under --cache, keyed by view, size, spp, seed and variant). Then every se
   N spp gaussian + OIDN      (ablation, the default N only) OIDN on correlated noise
 
 and is scored with synthua_usd.image_quality (PSNR and SSIM on display values at the reference's exposure).
-The reference's own noise caps every score: the ceiling printed per view is what a noise-free image would score
-(estimated from the 16-spp box row, whose error is 32 parts its own noise to 1 part the reference's at 512).
+The reference's own noise caps every score: the ceiling printed per view is what a noise-free image would score,
+from the difference of the two halves (synthua_usd.image_quality.reference_ceiling_db).
 Time is the RGB pass plus denoising (labels and scene loads left out; each setting renders one warm-up
 frame first so kernel compilation is not counted). Other seeds than the reference's. Printed: one row per
 view and setting, then per setting the mean PSNR, the minimum PSNR, the mean SSIM, the mean time and the
-speed-up and PSNR difference against 16 spp gaussian; the RenderConfig default is marked.
+speed-up and PSNR difference against 16 spp gaussian (or the first row); the RenderConfig default is marked.
 Not a test: times depend on the machine and its load; compare ratios measured in the same run.
 """
 
@@ -53,9 +55,10 @@ class Setting:
     fireflies: bool = True
 
 
-def settings(spp_list, default_spp: int, ablation: bool) -> list[Setting]:
+def settings(spp_list, default_spp: int, ablation: bool, plain: bool = True) -> list[Setting]:
     rows = [Setting("16 spp gaussian", 16, "gaussian", False), Setting("16 spp box", 16, "box", False),
-            Setting("64 spp gaussian (the old default)", 64, "gaussian", False), Setting("64 spp box", 64, "box", False)]
+            Setting("64 spp gaussian (the old default)", 64, "gaussian", False),
+            Setting("64 spp box", 64, "box", False)] if plain else []
     rows += [Setting(f"{n} spp box + OIDN", n, "box", True) for n in spp_list]
     if ablation:
         rows.append(Setting(f"{default_spp} spp box + OIDN, no firefly filter", default_spp, "box", True, False))
@@ -74,6 +77,7 @@ def main() -> int:
     parser.add_argument("--variant", default=None)
     parser.add_argument("--cache", type=Path, default=REPO / "out" / "bench_denoise")
     parser.add_argument("--no-ablation", action="store_true", help="skip the firefly and gaussian ablation rows")
+    parser.add_argument("--no-plain", action="store_true", help="skip the rows without a denoiser (16 and 64 spp)")
     args = parser.parse_args()
 
     import numpy as np
@@ -82,7 +86,7 @@ def main() -> int:
     from synthua_usd.backends.denoise import FireflyReport
     from synthua_usd.backends import denoise as denoise_module
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.image_quality import psnr_db, ssim
+    from synthua_usd.image_quality import psnr_db, reference_ceiling_db, reference_scale, ssim
     from synthua_usd.render_config import RenderConfig
     from synthua_usd.taxonomy import ClassMap
     from synthua_usd.usd.cameras import read_camera
@@ -97,7 +101,7 @@ def main() -> int:
     cameras = {path: read_camera(stage, path, args.time_code) for path in args.views}
     default = RenderConfig()
     print(f"{args.scenario.name} at {args.time_code:g}, {width}x{height}, reference {args.reference_spp} spp box "
-          f"(seed 0), condition {condition.name if condition else None}; settings seed 1; "
+          f"(two halves, seeds 0 and 1000), condition {condition.name if condition else None}; settings seed 1; "
           f"RenderConfig default: {default.spp} spp {default.pixel_filter}, denoise {default.denoise}")
 
     def render_all(config: RenderConfig, warm_up: bool, fireflies: bool = True) -> dict:
@@ -117,28 +121,36 @@ def main() -> int:
         finally:
             denoise_module.suppress_fireflies = real
 
-    references = {}
+    # The reference is the mean of two halves of --reference-spp / 2 samples with other seeds: their difference
+    # says how much noise the reference itself has (image_quality.reference_ceiling_db).
+    references, ceilings = {}, {}
     variant = None
-    ref_config = RenderConfig(width=width, height=height, spp=args.reference_spp, pixel_filter="box", denoise=False,
-                              seed=0, variant=args.variant)
+    half_spp = max(args.reference_spp // 2, 1)
     ref_session = None
     for path, camera in cameras.items():
-        key = hashlib.sha256(f"{args.scenario.resolve()}|{path}|{args.time_code}|{width}x{height}|"
-                             f"{args.reference_spp}|{args.variant}".encode()).hexdigest()[:16]
-        cached = args.cache / f"ref_{path.rsplit('/', 1)[-1]}_{key}.exr"
-        if cached.exists():
-            references[path] = images.read_image(cached)[0].astype(np.float32)
-            continue
-        t0 = time.perf_counter()
-        ref_session = ref_session or RenderSession(ref_config)
-        frame = ref_session.render(snapshot, camera, condition=condition)
-        references[path] = frame.rgb
-        cached.parent.mkdir(parents=True, exist_ok=True)
-        images.write_linear_exr(cached, frame.rgb)
-        print(f"reference {path}: {time.perf_counter() - t0:.0f} s ({frame.variant}) -> {cached}", flush=True)
+        halves = []
+        for seed in (0, 1000):
+            key = hashlib.sha256(f"{args.scenario.resolve()}|{path}|{args.time_code}|{width}x{height}|"
+                                 f"{half_spp}|{seed}|{args.variant}".encode()).hexdigest()[:16]
+            cached = args.cache / f"ref_{path.rsplit('/', 1)[-1]}_{key}.exr"
+            if cached.exists():
+                halves.append(images.read_image(cached)[0].astype(np.float32))
+                continue
+            t0 = time.perf_counter()
+            ref_session = ref_session or RenderSession(RenderConfig(
+                width=width, height=height, spp=half_spp, pixel_filter="box", denoise=False, seed=0,
+                variant=args.variant))
+            frame = ref_session.render(snapshot, camera, condition=condition, seed=seed)
+            halves.append(frame.rgb)
+            cached.parent.mkdir(parents=True, exist_ok=True)
+            images.write_linear_exr(cached, frame.rgb)
+            print(f"reference half {path} (seed {seed}): {time.perf_counter() - t0:.0f} s ({frame.variant}) -> "
+                  f"{cached}", flush=True)
+        references[path] = (halves[0] + halves[1]) / 2
+        ceilings[path] = reference_ceiling_db(*halves, reference_scale(references[path]))
     del ref_session
 
-    rows = settings(args.spp, default.spp, not args.no_ablation)
+    rows = settings(args.spp, default.spp, not args.no_ablation, not args.no_plain)
     results: dict[str, list] = {}
     print(f"\n{'view':34} {'setting':44} {'PSNR dB':>8} {'SSIM':>7} {'time s':>7} {'fireflies':>9}")
     for row in rows:
@@ -155,14 +167,10 @@ def main() -> int:
             print(f"{path.rsplit('/', 1)[-1]:34} {row.label:44} {p:8.2f} {s:7.4f} {seconds:7.2f} {ff!s:>9}",
                   flush=True)
 
-    # The reference has noise of its own: with independent box-filtered samples, the expected squared error of
-    # the 16-spp box row is s2/16 + s2/R (R the reference's spp), so the reference alone contributes s2/R, and
-    # a noise-free image would score PSNR(16 spp box) + 10 log10(1 + R/16) against it: the ceiling of the table.
-    lift = 10 * math.log10(1 + args.reference_spp / 16)
-    ceilings = [p + lift for p, _, _ in results["16 spp box"]]
-    print("\nreference noise ceiling (what a noise-free image would score), per view: "
-          + ", ".join(f"{path.rsplit('/', 1)[-1]} {c:.1f} dB" for path, c in zip(cameras, ceilings)))
-    base = results["16 spp gaussian"]
+    print("\nreference noise ceiling (what a noise-free image would score, from the two halves), per view: "
+          + ", ".join(f"{path.rsplit('/', 1)[-1]} {c:.1f} dB" for path, c in ceilings.items()))
+    base_label = "16 spp gaussian" if "16 spp gaussian" in results else rows[0].label
+    base = results[base_label]
     base_time = statistics.mean(r[2] for r in base)
     base_psnr = statistics.mean(r[0] for r in base)
     print(f"\nsummary over {len(cameras)} views ({variant}, {width}x{height}, reference {args.reference_spp} spp):")

@@ -44,25 +44,6 @@ def _reference_distances(snapshot, camera, width: int, height: int, pixels: np.n
     return out
 
 
-def _edge_distance(snapshot, instance_id: int, origin: np.ndarray, direction: np.ndarray) -> float:
-    """Metres from the ray (origin, unit direction (3,)) to the nearest triangle edge of ``instance_id``'s
-    meshes; inf for instance 0 (nothing)."""
-    meshes = [m for m in snapshot.meshes if m.instance_id == instance_id]
-    if not meshes:
-        return np.inf
-    verts, faces, _ = snapshot.world_triangles(meshes)
-    best = np.inf
-    for i, j in ((0, 1), (1, 2), (2, 0)):
-        start = verts[faces[:, i]]
-        edge = verts[faces[:, j]] - start
-        w = start - origin
-        ee, ed, wd, ew = np.einsum("ij,ij->i", edge, edge), edge @ direction, w @ direction, np.einsum("ij,ij->i", edge, w)
-        s = np.clip((ed * wd - ew) / np.maximum(ee - ed * ed, 1e-18), 0.0, 1.0)   # along the edge
-        t = np.maximum(wd + s * ed, 0.0)                                            # along the ray
-        best = min(best, float(np.min(np.linalg.norm(origin + t[:, None] * direction - start - s[:, None] * edge, axis=1))))
-    return best
-
-
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenario", type=Path, default=REPO / "stages" / "district" / "scenario.usda")
@@ -74,7 +55,7 @@ def main() -> int:
     parser.add_argument("--variant", default=None)
     args = parser.parse_args()
 
-    from reference_raycast import reference_labels
+    from reference_raycast import edge_distance, reference_labels
     from synthua_usd.backends.mitsuba.session import RenderSession
     from synthua_usd.demo.district import DISTRICT_CAMERAS
     from synthua_usd.render_config import RenderConfig
@@ -113,8 +94,8 @@ def main() -> int:
         origins, _ = camera.pixel_center_rays(w, h)
         for (a, b), n in Counter(zip(ours.tolist(), theirs.tolist())).most_common(args.pairs):
             sel = np.flatnonzero((ours == a) & (theirs == b))
-            edge = [min(_edge_distance(snapshot, a, origins[bad[k]], dirs[bad[k]]),
-                        _edge_distance(snapshot, b, origins[bad[k]], dirs[bad[k]])) for k in sel]
+            edge = [min(edge_distance(snapshot, a, origins[bad[k]], dirs[bad[k]]),
+                        edge_distance(snapshot, b, origins[bad[k]], dirs[bad[k]])) for k in sel]
             print(f"  {n:6d}  {names[a]}  vs  {names[b]}  gap {np.median(gap[sel]):+.4f} m, "
                   f"edge {np.median(edge):.1e} m")
     print(f"\ntotal disagreeing pixels: {total}")

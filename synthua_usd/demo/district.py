@@ -37,7 +37,8 @@ STREET_Y = (-33.0, 5.0)      # the slope; the street itself reaches down to the 
 PLAZA_X = (-45.0, 45.0)
 PLAZA_Y = (5.0, 34.0)
 PLAZA_Z = 3.0
-PAVER_H = 0.04
+PAVER_H = 0.04   # the largo's paving over its slab
+COBBLE_H = 0.07  # the cobbled street's setts over its bed (0 at the road)
 KERB_H = 0.15
 HALF_X = 75.0
 CROSSWALK_XS = (-30.0, 30.0)
@@ -105,30 +106,6 @@ class _Builder:
         return path
 
 
-def _cobbles(rng: np.random.Generator, x0, x1, y0, y1, size, gap, height, materials) -> list[TwinPart]:
-    """Stones in running bond; heights jittered by up to 1 cm; split into chunks of ~5 m along y."""
-    sx, sy = size
-    pieces = []
-    for cy0 in np.arange(y0, y1, 5.0):
-        cy1 = min(cy0 + 5.0, y1)
-        boxes: dict[str, list[geo.Mesh]] = {m: [] for m in materials}
-        row = 0
-        y = cy0
-        while y + sy <= cy1 + 1e-9:
-            x = x0 + (sx / 2 if row % 2 else 0.0)
-            while x + sx <= x1 + 1e-9:
-                h = height - rng.uniform(0.0, 0.01)
-                mat = materials[int(rng.integers(len(materials)))]
-                boxes[mat].append(geo.box((x + gap / 2, y + gap / 2, 0.0), (x + sx - gap / 2, y + sy - gap / 2, h)))
-                x += sx
-            y += sy
-            row += 1
-        for mat, items in boxes.items():
-            if items:
-                pieces.append(TwinPart.of(f"Stones_{int(cy0 - y0):03d}_{mat}", geo.merge(*items), mat))
-    return pieces
-
-
 def _sidewalk_x_strip(x0, x1, y_kerb, y_back, gaps: list[float], z_of=None) -> list[TwinPart]:
     """A sidewalk along x whose kerb faces the road at ``y_kerb``; curb-ramp gaps centred at ``gaps``.
     Returns slab and kerb pieces (the kerb is 20 cm of granite along the road edge)."""
@@ -190,13 +167,12 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
             b.add("CurbRamps", "Ramp", "curb_ramp", [TwinPart.of("Surface", (pts, tris), "RampConcrete")])
         bars = [geo.box((x - 1.5, y, 0.0), (x + 1.5, y + 0.5, 0.01)) for y in np.arange(ROAD_Y[0] + 0.25, ROAD_Y[1] - 0.4, 1.0)]
         b.add("Crosswalks", "Zebra", "crosswalk", [TwinPart.of("Bars", geo.merge(*bars), "RoadPaint")])
-    # The cobbled street: a mortar bed and stones, sloping up to the largo.
+    # The cobbled street, sloping up to the largo: its setts are an image with a normal map
+    # (district_textures.PAVED), laid on a bed whose top is the stones' top.
     x0, x1 = STREET_X
     y_start = ROAD_Y[1]
-    bed = _street_box((x0, y_start, -0.5), (x1, STREET_Y[1], 0.0))
-    stones = [TwinPart.of(p.name, _shear(p.mesh), p.material)
-              for p in _cobbles(rng, x0, x1, y_start, STREET_Y[1], (0.18, 0.14), 0.015, 0.07, ["Cobble0", "Cobble1", "Cobble2"])]
-    b.add("Streets", "CobbledStreet", "street_road", [TwinPart.of("Bed", bed, "Mortar")] + stones, surface="cobblestone")
+    bed = _street_box((x0, y_start, -0.5), (x1, STREET_Y[1], COBBLE_H))
+    b.add("Streets", "CobbledStreet", "street_road", [TwinPart.of("Setts", bed, "Cobble0")], surface="cobblestone")
     # Its sidewalks (sheared with the slope) and a crosswalk near the bottom with ramps on both sides.
     cy = STREET_CROSSWALK_Y
     for side, (kx, sgn) in (("StreetWest", (x0, -1.0)), ("StreetEast", (x1, 1.0))):
@@ -217,13 +193,11 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
                      "RampConcrete")])
     bars = [geo.box((x, cy - 1.5, 0.072), (x + 0.5, cy + 1.5, 0.085)) for x in np.arange(x0 + 0.25, x1 - 0.4, 1.0)]
     b.add("Crosswalks", "Zebra", "crosswalk", [TwinPart.of("Bars", _shear(geo.merge(*bars)), "RoadPaint")])
-    # The largo: a slab paved with stones of three close shades (light, warm, grey); with two far apart
-    # (light and near-black) it read as a checkerboard from every camera.
-    pavers = _cobbles(rng, PLAZA_X[0], PLAZA_X[1], PLAZA_Y[0], PLAZA_Y[1], (0.35, 0.35), 0.02, PAVER_H,
-                      ["PaverLight", "PaverWarm", "PaverGrey"])
+    # The largo: a slab paved with stones of three close shades (light, warm, grey), an image with a normal map
+    # as the setts; with two shades far apart (light and near-black) it read as a checkerboard from every camera.
     b.add("Sidewalks", "Largo", "sidewalk",
-          [TwinPart.of("Bed", geo.box((PLAZA_X[0], PLAZA_Y[0], PLAZA_Z - 3.5), (PLAZA_X[1], PLAZA_Y[1], PLAZA_Z)), "Mortar")]
-          + [TwinPart.of(p.name, (p.mesh[0] + [0, 0, PLAZA_Z], p.mesh[1]), p.material) for p in pavers])
+          [TwinPart.of("Pavers", geo.box((PLAZA_X[0], PLAZA_Y[0], PLAZA_Z - 3.5), (PLAZA_X[1], PLAZA_Y[1], PLAZA_Z + PAVER_H)),
+                       "PaverWarm")])
     # Grass slope west of the street, steps down it, railings along the steps and the slope's top edge.
     gx0, gx1, gy0 = SLOPE_X[0], SLOPE_X[1], SLOPE_Y0
     slope = geo.ramp(gx0, gx1, gy0, PLAZA_Y[0], KERB_H, PLAZA_Z, -0.5)
@@ -244,9 +218,9 @@ def _streets(b: _Builder, rng: np.random.Generator) -> None:
     b.add("Railings", "Railing", "railing", street.railing((gx0 + 0.1, top, slope_z(top)), (STEPS_X - 1.8, top, slope_z(top))))
     b.add("Railings", "Railing", "railing", street.railing((STEPS_X + 1.8, top, slope_z(top)), (gx1 - 0.1, top, slope_z(top))))
     # Manhole covers on the road, the cobbles and the largo; the one on the cobbles (z None) tilts with the
-    # street, on its highest stones.
+    # street, on its stones.
     for x, y, z in [(-55.0, -41.0, 0.0), (12.0, -39.5, 0.0), (48.0, -43.0, 0.0), (0.0, -12.0, None), (-20.0, 28.0, PLAZA_Z + PAVER_H)]:
-        cover = place(street.manhole_cover(), (x, y, 0.07 if z is None else z))
+        cover = place(street.manhole_cover(), (x, y, COBBLE_H if z is None else z))
         if z is None:
             cover = [TwinPart.of(p.name, _shear(p.mesh), p.material) for p in cover]
         b.add("Covers", "Manhole", "cover", cover)

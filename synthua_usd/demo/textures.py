@@ -11,6 +11,10 @@ colour's mean (:mod:`synthua_usd.demo.district_textures`). Images are 8-bit sRGB
 * ``wood``: planks with grain: wavy stripes along the planks, per-plank tone and a few knots;
 * ``asphalt``: bitumen with bright and dark aggregate, lighter worn patches where the binder is gone, and
   a few darker stains.
+
+:func:`paving` makes the stones of the cobbled street and the largo: stones in running bond, each of one of a
+few shades, with joints and rounded edges, as a colour image and a tangent-space normal map (the stones used
+to be modelled one by one: 444,000 triangles of sub-pixel edges that no affordable sample count resolves).
 """
 
 from __future__ import annotations
@@ -99,6 +103,46 @@ def asphalt(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
     grey = (1.0 + 0.2 * wear) * (1.0 + aggregate * (0.5 + 0.5 * np.tanh(wear))) * (1.0 - 0.3 * stains)
     grey += 0.05 * rng.standard_normal((size, size))
     return _tint(rng, size, np.clip(grey, 0.4, 2.5), 0.02, 60.0)
+
+
+def paving(rng: np.random.Generator, size: int, tile_m: float, stones: int, rows: int, joint_m: float,
+           bevel_m: float, depth_m: float, shades: np.ndarray, joint_tone: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A square tile ``tile_m`` metres wide of stones in running bond (``stones`` per row, ``rows`` rows, even
+    so that the bond repeats; every other row shifted by half a stone), ``joint_m`` wide joints ``depth_m``
+    deep, stone edges rounded over ``bevel_m``. Each stone takes one of ``shades`` ((k, 3) linear factors)
+    at random, times the ``stone`` grain; joints take ``joint_tone`` (3,) with a sandy grain.
+
+    Returns (size, size, 3) linear colour (variation around the shades) and (size, size, 3) tangent-space
+    normals in [-1, 1] (x along s, y along t, z out of the surface; the image's row 0 is at t = 1, as
+    :mod:`synthua_usd.uv` has it), both tileable."""
+    if rows % 2:
+        raise ValueError(f"paving: rows should be even so that the running bond tiles, but was {rows}")
+    texel = tile_m / size
+    s = (np.arange(size) + 0.5) / size
+    t = 1.0 - (np.arange(size) + 0.5) / size
+    row = np.floor(t * rows).astype(np.int64)[:, None] * np.ones((1, size), np.int64)
+    shifted = s[None, :] * stones - 0.5 * (row % 2)
+    col = np.floor(shifted).astype(np.int64) % stones
+    fs, ft = shifted - np.floor(shifted), (t * rows - np.floor(t * rows))[:, None]
+    # distance (m) from the pixel to the nearest edge of its stone, less half a joint: < 0 in the joint
+    inside = np.minimum(np.minimum(fs, 1 - fs) * tile_m / stones, np.minimum(ft, 1 - ft) * tile_m / rows)
+    inside = inside - joint_m / 2
+    height = np.where(inside <= 0, -depth_m, -depth_m * np.clip(1 - inside / bevel_m, 0, 1) ** 2)
+    dh_ds = (np.roll(height, -1, axis=1) - np.roll(height, 1, axis=1)) / (2 * texel)
+    dh_dt = (np.roll(height, 1, axis=0) - np.roll(height, -1, axis=0)) / (2 * texel)  # row - 1 is higher t
+    normals = np.stack([-dh_ds, -dh_dt, np.ones_like(height)], axis=2)
+    normals /= np.linalg.norm(normals, axis=2, keepdims=True)
+    shade = np.asarray(shades, np.float64)[rng.integers(len(shades), size=rows * stones)[row * stones + col]]
+    grain = stone(rng, size)
+    sand = np.clip(1.0 + 0.15 * rng.standard_normal((size, size)), 0.6, 1.4)[:, :, None]
+    colour = np.where((inside <= 0)[:, :, None], np.asarray(joint_tone, np.float64) * sand, shade * grain)
+    return colour, normals
+
+
+def encode_normals8(normals: np.ndarray) -> np.ndarray:
+    """(H, W, 3) unit normals in [-1, 1] → 8-bit ``n * 0.5 + 0.5`` (read back with scale 2 and bias -1, as
+    UsdPreviewSurface's normal input expects)."""
+    return np.round((np.clip(normals, -1.0, 1.0) * 0.5 + 0.5) * 255.0).astype(np.uint8)
 
 
 def encode_srgb8(linear: np.ndarray) -> np.ndarray:

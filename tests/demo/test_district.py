@@ -56,7 +56,9 @@ def test_every_class_but_person_appears(seed0, class_map):
 
 
 def test_triangle_budget(seed0):
-    assert 400_000 <= seed0.triangle_count() <= 2_000_000
+    # At most 2 M triangles renders on 2 cores; the paving is images and normal maps (it was 444,000 triangles of
+    # modelled stones), so the rest of the district is about 68,000.
+    assert 50_000 <= seed0.triangle_count() <= 2_000_000
 
 
 def test_district_size(seed0):

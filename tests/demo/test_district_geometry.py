@@ -19,7 +19,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from conftest import STAGES
-from reference_raycast import reference_labels
+from reference_raycast import edge_distance, reference_labels
 from synthua_usd import geometry as geo
 from synthua_usd.demo.district import build_district
 from synthua_usd.twin import TwinObject, TwinPart
@@ -242,6 +242,14 @@ def test_cctv_largo_labels_agree_with_embree_on_every_pixel():
     frame = RenderSession(RenderConfig(width=640, height=480, spp=1)).render(snapshot, camera, rgb=False)
     _, ref_instances = reference_labels(snapshot, camera, 640, 480)
     differ = frame.instance_ids != ref_instances
+    # A ray within 10 µm of an edge of either instance is a float edge case (the casts' rays differ by float32
+    # rounding; either answer is right); anywhere else the two must agree. At most a few such grazing rays.
+    origins, dirs = camera.pixel_center_rays(640, 480)
+    grazing = [k for k in np.flatnonzero(differ.ravel())
+               if min(edge_distance(snapshot, int(frame.instance_ids.flat[k]), origins[k], dirs[k]),
+                      edge_distance(snapshot, int(ref_instances.flat[k]), origins[k], dirs[k])) < 1e-5]
+    assert len(grazing) <= 3, f"{len(grazing)} grazing rays differ"
+    differ.flat[grazing] = False
     path = {i.id: i.prim_path for i in snapshot.instances} | {0: "(nothing)"}
     pairs = Counter((path[int(a)], path[int(b)]) for a, b in zip(frame.instance_ids[differ], ref_instances[differ]))
-    assert not pairs, f"{differ.sum()} pixels differ (mitsuba, embree): {pairs.most_common(10)}"
+    assert not pairs, f"{differ.sum()} pixels differ (mitsuba, embree) off any edge: {pairs.most_common(10)}"

@@ -7,20 +7,18 @@ samples, so edges would not match any pixel-centre reference. Labels come from r
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from tqdm import tqdm
 
 from synthua_usd.backends.exposure import Exposure
+from synthua_usd.backends.mitsuba.translate import pass_sample_counts
 from synthua_usd.cameras import PinholeCamera
 from synthua_usd.conditions import Condition
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.scene import SceneSnapshot
 
-#: RGB is rendered in passes of at most this many samples per pixel so a progress bar can move.
-SPP_PER_PASS = 16
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,18 +67,17 @@ class RgbPass:
 
 def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sensor=None,
                seed: int | None = None, guides=None) -> RgbPass:
-    """The RGB pass: the mean of passes of at most SPP_PER_PASS samples each; ``sensor`` (e.g. a
+    """The RGB pass: the mean of passes of at most 16 samples each (so that a progress bar can move; counts by
+    :func:`synthua_usd.backends.mitsuba.translate.pass_sample_counts`); ``sensor`` (e.g. a
     :func:`synthua_usd.backends.mitsuba.lens.distorted_sensor`) replaces the scene's own; ``seed`` replaces
     ``config.seed``. ``guides`` (a loaded :func:`synthua_usd.backends.mitsuba.translate.guide_integrator_dict`)
     adds albedo and normal at the colour's film positions: a guides-only integrator is rendered after the colour
     with the same seed and sample count (JIT variants); one wrapped around the path tracer renders both."""
     seed = config.seed if seed is None else seed
-    passes = math.ceil(config.spp / SPP_PER_PASS)
+    counts = pass_sample_counts(config.spp)
     total = np.zeros((config.height, config.width, 3 if guides is None else 9), np.float64)
-    done = 0
     with tqdm(total=config.spp, unit="spp", desc="rgb", disable=not show_progress, leave=False) as bar:
-        for k in range(passes):
-            spp = min(SPP_PER_PASS, config.spp - done)
+        for k, spp in enumerate(counts):
             pass_seed = seed * 100_003 + k
             which = 0 if sensor is None else sensor  # the scene's own sensor, or the given one
             aux = None if guides is None else np.asarray(mi.render(scene, spp=spp, seed=pass_seed, sensor=which,
@@ -92,7 +89,6 @@ def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sen
                 total[..., :3] += np.asarray(image, np.float64)[..., :3] * spp
                 if aux is not None:  # albedo (3), then shading normal (3)
                     total[..., 3:] += aux[..., :6] * spp
-            done += spp
             bar.update(spp)
     mean = (total / config.spp).astype(np.float32)
     if guides is None:
