@@ -72,33 +72,52 @@ def _cycles(snap, cam, folder, width, height, samples):
     return result.images["a"]
 
 
+#: A UsdUVTexture tint as the district's materials author them; red's scale clips the brighter texels at 1.
+TINT = ((1.6, 1.0, 0.5, 1.0), (0.0, 0.1, 0.0, 0.0))
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("space", ["sRGB", "raw"])
-def test_cycles_renders_the_texels_where_the_independent_lookup_puts_them(quads, class_map, tmp_path, space):
+@pytest.mark.parametrize("space, tinted", [("sRGB", False), ("raw", False), ("sRGB", True)])
+def test_cycles_renders_the_texels_where_the_independent_lookup_puts_them(quads, class_map, tmp_path, space,
+                                                                          tinted):
     W, H = 256, 192  # about 13 pixels a texel: Cycles' pixel filter blurs texel edges little
     stage = open_stage(quads)
-    stage.GetPrimAtPath("/World/Looks/Quadrants/Image").GetAttribute("inputs:sourceColorSpace").Set(space)
+    image_prim = stage.GetPrimAtPath("/World/Looks/Quadrants/Image")
+    image_prim.GetAttribute("inputs:sourceColorSpace").Set(space)
+    if tinted:
+        for name, value in zip(("scale", "bias"), TINT):
+            image_prim.CreateAttribute(f"inputs:{name}", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(*value))
     snap = read_snapshot(stage, 1.0, class_map)
     cam = read_camera(stage, "/World/Cam", 1.0)
     image = _cycles(snap, cam, tmp_path, W, H, 32).reshape(-1, 3)
 
-    def lookup(texels, decode):
-        # Cycles filters an 8-bit sRGB image before decoding it (Mitsuba decodes first): bilinear then decode
+    def lookup(texels, decode, tint):
+        # Cycles filters an 8-bit sRGB image before decoding it (Mitsuba decodes first): bilinear then decode;
+        # then UsdUVTexture's scale and bias, clipped to [0, 1] as Mitsuba's translation clips
         values, hit = reference_albedo(snap, cam, texels / 255.0, W, H)
-        return (srgb_decoded(np.clip(values, 0.0, 1.0) * 255.0) if decode else values), hit
+        values = srgb_decoded(np.clip(values, 0.0, 1.0) * 255.0) if decode else values
+        if tint:
+            values = np.clip(values * np.array(TINT[0][:3]) + np.array(TINT[1][:3]), 0.0, 1.0)
+        return values, hit
 
-    def fit(texels, decode):
+    def fit(texels, decode, tint=tinted):
         # under a uniform white sky a diffuse quad returns its albedo; the BSDF's specular layer adds a little
-        expected, hit = lookup(texels, decode)
+        expected, hit = lookup(texels, decode, tint)
         a, b = np.polyfit(expected[hit].ravel(), image[hit].ravel(), 1)
         return a, np.median(np.abs(image[hit] - (a * expected[hit] + b)))
 
     a, error = fit(TEXELS, space == "sRGB")
     assert 0.85 < a < 1.1 and error < 0.012
-    # the same texels upside down, mirrored, or decoded by the other colour space fit far worse
-    for texels, decode in ((TEXELS[::-1], space == "sRGB"), (TEXELS[:, ::-1], space == "sRGB"),
-                           (TEXELS, space != "sRGB")):
+    # the same texels upside down, mirrored, decoded by the other colour space, or without their tint fit far worse
+    wrong = [(TEXELS[::-1], space == "sRGB"), (TEXELS[:, ::-1], space == "sRGB"), (TEXELS, space != "sRGB")]
+    for texels, decode in wrong:
         assert fit(texels, decode)[1] > 3 * error
+    if tinted:
+        assert fit(TEXELS, space == "sRGB", tint=False)[1] > 3 * error
+        # where the tinted red would exceed 1.2 it is clipped to 1 (its fit to the white sky: about a + b)
+        raw, hit = lookup(TEXELS, space == "sRGB", False)
+        over = hit & (raw[:, 0] * TINT[0][0] + TINT[1][0] > 1.2)
+        assert over.sum() > 100 and np.median(image[over, 0]) < 1.05 * a
 
 
 @pytest.mark.slow
