@@ -1,4 +1,4 @@
-"""Independent checks of textured renders for tests.
+"""Independent checks of textured renders for tests, and the textured-quad stage edits they share.
 
 The reference casts pixel-centre rays with Embree (trimesh), interpolates the reader's texture coordinates
 (``MeshItem.uvs``) with the hit's barycentric coordinates, and looks the texel up in numpy (bilinear, texel
@@ -9,13 +9,28 @@ first hit of each ray, which for ``principled`` is the base colour: no light tra
 
 from __future__ import annotations
 
+import shutil
+
 import colour
 import numpy as np
 import OpenImageIO as oiio
 import trimesh
+from conftest import DATA
+from pxr import Sdf, UsdGeom, UsdLux, UsdShade
 
 from synthua_usd.backends.mitsuba.translate import translate
 from synthua_usd.render_config import RenderConfig
+
+
+#: 8 wide, 6 tall, every texel different: a transposed, mirrored or flipped lookup cannot pass.
+TEXELS = np.random.default_rng(7).integers(0, 256, (6, 8, 3), dtype=np.uint8)
+
+
+def textured_quads(folder, texels: np.ndarray = TEXELS):
+    """A copy of tests/data/valid/textured_quads.usda in ``folder`` with ``texels`` as its texture; its path."""
+    shutil.copy(DATA / "valid" / "textured_quads.usda", folder / "quads.usda")
+    write_png(folder / "textures" / "quadrants.png", texels)
+    return folder / "quads.usda"
 
 
 def write_png(path, pixels: np.ndarray) -> None:
@@ -86,3 +101,30 @@ def srgb_decoded(texels: np.ndarray) -> np.ndarray:
 def srgb_decoded(texels: np.ndarray) -> np.ndarray:
     """Linear values of 8-bit sRGB ``texels`` (colour-science, not synthua's decoder)."""
     return colour.models.eotf_sRGB(texels / 255.0)
+
+
+def add_texture(stage, name: str, file: str, output: str, target: str, type_name, **inputs) -> None:
+    """A UsdUVTexture ``name`` reading ``file`` through the material's st reader, feeding surface input
+    ``target`` from ``output``."""
+    looks = "/World/Looks/Quadrants"
+    shader = UsdShade.Shader.Define(stage, f"{looks}/{name}")
+    shader.CreateIdAttr("UsdUVTexture")
+    shader.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(file)
+    shader.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(
+        UsdShade.Shader(stage.GetPrimAtPath(f"{looks}/StReader")).ConnectableAPI(), "result")
+    for key, (vtype, value) in inputs.items():
+        shader.CreateInput(key, vtype).Set(value)
+    shader.CreateOutput(output, type_name)
+    surface = UsdShade.Shader(stage.GetPrimAtPath(f"{looks}/Surface"))
+    surface.CreateInput(target, type_name).ConnectToSource(shader.ConnectableAPI(), output)
+
+
+def lit_from(stage, axis: str) -> None:
+    """Replace the sky by a sun 60° off vertical, shining from +X or +Y (``axis``), and a dim sky."""
+    stage.GetPrimAtPath("/World/Sky").GetAttribute("inputs:intensity").Set(0.05)
+    sun = UsdLux.DistantLight.Define(stage, "/World/Sun")
+    sun.CreateIntensityAttr(3.0)
+    if axis == "x":
+        UsdGeom.Xformable(sun).AddRotateYOp().Set(60.0)  # the light's -Z towards -X and down
+    else:
+        UsdGeom.Xformable(sun).AddRotateXOp().Set(-60.0)  # the light's -Z towards -Y and down

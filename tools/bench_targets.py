@@ -25,7 +25,7 @@ Prints one markdown table with ratios, then where each target stands:
   consecutive time codes; another camera) against the frame time, and the next time code against a
   default-quality frame — target at most 5 %;
 * Blender Cycles (PyPI ``bpy``, in its own interpreter) rendering the same exported scene (meshes, material
-  constants, the stage's UsdLux sun and dome, same camera) on the CPU with 2 threads, max_bounces 2 (Mitsuba
+  constants and textures, the stage's UsdLux sun and dome, same camera) on the CPU with 2 threads, max_bounces 2 (Mitsuba
   max_depth 4), adaptive sampling with and without OpenImageDenoise, its fastest setting that reaches the PSNR
   of Mitsuba's fast mode and of its default quality (a ratio for each), each renderer measured against its own reference at ``--reference-spp``; and the PSNR between the two
   references, which says how close the two scenes are — target Mitsuba 3x Cycles' throughput.

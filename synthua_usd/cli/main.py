@@ -26,6 +26,7 @@ from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.twin_commands import twin
 from synthua_usd.cli.failures import configure_logging, guarded
 from synthua_usd.findings import Finding, Severity
+from synthua_usd.render_config import RenderConfig
 
 
 def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
@@ -198,13 +199,13 @@ def create_district(out_dir: Path, seed: int) -> int:
                    "the same option [default: the stage's start time code].")
 @click.option("--width", type=click.IntRange(1, 16384), help="Image width in pixels [default: render settings, else 1280].")
 @click.option("--height", type=click.IntRange(1, 16384), help="Image height in pixels [default: render settings, else 960].")
-@click.option("--spp", type=click.IntRange(1, 65536), help="RGB samples per pixel [default: render settings, else 4]. "
-                                                          "Labels always use one ray per pixel centre.")
+@click.option("--spp", type=click.IntRange(1, 65536), help=f"RGB samples per pixel [default: render settings, else "
+                                                          f"{RenderConfig.spp}]. Labels always use one ray per pixel centre.")
 @click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed of the RGB pass.")
 @click.option("--denoise/--no-denoise", default=None,
               help="Denoise RGB: a firefly filter, then Intel Open Image Denoise guided by albedo and normal from the "
-                   "same samples, before fog, rain and exposure (box pixel filter either way) [default: on; 8 spp "
-                   "denoised match 64 spp undenoised on the district in a fifth of the time].")
+                   "same samples, before fog, rain and exposure (box pixel filter either way) [default: on; see the "
+                   "README's Denoising for what each sample count reaches].")
 @click.option("--variant", help="Mitsuba variant (cuda_ad_rgb, llvm_ad_rgb, scalar_rgb) [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--condition", help="Weather and light condition, one the stage offers (see `synthua inspect`), e.g. "

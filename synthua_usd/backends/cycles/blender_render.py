@@ -4,8 +4,9 @@
 
 Run by the Python of a virtual environment holding PyPI's ``bpy`` (Blender as a Python module), never
 imported by synthua itself (:mod:`synthua_usd.backends.cycles.runner` starts it). It builds the Blender scene
-from what :mod:`synthua_usd.backends.cycles.interchange` wrote (one mesh per material, Principled BSDF
-constants, flat shading, a sun lamp and a uniform world for UsdLux distant and dome lights, the camera with its conformed
+from what :mod:`synthua_usd.backends.cycles.interchange` wrote (one mesh per soup, flat shading, a Principled
+BSDF of the material's constants or, for a textured soup, its textures (:func:`principled`) on the soup's UV
+map, a sun lamp and a uniform world for UsdLux distant and dome lights, the camera with its conformed
 horizontal field of view and clipping range), sets Cycles up (CPU, fixed threads, path length, view
 transform ``Standard`` so the output stays scene-linear), renders a warm-up frame (scene sync and BVH build,
 kept by ``use_persistent_data``), then renders every job of ``JOBS_JSON`` and writes ``OUT_DIR/{name}.exr``
@@ -39,7 +40,7 @@ from synthua_usd.backends.cycles.interchange import read_interchange  # noqa: E4
 def build_scene(document: dict, soups: list) -> bpy.types.Scene:
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    for material, (points, triangles) in zip(document["materials"], soups):
+    for material, (points, triangles, uvs) in zip(document["materials"], soups):
         mesh = bpy.data.meshes.new(f"mesh_{material['index']}")
         n, m = len(points), len(triangles)
         mesh.vertices.add(n)
@@ -52,6 +53,9 @@ def build_scene(document: dict, soups: list) -> bpy.types.Scene:
         # Flat shading, as Mitsuba renders these meshes (no vertex normals): a Blender mesh made through the API
         # is smooth-shaded unless its faces are marked sharp, which rounds every box and tilts walls to the sun.
         mesh.polygons.foreach_set("use_smooth", np.zeros(m, dtype=bool))
+        if uvs is not None:  # per point in USD's st: Blender's UVs also put (0, 0) at the image's bottom-left
+            layer = mesh.uv_layers.new(name=UV_MAP)
+            layer.data.foreach_set("uv", np.ascontiguousarray(uvs[triangles.ravel()], np.float32).ravel())
         mesh.materials.append(principled(material))
         obj = bpy.data.objects.new(mesh.name, mesh)
         scene.collection.objects.link(obj)
@@ -97,17 +101,102 @@ def build_scene(document: dict, soups: list) -> bpy.types.Scene:
     return scene
 
 
+UV_MAP = "st"
+#: Texture wrap modes → Blender's image extension (one for both axes, as Mitsuba: ``wrap_s`` decides).
+EXTENSION = {"repeat": "REPEAT", "mirror": "MIRROR", "clamp": "EXTEND", "black": "CLIP"}
+
+
 def principled(material: dict) -> bpy.types.Material:
+    """A Principled BSDF of ``material``'s constants, its textured inputs replaced by image textures decoded as
+    Mitsuba's translation does (:mod:`synthua_usd.backends.mitsuba.surfaces`): texels by colour space, then
+    ``value * scale + bias`` and the channel, clipped to [0, 1]; a normal map's [-1, 1] values into a
+    tangent-space Normal Map node (red along +s, green along +t). One difference stays: Cycles filters an 8-bit
+    sRGB image between texels before decoding it, Mitsuba after (the texel values agree)."""
     out = bpy.data.materials.new(material["key"])
     out.use_nodes = True
-    bsdf = out.node_tree.nodes["Principled BSDF"]
+    tree = out.node_tree
+    bsdf = tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = tuple(material["base_color"]) + (1.0,)
     bsdf.inputs["Roughness"].default_value = min(max(material["roughness"], 0.0), 1.0)
     bsdf.inputs["Metallic"].default_value = min(max(material["metallic"], 0.0), 1.0)
     if any(material["emissive_color"]):
         bsdf.inputs["Emission Color"].default_value = tuple(material["emissive_color"]) + (1.0,)
         bsdf.inputs["Emission Strength"].default_value = 1.0
+    textures = material.get("textures", {})
+    if "base_color" in textures:
+        tree.links.new(clipped(tree, texture_values(tree, textures["base_color"])), bsdf.inputs["Base Color"])
+    for name, socket in (("roughness", "Roughness"), ("metallic", "Metallic")):
+        if name in textures:
+            tree.links.new(clipped(tree, texture_values(tree, textures[name])), bsdf.inputs[socket])
+    if "normal" in textures:
+        normals = texture_values(tree, textures["normal"])
+        encode = tree.nodes.new("ShaderNodeVectorMath")  # [-1, 1] → the [0, 1] colour a Normal Map node decodes
+        encode.operation = "MULTIPLY_ADD"
+        encode.inputs[1].default_value = (0.5, 0.5, 0.5)
+        encode.inputs[2].default_value = (0.5, 0.5, 0.5)
+        tree.links.new(normals, encode.inputs[0])
+        normal_map = tree.nodes.new("ShaderNodeNormalMap")
+        normal_map.space = "TANGENT"
+        normal_map.uv_map = UV_MAP
+        tree.links.new(encode.outputs["Vector"], normal_map.inputs["Color"])
+        tree.links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
     return out
+
+
+def texture_values(tree, texture: dict):
+    """The output socket of ``texture``'s decoded values after scale, bias and channel: a vector for 'rgb', a
+    float for one channel."""
+    image = bpy.data.images.load(texture["path"], check_existing=True)
+    image.alpha_mode = "CHANNEL_PACKED"  # colour independent of alpha, as Mitsuba reads it
+    space = texture["color_space"]
+    if space == "auto":  # UsdUVTexture's rule, as surfaces.TextureImages applies it: 8-bit RGB(A) is sRGB
+        space = "sRGB" if not image.is_float and image.channels in (3, 4) else "raw"
+    image.colorspace_settings.name = "sRGB" if space == "sRGB" else "Non-Color"
+    node = tree.nodes.new("ShaderNodeTexImage")
+    node.image = image
+    node.interpolation = "Linear"  # Mitsuba's bilinear filter
+    node.extension = EXTENSION[texture["wrap_s"]]
+    uv = tree.nodes.new("ShaderNodeUVMap")
+    uv.uv_map = UV_MAP
+    tree.links.new(uv.outputs["UV"], node.inputs["Vector"])
+    scale, bias, channel = texture["scale"], texture["bias"], texture["channel"]
+    if channel == "rgb":
+        affine = tree.nodes.new("ShaderNodeVectorMath")
+        affine.operation = "MULTIPLY_ADD"
+        affine.inputs[1].default_value = scale[:3]
+        affine.inputs[2].default_value = bias[:3]
+        tree.links.new(node.outputs["Color"], affine.inputs[0])
+        return affine.outputs["Vector"]
+    index = "rgba".index(channel)
+    if channel == "a":
+        source = node.outputs["Alpha"]
+    else:
+        separate = tree.nodes.new("ShaderNodeSeparateColor")
+        tree.links.new(node.outputs["Color"], separate.inputs["Color"])
+        source = separate.outputs[index]
+    affine = tree.nodes.new("ShaderNodeMath")
+    affine.operation = "MULTIPLY_ADD"
+    affine.inputs[1].default_value = scale[index]
+    affine.inputs[2].default_value = bias[index]
+    tree.links.new(source, affine.inputs[0])
+    return affine.outputs["Value"]
+
+
+def clipped(tree, socket):
+    """``socket`` clipped to [0, 1] (per component for a vector), as Mitsuba's translation clips texture values."""
+    if socket.type == "VECTOR":
+        low = tree.nodes.new("ShaderNodeVectorMath")
+        low.operation = "MAXIMUM"
+        low.inputs[1].default_value = (0.0, 0.0, 0.0)
+        high = tree.nodes.new("ShaderNodeVectorMath")
+        high.operation = "MINIMUM"
+        high.inputs[1].default_value = (1.0, 1.0, 1.0)
+        tree.links.new(socket, low.inputs[0])
+        tree.links.new(low.outputs["Vector"], high.inputs[0])
+        return high.outputs["Vector"]
+    clamp = tree.nodes.new("ShaderNodeClamp")
+    tree.links.new(socket, clamp.inputs["Value"])
+    return clamp.outputs["Result"]
 
 
 def configure(scene: bpy.types.Scene, settings: dict) -> None:

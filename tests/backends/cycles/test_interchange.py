@@ -27,12 +27,13 @@ def test_round_trip_keeps_triangles_materials_lights_and_camera(lit, tmp_path):
     write_interchange(snap, cam, 64, 48, tmp_path)
     assert (tmp_path / GEOMETRY).is_file() and (tmp_path / SCENE).is_file()
     doc, soups = read_interchange(tmp_path)
-    assert sum(len(t) for _, t in soups) == snap.triangle_count()
+    assert sum(len(t) for _, t, _ in soups) == snap.triangle_count()
     assert {m["key"] for m in doc["materials"]} == {m.material_key for m in snap.meshes}
-    for material, (points, triangles) in zip(doc["materials"], soups):
+    for material, (points, triangles, uvs) in zip(doc["materials"], soups):
         meshes = [m for m in snap.meshes if m.material_key == material["key"]]
         assert material["triangles"] == len(triangles) == sum(len(m.triangles) for m in meshes)
         assert points.dtype == np.float32 and triangles.dtype == np.int32 and triangles.max() < len(points)
+        assert uvs is None and not material["textured"] and material["textures"] == {}  # no textures here
         source = snap.materials[material["key"]]
         assert material["base_color"] == pytest.approx(list(source.base_color))
         assert (material["roughness"], material["metallic"]) == pytest.approx((source.roughness, source.metallic))

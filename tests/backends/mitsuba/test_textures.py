@@ -10,7 +10,8 @@ import numpy as np
 import OpenImageIO as oiio
 import pytest
 from conftest import DATA, third_party
-from texture_checks import mitsuba_albedo, reference_albedo, srgb_decoded, write_png
+from texture_checks import (TEXELS, add_texture, lit_from, mitsuba_albedo, reference_albedo, srgb_decoded,
+                            textured_quads, write_png)
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdShade
 
 from synthua_usd.backends.mitsuba import variants
@@ -23,16 +24,10 @@ from synthua_usd.usd.stage_io import open_stage
 W, H = 64, 48
 
 
-#: 8 wide, 6 tall, every texel different: a transposed, mirrored or flipped lookup cannot pass.
-TEXELS = np.random.default_rng(7).integers(0, 256, (6, 8, 3), dtype=np.uint8)
-
-
 @pytest.fixture
 def quads(tmp_path):
-    """A copy of tests/data/valid/textured_quads.usda with its texture written beside it."""
-    shutil.copy(DATA / "valid" / "textured_quads.usda", tmp_path / "quads.usda")
-    write_png(tmp_path / "textures" / "quadrants.png", TEXELS)
-    return tmp_path / "quads.usda"
+    """tests/data/valid/textured_quads.usda in tmp_path with TEXELS as its texture."""
+    return textured_quads(tmp_path)
 
 
 @pytest.mark.parametrize("space", ["sRGB", "raw", "auto"])
@@ -151,33 +146,6 @@ def test_a_session_moves_a_textured_mesh_and_keeps_its_uvs(quads, class_map):
     assert np.allclose(moved.rgb, fresh.rgb, atol=1e-6)
 
 
-def _add_texture(stage, name: str, file: str, output: str, target: str, type_name, **inputs) -> None:
-    """A UsdUVTexture ``name`` reading ``file`` through the material's st reader, feeding surface input
-    ``target`` from ``output``."""
-    looks = "/World/Looks/Quadrants"
-    shader = UsdShade.Shader.Define(stage, f"{looks}/{name}")
-    shader.CreateIdAttr("UsdUVTexture")
-    shader.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(file)
-    shader.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(
-        UsdShade.Shader(stage.GetPrimAtPath(f"{looks}/StReader")).ConnectableAPI(), "result")
-    for key, (vtype, value) in inputs.items():
-        shader.CreateInput(key, vtype).Set(value)
-    shader.CreateOutput(output, type_name)
-    surface = UsdShade.Shader(stage.GetPrimAtPath(f"{looks}/Surface"))
-    surface.CreateInput(target, type_name).ConnectToSource(shader.ConnectableAPI(), output)
-
-
-def _lit_from(stage, axis: str) -> None:
-    """Replace the sky by a sun 60° off vertical, shining from +X or +Y (``axis``), and a dim sky."""
-    stage.GetPrimAtPath("/World/Sky").GetAttribute("inputs:intensity").Set(0.05)
-    sun = UsdLux.DistantLight.Define(stage, "/World/Sun")
-    sun.CreateIntensityAttr(3.0)
-    if axis == "x":
-        UsdGeom.Xformable(sun).AddRotateYOp().Set(60.0)  # the light's -Z towards -X and down
-    else:
-        UsdGeom.Xformable(sun).AddRotateXOp().Set(-60.0)  # the light's -Z towards -Y and down
-
-
 def _mean_rgb(stage, class_map, prim: str):
     snap = read_snapshot(stage, 1.0, class_map)
     cam = read_camera(stage, "/World/Cam", 1.0)
@@ -197,9 +165,9 @@ def test_a_normal_map_tilts_the_shading(tmp_path, class_map, axis, tilt, brighte
     n /= np.linalg.norm(n)
     write_png(tmp_path / "textures" / "normal.png", np.tile(np.round((n * 0.5 + 0.5) * 255), (2, 2, 1)))
     stage = open_stage(tmp_path / "quads.usda")
-    _lit_from(stage, axis)
+    lit_from(stage, axis)
     flat = _mean_rgb(stage, class_map, "/World/Left")
-    _add_texture(stage, "Normals", "./textures/normal.png", "rgb", "normal", Sdf.ValueTypeNames.Normal3f,
+    add_texture(stage, "Normals", "./textures/normal.png", "rgb", "normal", Sdf.ValueTypeNames.Normal3f,
                  sourceColorSpace=(Sdf.ValueTypeNames.Token, "raw"),
                  scale=(Sdf.ValueTypeNames.Float4, Gf.Vec4f(2, 2, 2, 1)),
                  bias=(Sdf.ValueTypeNames.Float4, Gf.Vec4f(-1, -1, -1, 0)))
@@ -215,7 +183,7 @@ def test_an_opacity_texture_cuts_the_surface_away(tmp_path, class_map):
     write_png(tmp_path / "textures" / "quadrants.png", rgba)
     stage = open_stage(tmp_path / "quads.usda")
     clamp = (Sdf.ValueTypeNames.Token, "clamp")  # repeat would blend the opaque right edge into the left one
-    _add_texture(stage, "Alpha", "./textures/quadrants.png", "a", "opacity", Sdf.ValueTypeNames.Float, wrapS=clamp,
+    add_texture(stage, "Alpha", "./textures/quadrants.png", "a", "opacity", Sdf.ValueTypeNames.Float, wrapS=clamp,
                  wrapT=clamp)
     stage.GetPrimAtPath("/World/Looks/Quadrants/Surface").CreateAttribute(
         "inputs:opacityThreshold", Sdf.ValueTypeNames.Float).Set(0.5)
