@@ -21,6 +21,8 @@ demo: setup
 	$(BIN)/synthua render $(SCENARIO) --camera /World/Cameras/PedestrianEye --time-code 24 --out $(DEMO_OUT)/pedestrian_eye
 	$(BIN)/synthua validate stage $(DISTRICT)
 	$(BIN)/synthua render $(DISTRICT) --camera /World/Cameras/CCTV_Largo --time-code 24 --out $(DEMO_OUT)/district_cctv_largo
+	@# the demo's dataset is made afresh: a dataset folder only resumes the same job, and a changed scenario is another
+	rm -rf $(DEMO_OUT)/dataset
 	$(BIN)/synthua generate $(SCENARIO) --config configs/demo.json --out $(DEMO_OUT)/dataset
 	$(BIN)/synthua verify $(DEMO_OUT)/dataset
 	$(BIN)/synthua stats $(DEMO_OUT)/dataset --out $(DEMO_OUT)/dataset_report
