@@ -134,7 +134,7 @@ def build_district(seed: int = 0, textures: bool = True) -> TwinModel:
     its procedural textures (:mod:`synthua_usd.demo.district_textures`) unless ``textures`` is False."""
     rng = np.random.default_rng(seed)
     b = _Builder()
-    _streets(b, rng)
+    _streets(b)
     _buildings(b, rng)
     _furniture(b, rng)
     _market(b, rng)
@@ -146,7 +146,7 @@ def build_district(seed: int = 0, textures: bool = True) -> TwinModel:
     return add_textures(model, seed) if textures else model
 
 
-def _streets(b: _Builder, rng: np.random.Generator) -> None:
+def _streets(b: _Builder) -> None:
     L = HALF_X
     # Open ground under everything, 2 cm below the road so that no two surfaces are coplanar: for the same
     # reason it reaches 1 m past the road's ends and further down than any bed or slab (their end and
