@@ -20,7 +20,8 @@ a denoiser):
   N spp box + OIDN, no ff    (ablation, the default N only) the same without the firefly filter
   N spp gaussian + OIDN      (ablation, the default N only) OIDN on correlated noise
 
-and is scored with synthua_usd.image_quality (PSNR and SSIM on display values at the reference's exposure).
+and is scored with synthua_usd.image_quality (PSNR and SSIM on display values at the reference's exposure,
+metered as rgb.png is: over the pixels whose label-pass ray sees a surface, not the sky or the void).
 The reference's own noise caps every score: the ceiling printed per view is what a noise-free image would score,
 from the difference of the two halves (synthua_usd.image_quality.reference_ceiling_db).
 Time is the RGB pass plus denoising (labels and scene loads left out; each setting renders one warm-up
@@ -123,7 +124,7 @@ def main() -> int:
 
     # The reference is the mean of two halves of --reference-spp / 2 samples with other seeds: their difference
     # says how much noise the reference itself has (image_quality.reference_ceiling_db).
-    references, ceilings = {}, {}
+    references, reference_halves, ceilings, scales = {}, {}, {}, {}
     variant = None
     half_spp = max(args.reference_spp // 2, 1)
     ref_session = None
@@ -147,7 +148,7 @@ def main() -> int:
             print(f"reference half {path} (seed {seed}): {time.perf_counter() - t0:.0f} s ({frame.variant}) -> "
                   f"{cached}", flush=True)
         references[path] = (halves[0] + halves[1]) / 2
-        ceilings[path] = reference_ceiling_db(*halves, reference_scale(references[path]))
+        reference_halves[path] = halves
     del ref_session
 
     rows = settings(args.spp, default.spp, not args.no_ablation, not args.no_plain)
@@ -159,7 +160,10 @@ def main() -> int:
         rendered = render_all(config, warm_up=True, fireflies=row.fireflies)
         for path, (frame, seconds) in rendered.items():
             variant = frame.variant
-            scale = None  # the reference's exposure, metered over all its pixels (image_quality's rule)
+            if path not in scales:  # the reference's exposure, metered as rgb.png is: over the surface pixels
+                scales[path] = reference_scale(references[path], frame.hits.mesh_index >= 0)
+                ceilings[path] = reference_ceiling_db(*reference_halves[path], scales[path])
+            scale = scales[path]
             p = psnr_db(frame.rgb, references[path], scale)
             s = ssim(frame.rgb, references[path], scale)
             ff = frame.denoised["firefly_pixels"] if frame.denoised else ""
