@@ -121,10 +121,16 @@ class PinholeCamera:
         Computed from the lens values alone, independently of any renderer. With ``distortion``, each pixel
         centre's distorted normalised coordinates are inverted (:meth:`BrownConrady.undistort`) first.
         """
+        px, py = np.meshgrid(np.arange(width) + 0.5, np.arange(height) + 0.5)
+        return self.pixel_rays(px.ravel(), py.ravel(), width, height)
+
+    def pixel_rays(self, px: np.ndarray, py: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """Rays through image points ``px``, ``py`` (n,) (pixel units from the top-left corner, so pixel centres
+        are at +0.5) of a W×H image: ``origins`` and unit ``directions`` (n, 3) float64, world space. With
+        ``distortion``, the points' distorted normalised coordinates are inverted first."""
         k = self.intrinsics(width, height)
-        xs = (np.arange(width) + 0.5 - k[0, 2]) / k[0, 0]
-        ys = (np.arange(height) + 0.5 - k[1, 2]) / k[1, 1]
-        gx, gy = np.meshgrid(xs, ys)
+        gx = (np.asarray(px, np.float64) - k[0, 2]) / k[0, 0]
+        gy = (np.asarray(py, np.float64) - k[1, 2]) / k[1, 1]
         if self.distortion is not None:
             gx, gy = self.distortion.undistort(gx, gy, where=f"camera {self.path}")
         right, up, forward = self.axes()

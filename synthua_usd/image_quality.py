@@ -5,8 +5,11 @@ hundreds and street values of a few hundredths, and an error in the sky would sw
 Both images are therefore
 
 1. multiplied by the same exposure scale: the reference's (:func:`synthua_usd.backends.exposure.choose_exposure`,
-   the rule ``rgb.png`` is made with, metered over every pixel) unless ``scale`` is given — pass a frame's
-   own ``exposure.scale`` to meter exactly as the render did (over the pixels that see a surface);
+   the rule ``rgb.png`` is made with) unless ``scale`` is given. ``rgb.png`` is metered over the pixels that see
+   a surface; without that mask every pixel is metered, and a view with much sky or void beyond a twin's edge
+   then gets another exposure than its ``rgb.png`` (a UAV view half void: 3,600 times brighter, every lit
+   surface clipped to white, so that only its outline was scored). Benchmarks therefore pass
+   ``reference_scale(reference, frame.hits.mesh_index >= 0)`` — the label pass's surface pixels;
 2. encoded with the sRGB transfer function (IEC 61966-2-1, through colour-science's ``cctf_encoding``), in
    float: no 8-bit quantisation;
 3. clipped to [0, 1], as ``rgb.png`` is.
@@ -37,11 +40,12 @@ def _checked(test: np.ndarray, reference: np.ndarray) -> tuple[np.ndarray, np.nd
     return test, reference
 
 
-def reference_scale(reference: np.ndarray) -> float:
-    """The exposure scale of (H, W, 3) scene-linear ``reference``, metered over all its pixels."""
+def reference_scale(reference: np.ndarray, metered: np.ndarray | None = None) -> float:
+    """The exposure scale of (H, W, 3) scene-linear ``reference``, metered over the (H, W) bool mask ``metered``
+    (the pixels that see a surface, as ``rgb.png`` is metered; None: all its pixels)."""
     from synthua_usd.backends.exposure import choose_exposure
 
-    return choose_exposure(np.asarray(reference, np.float32)).scale
+    return choose_exposure(np.asarray(reference, np.float32), metered).scale
 
 
 def display_values(rgb: np.ndarray, scale: float) -> np.ndarray:

@@ -6,7 +6,7 @@ Rec.709 luminance ``Y`` of a pixel is the ȳ-weighted mean spectral radiance in 
 
     L_v [cd/m²] = 683 lm/W × ∫ȳ(λ) dλ × Y = 683 × 106.857 nm × Y ≈ 72 983 × Y.
 
-Check (``tests/backends/mitsuba/test_sky.py``): Mitsuba's ``sunsky`` emitter with the sun 65° high and
+Check (``tests/backends/mitsuba/test_weather_scene.py``): Mitsuba's ``sunsky`` emitter with the sun 65° high and
 turbidity 3 lights a horizontal plane with ≈ 105 klx, within the 100–120 klx measured under clear noon
 skies. Lamps (:mod:`synthua_usd.lamps`) are authored in lumens and cd/m² and converted with the same
 constant, so sun, sky and street lights share one scale and one exposure rule.

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from synthua_usd.backends.exposure import choose_exposure
-from synthua_usd.image_quality import display_values, psnr_db, reference_ceiling_db, ssim
+from synthua_usd.image_quality import display_values, psnr_db, reference_ceiling_db, reference_scale, ssim
 
 
 def srgb_decode(v: float) -> float:
@@ -44,6 +44,18 @@ def test_psnr_uses_the_reference_exposure_by_default():
     assert psnr_db(test, reference) == psnr_db(test, reference, scale=scale)
     # Exposure follows the reference: the same scene 8x brighter scores the same (within float rounding).
     assert psnr_db(test * 8, reference * 8) == pytest.approx(psnr_db(test, reference), abs=1e-3)
+
+
+def test_reference_scale_meters_the_masked_pixels_as_rgb_png_is_metered():
+    # Half the view is black void beyond a twin's edge: metered over every pixel, the log-average falls to
+    # the void's and the lit street is exposed thousands of times too bright; over the surface pixels it is
+    # the street's own exposure.
+    street = np.full((8, 16, 3), 0.05, np.float32)
+    view = np.concatenate([np.zeros_like(street), street])
+    surface = np.concatenate([np.zeros((8, 16), bool), np.ones((8, 16), bool)])
+    assert reference_scale(view, surface) == pytest.approx(reference_scale(street), rel=1e-6)
+    assert reference_scale(view) > 1000 * reference_scale(view, surface)
+    assert display_values(view, reference_scale(view))[8:].min() == 1.0  # every lit pixel clipped
 
 
 def test_ssim_of_constant_images_by_hand():

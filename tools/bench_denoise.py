@@ -3,7 +3,7 @@
 
 Usage: python tools/bench_denoise.py [--scenario stages/district/scenario.usda] [--views CAM ...]
        [--time-code 24] [--large (1280x960; default 640x480)] [--reference-spp 512] [--spp 1 2 4 8]
-       [--variant llvm_ad_rgb] [--cache out/bench_denoise] [--no-ablation] [--no-plain]
+       [--variant llvm_ad_rgb] [--cache out/bench_denoise] [--no-ablation] [--no-plain] [--save-images DIR]
 
 Per view (default: CCTV_Largo, CCTV_AidUser_1, PedestrianEye_Street, UAV_Oblique of the district at time
 code 24, under the stage's selected condition, as `synthua render` renders it) a reference is rendered at
@@ -20,13 +20,16 @@ a denoiser):
   N spp box + OIDN, no ff    (ablation, the default N only) the same without the firefly filter
   N spp gaussian + OIDN      (ablation, the default N only) OIDN on correlated noise
 
-and is scored with synthua_usd.image_quality (PSNR and SSIM on display values at the reference's exposure).
+and is scored with synthua_usd.image_quality (PSNR and SSIM on display values at the reference's exposure,
+metered as rgb.png is: over the pixels whose label-pass ray sees a surface, not the sky or the void).
 The reference's own noise caps every score: the ceiling printed per view is what a noise-free image would score,
 from the difference of the two halves (synthua_usd.image_quality.reference_ceiling_db).
 Time is the RGB pass plus denoising (labels and scene loads left out; each setting renders one warm-up
 frame first so kernel compilation is not counted). Other seeds than the reference's. Printed: one row per
 view and setting, then per setting the mean PSNR, the minimum PSNR, the mean SSIM, the mean time and the
 speed-up and PSNR difference against 16 spp gaussian (or the first row); the RenderConfig default is marked.
+--save-images DIR writes, per view, the reference and, per denoised row, the pass before and after the denoiser
+as sRGB PNGs at the exposure they are scored at (<view>_reference.png, <view>_<N>spp_noisy.png, ..._oidn.png).
 Not a test: times depend on the machine and its load; compare ratios measured in the same run.
 """
 
@@ -78,6 +81,8 @@ def main() -> int:
     parser.add_argument("--cache", type=Path, default=REPO / "out" / "bench_denoise")
     parser.add_argument("--no-ablation", action="store_true", help="skip the firefly and gaussian ablation rows")
     parser.add_argument("--no-plain", action="store_true", help="skip the rows without a denoiser (16 and 64 spp)")
+    parser.add_argument("--save-images", type=Path, default=None, metavar="DIR",
+                        help="write the reference and each denoised row's pass before and after OIDN as PNGs")
     args = parser.parse_args()
 
     import numpy as np
@@ -105,25 +110,35 @@ def main() -> int:
           f"RenderConfig default: {default.spp} spp {default.pixel_filter}, denoise {default.denoise}")
 
     def render_all(config: RenderConfig, warm_up: bool, fireflies: bool = True) -> dict:
+        """Per view: (frame, RGB + denoise seconds, the pass before the denoiser or None)."""
         session = RenderSession(config)
         real = denoise_module.suppress_fireflies
+        real_pass = denoise_module.Denoiser.denoise_pass
+        noisy = []
         if not fireflies:  # the ablation row: OIDN on the raw pass
             denoise_module.suppress_fireflies = lambda rgb: (rgb, FireflyReport(0, 0.0, 0.0))
+        if args.save_images:  # keep the pass the denoiser is given
+            def keeping(denoiser, color, albedo, normal):
+                noisy.append(np.array(color))
+                return real_pass(denoiser, color, albedo, normal)
+            denoise_module.Denoiser.denoise_pass = keeping
         try:
             if warm_up:
                 session.render(snapshot, cameras[args.views[0]], condition=condition)
             out = {}
             for path, camera in cameras.items():
+                noisy.clear()
                 frame = session.render(snapshot, camera, condition=condition)
                 seconds = frame.seconds["rgb"] + frame.seconds.get("denoise", 0.0)
-                out[path] = (frame, seconds)
+                out[path] = (frame, seconds, noisy[-1] if noisy else None)
             return out
         finally:
             denoise_module.suppress_fireflies = real
+            denoise_module.Denoiser.denoise_pass = real_pass
 
     # The reference is the mean of two halves of --reference-spp / 2 samples with other seeds: their difference
     # says how much noise the reference itself has (image_quality.reference_ceiling_db).
-    references, ceilings = {}, {}
+    references, reference_halves, ceilings, scales = {}, {}, {}, {}
     variant = None
     half_spp = max(args.reference_spp // 2, 1)
     ref_session = None
@@ -147,7 +162,7 @@ def main() -> int:
             print(f"reference half {path} (seed {seed}): {time.perf_counter() - t0:.0f} s ({frame.variant}) -> "
                   f"{cached}", flush=True)
         references[path] = (halves[0] + halves[1]) / 2
-        ceilings[path] = reference_ceiling_db(*halves, reference_scale(references[path]))
+        reference_halves[path] = halves
     del ref_session
 
     rows = settings(args.spp, default.spp, not args.no_ablation, not args.no_plain)
@@ -157,9 +172,19 @@ def main() -> int:
         config = RenderConfig(width=width, height=height, spp=row.spp, pixel_filter=row.pixel_filter,
                               denoise=row.denoise, seed=1, variant=args.variant)
         rendered = render_all(config, warm_up=True, fireflies=row.fireflies)
-        for path, (frame, seconds) in rendered.items():
+        for path, (frame, seconds, before) in rendered.items():
             variant = frame.variant
-            scale = None  # the reference's exposure, metered over all its pixels (image_quality's rule)
+            if path not in scales:  # the reference's exposure, metered as rgb.png is: over the surface pixels
+                scales[path] = reference_scale(references[path], frame.hits.mesh_index >= 0)
+                ceilings[path] = reference_ceiling_db(*reference_halves[path], scales[path])
+            scale = scales[path]
+            if args.save_images and before is not None:
+                name = path.rsplit("/", 1)[-1]
+                args.save_images.mkdir(parents=True, exist_ok=True)
+                if not (args.save_images / f"{name}_reference.png").exists():
+                    images.write_display_png(args.save_images / f"{name}_reference.png", references[path] * scale)
+                images.write_display_png(args.save_images / f"{name}_{row.spp}spp_noisy.png", before * scale)
+                images.write_display_png(args.save_images / f"{name}_{row.spp}spp_oidn.png", frame.rgb * scale)
             p = psnr_db(frame.rgb, references[path], scale)
             s = ssim(frame.rgb, references[path], scale)
             ff = frame.denoised["firefly_pixels"] if frame.denoised else ""

@@ -100,12 +100,21 @@ def verdict(met: bool | None, detail: str = "") -> str:
 # ---- quality ------------------------------------------------------------------------------------------------
 
 def quality_metric():
-    """(psnr(test, reference) -> dB, a line saying which), both (H, W, 3) float32 scene-linear:
-    :func:`synthua_usd.image_quality.psnr_db`, display-referred at the reference's exposure."""
+    """(psnr(test, reference, scale) -> dB, a line saying which), both (H, W, 3) float32 scene-linear, ``scale``
+    the view's exposure (:func:`view_scale`): :func:`synthua_usd.image_quality.psnr_db` on display values."""
     from synthua_usd.image_quality import psnr_db
 
-    return (lambda test, reference: float(psnr_db(test, reference)),
-            "PSNR: synthua_usd.image_quality.psnr_db, display-referred at the reference's exposure")
+    return (lambda test, reference, scale: float(psnr_db(test, reference, scale)),
+            "PSNR: synthua_usd.image_quality.psnr_db, display-referred at the reference's exposure, metered as "
+            "rgb.png is (over the pixels that see a surface)")
+
+
+def view_scale(reference: np.ndarray, frame) -> float:
+    """The exposure scores are taken at: ``reference``'s, metered over the pixels whose label-pass ray (of
+    ``frame``, any render of the view) sees a surface, the rule ``rgb.png`` is exposed by."""
+    from synthua_usd.image_quality import reference_scale
+
+    return reference_scale(reference, frame.hits.mesh_index >= 0)
 
 
 def rgb_seconds(seconds: dict) -> float:
@@ -125,7 +134,7 @@ def measure_session(args, stage, reader, views, psnr, ssim) -> dict:
     """Label pass and raw bound, RGB (reference, 16 spp, denoised), first load and per-frame updates, through one
     render session; also hands on the snapshot, cameras and references for the Cycles comparison."""
     from synthua_usd.backends.mitsuba.render import intersect_pixel_centres, render_rgb
-    from synthua_usd.image_quality import reference_ceiling_db, reference_scale
+    from synthua_usd.image_quality import reference_ceiling_db
     from synthua_usd.backends.mitsuba.session import RenderSession
     from synthua_usd.render_config import RenderConfig
     from synthua_usd.usd.cameras import camera_paths, read_camera
@@ -161,13 +170,15 @@ def measure_session(args, stage, reader, views, psnr, ssim) -> dict:
             r["reference_s"] += seconds
             halves.append(half)
         reference = (halves[0] + halves[1]) / 2
-        r["reference_ceiling_db"] = reference_ceiling_db(*halves, reference_scale(reference))
         session.render(snapshot, cam, rgb=True, seed=1)
         frame = session.render(snapshot, cam, rgb=True, seed=2)
+        r["scale"] = view_scale(reference, frame)
+        r["metered"] = frame.hits.mesh_index >= 0
+        r["reference_ceiling_db"] = reference_ceiling_db(*halves, r["scale"])
         r["rgb16_s"] = rgb_seconds(frame.seconds)
-        r["rgb16_psnr_db"] = psnr(frame.rgb, reference)
+        r["rgb16_psnr_db"] = psnr(frame.rgb, reference, r["scale"])
         if args.save_images:
-            save_display(args.save_images / f"mitsuba_{RGB_SPP}spp_{len(out['views'])}.png", frame.rgb, reference)
+            save_display(args.save_images / f"mitsuba_{RGB_SPP}spp_{len(out['views'])}.png", frame.rgb, r["scale"])
         r["reference"] = reference
         out["views"][view] = r
     # per-frame update: the next time code (moving agents re-read and re-uploaded; best of --repeat consecutive
@@ -199,7 +210,8 @@ def measure_session(args, stage, reader, views, psnr, ssim) -> dict:
         for v in views:
             dn.render(snapshot, cameras[v], rgb=True, seed=1)  # load and compile
             f = dn.render(snapshot, cameras[v], rgb=True, seed=2)
-            results.append((rgb_seconds(f.seconds), psnr(f.rgb, out["views"][v]["reference"])))
+            results.append((rgb_seconds(f.seconds), psnr(f.rgb, out["views"][v]["reference"],
+                                                         out["views"][v]["scale"])))
         del dn
         seconds, db = float(np.mean([x[0] for x in results])), float(np.mean([x[1] for x in results]))
         out["denoise"] = {"spp": spp, "rgb_s": seconds, "psnr_db": db, "reached_16spp": db >= target}
@@ -215,8 +227,8 @@ def measure_session(args, stage, reader, views, psnr, ssim) -> dict:
         for v in views:
             dq.render(snapshot, cameras[v], rgb=True, seed=1)  # load and compile
             f = dq.render(snapshot, cameras[v], rgb=True, seed=2)
-            results.append((rgb_seconds(f.seconds), psnr(f.rgb, out["views"][v]["reference"]),
-                            ssim(f.rgb, out["views"][v]["reference"])))
+            ref, scale = out["views"][v]["reference"], out["views"][v]["scale"]
+            results.append((rgb_seconds(f.seconds), psnr(f.rgb, ref, scale), ssim(f.rgb, ref, scale)))
         del dq
         out["default_quality"] = {"spp": defaults.spp, "pixel_filter": defaults.pixel_filter,
                                   "rgb_s": float(np.mean([x[0] for x in results])),
@@ -265,11 +277,13 @@ def measure_pipeline(args, views, spp: int, denoise: bool) -> dict:
 def measure_cycles(args, session_out: dict, targets_db: dict, psnr, views) -> dict:
     from synthua_usd.backends.cycles.interchange import write_interchange
     from synthua_usd.backends.cycles.runner import CyclesJob, find_cycles_python, render_jobs
+    from synthua_usd.image_quality import reference_scale
 
     python = find_cycles_python(args.cycles_python)
     view = views[0]
     snapshot, camera = session_out["snapshot"], session_out["cameras"][view]
     mitsuba_ref = session_out["views"][view]["reference"]
+    mitsuba_scale = session_out["views"][view]["scale"]
     work = Path(tempfile.mkdtemp(prefix="bench_cycles_"))
     try:
         t_export, _ = timed(lambda: write_interchange(snapshot, camera, args.width, args.height, work / "scene"))
@@ -280,36 +294,37 @@ def measure_cycles(args, session_out: dict, targets_db: dict, psnr, views) -> di
     finally:
         shutil.rmtree(work, ignore_errors=True)
     reference = result.images["reference"]
+    # Cycles' images are scored at its own reference's exposure, metered over the same surface pixels.
+    scale = reference_scale(reference, session_out["views"][view]["metered"])
     if args.save_images:
-        save_display(args.save_images / "mitsuba_reference.png", mitsuba_ref, mitsuba_ref)
-        save_display(args.save_images / "cycles_reference.png", reference, mitsuba_ref)
+        save_display(args.save_images / "mitsuba_reference.png", mitsuba_ref, mitsuba_scale)
+        save_display(args.save_images / "cycles_reference.png", reference, mitsuba_scale)
         for name, image in result.images.items():
             if name != "reference":
-                save_display(args.save_images / f"cycles_{name}.png", image, reference)
+                save_display(args.save_images / f"cycles_{name}.png", image, scale)
     candidates = []
     for name in result.images:
         if name != "reference":
             kind, samples = name.split("_")
             candidates.append({"samples": int(samples), "denoise": kind == "oidn", "render_s": result.seconds[name],
-                               "psnr_db": psnr(result.images[name], reference)})
+                               "psnr_db": psnr(result.images[name], reference, scale)})
     chosen = {}  # per Mitsuba operating point: Cycles' fastest setting at (at least) its PSNR
     for point, target_db in targets_db.items():
         reached = [c for c in candidates if c["psnr_db"] >= target_db]
         chosen[point] = min(reached, key=lambda c: c["render_s"]) if reached else None
     return {"blender": result.blender, "export_s": t_export, "build_s": result.build_s, "warmup_s": result.warmup_s,
             "reference_s": result.seconds["reference"], "candidates": candidates, "chosen": chosen,
-            "targets_db": targets_db, "cross_renderer_psnr_db": psnr(reference, mitsuba_ref),
+            "targets_db": targets_db, "cross_renderer_psnr_db": psnr(reference, mitsuba_ref, mitsuba_scale),
             "cross_renderer_mean_ratio": (reference.mean(axis=(0, 1)) / np.maximum(mitsuba_ref.mean(axis=(0, 1)),
                                                                                   1e-9)).tolist()}
 
 
-def save_display(path: Path, rgb: np.ndarray, reference: np.ndarray) -> None:
-    """``rgb`` as an sRGB PNG at ``reference``'s exposure (what the PSNR compares)."""
-    from synthua_usd.backends.exposure import choose_exposure
+def save_display(path: Path, rgb: np.ndarray, scale: float) -> None:
+    """``rgb`` as an sRGB PNG at exposure ``scale`` (what the PSNR compares)."""
     from synthua_usd.backends.images import write_display_png
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    write_display_png(path, rgb * np.float32(choose_exposure(reference).scale))
+    write_display_png(path, rgb * np.float32(scale))
 
 
 # ---- the table ----------------------------------------------------------------------------------------------
@@ -486,8 +501,8 @@ def main(argv: list[str] | None = None) -> int:
     psnr, psnr_note = quality_metric()
     from synthua_usd.image_quality import ssim as ssim_of
 
-    def ssim(test, reference):
-        return float(ssim_of(test, reference))
+    def ssim(test, reference, scale):
+        return float(ssim_of(test, reference, scale))
     stage = open_stage(args.scenario)
     reader = StageReader(stage, ClassMap.default())
     session_out = measure_session(args, stage, reader, args.views, psnr, ssim)
@@ -532,7 +547,8 @@ def main(argv: list[str] | None = None) -> int:
     for line in stands:
         print(f"- {line}")
     if args.json:
-        views = {k: {kk: vv for kk, vv in v.items() if kk != "reference"} for k, v in session_out["views"].items()}
+        views = {k: {kk: vv for kk, vv in v.items() if kk not in ("reference", "metered")}
+                 for k, v in session_out["views"].items()}
         doc = {"args": {k: str(v) if isinstance(v, Path) else v for k, v in vars(args).items()},
                "psnr": psnr_note, "load_average": [load_before, load_after],
                "session": {k: v for k, v in session_out.items() if k not in ("views", "snapshot", "cameras")},

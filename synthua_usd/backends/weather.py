@@ -24,6 +24,13 @@ rain streaks"): drop sizes ≥ 1 mm from the Marshall–Palmer distribution N(D)
 share of the pixel and of the exposure it covers; its radiance is the mean of the frame and of the sky
 light A (a drop refracts light from a ~165° cone around it). Drops behind the surface a pixel sees are
 hidden. Streaks are drawn from a seeded generator: the same seed, camera and time code give the same rain.
+
+The sun's disk: the path tracer lights the scene with the sun as a directional (delta) light, which no
+camera ray can hit, so :func:`sun_disk` draws the disk where it is seen: a uniform disk of angular radius
+``SUN_HALF_ANGLE_DEG`` whose radiance is the sun's normal irradiance over its solid angle, on the pixels
+whose centre ray escapes, weighted by the share of each pixel's area (8×8 points) that looks into it. Fog
+then covers it like any other escaped pixel. Left out: limb darkening, and the sun seen in mirror-like
+reflections.
 """
 
 from __future__ import annotations
@@ -39,6 +46,9 @@ SHUTTER_S = 1.0 / 50.0
 RAIN_RANGE_M = (1.0, 10.0)
 RAIN_MIN_DROP_MM = 1.0
 MARSHALL_PALMER_N0 = 8000.0  # m⁻³ mm⁻¹
+#: Half the sun's apparent diameter (0.5358°, as Mitsuba's ``sunsky`` has it).
+SUN_HALF_ANGLE_DEG = 0.5358 / 2.0
+SUN_DISK_SUBSAMPLES = 8
 
 
 def fog_lighting(condition, e_sun: np.ndarray, e_sky: np.ndarray) -> tuple[float, float, np.ndarray]:
@@ -57,6 +67,42 @@ def fog_lighting(condition, e_sun: np.ndarray, e_sky: np.ndarray) -> tuple[float
         sky_scale = total + max(total - direct, 0.0) * (sun_y / sky_y if sky_y > 0 else 0.0)
     airlight = (sun_scale * np.asarray(e_sun, float) + sky_scale * np.asarray(e_sky, float)) / math.pi
     return sun_scale, sky_scale, airlight
+
+
+def sun_disk(rgb: np.ndarray, escaped: np.ndarray, camera: PinholeCamera, direction: np.ndarray,
+             normal_irradiance: np.ndarray, half_angle_deg: float = SUN_HALF_ANGLE_DEG) -> np.ndarray:
+    """``rgb`` (H, W, 3) float32 linear with the sun's disk added where ``escaped`` (H, W) bool: the sun in
+    unit world ``direction`` (towards the sun), ``normal_irradiance`` (3,) linear RGB on a surface facing it
+    (renderer units). Returns ``rgb`` itself when the disk is nowhere in the image."""
+    h, w = escaped.shape
+    d = np.asarray(direction, np.float64) / np.linalg.norm(direction)
+    cos_max = math.cos(math.radians(half_angle_deg))
+    centre, z = camera.project(camera.origin[None, :] + d[None, :], w, h)
+    if not z[0] > 0 or not np.all(np.isfinite(centre)):
+        return rgb
+    # The disk's radius in pixels near the image axis, doubled (and 2 px more) to cover oblique views and lenses.
+    k = camera.intrinsics(w, h)
+    reach = 2.0 * max(k[0, 0], k[1, 1]) * math.tan(math.radians(half_angle_deg)) + 2.0
+    x0, x1 = max(int(centre[0, 0] - reach), 0), min(int(centre[0, 0] + reach) + 1, w)
+    y0, y1 = max(int(centre[0, 1] - reach), 0), min(int(centre[0, 1] + reach) + 1, h)
+    if x0 >= x1 or y0 >= y1:
+        return rgb
+    n = SUN_DISK_SUBSAMPLES
+    offsets = (np.arange(n) + 0.5) / n
+    px = (np.arange(x0, x1)[:, None] + offsets[None, :]).ravel()
+    py = (np.arange(y0, y1)[:, None] + offsets[None, :]).ravel()
+    gx, gy = np.meshgrid(px, py)
+    _, rays = camera.pixel_rays(gx.ravel(), gy.ravel(), w, h)
+    inside = (rays @ d >= cos_max).reshape(y1 - y0, n, x1 - x0, n)
+    share = inside.mean(axis=(1, 3))
+    share = np.where(escaped[y0:y1, x0:x1], share, 0.0)
+    if not share.any():
+        return rgb
+    solid_angle = 2.0 * math.pi * (1.0 - cos_max)
+    radiance = np.asarray(normal_irradiance, np.float64) / solid_angle
+    out = rgb.copy()
+    out[y0:y1, x0:x1] += (share[..., None] * radiance).astype(np.float32)
+    return out
 
 
 def apply_fog(rgb: np.ndarray, distance_m: np.ndarray, hit: np.ndarray, beta_per_m: float,

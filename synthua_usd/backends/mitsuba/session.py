@@ -88,7 +88,7 @@ class RenderSession:
         if self._meter is None:
             self._meter = weather_scene.LightMeter(self.mi)
         self._lighting = weather_scene.apply_condition(self.mi, self._params, self._translation.shape_ids,
-                                                       self._translation.lamps, condition, self._snapshot,
+                                                       self._translation.lamps, condition, self._snapshot.up_axis,
                                                        self._meter)
         self._condition = condition
 
@@ -231,9 +231,12 @@ class RenderSession:
 
     def _weather(self, image: np.ndarray, hits, camera: PinholeCamera, condition: Condition,
                  snapshot: SceneSnapshot, seed: int) -> np.ndarray:
-        """Fog, then rain streaks in front of it; the rain of a frame is seeded by the session's seed, the
+        """The sun's disk where it is seen, fog, then rain streaks in front of it; the rain of a frame is seeded by the session's seed, the
         camera and the time code."""
-        airlight = self._lighting.airlight
+        airlight, lighting = self._lighting.airlight, self._lighting
+        if lighting.sun_direction is not None:
+            image = weather.sun_disk(image, hits.mesh_index < 0, camera, lighting.sun_direction,
+                                     lighting.sun_irradiance)
         image = weather.apply_fog(image, hits.distance_m, hits.mesh_index >= 0, condition.fog_extinction_per_m,
                                   airlight)
         rng = np.random.default_rng([seed, zlib.crc32(camera.path.encode("utf-8")),

@@ -3,16 +3,25 @@ scene is switched from one condition to another.
 
 Built into the scene when it is loaded with a condition (:mod:`synthua_usd.backends.mitsuba.translate`):
 
-* the sky: Mitsuba's ``sunsky`` emitter (Hosek–Wilkie sky and sun, turbidity, ground albedo) while the sun
-  is up, else a uniform ``constant`` dome for the night sky (Mitsuba allows one environment emitter per
-  scene, and ``sunsky`` is dark with the sun below the horizon);
+* the sky: Mitsuba's ``sunsky`` emitter (Hosek–Wilkie sky, turbidity, ground albedo) while the sun is up,
+  else a uniform ``constant`` dome for the night sky (Mitsuba allows one environment emitter per scene, and
+  ``sunsky`` is dark with the sun below the horizon);
+* the sun while it is up: a ``directional`` emitter with the irradiance of ``sunsky``'s own sun disk
+  (measured by :class:`LightMeter`), whose disk is switched off (``sun_scale`` 0). A delta light is sampled
+  exactly by every shadow ray, where the disk's own sampling also spends samples on the sky and puts
+  penumbra noise into every sunlit pixel: measured on the district at 640×480, 16 spp, two seeds, the same
+  mean image (within 0.03 %) with 21 % less noise variance on CCTV_Largo and PedestrianEye_Street, equal on
+  UAV_Oblique, and 15–18 % less RGB time on UAV_Oblique at 1280×960. What it leaves out: the sun's 0.27°
+  penumbrae and its disk seen in mirror-like reflections; the disk seen straight is drawn in image space
+  (:func:`synthua_usd.backends.weather.sun_disk`);
 * an ``area`` emitter on every lamp mesh (:mod:`synthua_usd.lamps`), dark until a condition turns it on;
 * weathered surfaces, only when the condition has them: a ``blendbsdf`` per material between the dry
   ``principled`` BSDF and a wet or snowy one, weighted per face by a mesh attribute (``face_wet``,
   ``face_snow``) that holds the wetness or snow cover of upward-facing faces.
 
 :func:`apply_condition` then sets, through ``traverse()`` parameters and without reloading: the sun's
-direction, turbidity, the sun and sky scales (fog dims the sun, see :mod:`synthua_usd.backends.weather`),
+direction, turbidity, the sun's irradiance and the sky's scale (fog dims both, see
+:mod:`synthua_usd.backends.weather`),
 the night sky's radiance, every lamp's radiance, and the emitters' sampling weights (lumens, so unlit
 lamps are never sampled). Day ↔ night changes the environment emitter's type, and changing wetness or
 snow cover changes the BSDFs and mesh attributes the scene was built with: :func:`scene_key` differs and
@@ -41,6 +50,7 @@ from synthua_usd.scenario import ENVIRONMENT_PATH
 from synthua_usd.scene import Material, SceneSnapshot
 
 SUNSKY = "sky_sunsky"
+SUN = "sky_sun"
 NIGHT_SKY = "sky_night"
 GROUND_ALBEDO = 0.2
 SNOW_ALBEDO = 0.85
@@ -71,13 +81,16 @@ class LampMesh:
 @dataclass(frozen=True)
 class Lighting:
     """What :func:`apply_condition` set: the sun and sky scales (fog), ``airlight`` (3,) float64, the linear
-    RGB radiance of fog at infinite distance (renderer units), and the luminous flux of every lit lamp mesh
-    by mesh index."""
+    RGB radiance of fog at infinite distance (renderer units), the luminous flux of every lit lamp mesh by
+    mesh index, and the sun: its unit world ``sun_direction`` (3,) (towards the sun; None at night) and
+    ``sun_irradiance`` (3,) linear RGB on a surface facing it, after fog."""
 
     sun_scale: float
     sky_scale: float
     airlight: np.ndarray
     lamp_flux_lm: dict[int, float]
+    sun_direction: np.ndarray | None = None
+    sun_irradiance: np.ndarray | None = None
 
 
 def up_vector(up_axis: str) -> np.ndarray:
@@ -197,7 +210,16 @@ def sky_emitter(mi, up_axis: str, sun_up: bool) -> dict:
         return {NIGHT_SKY: {"type": "constant", "radiance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}}
     to_world = mi.ScalarTransform4f().rotate([1, 0, 0], -90) if up_axis == "Y" else mi.ScalarTransform4f()
     return {SUNSKY: {"type": "sunsky", "sun_direction": up_vector(up_axis).tolist(), "to_world": to_world,
-                     "sun_scale": 0.0, "sky_scale": 0.0}}
+                     "sun_scale": 0.0, "sky_scale": 0.0},
+            SUN: {"type": "directional", "direction": (-up_vector(up_axis)).tolist(),
+                  "irradiance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}}
+
+
+def _perpendicular(direction) -> np.ndarray:
+    """A unit vector perpendicular to ``direction`` (3,): the ``up`` a look-at frame needs."""
+    d = np.asarray(direction, np.float64)
+    axis = np.eye(3)[int(np.argmin(np.abs(d)))]
+    return np.cross(d, axis) / np.linalg.norm(np.cross(d, axis))
 
 
 def dark_area_emitter(mi):
@@ -205,23 +227,33 @@ def dark_area_emitter(mi):
 
 
 def apply_condition(mi, params, shape_ids: tuple[str, ...], lamps: tuple[LampMesh, ...], condition: Condition,
-                    snapshot: SceneSnapshot, meter: "LightMeter") -> Lighting:
+                    up_axis: str, meter: "LightMeter") -> Lighting:
     """Set the sky and lamp parameters of a scene loaded by ``translate(..., condition=...)`` to ``condition``
     (``params.update()`` is left to the caller)."""
     if condition.sun_up:
-        direction = condition.sun_direction(snapshot.up_axis)
+        direction = condition.sun_direction(up_axis)
         albedo = GROUND_ALBEDO + (SNOW_ALBEDO - GROUND_ALBEDO) * condition.snow_cover
-        e_sun, e_sky = meter.measure(direction, condition.turbidity, albedo, snapshot.up_axis)
+        e_sun, e_sky = meter.measure(direction, condition.turbidity, albedo, up_axis)
         sun_scale, sky_scale, airlight = fog_lighting(condition, e_sun, e_sky)
         params[f"{SUNSKY}.sun_direction"] = type(params[f"{SUNSKY}.sun_direction"])(*map(float, direction))
         params[f"{SUNSKY}.turbidity"] = type(params[f"{SUNSKY}.turbidity"])(float(condition.turbidity))
         params[f"{SUNSKY}.albedo.value"] = type(params[f"{SUNSKY}.albedo.value"])(float(albedo))
-        params[f"{SUNSKY}.sun_scale"] = float(sun_scale)
         params[f"{SUNSKY}.sky_scale"] = float(sky_scale)
-        sky_lux = float(np.mean(sun_scale * e_sun + sky_scale * e_sky)) * CD_PER_M2_PER_UNIT
+        params[f"{SUNSKY}.sun_scale"] = 0.0  # the sun is the directional emitter
+        # The directional sun gives, on a surface facing it, what sunsky's sun disk gives: E_horizontal / cos(zenith).
+        cos_zenith = float(np.dot(direction, up_vector(up_axis)))
+        normal = sun_scale * np.asarray(e_sun, np.float64) / max(cos_zenith, 1e-6)
+        params[f"{SUN}.irradiance.value"] = type(params[f"{SUN}.irradiance.value"])(*map(float, normal))
+        params[f"{SUN}.to_world"] = mi.ScalarTransform4f().look_at(
+            origin=[0.0, 0.0, 0.0], target=(-np.asarray(direction, np.float64)).tolist(),
+            up=_perpendicular(direction).tolist())
+        sun_lux = float(np.mean(sun_scale * e_sun)) * CD_PER_M2_PER_UNIT
+        sky_lux = float(np.mean(sky_scale * e_sky)) * CD_PER_M2_PER_UNIT
+        params[f"{SUN}.sampling_weight"] = max(sun_lux, MIN_SKY_WEIGHT)
         params[f"{SUNSKY}.sampling_weight"] = max(sky_lux, MIN_SKY_WEIGHT)
     else:
         sun_scale = sky_scale = 0.0
+        direction = normal = None
         airlight = np.asarray(radiance_rgb(condition.night_sky_luminance_cd_m2, CCT_4000K))
         params[f"{NIGHT_SKY}.radiance.value"] = type(params[f"{NIGHT_SKY}.radiance.value"])(*map(float, airlight))
         params[f"{NIGHT_SKY}.sampling_weight"] = max(math.pi * condition.night_sky_luminance_cd_m2, MIN_SKY_WEIGHT)
@@ -236,7 +268,7 @@ def apply_condition(mi, params, shape_ids: tuple[str, ...], lamps: tuple[LampMes
         flux_lm[lamp.index] = math.pi * lamp.area_m2 * luminance
         params[f"{key}.emitter.sampling_weight"] = flux_lm[lamp.index] / (4.0 * math.pi * REFERENCE_DISTANCE_M ** 2)
     return Lighting(sun_scale=sun_scale, sky_scale=sky_scale, airlight=np.asarray(airlight, np.float64),
-                    lamp_flux_lm=flux_lm)
+                    lamp_flux_lm=flux_lm, sun_direction=direction, sun_irradiance=normal)
 
 
 def focus_lamps(params, shape_ids: tuple[str, ...], lamps: tuple[LampMesh, ...], lighting: Lighting,
