@@ -231,9 +231,10 @@ class RenderSession:
 
     def _weather(self, image: np.ndarray, hits, camera: PinholeCamera, condition: Condition,
                  snapshot: SceneSnapshot, seed: int) -> np.ndarray:
-        """The sun's disk where it is seen, fog, then rain streaks in front of it; the rain of a frame is seeded by the session's seed, the
-        camera and the time code."""
-        airlight, lighting = self._lighting.airlight, self._lighting
+        """The sun's disk where it is seen, fog, then rain streaks in front of it; the rain of a frame is seeded
+        by the session's seed, the camera and the time code."""
+        lighting = self._lighting
+        airlight = lighting.airlight
         if lighting.sun_direction is not None:
             image = weather.sun_disk(image, hits.mesh_index < 0, camera, lighting.sun_direction,
                                      lighting.sun_irradiance)
