@@ -43,6 +43,9 @@ class PinholeCamera:
         Rigid transform, column-vector convention, metres.
     distortion : BrownConrady or None
         Lens distortion; None (and all-zero coefficients, which are stored as None) is the ideal pinhole.
+    exposure_ev : float
+        Exposure compensation in stops (USD's ``exposure``: 1 doubles the image's intensities), applied on top
+        of the metered exposure.
     """
 
     path: str
@@ -53,6 +56,7 @@ class PinholeCamera:
     clip_far_m: float
     camera_to_world: np.ndarray = field(repr=False)
     distortion: BrownConrady | None = None
+    exposure_ev: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("focal_length_mm", "horizontal_aperture_mm", "vertical_aperture_mm"):
@@ -66,6 +70,9 @@ class PinholeCamera:
         if m.shape != (4, 4) or not np.all(np.isfinite(m)):
             raise InputError(f"camera {self.path}: camera_to_world should be a finite 4x4 matrix")
         object.__setattr__(self, "camera_to_world", m)
+        if not (math.isfinite(self.exposure_ev) and abs(self.exposure_ev) <= 20):
+            raise InputError(f"camera {self.path}: exposure should be a finite number of stops within ±20, "
+                             f"but was {self.exposure_ev}")
         if self.distortion is not None and self.distortion.is_zero:
             object.__setattr__(self, "distortion", None)  # zero distortion is the pinhole, exactly
 

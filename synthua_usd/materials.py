@@ -97,3 +97,46 @@ def class_material(class_name: str) -> Material:
 def subset(keys) -> dict[str, Material]:
     """The palette entries for ``keys`` (a twin's ``materials``), sorted by key."""
     return {k: material(k) for k in sorted(set(keys))}
+
+
+# --- palettes of scene randomisation (synthua_usd.randomisation) ------------------------------------------
+# Linear Rec.709 base colours. Façades: lime washes and paints of colonial and 20th-century row houses (ochre,
+# terracotta, blue, green, cream, white, pink, grey); car paints in rough proportion to the world's car colours
+# (white, black, grey, silver most often); canvases, umbrellas and stands; door paints and woods; mural paints.
+FACADE_COLOURS = (*WALL_COLOURS, (0.8, 0.62, 0.3), (0.72, 0.36, 0.22), (0.3, 0.45, 0.62), (0.55, 0.65, 0.5),
+                  (0.85, 0.8, 0.65), (0.82, 0.82, 0.8), (0.8, 0.55, 0.55), (0.5, 0.5, 0.52), (0.62, 0.3, 0.3))
+CAR_PAINTS = ((0.75, 0.75, 0.75), (0.75, 0.75, 0.75), (0.02, 0.02, 0.02), (0.02, 0.02, 0.02), (0.25, 0.25, 0.26),
+              (0.45, 0.46, 0.48), (0.45, 0.46, 0.48), (0.45, 0.03, 0.03), (0.03, 0.1, 0.4), (0.05, 0.2, 0.08),
+              (0.45, 0.38, 0.25), (0.7, 0.25, 0.02))
+CANVAS_COLOURS = ((0.8, 0.8, 0.78), (0.55, 0.06, 0.05), (0.06, 0.15, 0.5), (0.75, 0.55, 0.05), (0.1, 0.35, 0.12),
+                  (0.6, 0.25, 0.05), (0.45, 0.1, 0.35), (0.3, 0.3, 0.3))
+WOOD_COLOURS = ((0.35, 0.2, 0.08), (0.25, 0.12, 0.05), (0.45, 0.3, 0.15), (0.18, 0.1, 0.05), (0.5, 0.38, 0.22))
+DOOR_COLOURS = (*WOOD_COLOURS, (0.05, 0.2, 0.1), (0.05, 0.1, 0.3), (0.5, 0.05, 0.05), (0.8, 0.8, 0.78))
+MURAL_COLOURS = ((0.1, 0.35, 0.6), (0.7, 0.25, 0.4), (0.8, 0.6, 0.1), (0.2, 0.55, 0.25), (0.75, 0.3, 0.1),
+                 (0.4, 0.2, 0.6))
+#: Ground materials keep their hue: a grey or a warm or cool stone, as multipliers of the material's own colour
+#: or texture (road wear and paving lots).
+GROUND_TINTS = ((1.0, 1.0, 1.0), (1.12, 1.05, 0.95), (0.92, 0.96, 1.05), (0.8, 0.8, 0.8), (1.25, 1.22, 1.18),
+                (1.05, 0.98, 0.9))
+
+#: Class -> ("colour", palette) for a new base colour, or ("tint", tints) for a multiplier of the material's own
+#: colour or texture. Classes not listed keep their materials.
+RECOLOUR_PALETTES = {
+    "building": ("colour", FACADE_COLOURS), "mural": ("colour", MURAL_COLOURS), "door": ("colour", DOOR_COLOURS),
+    "car": ("colour", CAR_PAINTS), "bus": ("colour", CAR_PAINTS), "motorcycle": ("colour", CAR_PAINTS),
+    "bicycle": ("colour", CAR_PAINTS), "tent": ("colour", CANVAS_COLOURS), "umbrella": ("colour", CANVAS_COLOURS),
+    "stand": ("colour", WOOD_COLOURS), "road": ("tint", GROUND_TINTS), "street_road": ("tint", GROUND_TINTS),
+    "sidewalk": ("tint", GROUND_TINTS), "crosswalk": ("tint", GROUND_TINTS),
+}
+
+#: Mobility-aid frames: (base colour palette or None for the fixed colour, roughness, metallic) per finish.
+DEVICE_FINISHES = {
+    "painted_metal": (((0.45, 0.03, 0.03), (0.03, 0.1, 0.4), (0.02, 0.02, 0.02), (0.45, 0.46, 0.48), (0.05, 0.2, 0.08),
+                       (0.6, 0.3, 0.02), (0.3, 0.05, 0.3)), 0.35, 0.0),
+    "chrome": (((0.62, 0.62, 0.64),), 0.08, 1.0),
+    "anodised": (((0.5, 0.05, 0.05), (0.05, 0.15, 0.5), (0.1, 0.1, 0.12), (0.4, 0.4, 0.42), (0.35, 0.1, 0.4)), 0.25, 0.85),
+    "matte_black": (((0.025, 0.025, 0.028),), 0.75, 0.0),
+}
+#: Seat and backrest fabrics of wheelchairs.
+SEAT_FABRICS = ((0.03, 0.05, 0.15), (0.02, 0.02, 0.02), (0.15, 0.15, 0.16), (0.3, 0.04, 0.04), (0.04, 0.15, 0.06),
+                (0.25, 0.18, 0.1))

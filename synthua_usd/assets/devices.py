@@ -104,7 +104,7 @@ def tripod_cane(fit: DeviceFit = DeviceFit(grip_height_m=0.88)) -> list[TwinPart
     return _cane(fit.grip_height_m, "Frame", feet=3)
 
 
-#: class name → builder.
+#: class name → builder of its standard model.
 DEVICES = {
     "manual_wheelchair": manual_wheelchair,
     "electric_wheelchair": electric_wheelchair,
@@ -115,3 +115,6 @@ DEVICES = {
     "orthopedic_cane": orthopedic_cane,
     "tripod_cane": tripod_cane,
 }
+
+#: class name → {model name: builder}: the models a randomised scene draws among (one per class so far).
+DEVICE_MODELS = {name: {"standard": builder} for name, builder in DEVICES.items()}

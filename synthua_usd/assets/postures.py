@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synthua_usd.assets.bodies import (BONES, SEGMENTS, Bank, Pose, forward_kinematics, rot_y, rotation_between, skin,
-                                       two_bone_aims)
+from synthua_usd.assets.bodies import (BONES, REGIONS, SEGMENTS, Bank, Pose, forward_kinematics, load_bank, rot_y,
+                                       rotation_between, skin, two_bone_aims)
 
 #: Walk ratio (step length / cadence) of adults, m per (steps/min), for a 1.7 m person (Sekiya & Nagasaki 1998).
 WALK_RATIO = 0.0064
@@ -253,3 +253,31 @@ def segment_motion(bank: Bank, body: int, base: Pose, now: Pose) -> dict[str, np
         r = b[k, :, :3] @ a[k, :, :3].T
         out[name] = np.concatenate([r, (b[k, :, 3] - r @ a[k, :, 3])[:, None]], axis=1)
     return out
+
+
+class BodyParts:
+    """Base postures, fits and segment meshes per (body, posture, fit), each computed once: what authoring a
+    crowd needs of the body bank (the agents layer, a randomised scene)."""
+
+    def __init__(self) -> None:
+        self.bank = load_bank()
+        self._cache: dict[tuple, tuple] = {}
+
+    def get(self, body: int, posture: str | None, fit: DeviceFit | None = None):
+        """``posture`` a device class, :data:`BENCH` or None (walking); ``fit`` None: the device fitted to the body."""
+        key = (body, posture, fit)
+        if key not in self._cache:
+            fit = fit or fit_device(self.bank, body, posture)
+            base = pose(self.bank, body, posture, fit, 0.0, 0.0)
+            pts = skin(self.bank.points[body], self.bank, base.skinning(self.bank.joints[body]))
+            region = self.bank.face_region(body)
+            segment_faces = self.bank.segment_faces(body)
+            parts = {}
+            for k, name in enumerate(SEGMENTS):
+                for r, region_name in enumerate(REGIONS):
+                    tris = self.bank.triangles[segment_faces[k] & (region == r)]
+                    if len(tris):
+                        used, inverse = np.unique(tris, return_inverse=True)
+                        parts[(name, region_name)] = (pts[used], inverse.reshape(-1, 3))
+            self._cache[key] = (fit, base, parts)
+        return self._cache[key]

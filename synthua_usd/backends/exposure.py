@@ -42,17 +42,23 @@ class Exposure:
     ev100: float
     clamped: bool
     scale: float
+    #: The camera's exposure compensation (stops), already in ``scale``.
+    compensation_ev: float = 0.0
 
     def to_dict(self) -> dict:
-        return {"rule": RULE, "key": KEY, "log_average_luminance_cd_m2": self.log_average_cd_m2,
-                "ev100": self.ev100, "ev100_range": list(EV100_RANGE), "clamped": self.clamped,
-                "scale": self.scale}
+        out = {"rule": RULE, "key": KEY, "log_average_luminance_cd_m2": self.log_average_cd_m2,
+               "ev100": self.ev100, "ev100_range": list(EV100_RANGE), "clamped": self.clamped,
+               "scale": self.scale}
+        if self.compensation_ev:
+            out["compensation_ev"] = self.compensation_ev
+        return out
 
 
-def choose_exposure(rgb: np.ndarray, metered: np.ndarray | None = None) -> Exposure:
+def choose_exposure(rgb: np.ndarray, metered: np.ndarray | None = None, compensation_ev: float = 0.0) -> Exposure:
     """The exposure of (H, W, 3) scene-linear Rec.709 ``rgb`` in renderer units (see
     :mod:`synthua_usd.photometry`), metered over the (H, W) bool mask ``metered`` (pixels that see a
-    surface; None or an empty mask: every pixel)."""
+    surface; None or an empty mask: every pixel), then brightened by ``compensation_ev`` stops (the camera's
+    USD ``exposure``)."""
     lum = np.maximum(luminance(rgb), 0.0) * CD_PER_M2_PER_UNIT
     if metered is not None and np.any(metered):
         lum = lum[metered]
@@ -61,4 +67,5 @@ def choose_exposure(rgb: np.ndarray, metered: np.ndarray | None = None) -> Expos
     ev100 = float(np.clip(reading, *EV100_RANGE))
     exposed_cd_m2 = METER_K * 2.0 ** ev100 / ISO
     return Exposure(log_average_cd_m2=log_average, ev100=ev100, clamped=ev100 != reading,
-                    scale=CD_PER_M2_PER_UNIT * KEY / exposed_cd_m2)
+                    scale=CD_PER_M2_PER_UNIT * KEY / exposed_cd_m2 * 2.0 ** compensation_ev,
+                    compensation_ev=float(compensation_ev))

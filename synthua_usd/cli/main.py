@@ -21,6 +21,7 @@ from synthua_usd.cli.cameras_commands import cameras
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
 from synthua_usd.cli.common import parse_time_codes as _time_codes
 from synthua_usd.cli.dataset_commands import generate, replay, verify
+from synthua_usd.cli.randomise_commands import randomise
 from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.twin_commands import twin
@@ -206,6 +207,12 @@ def create_district(out_dir: Path, seed: int) -> int:
               help="Denoise RGB: a firefly filter, then Intel Open Image Denoise guided by albedo and normal from the "
                    "same samples, before fog, rain and exposure (box pixel filter either way) [default: on; see the "
                    "README's Denoising for what each sample count reaches].")
+@click.option("--max-depth", type=click.IntRange(1, 1024),
+              help=f"Path length of the RGB pass [default: {RenderConfig.max_depth}; 4 matches Cycles' max_bounces 2].")
+@click.option("--layer", "layers", multiple=True, type=click.Path(path_type=Path),
+              help="A layer composed over SCENARIO for this render only (through its session layer; no file is "
+                   "edited), e.g. the randomisation layer `synthua randomise` writes; repeat for several, strongest "
+                   "first.")
 @click.option("--variant", help="Mitsuba variant (cuda_ad_rgb, llvm_ad_rgb, scalar_rgb) [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--condition", help="Weather and light condition, one the stage offers (see `synthua inspect`), e.g. "
@@ -215,8 +222,9 @@ def create_district(out_dir: Path, seed: int) -> int:
 @click.option("--allow-external-assets", is_flag=True,
               help="Accept layers outside the stage's folder tree (refused by default).")
 def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ...], width: int | None,
-           height: int | None, spp: int | None, seed: int, denoise: bool | None, variant: str | None,
-           class_map: Path | None, condition: str | None, out_dir: Path, allow_external_assets: bool) -> int:
+           height: int | None, spp: int | None, seed: int, denoise: bool | None, max_depth: int | None,
+           layers: tuple[Path, ...], variant: str | None, class_map: Path | None, condition: str | None, out_dir: Path,
+           allow_external_assets: bool) -> int:
     """Render SCENARIO from each --camera at each time code into --out.
 
     \b
@@ -225,6 +233,8 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
           --camera /World/Cameras/PedestrianEye --time-code 1:48:8 --out out/sweep
     renders 12 frames from one loaded scene (only the camera and what moves are updated between them).
     --condition day_fog renders them under another of the stage's conditions (labels do not change).
+    --layer L.usda composes a layer over SCENARIO for this render, e.g. the randomisation layer of one dataset
+    image (synthua randomise prints the render command that reproduces that image).
     \b
     Files per frame (the stage's UsdRender vars choose; all when it names none): rgb.exr
     (scene-linear Rec.709) and rgb.png (display sRGB), class.png (8-bit class ids) and semantic.png
@@ -239,7 +249,7 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     run = run_frames(FrameRequest(stage_path=scenario, out_dir=out_dir, camera_paths=cameras, time_codes=time_codes,
                                   width=width, height=height, spp=spp, seed=seed, variant=variant,
                                   class_map_path=class_map, allow_external_assets=allow_external_assets,
-                                  condition=condition, denoise=denoise),
+                                  condition=condition, denoise=denoise, max_depth=max_depth, layers=layers),
                      show_progress=sys.stderr.isatty())
     for frame in run.frames:
         doc = frame.document
@@ -255,7 +265,7 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     return EXIT_OK
 
 
-for _group in (twin, agents, cameras, survey, contact_sheet, generate, verify, replay, stats, evaluate):
+for _group in (twin, agents, cameras, survey, contact_sheet, generate, verify, replay, randomise, stats, evaluate):
     cli.add_command(_group)
 
 

@@ -19,6 +19,7 @@ from typing import Any
 
 from synthua_usd.errors import InputError, echo
 from synthua_usd.input_files import shown
+from synthua_usd.randomisation.config import RandomisationConfig
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.rigs import RIG_TYPES
 from synthua_usd.schemas import load_schema, read_json, validate_document
@@ -201,6 +202,8 @@ class GenerationConfig:
     resample: Resample | None = None
     amodal_groups: tuple[str, ...] = ("person", "accessibility", "vehicle", "furniture", "animal")
     workers: int | None = None
+    #: Scene randomisation (None: the scenario rendered as composed).
+    randomise: RandomisationConfig | None = None
 
     @classmethod
     def load(cls, path: str | Path) -> "GenerationConfig":
@@ -238,6 +241,8 @@ class GenerationConfig:
             "resample": None if self.resample is None else dict(vars(self.resample)),
             "amodal_groups": list(self.amodal_groups),
             "workers": self.workers,
+            # absent when off, so that configs without it keep the documents (and job keys) they had
+            **({} if self.randomise is None else {"randomise": self.randomise.to_document()}),
         }
 
     def output_size(self, render_width: int, render_height: int) -> tuple[int, int]:
@@ -303,7 +308,13 @@ class _Builder:
             sampling_seed=doc.get("sampling_seed", GenerationConfig.sampling_seed),
             quotas=quotas, split=split, qa=qa, outputs=outputs, resample=resample,
             amodal_groups=tuple(doc.get("amodal_groups", GenerationConfig.amodal_groups)),
-            workers=doc.get("workers"))
+            workers=doc.get("workers"), randomise=self.randomise(doc.get("randomise")))
+
+    def randomise(self, doc) -> RandomisationConfig | None:
+        try:
+            return RandomisationConfig.from_document(doc)
+        except InputError as exc:
+            raise InputError(f"{self.source}: {exc}") from None
 
     def time_codes(self, value) -> tuple[float, ...]:
         if isinstance(value, list):

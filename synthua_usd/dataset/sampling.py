@@ -4,7 +4,8 @@
   config's seeds) into :class:`Candidate` views, checking the config's names against the stage.
 * :func:`plan` chooses ``config.images`` of them, deterministically, to meet the quotas as well as the pool
   allows, from :class:`ViewScore` s (visible aid users per camera and time code, measured by the caller on a
-  cheap label pass: a view's geometry does not depend on its condition or seed).
+  cheap label pass: a view's geometry does not depend on its condition, nor on its seed unless the config
+  randomises scenes, when each seed is a scene of its own and is scored per seed).
 * :func:`split_of` assigns whole cameras to train/val/test: the frames of one camera at other time codes,
   conditions and seeds are near duplicates, so they never straddle splits.
 
@@ -76,16 +77,25 @@ class AidUserView:
 
 @dataclass(frozen=True)
 class ViewScore:
-    """The aid users visible from one camera at one time code."""
+    """The aid users visible from one camera at one time code; with scene randomisation, of one seed's scene
+    (``seed``; None: the scenario as composed, whatever the seed)."""
 
     camera_path: str
     time_code: float
     aid_users: tuple[AidUserView, ...] = ()
+    seed: int | None = None
 
     @classmethod
-    def from_rows(cls, camera_path: str, time_code: float, rows: Iterable[Sequence]) -> "ViewScore":
+    def from_rows(cls, camera_path: str, time_code: float, rows: Iterable[Sequence],
+                  seed: int | None = None) -> "ViewScore":
         """From ``(aid_type, person_pixels, device_pixels, occlusion or None)`` rows."""
-        return cls(camera_path, float(time_code), tuple(AidUserView(*row) for row in rows))
+        return cls(camera_path, float(time_code), tuple(AidUserView(*row) for row in rows), seed)
+
+    def to_dict(self) -> dict:
+        out = asdict(self)
+        if self.seed is None:
+            del out["seed"]
+        return out
 
 
 @dataclass(frozen=True)
@@ -169,20 +179,21 @@ def candidates(config: GenerationConfig, cameras: Sequence[CameraInfo], time_cod
             for condition in names for path, name, rig in chosen for t in times for seed in config.seeds]
 
 
-def _scores_by_view(scores) -> dict[tuple[str, float], ViewScore]:
+def _scores_by_view(scores) -> dict[tuple[str, float, int | None], ViewScore]:
     if isinstance(scores, Mapping):
         scores = scores.values()
-    return {(s.camera_path, float(s.time_code)): s for s in scores}
+    return {(s.camera_path, float(s.time_code), s.seed): s for s in scores}
 
 
 def _qualifying(pool: Sequence[Candidate], scores, config: GenerationConfig) -> list[bool]:
     """Per candidate: whether its view shows an aid user that counts for the aid-user quota (a view without a
-    score shows none)."""
+    score shows none). A randomised candidate takes its seed's score."""
     quota = config.quotas.aid_users
     by_view = _scores_by_view(scores)
+    scene = config.randomise is not None
     out = []
     for c in pool:
-        score = by_view.get((c.camera_path, float(c.time_code)))
+        score = by_view.get((c.camera_path, float(c.time_code), c.seed if scene else None))
         out.append(bool(quota and score and any(quota.qualifies(a.visible_pixels, a.occlusion)
                                                 for a in score.aid_users)))
     return out

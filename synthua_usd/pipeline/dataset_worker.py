@@ -65,13 +65,19 @@ class WorkerState:
     session: object
     class_map: ClassMap
     conditions: dict = field(default_factory=dict)
+    #: Gives each image its randomisation layers (None when the config randomises nothing).
+    randomiser: object = None
     #: Writes the previous image (its files, then its record) while the next one renders.
     writer: BackgroundWriter = field(default_factory=BackgroundWriter)
     seconds: dict = field(default_factory=lambda: {"render": 0.0, "annotate": 0.0, "write": 0.0})
 
     def condition(self, name: str | None):
+        """The condition ``name`` as the stage composes it: read once, or for every image when randomised (the
+        view layer moves its sun)."""
         from synthua_usd.usd.conditions import read_condition
 
+        if self.randomiser is not None:
+            return read_condition(self.stage, name)
         if name not in self.conditions:
             self.conditions[name] = read_condition(self.stage, name)
         return self.conditions[name]
@@ -85,8 +91,13 @@ def init_worker(job: WorkerJob) -> WorkerState:
 
     class_map = ClassMap.from_document(job.class_map_document, source="class_map.json")
     stage = open_stage(job.scenario, job.allow_external_assets)
+    randomiser = None
+    if job.config.randomise is not None:
+        from synthua_usd.pipeline.randomiser import Randomiser
+
+        randomiser = Randomiser(stage, job.config.randomise, class_map, (job.render.width, job.render.height))
     return WorkerState(job=job, stage=stage, reader=StageReader(stage, class_map), session=RenderSession(job.render),
-                       class_map=class_map)
+                       class_map=class_map, randomiser=randomiser)
 
 
 def work(state: WorkerState, item) -> list[dict]:
@@ -116,6 +127,10 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
 
     job, class_map = state.job, state.class_map
     t0 = time.perf_counter()
+    randomised = None
+    if state.randomiser is not None:
+        randomised = state.randomiser.apply(planned.seed, planned.camera_path, planned.time_code, planned.condition)
+    t_randomise = time.perf_counter() - t0
     snapshot = state.reader.snapshot(planned.time_code)
     camera = read_camera(state.stage, planned.camera_path, planned.time_code)
     condition = state.condition(planned.condition)
@@ -130,6 +145,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     # "render" is all of it (snapshot, session, amodal); the render_* parts say where it went
     seconds = {"render": time.perf_counter() - t0, "render_amodal": time.perf_counter() - t_amodal,
                **{f"render_{key}": value for key, value in rendered.seconds.items()}}
+    if randomised is not None:
+        seconds["render_randomise"] = t_randomise
 
     t0 = time.perf_counter()
     meshes_of: dict[int, list] = {}
@@ -218,6 +235,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         "panoptic_segments": segments,
         "qa": {"verdict": verdict, "reasons": list(reasons), "measures": measures},
     }
+    if randomised is not None:
+        record["randomisation"] = randomised.to_dict()
     seconds["annotate"] = time.perf_counter() - t0
     return ImageBuffers(record, arrays, verdict == "rejected", seconds)
 

@@ -72,6 +72,10 @@ class FrameRequest:
     condition: str | None = None
     #: Denoise RGB (:attr:`RenderConfig.denoise`); None: the default.
     denoise: bool | None = None
+    #: Path length (:attr:`RenderConfig.max_depth`); None: the default.
+    max_depth: int | None = None
+    #: Layer files composed over the stage through its session layer, strongest first (a randomisation layer).
+    layers: tuple[Path, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,7 +108,7 @@ def time_code_folder(time_code: float) -> str:
 def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     """Check every input, render every frame from one session, then move all files into place together."""
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
-    stage = open_stage(request.stage_path, request.allow_external_assets)
+    stage = open_stage(request.stage_path, request.allow_external_assets, request.layers)
     defaults = render_defaults(stage)
     unknown = [n for n in defaults.var_names if n not in OUTPUT_NAMES]
     if unknown:
@@ -137,7 +141,8 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     spp = request.spp if request.spp is not None else defaults.spp if defaults.spp is not None else RenderConfig.spp
     config = RenderConfig(width=request.width or width, height=request.height or height, spp=spp, seed=request.seed,
                           variant=request.variant,
-                          denoise=RenderConfig.denoise if request.denoise is None else request.denoise)
+                          denoise=RenderConfig.denoise if request.denoise is None else request.denoise,
+                          max_depth=RenderConfig.max_depth if request.max_depth is None else request.max_depth)
     condition = read_condition(stage, request.condition)
     reader = StageReader(stage, class_map)
     if not reader.snapshot(time_codes[0]).meshes:

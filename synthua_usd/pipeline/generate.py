@@ -126,37 +126,53 @@ def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: 
 
 
 def score_views(stage, pool, render: RenderConfig, output_size: tuple[int, int], class_map: ClassMap,
-                show_progress: bool) -> list[sampling.ViewScore]:
+                show_progress: bool, randomise=None) -> list[sampling.ViewScore]:
     """The sampler's view scores: every mobility-aid user (:func:`synthua_usd.dataset.qa.aid_users`, the one
     definition QA and coverage use too) visible in each (camera, time code) view, from one label pass each
-    at the render size, pixel counts scaled to the written size (``output_size``)."""
+    at the render size, pixel counts scaled to the written size (``output_size``). With ``randomise`` (a
+    :class:`RandomisationConfig`), each (seed, camera, time code) view of the pool is scored in its own
+    randomised scene, as a worker will render it."""
     from tqdm import tqdm
 
     from synthua_usd.backends.mitsuba.session import RenderSession
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.reader import StageReader
 
+    randomiser = None
+    if randomise is not None:
+        from synthua_usd.pipeline.randomiser import Randomiser
+
+        randomiser = Randomiser(stage, randomise, class_map, (render.width, render.height))
     reader = StageReader(stage, class_map)
     session = RenderSession(RenderConfig(width=render.width, height=render.height, spp=1, variant=render.variant))
     scale = output_size[0] * output_size[1] / (render.width * render.height)
     scores = []
-    views = sorted(dict.fromkeys((c.time_code, c.camera_path) for c in pool))
-    for tc, path in tqdm(views, desc="score views", unit="view", disable=not show_progress):
-        snapshot = reader.snapshot(tc)
-        counts = np.bincount(session.quick_labels(snapshot, read_camera(stage, path, tc)).ravel(),
-                             minlength=len(snapshot.instances) + 1)
-        class_of = {inst.prim_path: inst.class_name for inst in snapshot.instances}
-        visible = []
-        for inst in snapshot.instances:
-            if counts[inst.id]:
-                relations = dict(inst.relations)
-                if relations.get("uses") in class_of:
-                    relations["uses_class"] = class_of[relations["uses"]]
-                visible.append({"class_name": inst.class_name, "prim_path": inst.prim_path,
-                                "area": int(round(counts[inst.id] * scale)), "relations": relations})
-        users = tuple(sampling.AidUserView(aid_type=u.aid_type, person_pixels=u.person_pixels,
-                                           device_pixels=u.device_pixels) for u in qa.aid_users(visible))
-        scores.append(sampling.ViewScore(camera_path=path, time_code=tc, aid_users=users))
+    if randomiser is None:
+        views = [(None, tc, path) for tc, path in sorted(dict.fromkeys((c.time_code, c.camera_path) for c in pool))]
+    else:
+        views = sorted(dict.fromkeys((c.seed, c.time_code, c.camera_path) for c in pool))
+    try:
+        for seed, tc, path in tqdm(views, desc="score views", unit="view", disable=not show_progress):
+            if randomiser is not None:
+                randomiser.apply(seed, path, tc, None)
+            snapshot = reader.snapshot(tc)
+            counts = np.bincount(session.quick_labels(snapshot, read_camera(stage, path, tc)).ravel(),
+                                 minlength=len(snapshot.instances) + 1)
+            class_of = {inst.prim_path: inst.class_name for inst in snapshot.instances}
+            visible = []
+            for inst in snapshot.instances:
+                if counts[inst.id]:
+                    relations = dict(inst.relations)
+                    if relations.get("uses") in class_of:
+                        relations["uses_class"] = class_of[relations["uses"]]
+                    visible.append({"class_name": inst.class_name, "prim_path": inst.prim_path,
+                                    "area": int(round(counts[inst.id] * scale)), "relations": relations})
+            users = tuple(sampling.AidUserView(aid_type=u.aid_type, person_pixels=u.person_pixels,
+                                               device_pixels=u.device_pixels) for u in qa.aid_users(visible))
+            scores.append(sampling.ViewScore(camera_path=path, time_code=tc, aid_users=users, seed=seed))
+    finally:
+        if randomiser is not None:
+            randomiser.close()
     return scores
 
 
@@ -195,14 +211,14 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
                           f"variant (its generate.json differs); expected an empty folder or the same job to "
                           f"resume: pick another --out or remove it")
     if job_document is None:
-        scores = score_views(stage, pool, render, output_size, class_map, show_progress)
+        scores = score_views(stage, pool, render, output_size, class_map, show_progress, config.randomise)
         plan = sampling.plan(pool, scores, config)
         job_document = {"synthua": __version__, "job_key": job_key, "job_key_digest": document_digest(job_key),
                         "scenario": str(Path(request.scenario).resolve()),
                         "allow_external_assets": request.allow_external_assets, "layer_stack": stack,
                         "render": asdict(render), "cameras": [list(c) for c in cameras],
                         "quota_targets": sampling.quota_targets(pool, config),
-                        "pool": sampling.pool_summary(pool, scores, config), "scores": [asdict(s) for s in scores],
+                        "pool": sampling.pool_summary(pool, scores, config), "scores": [s.to_dict() for s in scores],
                         "plan": [p.to_dict() for p in plan]}
         _write_job(out, job_document)
     plan = [sampling.PlannedImage(**p) for p in job_document["plan"]]
@@ -306,8 +322,15 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
     worker took with it."""
     from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
 
+    # a shard's images follow one another in the order that changes least in its loaded scene: the condition
+    # first (wetness and a sun below the horizon mean a reload), then camera and time code; with randomisation
+    # the seed comes first (each seed is a scene of its own, loaded once)
+    if job.config.randomise is not None:
+        order = lambda p: (p.seed, p.condition or "", p.camera_path, p.time_code, p.id)  # noqa: E731
+    else:
+        order = lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id)  # noqa: E731
     while todo:
-        ordered = sorted(todo, key=lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id))
+        ordered = sorted(todo, key=order)
         shards = [ordered[i:i + SHARD_IMAGES] + [FLUSH] for i in range(0, len(ordered), SHARD_IMAGES)]
         executor = ExecutorConfig(kind=request.executor, workers=min(workers, len(shards)), address=request.address,
                                   cpus_per_worker=request.cpus_per_worker)
@@ -321,7 +344,8 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
 
 def _score_from_dict(document: dict) -> sampling.ViewScore:
     return sampling.ViewScore(camera_path=document["camera_path"], time_code=document["time_code"],
-                              aid_users=tuple(sampling.AidUserView(**a) for a in document["aid_users"]))
+                              aid_users=tuple(sampling.AidUserView(**a) for a in document["aid_users"]),
+                              seed=document.get("seed"))
 
 
 def default_workers() -> int:

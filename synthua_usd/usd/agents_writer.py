@@ -45,21 +45,23 @@ from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd
 from synthua_usd.assets import devices
 from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points
-from synthua_usd.assets.bodies import REGIONS, SEGMENTS, load_bank, skin
-from synthua_usd.assets.postures import (AID_OFFSETS, BENCH, STEPPING_AIDS, DeviceFit, aid_shift_m, bench_fit,
-                                       fit_device, pose, segment_motion, step_length_m)
+from synthua_usd.assets.bodies import REGIONS, SEGMENTS
+from synthua_usd.assets.postures import (AID_OFFSETS, BENCH, STEPPING_AIDS, BodyParts, DeviceFit, aid_shift_m,
+                                       bench_fit, pose, segment_motion, step_length_m)
 from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.materials import PALETTE
 from synthua_usd.scenario import StageMetadata
-from synthua_usd.usd.authoring import (apply_label, bind_material, define_mesh, define_preview_material, define_xform,
-                                       new_layer, set_kind)
+from synthua_usd.usd.authoring import (apply_label, bind_material, bind_material_path, define_mesh,
+                                       define_preview_material, define_xform, new_layer, set_kind)
 from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR
 
 AGENTS_ROOT = "/World/Agents"
 #: Where the shared geometry lives: a ``class`` prim, so it is composed but never rendered itself.
 PROTOTYPES = f"{AGENTS_ROOT}/Prototypes"
 
-def _name(class_name: str) -> str:
+
+def prim_name(class_name: str) -> str:
+    """``ManualWheelchair`` for ``manual_wheelchair``: a class name as a prim name."""
     return "".join(part.title() for part in class_name.split("_"))
 
 
@@ -73,10 +75,11 @@ class PrototypeLibrary:
     Names are the shape with a counter in order of first use, so the same crowd gives the same layer.
     """
 
-    def __init__(self, stage: Usd.Stage, materials: dict[str, UsdShade.Material]) -> None:
+    def __init__(self, stage: Usd.Stage, materials: dict[str, UsdShade.Material], root: str = PROTOTYPES) -> None:
         self.stage = stage
         self.materials = materials
-        stage.CreateClassPrim(PROTOTYPES)
+        self.root = root
+        stage.CreateClassPrim(root)
         self._paths: dict[tuple, Sdf.Path] = {}
         self._counts: Counter[str] = Counter()
 
@@ -87,30 +90,36 @@ class PrototypeLibrary:
         tris = np.ascontiguousarray(mesh[1], np.int32)
         key = ("part", shape, points.tobytes(), tris.tobytes())
         if key not in self._paths:
-            path = Sdf.Path(f"{PROTOTYPES}/{shape}_{self._counts[shape]}")
+            path = Sdf.Path(f"{self.root}/{shape}_{self._counts[shape]}")
             self._counts[shape] += 1
             define_xform(self.stage, str(path))
             define_mesh(self.stage, f"{path}/Mesh", points, tris)
             self._paths[key] = path
         return self._paths[key]
 
-    def device(self, class_name: str, fit: DeviceFit) -> Sdf.Path:
-        """The prototype of the device ``class_name`` (a key of :data:`synthua_usd.assets.devices.DEVICES`)
-        sized by ``fit``."""
-        key = ("device", class_name, fit)
+    def device(self, class_name: str, fit: DeviceFit, model: str = "standard",
+               materials: dict[str, Sdf.Path] | None = None, name: str = "") -> Sdf.Path:
+        """The prototype of the device ``class_name`` (a key of :data:`synthua_usd.assets.devices.DEVICE_MODELS`)
+        in ``model``, sized by ``fit``. Its parts bind the library's materials, or for the palette keys in
+        ``materials`` those material paths instead; ``name`` (a prim name) tells such a prototype apart."""
+        key = ("device", class_name, model, fit, name)
         if key not in self._paths:
-            path = Sdf.Path(f"{PROTOTYPES}/{_name(class_name)}_{fit.key()}")
+            path = Sdf.Path(f"{self.root}/{name or f'{prim_name(class_name)}_{fit.key()}'}")
             define_xform(self.stage, str(path))
-            pieces = devices.DEVICES[class_name](fit)
+            pieces = devices.DEVICE_MODELS[class_name][model](fit)
             for k, (dx, dy) in enumerate(AID_OFFSETS.get(class_name, [(0.0, 0.0)])):
                 for part in pieces:
-                    define_mesh(self.stage, f"{path}/{part.name}{'' if k == 0 else f'_{k}'}",
-                                part.points + [dx, dy, 0.0], part.triangles, self.materials[part.material])
+                    mesh = define_mesh(self.stage, f"{path}/{part.name}{'' if k == 0 else f'_{k}'}",
+                                       part.points + [dx, dy, 0.0], part.triangles)
+                    if materials and part.material in materials:
+                        bind_material_path(mesh.GetPrim(), materials[part.material])
+                    else:
+                        bind_material(mesh.GetPrim(), self.materials[part.material])
             self._paths[key] = path
         return self._paths[key]
 
 
-def _instance(stage: Usd.Stage, path: str, prototype: Sdf.Path, translate=None) -> Usd.Prim:
+def instance(stage: Usd.Stage, path: str, prototype: Sdf.Path, translate=None) -> Usd.Prim:
     """An instanceable Xform at ``path`` referencing ``prototype``."""
     prim = define_xform(stage, path, translate=translate).GetPrim()
     prim.GetReferences().AddInternalReference(prototype)
@@ -133,38 +142,11 @@ def _phases(traj, height_m: float, fps: float) -> tuple[np.ndarray, np.ndarray, 
     return 2 * np.pi * d / cycle, amplitude, cycle
 
 
-class _BodyParts:
-    """Base postures, fits and segment meshes per (body, device), computed once per layer."""
-
-    def __init__(self) -> None:
-        self.bank = load_bank()
-        self._cache: dict[tuple, tuple] = {}
-
-    def get(self, body: int, posture: str | None, fit: DeviceFit | None = None):
-        """``posture`` a device class, :data:`BENCH` or None (walking); ``fit`` None: the device fitted to the body."""
-        key = (body, posture, fit)
-        if key not in self._cache:
-            fit = fit or fit_device(self.bank, body, posture)
-            base = pose(self.bank, body, posture, fit, 0.0, 0.0)
-            pts = skin(self.bank.points[body], self.bank, base.skinning(self.bank.joints[body]))
-            region = self.bank.face_region(body)
-            segment_faces = self.bank.segment_faces(body)
-            parts = {}
-            for k, name in enumerate(SEGMENTS):
-                for r, region_name in enumerate(REGIONS):
-                    tris = self.bank.triangles[segment_faces[k] & (region == r)]
-                    if len(tris):
-                        used, inverse = np.unique(tris, return_inverse=True)
-                        parts[(name, region_name)] = (pts[used], inverse.reshape(-1, 3))
-            self._cache[key] = (fit, base, parts)
-        return self._cache[key]
+def posture_name(device: str | None) -> str:
+    return prim_name(device) if device else "Walk"
 
 
-def _posture_name(device: str | None) -> str:
-    return _name(device) if device else "Walk"
-
-
-def _quat(r: np.ndarray) -> Gf.Quatf:
+def quat(r: np.ndarray) -> Gf.Quatf:
     q = Gf.Matrix3d(*r.T.ravel().tolist()).ExtractRotation().GetQuat()  # Gf matrices act on row vectors
     return Gf.Quatf(float(q.GetReal()), *map(float, q.GetImaginary()))
 
@@ -193,7 +175,7 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
     used |= {p.material for t in trajectories if t.plan.profile.device for p in devices.DEVICES[t.plan.profile.device]()}
     mats = {key: define_preview_material(stage, f"{AGENTS_ROOT}/Looks/{key}", PALETTE[key]) for key in sorted(used)}
     library = PrototypeLibrary(stage, mats)
-    bodies = _BodyParts()
+    bodies = BodyParts()
     times = [Usd.TimeCode(meta.start_time_code + f) for f in range(len(trajectories[0].positions))] if trajectories else []
     for i, (traj, look) in enumerate(zip(trajectories, looks)):
         profile = traj.plan.profile
@@ -232,15 +214,15 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
                 translate, orient = seg.AddTranslateOp(), seg.AddOrientOp()
                 for t, m in zip(times, track):
                     translate.Set(Gf.Vec3d(*map(float, m[:, 3])), t)
-                    orient.Set(_quat(m[:, :3]), t)
+                    orient.Set(quat(m[:, :3]), t)
             for region in REGIONS:
                 if (name, region) not in parts:
                     continue
-                shape = f"Body{look.body:02d}{_posture_name(posture)}{name}{region.title()}"
-                part = _instance(stage, f"{seg.GetPath()}/{region.title()}", library.part(shape, parts[(name, region)]))
+                shape = f"Body{look.body:02d}{posture_name(posture)}{name}{region.title()}"
+                part = instance(stage, f"{seg.GetPath()}/{region.title()}", library.part(shape, parts[(name, region)]))
                 bind_material(part, mats[look.region_material(region)])
         if profile.device:
-            aid = _instance(stage, f"{root.GetPath()}/{_name(device)}", library.device(device, fit))
+            aid = instance(stage, f"{root.GetPath()}/{prim_name(device)}", library.device(device, fit))
             if device in STEPPING_AIDS and times:  # the tips step with the gait
                 aid_translate = UsdGeom.Xformable(aid).AddTranslateOp()
                 for t, x in zip(times, shifts):

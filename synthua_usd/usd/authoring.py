@@ -85,6 +85,13 @@ def bind_material(prim: Usd.Prim, material: UsdShade.Material) -> None:
     UsdShade.MaterialBindingAPI.Apply(prim).Bind(material)
 
 
+def bind_material_path(prim: Usd.Prim, material: Sdf.Path | str) -> None:
+    """Bind the material at ``material``, a path that may live in another layer of the stack (not composed in
+    the stage being authored)."""
+    UsdShade.MaterialBindingAPI.Apply(prim)
+    prim.CreateRelationship(UsdShade.Tokens.materialBinding, False).SetTargets([Sdf.Path(str(material))])
+
+
 def define_preview_material(stage: Usd.Stage, path: str, spec: Material) -> UsdShade.Material:
     """A UsdPreviewSurface material: constant inputs, and a UsdUVTexture per texture of ``spec`` (its path
     authored relative to the layer, ``./textures/...``) reading st through one UsdPrimvarReader_float2 whose

@@ -96,7 +96,7 @@ def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
                          horizontal_aperture_mm=float(cam.GetHorizontalApertureAttr().Get(t)) * unit,
                          vertical_aperture_mm=float(cam.GetVerticalApertureAttr().Get(t)) * unit,
                          clip_near_m=float(near) * mpu, clip_far_m=float(far) * mpu, camera_to_world=m,
-                         distortion=distortion)
+                         distortion=distortion, exposure_ev=float(cam.GetExposureAttr().Get(t) or 0.0))
 
 
 #: The rig type a camera stands for (cctv, dashcam, uav_nadir, ...: :data:`synthua_usd.rigs.RIG_TYPES`).

@@ -132,6 +132,9 @@ def condition_selected(stage: Usd.Stage, name: str | None):
         yield
         return
     check_condition_name(stage, name)
+    if _variant_set(stage).GetVariantSelection() == name:  # composed so already: nothing to author (or notify)
+        yield
+        return
     session = stage.GetSessionLayer()
     spec = session.GetPrimAtPath(ENVIRONMENT_PATH)
     before = dict(spec.variantSelections).get(VARIANT_SET) if spec else None

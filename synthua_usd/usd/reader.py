@@ -10,11 +10,11 @@ finds with the checks of :mod:`synthua_usd.usd.prim_checks`, which ``synthua val
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
-from pxr import Usd, UsdGeom, UsdLux
+from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux
 
 from synthua_usd import geometry as geo
 from synthua_usd.errors import StageError, UnsupportedPrimError, echo
@@ -22,7 +22,7 @@ from synthua_usd.lamps import KINDS as LAMP_KINDS
 from synthua_usd.photometry import CD_PER_M2_PER_UNIT, MAX_RENDERER_UNITS, distant_irradiance, dome_radiance
 from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
-from synthua_usd.usd.keypoints import keypoint_prims, read_keypoints
+from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, keypoint_prims, read_keypoints
 from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
 from synthua_usd.usd.shading import Materials
@@ -33,6 +33,9 @@ log = logging.getLogger(__name__)
 
 #: The gprim attribute naming a lamp role (:mod:`synthua_usd.lamps`).
 LAMP_ATTRIBUTE = "synthua:lamp"
+
+#: Properties of a prim that its descendant gprims inherit (a change re-reads them).
+INHERITED_BY_GPRIMS = ("material:binding", "primvars:", "doubleSided", LAMP_ATTRIBUTE)
 
 Triangulator = Callable[[Usd.Prim, Usd.TimeCode], geo.Mesh]
 GPRIM_HANDLERS: dict[str, Triangulator] = {}
@@ -249,6 +252,15 @@ class StageReader:
     time code only re-places them in the world (as for constant gprims, a colour primvar inherited from an
     ancestor that varies over time is read once). The list of renderable gprims is kept too while no prim in
     the stage has a time-varying visibility.
+
+    Edits of the stage after the reader was made (a layer inserted into its session layer, attributes set on a
+    layer of its stack: what scene randomisation does between images) reach the reader through USD's
+    ``ObjectsChanged`` notices, and the next snapshot re-reads only what they touched: a changed transform
+    re-places the gprims below it (their local triangles kept), a changed gprim or binding re-reads it, a
+    changed shader re-reads its material and the gprims bound to it, and a resynced prim (added, removed,
+    activated, recomposed) refreshes the list of gprims, labels, keypoints and lights and re-reads what lies
+    below it. A snapshot after edits equals, array for array, the snapshot a new reader of the edited stage
+    gives.
     """
 
     def __init__(self, stage: Usd.Stage, class_map: ClassMap) -> None:
@@ -262,6 +274,13 @@ class StageReader:
         self._varying: dict[str, str] = {}
         self._xform_memo: dict[str, bool] = {}
         self._local: dict[str, _LocalGprim | None] = {}
+        #: Prim path -> the keys of the renderable gprims at or below it, and the keys themselves (kept with the
+        #: list of gprims).
+        self._under: dict[str, list[str]] = {}
+        self._gprim_keys: set[str] = set()
+        self._resynced: set[Sdf.Path] = set()
+        self._changed: set[Sdf.Path] = set()
+        self._notice = Tf.Notice.Register(Usd.Notice.ObjectsChanged, self._on_objects_changed, stage)
         #: The rigidly moving gprims placed last: (their paths, local points of all (n, 3), owner per point (n,),
         #: bounds (k + 1,) of each gprim's points), kept while the same gprims move.
         self._rigid_layout: tuple | None = None
@@ -272,6 +291,125 @@ class StageReader:
         self._warned_unlit = False
         self._warned_skinned = False
         self._last: SceneSnapshot | None = None
+        #: Whether :attr:`_last` still shows the stage as it is (False after an edit).
+        self._current = False
+
+    # --- edits of the stage --------------------------------------------------------------------------------
+
+    def _on_objects_changed(self, notice, sender) -> None:
+        """Collect what an edit touched (applied by the next :meth:`snapshot`)."""
+        self._resynced.update(notice.GetResyncedPaths())
+        self._changed.update(notice.GetChangedInfoOnlyPaths())
+        self._current = False
+
+    def _keys_under(self, path: str) -> list[str]:
+        return self._under.get(path, [])
+
+    def _forget(self, keys, geometry: bool) -> None:
+        """Drop the placed items (and with ``geometry`` the local gprims) of gprim ``keys``, and what was
+        memoised of their transforms' variation."""
+        for key in keys:
+            self._static.pop(key, None)
+            self._varying.pop(key, None)
+            if geometry:
+                self._local.pop(key, None)
+        if geometry:
+            self._rigid_layout = None
+
+    def _forget_transforms(self, prim_path: Sdf.Path, keys) -> None:
+        """A transform at ``prim_path`` changed: the variation memo of it and of every prim between it and the
+        gprims ``keys`` below it goes."""
+        top = str(prim_path)
+        for key in keys:
+            path = Sdf.Path(key)
+            while True:
+                self._xform_memo.pop(str(path), None)
+                if str(path) == top or path.IsAbsoluteRootPath():
+                    break
+                path = path.GetParentPath()
+
+    def _forget_materials(self, prim_path: Sdf.Path, below: bool = False) -> None:
+        """Something at ``prim_path`` changed that may be part of a material network: every material at or
+        above it (with ``below``, also below it) is read again, with the gprims bound to it."""
+        dropped = self._materials.forget(str(prim_path), below)
+        if dropped:
+            bound = [k for k, local in self._local.items() if local is not None and local.material_base in dropped]
+            self._forget(bound, geometry=True)
+
+    def _changes_structure(self, prim_path: Sdf.Path, name: str) -> bool:
+        """Whether a change of property ``name`` on ``prim_path`` may change which gprims render, the labelled
+        instances or their relations, or which prims carry keypoints."""
+        if name in ("", "visibility", "purpose", KEYPOINT_NAMES_ATTR) or name.startswith("semantics:"):
+            return True
+        if name.startswith("synthua:"):
+            prim = self.stage.GetPrimAtPath(prim_path)
+            return bool(prim) and bool(prim.GetRelationship(name))
+        return False
+
+    def _refresh_structure(self) -> None:
+        """The list of gprims, the labelled instances (their ids) and the keypoint and light prims, read again."""
+        self._gprims = self._entries = self._light_prims = None
+        self._under, self._gprim_keys = {}, set()
+        instances = collect_instances(self.stage, self.class_map)
+        if instances != self.instances:
+            self.instances = instances
+            self._relabel()
+        self._keypoint_prims = keypoint_prims(self.stage, self.instances)
+
+    def _apply_edits(self) -> None:
+        """Bring the caches up to date with the edits collected since the last snapshot."""
+        resynced, changed = self._resynced, self._changed
+        self._resynced, self._changed = set(), set()
+        structural = sorted(p for p in resynced if not p.IsPropertyPath())
+        properties: dict[Sdf.Path, set[str]] = {}
+        for path in resynced | changed:
+            if path.IsPropertyPath():
+                properties.setdefault(path.GetPrimPath(), set()).add(path.name)
+            elif path not in resynced:
+                properties.setdefault(path, set()).add("")  # prim metadata
+        for path in structural:
+            if path.IsAbsoluteRootPath():
+                self._forget(list(self._local), geometry=True)
+                self._xform_memo.clear()
+                self._materials.forget("/", below=True)
+                continue
+            keys = self._keys_under(str(path))
+            self._forget(keys, geometry=True)
+            self._forget_materials(path, below=True)
+            for memo in [k for k in self._xform_memo if Sdf.Path(k).HasPrefix(path)]:
+                del self._xform_memo[memo]
+        structure = bool(structural)
+        for path, names in sorted(properties.items()):
+            self._forget_materials(path)
+            keys = self._keys_under(str(path))
+            if not keys:
+                continue
+            if any(self._changes_structure(path, n) for n in names):
+                structure = True
+            if any(n.startswith("xformOp") for n in names):
+                self._forget(keys, geometry=False)
+                self._forget_transforms(path, keys)
+            if str(path) in self._gprim_keys and any(not n.startswith("xformOp") for n in names):
+                self._forget([str(path)], geometry=True)
+            elif any(n.startswith(INHERITED_BY_GPRIMS) for n in names):
+                self._forget(keys, geometry=True)
+        if structure:
+            self._refresh_structure()
+        self._entries = None  # variations may have changed with the transforms
+
+    def _relabel(self) -> None:
+        """New instance ids (labelled prims came or went): the cached gprims keep their geometry and take the
+        ids and classes of their labelled prims now."""
+        for key, local in list(self._local.items()):
+            if local is None:
+                continue
+            inst = self.instances.get(local.instance_path) if local.instance_path else None
+            ids = (inst.id, inst.class_id) if inst else (0, 0)
+            if ids != (local.instance_id, local.class_id):
+                self._local[key] = replace(local, instance_id=ids[0], class_id=ids[1])
+                item = self._static.get(key)
+                if item is not None:
+                    self._static[key] = replace(item, instance_id=ids[0], class_id=ids[1])
 
     def _variation(self, prim: Usd.Prim) -> str:
         """'geometry' when one of the gprim's own authored attributes may vary over time, else 'transform' when
@@ -300,6 +438,13 @@ class StageReader:
         gprims = self._renderable_gprims(t)
         if self._entries is None or self._entries[0] is not gprims:
             self._entries = (gprims, [(p, str(p.GetPath()), self._variation(p)) for p in gprims])
+            under: dict[str, list[str]] = {}
+            for _, key, _ in self._entries[1]:
+                path = Sdf.Path(key)
+                while not path.IsAbsoluteRootPath():
+                    under.setdefault(str(path), []).append(key)
+                    path = path.GetParentPath()
+            self._under, self._gprim_keys = under, {key for _, key, _ in self._entries[1]}
         return self._entries[1]
 
     def _local_gprim(self, prim: Usd.Prim, t: Usd.TimeCode) -> "_LocalGprim | None":
@@ -314,6 +459,8 @@ class StageReader:
         sites = label_sites(prim, self.class_map.taxonomy)
         inst = self.instances.get(sites[0].prim_path) if sites else None
         return _LocalGprim(points=points, triangles=tris, uvs=uvs, material_key=material.key,
+                           material_base=self._materials.base_of(material.key),
+                           instance_path=sites[0].prim_path if sites else None,
                            instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0,
                            lamp=_lamp_role(prim), double_sided=bool(UsdGeom.Gprim(prim).GetDoubleSidedAttr().Get()))
 
@@ -330,9 +477,17 @@ class StageReader:
                         material_key=local.material_key, instance_id=local.instance_id, class_id=local.class_id,
                         lamp=local.lamp, uvs=local.uvs, double_sided=local.double_sided)
 
-    def _mesh_item(self, prim: Usd.Prim, t: Usd.TimeCode, xcache: UsdGeom.XformCache) -> MeshItem | None:
-        """The gprim at ``t`` read whole and placed in world space (None without triangles)."""
-        local = self._local_gprim(prim, t)
+    def _mesh_item(self, prim: Usd.Prim, t: Usd.TimeCode, xcache: UsdGeom.XformCache, keep: bool = False
+                   ) -> MeshItem | None:
+        """The gprim at ``t`` read whole and placed in world space (None without triangles); with ``keep`` its
+        local gprim is kept (and taken when kept), for a constant gprim that an edit may move."""
+        key = str(prim.GetPath())
+        if keep and key in self._local:
+            local = self._local[key]
+        else:
+            local = self._local_gprim(prim, t)
+            if keep:
+                self._local[key] = local
         return None if local is None else self._placed(prim, local, t, xcache)
 
     def _placed_rigid(self, rigid: list, t: Usd.TimeCode, xcache: UsdGeom.XformCache,
@@ -362,8 +517,9 @@ class StageReader:
             points = world[bounds[k]:bounds[k + 1]]
             tris = gprim.triangles[:, ::-1] if flip[k] else gprim.triangles
             before = previous.get(key)
-            if (before is not None and np.array_equal(before.points, points)
-                    and np.array_equal(before.triangles, tris)):
+            if (before is not None and (before.instance_id, before.class_id, before.material_key, before.uvs) ==
+                    (gprim.instance_id, gprim.class_id, gprim.material_key, gprim.uvs)
+                    and np.array_equal(before.points, points) and np.array_equal(before.triangles, tris)):
                 out.append(before)
                 continue
             out.append(MeshItem(prim_path=key, points=points, triangles=np.ascontiguousarray(tris),
@@ -393,7 +549,9 @@ class StageReader:
         same time code again returns the same snapshot; a time-varying mesh whose points did not change
         since the previous snapshot keeps its previous :class:`MeshItem`."""
         check_time_code(self.stage, time_code)
-        if self._last is not None and self._last.time_code == time_code:
+        if self._resynced or self._changed:
+            self._apply_edits()
+        if self._current and self._last is not None and self._last.time_code == time_code:
             return self._last
         if not self._warned_skinned:
             self._warned_skinned = True
@@ -419,11 +577,13 @@ class StageReader:
                 before = previous.get(key)
                 if (item is not None and before is not None and np.array_equal(before.points, item.points)
                         and np.array_equal(before.triangles, item.triangles)
+                        and (before.instance_id, before.class_id, before.material_key, before.lamp) ==
+                        (item.instance_id, item.class_id, item.material_key, item.lamp)
                         and _same_uvs(before.uvs, item.uvs)):
                     item = before
             else:
                 if key not in self._static:
-                    self._static[key] = self._mesh_item(prim, t, xcache)
+                    self._static[key] = self._mesh_item(prim, t, xcache, keep=True)
                 item = self._static[key]
             if item is not None:
                 meshes.append(item)
@@ -449,6 +609,7 @@ class StageReader:
                                    instances=tuple(sorted(self.instances.values(), key=lambda i: i.id)),
                                    keypoints=read_keypoints(self._keypoint_prims, time_code, xcache,
                                                             self.meters_per_unit))
+        self._current = True
         return self._last
 
 
@@ -462,6 +623,9 @@ class _LocalGprim:
     triangles: np.ndarray
     uvs: np.ndarray | None
     material_key: str
+    #: The bound material's own key (``material_key`` less a per-gprim colour), and the labelled prim above.
+    material_base: str
+    instance_path: str | None
     instance_id: int
     class_id: int
     lamp: str

@@ -72,6 +72,32 @@ class Materials:
             return self.by_key.setdefault(key, Material(key, rgb, 0.6))
         return self.by_key.setdefault(DEFAULT_MATERIAL.key, DEFAULT_MATERIAL)
 
+    @staticmethod
+    def base_of(key: str) -> str:
+        """The bound material's own key of a material key (``<material>[<primvar>=...]`` -> ``<material>``)."""
+        return key.split("[", 1)[0] if key.startswith("/") else key
+
+    def forget(self, path: str, below: bool = False) -> set[str]:
+        """Forget every bound material at or above the prim ``path`` (a shader in its network changed), and with
+        ``below`` also those below it (the prim was recomposed), with their per-gprim colours; returns the
+        material paths forgotten."""
+        dropped = set()
+        walk = Sdf.Path(path)
+        while walk != Sdf.Path.emptyPath:
+            if str(walk) in self._colour_primvar:
+                dropped.add(str(walk))
+            if walk.IsAbsoluteRootPath():
+                break
+            walk = walk.GetParentPath()
+        if below:
+            top = Sdf.Path(path)
+            dropped |= {base for base in self._colour_primvar if Sdf.Path(base).HasPrefix(top)}
+        if dropped:
+            self.by_key = {k: v for k, v in self.by_key.items() if self.base_of(k) not in dropped}
+            for base in dropped:
+                del self._colour_primvar[base]
+        return dropped
+
     def _coloured(self, prim: Usd.Prim, t: Usd.TimeCode, base: Material, name: str,
                   fallback: tuple[float, float, float] | None) -> Material:
         primvar = UsdGeom.PrimvarsAPI(prim).FindPrimvarWithInheritance(name)

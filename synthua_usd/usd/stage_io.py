@@ -47,16 +47,26 @@ def open_layer(path: str | Path) -> Sdf.Layer:
     return _read(path, "layer", lambda: Sdf.Layer.FindOrOpen(str(path)))
 
 
-def open_stage(path: str | Path, allow_external_assets: bool = False) -> Usd.Stage:
-    """Open and compose a stage with all payloads loaded.
+def open_stage(path: str | Path, allow_external_assets: bool = False, layers=()) -> Usd.Stage:
+    """Open and compose a stage with all payloads loaded; ``layers`` (layer files, strongest first) are composed
+    over it through its session layer, never written into its files (a randomisation layer of
+    ``synthua randomise``, an override of one's own).
 
     Raises :class:`StageError` naming the file when it is missing, not USD, or fails to parse; when any
     sublayer, reference or payload is missing, unreadable or cyclic (OpenUSD only warns and skips it, which
     would silently render a scene without it); and, unless ``allow_external_assets``, when a layer it
-    composes, or a texture file a UsdUVTexture reads, lies outside the folder tree of the root layer.
+    composes, or a texture file a UsdUVTexture reads, lies outside the folder tree of the root layer (or of
+    one of ``layers``).
     """
     path = Path(path)
     stage = _read(path, "stage", lambda: Usd.Stage.Open(str(path), Usd.Stage.LoadAll))
+    extra = [Path(layer) for layer in layers]
+    for layer in extra:
+        open_layer(layer)  # the file checks, one line naming it
+    if extra:
+        session = stage.GetSessionLayer()
+        for k, layer in enumerate(extra):
+            session.subLayerPaths.insert(k, str(layer.resolve()))
     errors = stage.GetCompositionErrors()
     if errors:
         more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
@@ -64,36 +74,39 @@ def open_stage(path: str | Path, allow_external_assets: bool = False) -> Usd.Sta
         raise StageError(f"{path}: {echo(first, 400)}{more}; expected every sublayer, reference and payload of the "
                          f"stage to exist, open and compose without cycles")
     if not allow_external_assets:
-        check_layers_inside(stage, path)
-        check_textures_inside(stage, path)
+        check_layers_inside(stage, path, extra)
+        check_textures_inside(stage, path, extra)
     check_stage_metadata(stage, path)
     return stage
 
 
-def check_layers_inside(stage: Usd.Stage, path: Path) -> None:
-    """Refuse layers outside the root layer's folder tree (a scenario that reads ``/etc`` or ``../..``)."""
+def check_layers_inside(stage: Usd.Stage, path: Path, extra=()) -> None:
+    """Refuse layers outside the root layer's folder tree (a scenario that reads ``/etc`` or ``../..``) and the
+    folder trees of the ``extra`` layer files composed over it."""
     root = path.resolve().parent
+    roots = [root, *(Path(p).resolve().parent for p in extra)]
     for layer in stage.GetUsedLayers():
         if layer.anonymous or not layer.realPath:
             continue
         real = Path(layer.realPath).resolve()
-        if not real.is_relative_to(root):
+        if not any(real.is_relative_to(r) for r in roots):
             raise StageError(f"{path}: composes {echo(real)}, outside the scenario's folder {echo(root)}; expected "
                              f"layers in that folder tree (pass --allow-external-assets to accept it)")
 
 
-def check_textures_inside(stage: Usd.Stage, path: Path) -> None:
-    """Refuse texture files (``UsdUVTexture`` ``inputs:file``) outside the root layer's folder tree, as layers are
-    refused: a texture is read like a layer is. Missing files are left to the reader (a warning and the
-    constant) and to validation (an error)."""
+def check_textures_inside(stage: Usd.Stage, path: Path, extra=()) -> None:
+    """Refuse texture files (``UsdUVTexture`` ``inputs:file``) outside the root layer's folder tree (and those of
+    the ``extra`` layer files), as layers are refused: a texture is read like a layer is. Missing files are left
+    to the reader (a warning and the constant) and to validation (an error)."""
     root = path.resolve().parent
+    roots = [root, *(Path(p).resolve().parent for p in extra)]
     prims = list(stage.Traverse()) + [p for proto in stage.GetPrototypes() for p in Usd.PrimRange(proto)]
     for prim in prims:
         if prim.GetTypeName() != "Shader" or prim.GetAttribute("info:id").Get() != "UsdUVTexture":
             continue
         asset = prim.GetAttribute("inputs:file").Get()
         resolved = asset.resolvedPath if isinstance(asset, Sdf.AssetPath) else ""
-        if resolved and not Path(resolved).resolve().is_relative_to(root):
+        if resolved and not any(Path(resolved).resolve().is_relative_to(r) for r in roots):
             raise StageError(f"{path}: {prim.GetPath()} reads the texture {echo(Path(resolved).resolve())}, outside the "
                              f"scenario's folder {echo(root)}; expected textures in that folder tree (pass "
                              f"--allow-external-assets to accept it)")

@@ -5,6 +5,7 @@ import pytest
 from pxr import UsdGeom
 
 from conftest import DATA
+from snapshot_checks import assert_same_snapshot
 from synthua_usd.errors import StageError, UnsupportedPrimError
 from synthua_usd.usd.reader import StageReader, read_snapshot
 from synthua_usd.usd.texcoords import fan_corners
@@ -154,3 +155,62 @@ def test_rigidly_moving_gprims_are_placed_by_their_own_world_transforms(class_ma
                 placed = corners @ m[:3, :3] + m[3, :3]
                 assert np.allclose(meshes[path].points.min(axis=0), placed.min(axis=0), atol=1e-12), (path, t)
                 assert np.allclose(meshes[path].points.max(axis=0), placed.max(axis=0), atol=1e-12), (path, t)
+
+
+def test_reader_follows_edits_of_the_stage_as_a_fresh_reader_reads_them(class_map):
+    """Edits made after a reader was created (a layer inserted into the session layer, then transforms set in
+    it, a prim added and deactivated, a size changed, a material added, bound and recoloured) reach the reader
+    through USD's change notices: after each, its snapshot equals a fresh reader's, and a constant gprim no
+    edit touched keeps its MeshItem (the backend tells what moved by identity)."""
+    from pxr import Gf, Sdf, Usd, UsdShade
+
+    from synthua_usd.usd.authoring import apply_label
+
+    stage = open_stage(DATA / "valid" / "animated_gprims.usda")
+    reader = StageReader(stage, class_map)
+    reader.snapshot(1.0)
+    layer = Sdf.Layer.CreateAnonymous("edits.usda")
+    stage.GetSessionLayer().subLayerPaths.insert(0, layer.identifier)
+
+    def edit(fn):
+        with Usd.EditContext(stage, layer):
+            fn()
+        carried, fresh = reader.snapshot(1.0), read_snapshot(stage, 1.0, class_map)
+        assert_same_snapshot(carried, fresh)
+        return {m.prim_path: m for m in carried.meshes}
+
+    first = edit(lambda: None)
+
+    def add_group():
+        group = UsdGeom.Xform.Define(stage, "/World/Group")
+        group.AddTranslateOp().Set(Gf.Vec3d(3.0, 0.0, 0.0))
+        cube = UsdGeom.Cube.Define(stage, "/World/Group/Box")
+        cube.AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, 0.5))
+        apply_label(cube.GetPrim(), class_map.taxonomy, "furniture")
+    added = edit(add_group)
+    assert added["/World/Ground"] is first["/World/Ground"]
+    moved = edit(lambda: stage.GetPrimAtPath("/World/Group").GetAttribute("xformOp:translate").Set(Gf.Vec3d(4, 1, 0)))
+    assert np.allclose(moved["/World/Group/Box"].points - added["/World/Group/Box"].points, [1.0, 1.0, 0.0])
+    assert moved["/World/Ground"] is first["/World/Ground"]
+    ground = edit(lambda: UsdGeom.Xformable(stage.GetPrimAtPath("/World/Ground")).AddTranslateOp().Set(
+        Gf.Vec3d(0.0, 0.0, -0.25)))
+    assert np.allclose(ground["/World/Ground"].points[:, 2], -0.25)
+    resized = edit(lambda: UsdGeom.Cube(stage.GetPrimAtPath("/World/Group/Box")).GetSizeAttr().Set(3.0))
+    assert np.ptp(resized["/World/Group/Box"].points[:, 0]) == pytest.approx(3.0)
+
+    def bind_red():
+        mat = UsdShade.Material.Define(stage, "/World/EditLooks/Red")
+        shader = UsdShade.Shader.Define(stage, "/World/EditLooks/Red/Surface")
+        shader.CreateIdAttr("UsdPreviewSurface")
+        shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(0.8, 0.1, 0.1))
+        mat.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+        UsdShade.MaterialBindingAPI.Apply(stage.GetPrimAtPath("/World/Group/Box")).Bind(mat)
+    bound = edit(bind_red)
+    assert bound["/World/Group/Box"].material_key == "/World/EditLooks/Red"
+    edit(lambda: UsdShade.Shader(stage.GetPrimAtPath("/World/EditLooks/Red/Surface")).GetInput(
+        "diffuseColor").Set(Gf.Vec3f(0.1, 0.8, 0.1)))
+    assert reader.snapshot(1.0).materials["/World/EditLooks/Red"].base_color == pytest.approx((0.1, 0.8, 0.1))
+    gone = edit(lambda: stage.GetPrimAtPath("/World/Group").SetActive(False))
+    assert "/World/Group/Box" not in gone
+    stage.GetSessionLayer().subLayerPaths.remove(layer.identifier)  # the stage as it was
+    assert_same_snapshot(reader.snapshot(1.0), read_snapshot(stage, 1.0, class_map))

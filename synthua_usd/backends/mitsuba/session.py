@@ -94,8 +94,11 @@ class RenderSession:
 
     def _same_layout(self, snapshot: SceneSnapshot, condition: Condition | None = None) -> bool:
         old = self._snapshot
+        # the lights the scene was built with (with a condition, the environment's own sun and sky stand in for
+        # it in viewers only: a view layer may turn them)
         return (self._translation.condition_key == weather_scene.scene_key(condition)
-                and len(old.meshes) == len(snapshot.meshes) and old.lights == snapshot.lights
+                and len(old.meshes) == len(snapshot.meshes)
+                and weather_scene.own_lights(old, condition) == weather_scene.own_lights(snapshot, condition)
                 and all(a is b or (a.prim_path == b.prim_path and a.material_key == b.material_key
                                    and a.points.shape == b.points.shape
                                    and (a.triangles is b.triangles or np.array_equal(a.triangles, b.triangles)))
@@ -193,7 +196,7 @@ class RenderSession:
             if condition is not None:
                 image = self._weather(image, hits, camera, condition, snapshot,
                                       self.config.seed if seed is None else seed)
-            exposure = choose_exposure(image, hits.mesh_index >= 0)
+            exposure = choose_exposure(image, hits.mesh_index >= 0, camera.exposure_ev)
             seconds["weather"] = time.perf_counter() - t0
         return RenderedFrame(rgb=image, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
                              variant=self.variant, seconds=seconds, exposure=exposure, condition=condition,

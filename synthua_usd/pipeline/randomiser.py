@@ -1,0 +1,282 @@
+"""Scene randomisation applied to a loaded stage: what a dataset worker, the planner and ``synthua randomise``
+hold to give each image its own scene.
+
+A :class:`Randomiser` inserts three layers into its stage's session layer, never into the user's files (the
+view layer, sublayering the scene layer, sublayering the prototypes layer: see
+:mod:`synthua_usd.usd.randomisation_layer`). :meth:`Randomiser.apply` draws an image's randomisation
+(:mod:`synthua_usd.randomisation`) and moves it into those layers: a new scene (another seed) replaces the
+scene and prototypes layers, every image replaces the view layer. Layers are replaced through
+``Sdf.Layer.TransferContent``, so USD notifies only what differs: a :class:`StageReader` of the stage then
+re-places the crowd and a :class:`RenderSession` updates vertices, sensor and sky in place, while a new scene
+is read and loaded afresh.
+
+What a draw needs of the scenario itself (the twin's walkable surfaces and materials, the cameras, the
+conditions) is read from a second composition of the same root layer with an empty session layer, so it never
+sees an earlier image's randomisation.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pxr import Sdf, Usd, UsdGeom
+
+from synthua_usd.assets.postures import BodyParts
+from synthua_usd.errors import StageError
+from synthua_usd.randomisation.config import RandomisationConfig
+from synthua_usd.randomisation.light import LightDraw, draw_light
+from synthua_usd.randomisation.scene import SceneDraw, draw_scene
+from synthua_usd.randomisation.streams import stream
+from synthua_usd.randomisation.view import CameraJitter, ViewDraw, WalkArea, draw_camera, place_cast
+from synthua_usd.scenario import StageMetadata
+from synthua_usd.taxonomy import ClassMap
+from synthua_usd.usd.agents_writer import AGENTS_ROOT
+from synthua_usd.usd.cameras import camera_rig_type, read_camera
+from synthua_usd.usd.conditions import read_condition
+from synthua_usd.usd.randomisation_layer import (RANDOM_ROOT, camera_override, export_layers, recolourable_objects,
+                                                 scene_layers, view_layer)
+from synthua_usd.usd.reader import StageReader
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ImageRandomisation:
+    """What one image drew: the randomisation seed, its scene, its view, its light (None without a condition),
+    and the SHA-256 of its view layer as authored (the same draws author the same bytes)."""
+
+    seed: int
+    scene: SceneDraw
+    view: ViewDraw
+    light: LightDraw | None
+    view_layer_digest: str
+
+    def to_dict(self) -> dict:
+        return {"seed": self.seed, "scene_seed": self.scene.scene_seed, "district_seed": self.scene.district_seed,
+                "view_layer_sha256": self.view_layer_digest, "scene": self.scene.to_dict(),
+                "view": self.view.to_dict(), "light": None if self.light is None else self.light.to_dict()}
+
+
+def _metadata(stage: Usd.Stage) -> StageMetadata:
+    return StageMetadata(up_axis=str(UsdGeom.GetStageUpAxis(stage)),
+                         meters_per_unit=float(UsdGeom.GetStageMetersPerUnit(stage)),
+                         time_codes_per_second=float(stage.GetTimeCodesPerSecond()),
+                         start_time_code=float(stage.GetStartTimeCode()), end_time_code=float(stage.GetEndTimeCode()),
+                         default_prim="World")
+
+
+class Randomiser:
+    """Randomises ``stage`` image by image under ``config``: ``size`` (width, height) is the render size (where a
+    person counts as seen), ``time_code`` the one the twin is read at (it does not move)."""
+
+    def __init__(self, stage: Usd.Stage, config: RandomisationConfig, class_map: ClassMap, size: tuple[int, int],
+                 time_code: float | None = None) -> None:
+        self.stage, self.config, self.class_map, self.size = stage, config, class_map, tuple(size)
+        if config.crowd.enabled and UsdGeom.GetStageUpAxis(stage) != UsdGeom.Tokens.z:
+            raise StageError(f"{stage.GetRootLayer().identifier}: is Y-up; crowd randomisation places people on "
+                             f"Z-up stages (as synthua agents populate); expected upAxis Z, or randomise.crowd off")
+        self.base = Usd.Stage.Open(stage.GetRootLayer(), Sdf.Layer.CreateAnonymous("base-session.usda"))
+        self.meta = _metadata(self.base)
+        t = self.base.GetStartTimeCode() if time_code is None else time_code
+        snapshot = StageReader(self.base, class_map).snapshot(float(t))
+        twin = [m for m in snapshot.meshes if not m.prim_path.startswith((AGENTS_ROOT + "/", RANDOM_ROOT + "/"))]
+        self.area = None
+        if config.crowd.enabled or config.camera.enabled:
+            vertices, faces, owner = snapshot.world_triangles(twin)
+            names = np.array([class_map.by_id(m.class_id).name for m in twin], object)
+            self.area = WalkArea.build(vertices, faces, names[owner] if len(owner) else np.zeros(0, object))
+        self.materials = snapshot.materials
+        self.objects, self.bound = ([], {})
+        if config.materials.enabled:
+            self.objects, self.bound = recolourable_objects(self.base, snapshot, config.materials.classes)
+        self.has_agents = bool(self.base.GetPrimAtPath(AGENTS_ROOT))
+        self.bodies = BodyParts()
+        # the three layers the stage composes, strongest first, each sublayering the next
+        self.prototypes = Sdf.Layer.CreateAnonymous("prototypes.usdc")
+        self.scene_layer = Sdf.Layer.CreateAnonymous("scene.usda")
+        self.scene_layer.subLayerPaths.append(self.prototypes.identifier)
+        self.view_layer = Sdf.Layer.CreateAnonymous("view.usda")
+        self.view_layer.subLayerPaths.append(self.scene_layer.identifier)
+        stage.GetSessionLayer().subLayerPaths.insert(0, self.view_layer.identifier)
+        self._scene: SceneDraw | None = None
+        self._cast = None  # the scene's CastPrims
+
+    def close(self) -> None:
+        """Take the layers out of the stage's session layer again (the stage as composed before)."""
+        session = self.stage.GetSessionLayer()
+        if self.view_layer.identifier in session.subLayerPaths:
+            session.subLayerPaths.remove(self.view_layer.identifier)
+
+    def scene(self, seed: int, district_seed: int | None = None) -> SceneDraw:
+        """Make the scene of ``seed`` the stage's (drawn and authored once per seed in a row)."""
+        if self._scene is not None and self._scene.scene_seed == seed:
+            return self._scene
+        rng = stream(self.config.seed, seed, "scene")
+        draw = draw_scene(rng, self.config, seed, walkable_area_m2=self.area.area_m2() if self.area else 0.0,
+                          seats=list(self.area.seats) if self.area else [], objects=self.objects,
+                          district_seed=district_seed)
+        prototypes, scene, cast = scene_layers(draw, self.meta, self.class_map.taxonomy, self.bodies, self.materials,
+                                               self.bound, deactivate_agents=self.has_agents and self.config.crowd.enabled)
+        linked = Sdf.Layer.CreateAnonymous("scene.usda")
+        linked.TransferContent(scene)
+        linked.subLayerPaths.clear()
+        linked.subLayerPaths.append(self.prototypes.identifier)
+        with Sdf.ChangeBlock():  # both at once: the stage never composes the old instances over new prototypes
+            self.prototypes.TransferContent(prototypes)
+            self.scene_layer.TransferContent(linked)
+        self._scene, self._cast = draw, cast
+        return draw
+
+    def apply(self, seed: int, camera_path: str, time_code: float, condition: str | None) -> ImageRandomisation:
+        """Give the stage the randomisation of the image (``seed``, ``camera_path``, ``time_code``, ``condition``
+        name or None for the stage's own lights) and return what it drew."""
+        scene = self.scene(seed)
+        cast = self._cast
+        base_camera = read_camera(self.base, camera_path, time_code)
+        rng = stream(self.config.seed, seed, "view", camera_path, time_code)
+        jitter: CameraJitter | None = None
+        camera = base_camera
+        if self.config.camera.enabled:
+            below = self.area.height_below(base_camera.origin) if self.area is not None else None
+            jitter = draw_camera(rng, base_camera, camera_rig_type(self.base, camera_path), below, self.config.camera)
+            camera = jitter.camera(base_camera)
+        placements = ()
+        if self.config.crowd.enabled and scene.cast:
+            placements = place_cast(rng, scene.cast, self.area, camera, self.size, self.config.crowd)
+        light = randomised = None
+        if condition is not None:
+            base_condition = read_condition(self.base, condition)
+            light = draw_light(stream(self.config.seed, seed, "light", camera_path, time_code, condition),
+                               base_condition, self.config.light)
+            randomised = light.condition(base_condition)
+        override = None
+        if jitter is not None or (light is not None and light.exposure_ev):
+            override = camera_override(self.base, camera_path, time_code, camera.camera_to_world,
+                                       camera.focal_length_mm, base_camera.focal_length_mm,
+                                       light.exposure_ev if light is not None else 0.0)
+        fresh = view_layer(cast, placements, self.bodies, self.meta, override, randomised,
+                           doc=f"synthua randomisation: scene {seed}, {camera_path} at time code {time_code:g}"
+                               + (f", {condition}" if condition else ""))
+        digest = hashlib.sha256(fresh.ExportToString().encode("utf-8")).hexdigest()
+        fresh.subLayerPaths.append(self.scene_layer.identifier)
+        self.view_layer.TransferContent(fresh)
+        return ImageRandomisation(self.config.seed, scene, ViewDraw(jitter, placements), light, digest)
+
+    def export(self, out: Path, anchor: Path | None = None) -> tuple[Path, Path, Path]:
+        """Write the current image's layers: ``out`` (the view layer), ``<stem>.scene.usda`` and
+        ``<stem>.prototypes.usdc`` beside it (:func:`synthua_usd.usd.randomisation_layer.export_layers`; asset
+        paths relative to ``anchor``, the folder the files will be in, default ``out``'s)."""
+        return export_layers(self.view_layer, self.scene_layer, self.prototypes, Path(out), anchor)
+
+
+# --- synthua randomise: the layers of one image, written out ----------------------------------------------
+
+@dataclass(frozen=True)
+class RandomiseRequest:
+    """One image's randomisation to write: of ``config_path``'s ``randomise`` block with ``seed``, ``camera``,
+    ``time_code`` and ``condition`` (None: the stage's own lights), at ``size`` (None: the config's render size,
+    else the stage's); or, with ``record_path``, of that record of a dataset (its generate.json gives the config)."""
+
+    scenario: Path
+    out: Path
+    config_path: Path | None = None
+    record_path: Path | None = None
+    seed: int = 0
+    camera: str | None = None
+    time_code: float | None = None
+    condition: str | None = None
+    class_map_path: Path | None = None
+    allow_external_assets: bool = False
+
+
+@dataclass(frozen=True)
+class RandomiseResult:
+    """The layer files written, what the image drew, and the ``synthua render`` arguments that render it."""
+
+    files: tuple[Path, ...]
+    randomisation: ImageRandomisation
+    render_args: tuple[str, ...]
+
+
+def _from_record(path: Path) -> tuple:
+    """(config document, seed, camera path, time code, condition name, render dict) of a dataset record."""
+    import json
+
+    from synthua_usd.dataset.layout import Layout
+    from synthua_usd.errors import InputError
+    from synthua_usd.schemas import read_json
+
+    record = read_json(path, "an image record of a dataset (records/NAME.json)")
+    job_path = Path(path).resolve().parent.parent / Layout.CONFIG
+    job = read_json(job_path, "the generate.json of the record's dataset")
+    try:
+        config = job["job_key"]["config"]
+        condition = record["condition"]["name"] if record.get("condition") else None
+        return (config, int(record["seed"]), str(record["camera"]["prim_path"]), float(record["time_code"]),
+                condition, dict(record["render"]))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"{path}: not a dataset image record ({json.dumps(str(exc))[1:-1]} missing or malformed); "
+                         f"expected records/NAME.json of a dataset synthua generate wrote") from None
+
+
+def randomise_image(request: RandomiseRequest) -> RandomiseResult:
+    """Draw one image's randomisation over ``request.scenario`` and write its three layers as one output set."""
+    import shlex
+
+    from synthua_usd.atomic import output_set
+    from synthua_usd.dataset.config import GenerationConfig
+    from synthua_usd.errors import InputError
+    from synthua_usd.render_config import RenderConfig
+    from synthua_usd.usd.render_settings import render_defaults
+    from synthua_usd.usd.stage_io import USD_SUFFIXES, check_time_code, open_stage
+
+    out = Path(request.out)
+    if out.suffix.lower() not in USD_SUFFIXES[:3]:
+        raise InputError(f"{out}: --out needs a USD layer name (.usda, .usdc or .usd); expected e.g. layer.usda")
+    render: dict = {}
+    if request.record_path is not None:
+        document, seed, camera, time_code, condition, render = _from_record(Path(request.record_path))
+        config = GenerationConfig.from_document(document, source=str(request.record_path))
+    else:
+        if request.config_path is None:
+            raise InputError("randomise: neither --config nor --record given; expected a generation config with a "
+                             "randomise block, or an image record of a randomised dataset")
+        config = GenerationConfig.load(request.config_path)
+        seed, camera, time_code, condition = request.seed, request.camera, request.time_code, request.condition
+    source = request.record_path or request.config_path
+    if config.randomise is None:
+        raise InputError(f"{source}: has no randomise block; expected a config that randomises scenes (see "
+                         f"schemas/generate.schema.json, randomise)")
+    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    stage = open_stage(request.scenario, request.allow_external_assets)
+    defaults = render_defaults(stage)
+    if camera is None:
+        camera = defaults.camera_path
+        if not camera:
+            raise StageError(f"{request.scenario}: no --camera given and no UsdRender settings name one; expected "
+                             f"--camera PATH")
+    time_code = float(stage.GetStartTimeCode()) if time_code is None else float(time_code)
+    check_time_code(stage, time_code)
+    read_camera(stage, camera, time_code)  # a missing camera is one line, before anything is drawn
+    if render:
+        width, height = int(render["width"]), int(render["height"])
+    else:
+        width, height = config.render.size(*(defaults.resolution or (RenderConfig.width, RenderConfig.height)))
+    randomiser = Randomiser(stage, config.randomise, class_map, (width, height))
+    drawn = randomiser.apply(seed, camera, time_code, condition)
+    with output_set(out.parent) as staging:
+        randomiser.export(staging / out.name, anchor=out.parent)
+        files = tuple(out.parent / p.name for p in sorted(staging.iterdir()))
+    spp = render.get("spp", config.render.spp)
+    max_depth = render.get("max_depth", config.render.max_depth)
+    denoise = render["denoise"] is not None if "denoise" in render else config.render.denoise
+    args = ("synthua", "render", str(request.scenario), "--layer", str(out), "--camera", camera,
+            "--time-code", f"{time_code:g}", *(("--condition", condition) if condition else ()), "--seed", str(seed),
+            "--width", str(width), "--height", str(height), "--spp", str(spp), "--max-depth", str(max_depth),
+            "--denoise" if denoise else "--no-denoise", "--out", "OUT")
+    log.info("render with: %s", " ".join(shlex.quote(a) for a in args))
+    return RandomiseResult(files, drawn, args)

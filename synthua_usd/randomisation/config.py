@@ -1,0 +1,242 @@
+"""What scene randomisation varies and within which ranges: the ``randomise`` block of a generation config
+(``schemas/generate.schema.json``, ``$defs.randomise``) as checked, frozen plain data.
+
+Every range is ``(low, high)`` with ``low <= high`` (equal ends fix the value). Each part has ``enabled``
+(default true), so a part is switched off without deleting its ranges; a config without a ``randomise``
+block (or with ``null``) randomises nothing and renders the scenario as composed, as before. The meaning of
+every field is documented once, in the schema's descriptions; the defaults are owned here and a test holds
+the schema's documentation to them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any
+
+from synthua_usd.errors import InputError, echo
+from synthua_usd.materials import DEVICE_FINISHES, RECOLOUR_PALETTES
+
+#: The mobility-aid classes a randomised crowd can use (the device classes of the agent profiles).
+AID_CLASSES = ("manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
+               "orthopedic_cane", "tripod_cane")
+#: Finishes a device frame can take.
+DEVICE_FINISH_NAMES = tuple(DEVICE_FINISHES)
+#: Twin classes whose objects can get their own variant of their material ("within its class": a building
+#: keeps a façade colour, a car a car paint); all of them by default.
+RECOLOURED_CLASSES = tuple(RECOLOUR_PALETTES)
+
+Range = tuple[float, float]
+#: Densest randomised crowd, persons/m² of walkable area: placing a crowd anew for every view keeps people
+#: apart by rejection, which stays reliable up to about this (free walking ends near 0.7/m²).
+MAX_DENSITY_PER_M2 = 0.3
+
+
+def _range(name: str, value, lo: float | None = None, hi: float | None = None) -> Range:
+    """``value`` (two numbers, low <= high) as a tuple, within [lo, hi] when given."""
+    try:
+        a, b = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: {echo(str(value))}; expected [low, high], two numbers") from None
+    if not (math.isfinite(a) and math.isfinite(b) and a <= b):
+        raise InputError(f"{name}: [{a:g}, {b:g}]; expected two finite numbers with low <= high")
+    if (lo is not None and a < lo) or (hi is not None and b > hi):
+        raise InputError(f"{name}: [{a:g}, {b:g}]; expected a range within [{lo:g}, {hi:g}]")
+    return a, b
+
+
+@dataclass(frozen=True)
+class CrowdRandomisation:
+    """A new crowd per scene (who: density, aid share, which aids, bodies, clothes) placed anew per view
+    (where: position, heading, gait phase on the walkable surfaces; some aid users where the camera sees
+    them at a projected height within ``view_height_share`` of the image's). Densities are persons per m² of
+    walkable area."""
+
+    enabled: bool = True
+    density_per_m2: Range = (0.01, 0.05)
+    aid_share: Range = (0.2, 0.5)
+    aids: tuple[str, ...] = AID_CLASSES
+    aid_users_in_view: Range = (1, 3)
+    view_height_share: Range = (0.03, 0.6)
+    seated_share: Range = (0.0, 0.1)
+    group_share: Range = (0.1, 0.4)
+    clothing_jitter: float = 0.15
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "density_per_m2", _range("crowd.density_per_m2", self.density_per_m2, 0.0,
+                                                                  MAX_DENSITY_PER_M2))
+        if self.density_per_m2[0] <= 0:
+            raise InputError(f"crowd.density_per_m2: [{self.density_per_m2[0]:g}, {self.density_per_m2[1]:g}]; "
+                             f"expected a low end > 0 persons/m²")
+        for name in ("aid_share", "seated_share", "group_share"):
+            object.__setattr__(self, name, _range(f"crowd.{name}", getattr(self, name), 0.0, 1.0))
+        users = _range("crowd.aid_users_in_view", self.aid_users_in_view, 0, 50)
+        if not all(float(v).is_integer() for v in users):
+            raise InputError(f"crowd.aid_users_in_view: {list(users)}; expected two whole numbers")
+        object.__setattr__(self, "aid_users_in_view", (int(users[0]), int(users[1])))
+        object.__setattr__(self, "view_height_share", _range("crowd.view_height_share", self.view_height_share, 0.0, 10.0))
+        aids = tuple(self.aids)
+        unknown = [a for a in aids if a not in AID_CLASSES]
+        if unknown or not aids:
+            raise InputError(f"crowd.aids: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
+                             f"{', '.join(AID_CLASSES)}")
+        object.__setattr__(self, "aids", aids)
+        if not (math.isfinite(self.clothing_jitter) and 0 <= self.clothing_jitter <= 1):
+            raise InputError(f"crowd.clothing_jitter: {self.clothing_jitter!r}; expected a number in [0, 1]")
+
+
+@dataclass(frozen=True)
+class DeviceRandomisation:
+    """Each aid user's device: a model among those available for its type, a frame finish and colour, a
+    seat or grip fabric colour."""
+
+    enabled: bool = True
+    finishes: tuple[str, ...] = DEVICE_FINISH_NAMES
+
+    def __post_init__(self) -> None:
+        finishes = tuple(self.finishes)
+        unknown = [f for f in finishes if f not in DEVICE_FINISH_NAMES]
+        if unknown or not finishes:
+            raise InputError(f"devices.finishes: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
+                             f"{', '.join(DEVICE_FINISH_NAMES)}")
+        object.__setattr__(self, "finishes", finishes)
+
+
+@dataclass(frozen=True)
+class MaterialRandomisation:
+    """Each twin object of ``classes`` gets its own variant of its main material: a colour from its class's
+    palette (façades, car paints, canvas, ...) or, for a textured material, its texture tinted; ``value_jitter``
+    scales brightness by up to ±that share."""
+
+    enabled: bool = True
+    classes: tuple[str, ...] = RECOLOURED_CLASSES
+    value_jitter: float = 0.2
+
+    def __post_init__(self) -> None:
+        classes = tuple(self.classes)
+        unknown = [c for c in classes if c not in RECOLOURED_CLASSES]
+        if unknown:
+            raise InputError(f"materials.classes: {', '.join(map(echo, unknown))}; expected among "
+                             f"{', '.join(RECOLOURED_CLASSES)}")
+        object.__setattr__(self, "classes", classes)
+        if not (math.isfinite(self.value_jitter) and 0 <= self.value_jitter <= 0.9):
+            raise InputError(f"materials.value_jitter: {self.value_jitter!r}; expected a number in [0, 0.9]")
+
+
+@dataclass(frozen=True)
+class LightRandomisation:
+    """The light of each image within its condition: a date and a solar time at ``latitude_deg`` whose sun
+    lies in the condition's elevation band, a turbidity offset, the night sky's luminance scaled, and an
+    exposure compensation in EV."""
+
+    enabled: bool = True
+    latitude_deg: float = -25.43
+    sun_band_deg: float = 25.0
+    turbidity_offset: Range = (-1.0, 2.0)
+    exposure_ev: Range = (-0.5, 0.5)
+    night_sky_factor: Range = (0.5, 2.0)
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.latitude_deg) and -66.0 <= self.latitude_deg <= 66.0):
+            raise InputError(f"light.latitude_deg: {self.latitude_deg!r}; expected a latitude in [-66, 66] degrees "
+                             f"(beyond the polar circles the sun may not rise or set)")
+        if not (math.isfinite(self.sun_band_deg) and 0 <= self.sun_band_deg <= 90):
+            raise InputError(f"light.sun_band_deg: {self.sun_band_deg!r}; expected degrees in [0, 90]")
+        object.__setattr__(self, "turbidity_offset", _range("light.turbidity_offset", self.turbidity_offset, -9.0, 9.0))
+        object.__setattr__(self, "exposure_ev", _range("light.exposure_ev", self.exposure_ev, -4.0, 4.0))
+        object.__setattr__(self, "night_sky_factor", _range("light.night_sky_factor", self.night_sky_factor, 0.01, 100.0))
+
+
+@dataclass(frozen=True)
+class CameraRandomisation:
+    """Each view's camera moved within its rig type's envelope: height by up to ±``height_m`` (kept within
+    the rig type's heights above the ground), yaw and pitch by up to ±degrees, focal length scaled within
+    ``focal_length_factor`` (kept within the rig type's lens)."""
+
+    enabled: bool = True
+    height_m: float = 0.3
+    yaw_deg: float = 5.0
+    pitch_deg: float = 3.0
+    focal_length_factor: Range = (0.9, 1.1)
+
+    def __post_init__(self) -> None:
+        for name, hi in (("height_m", 50.0), ("yaw_deg", 180.0), ("pitch_deg", 45.0)):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and 0 <= value <= hi):
+                raise InputError(f"camera.{name}: {value!r}; expected a number in [0, {hi:g}]")
+        object.__setattr__(self, "focal_length_factor",
+                           _range("camera.focal_length_factor", self.focal_length_factor, 0.25, 4.0))
+
+
+@dataclass(frozen=True)
+class DistrictRandomisation:
+    """Scenes drawn over procedural district seeds (``synthua create district --seed``): each scene's twin is
+    the district of one of ``seeds``. Off by default; only for scenarios whose twin is the demo district."""
+
+    enabled: bool = False
+    seeds: tuple[int, ...] = (0, 1, 2, 3)
+
+    def __post_init__(self) -> None:
+        seeds = tuple(int(s) for s in self.seeds)
+        if not seeds or any(s < 0 or s > 2**32 - 1 for s in seeds) or len(set(seeds)) != len(seeds):
+            raise InputError(f"district.seeds: {list(seeds)}; expected one or more distinct integers in 0..2^32-1")
+        object.__setattr__(self, "seeds", seeds)
+
+
+_PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "materials": MaterialRandomisation,
+          "light": LightRandomisation, "camera": CameraRandomisation, "district": DistrictRandomisation}
+
+
+@dataclass(frozen=True)
+class RandomisationConfig:
+    """Scene randomisation of a generation run. ``seed`` is mixed with each image's seed: images of one seed
+    share a scene (crowd, looks, materials, district), and each (camera, time code) places it anew."""
+
+    seed: int = 0
+    crowd: CrowdRandomisation = field(default_factory=CrowdRandomisation)
+    devices: DeviceRandomisation = field(default_factory=DeviceRandomisation)
+    materials: MaterialRandomisation = field(default_factory=MaterialRandomisation)
+    light: LightRandomisation = field(default_factory=LightRandomisation)
+    camera: CameraRandomisation = field(default_factory=CameraRandomisation)
+    district: DistrictRandomisation = field(default_factory=DistrictRandomisation)
+
+    def __post_init__(self) -> None:
+        if self.devices.enabled and not self.crowd.enabled:
+            # devices belong to the randomised crowd's aid users
+            object.__setattr__(self, "devices", DeviceRandomisation(enabled=False, finishes=self.devices.finishes))
+        if self.district.enabled and not self.crowd.enabled:
+            raise InputError("randomise.district: enabled while randomise.crowd is not; expected the crowd randomised "
+                             "too (the scenario's own crowd walks the routes of its own district)")
+
+    @classmethod
+    def from_document(cls, doc: dict | None, source: str = "randomise") -> "RandomisationConfig | None":
+        """From a schema-valid ``randomise`` block; None (no block) is None (no randomisation)."""
+        if doc is None:
+            return None
+        parts = {}
+        for name, kind in _PARTS.items():
+            values = dict(doc.get(name, {}))
+            known = {f.name for f in fields(kind)}
+            unknown = sorted(set(values) - known)
+            if unknown:
+                raise InputError(f"{source}.{name}: unknown keys {unknown}; expected among {sorted(known)}")
+            for key, value in values.items():
+                if isinstance(value, list):
+                    values[key] = tuple(value)
+            try:
+                parts[name] = kind(**values)
+            except InputError as exc:
+                raise InputError(f"{source}.{exc}") from None
+        return cls(seed=int(doc.get("seed", 0)), **parts)
+
+    def to_document(self) -> dict:
+        """Every value explicit (as ``generate.json`` records it); ``from_document(to_document())`` is equal."""
+        out: dict[str, Any] = {"seed": self.seed}
+        for name in _PARTS:
+            out[name] = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(getattr(self, name)).items()}
+        return out
+
+    @property
+    def enabled_parts(self) -> tuple[str, ...]:
+        """Names of the parts that vary something."""
+        return tuple(name for name in _PARTS if getattr(self, name).enabled)

@@ -1,0 +1,228 @@
+"""One randomised scene as plain data: who is in the crowd and how they look, each aid user's device, each
+twin object's material variant, and the district seed.
+
+A scene is shared by the images of one seed (:mod:`synthua_usd.randomisation.streams`): a worker loads it
+once and every (camera, time code) then places its crowd anew (:mod:`synthua_usd.randomisation.view`). Every
+choice is recorded (:meth:`SceneDraw.to_dict`) so a record names it; the USD side authors it
+(:mod:`synthua_usd.usd.randomisation_layer`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from synthua_usd.agents.profiles import PROFILES
+from synthua_usd.agents.seats import SeatPlace
+from synthua_usd.assets.devices import DEVICE_MODELS
+from synthua_usd.assets.people import PersonLook
+from synthua_usd.materials import (DEVICE_FINISHES, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
+                                   WOOD_COLOURS)
+from synthua_usd.randomisation.config import RandomisationConfig
+
+RGB = tuple[float, float, float]
+#: Most people one randomised scene holds (a bound on the layers and the render, whatever the walkable area).
+MAX_CAST = 2000
+#: Group sizes of pedestrians walking together.
+GROUP_SIZES = (2, 3)
+#: The profile of each aid class.
+PROFILE_OF_AID = {p.device: p.name for p in PROFILES.values() if p.device is not None}
+
+
+def _jitter(rng: np.random.Generator, rgb, amount: float) -> RGB:
+    """``rgb`` with each channel scaled by 1 + U(-amount, amount) (hue and value both move a little), clipped
+    to [0, 1]."""
+    scale = 1.0 + rng.uniform(-amount, amount, 3)
+    return tuple(float(v) for v in np.clip(np.asarray(rgb, float) * scale, 0.0, 1.0))
+
+
+def _pick(rng: np.random.Generator, palette):
+    return palette[int(rng.integers(len(palette)))]
+
+
+@dataclass(frozen=True)
+class Finish:
+    """A device part's surface: linear Rec.709 base colour, roughness, metallic; ``name`` the finish or fabric."""
+
+    name: str
+    base_color: RGB
+    roughness: float
+    metallic: float
+
+
+@dataclass(frozen=True)
+class DeviceLook:
+    """An aid user's device: its ``model`` (a key of :data:`synthua_usd.assets.devices.DEVICE_MODELS` for its
+    class), the finish of its frame (wood for a wooden cane) and the fabric of its seat."""
+
+    model: str
+    frame: Finish
+    seat: Finish
+
+
+@dataclass(frozen=True)
+class CastMember:
+    """One person of the scene: profile (a key of :data:`synthua_usd.agents.profiles.PROFILES`), body index into
+    the body bank, skin tone (a Monk swatch's palette key), garment colours, sleeve and leg length, the device
+    of an aid user, the bench place of a sitter (kept for the whole scene), and the group of pedestrians
+    walking together."""
+
+    profile: str
+    body: int
+    skin: str
+    upper: RGB
+    lower: RGB
+    shoes: RGB
+    long_sleeves: bool
+    long_legs: bool
+    device: DeviceLook | None = None
+    seat: SeatPlace | None = None
+    group: int | None = None
+
+    @property
+    def aid(self) -> str | None:
+        return PROFILES[self.profile].device
+
+    def region_colour(self, region: str) -> RGB | str:
+        """The colour of a garment region of :data:`synthua_usd.assets.bodies.REGIONS`, or the skin's palette key
+        where the region shows skin."""
+        return {"skin": self.skin, "upper": self.upper, "forearm": self.upper if self.long_sleeves else self.skin,
+                "lower": self.lower, "shin": self.lower if self.long_legs else self.skin, "shoes": self.shoes}[region]
+
+
+@dataclass(frozen=True)
+class Recolour:
+    """One twin object's variant of its main material: ``material`` the bound material's key (its prim path),
+    and either a new constant ``base_color`` or a ``tint`` multiplying its colour or texture (RGB)."""
+
+    prim_path: str
+    class_name: str
+    material: str
+    base_color: RGB | None = None
+    tint: RGB | None = None
+
+
+@dataclass(frozen=True)
+class Recolourable:
+    """What the twin offers for recolouring: a labelled object, its class, the key of the material that covers
+    most of it, whether that material is textured, and its base colour."""
+
+    prim_path: str
+    class_name: str
+    material: str
+    textured: bool
+    base_color: RGB
+
+
+@dataclass(frozen=True)
+class SceneDraw:
+    """Everything one scene drew. ``cast`` empty and ``density_per_m2`` None when the crowd is not randomised."""
+
+    scene_seed: int
+    district_seed: int | None
+    density_per_m2: float | None
+    aid_share: float | None
+    cast: tuple[CastMember, ...]
+    recolours: tuple[Recolour, ...]
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def _device_look(rng: np.random.Generator, aid: str, config: RandomisationConfig) -> DeviceLook:
+    models = sorted(DEVICE_MODELS[aid])
+    model = _pick(rng, models)
+    if not config.devices.enabled:
+        base = PALETTE["Frame"]
+        seat = PALETTE["Seat"]
+        return DeviceLook(model, Finish("standard", base.base_color, base.roughness, base.metallic),
+                          Finish("standard", seat.base_color, seat.roughness, seat.metallic))
+    if aid == "wooden_cane":
+        frame = Finish("wood", _jitter(rng, _pick(rng, WOOD_COLOURS), 0.15), 0.6, 0.0)
+    else:
+        name = _pick(rng, config.devices.finishes)
+        palette, roughness, metallic = DEVICE_FINISHES[name]
+        frame = Finish(name, _jitter(rng, _pick(rng, palette), 0.1), roughness, metallic)
+    seat = Finish("fabric", _jitter(rng, _pick(rng, SEAT_FABRICS), 0.2), 0.9, 0.0)
+    return DeviceLook(model, frame, seat)
+
+
+def _member(rng: np.random.Generator, profile: str, config: RandomisationConfig, seat=None,
+            group=None) -> CastMember:
+    aid = PROFILES[profile].device
+    look = PersonLook.random(rng, aid_user=aid is not None)
+    jitter = config.crowd.clothing_jitter
+    colour = {"Shirt": SHIRTS, "Trousers": TROUSERS, "Shoes": SHOES}
+    upper, lower, shoes = (_jitter(rng, _pick(rng, colour[kind]).base_color, jitter) for kind in colour)
+    device = _device_look(rng, aid, config) if aid is not None else None
+    return CastMember(profile=profile, body=look.body, skin=look.skin, upper=upper, lower=lower, shoes=shoes,
+                      long_sleeves=look.long_sleeves, long_legs=look.long_legs, device=device, seat=seat, group=group)
+
+
+def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_area_m2: float,
+              seats: list[SeatPlace]) -> tuple[float, float, tuple[CastMember, ...]]:
+    """(density, aid share, members): N ~ Poisson(density x ``walkable_area_m2``) people (at most
+    :data:`MAX_CAST`), each an aid user with probability ``aid share`` (the aid uniform over the config's
+    aids), else a pedestrian who sits on a free bench place of ``seats`` with probability ``seated_share`` or
+    walks in a group of 2-3 with probability ``group_share``."""
+    crowd = config.crowd
+    density = float(rng.uniform(*crowd.density_per_m2))
+    aid_share = float(rng.uniform(*crowd.aid_share))
+    seated_share = float(rng.uniform(*crowd.seated_share))
+    group_share = float(rng.uniform(*crowd.group_share))
+    count = min(MAX_CAST, int(rng.poisson(density * walkable_area_m2)))
+    free = list(range(len(seats)))
+    members: list[CastMember] = []
+    groups = 0
+    while len(members) < count:
+        if rng.random() < aid_share:
+            members.append(_member(rng, PROFILE_OF_AID[_pick(rng, crowd.aids)], config))
+        elif free and rng.random() < seated_share:
+            members.append(_member(rng, "pedestrian", config, seat=seats[free.pop(int(rng.integers(len(free))))]))
+        elif rng.random() < group_share and count - len(members) >= 2:
+            size = min(int(_pick(rng, GROUP_SIZES)), count - len(members))
+            members += [_member(rng, "pedestrian", config, group=groups) for _ in range(size)]
+            groups += 1
+        else:
+            members.append(_member(rng, "pedestrian", config))
+    return density, aid_share, tuple(members)
+
+
+def draw_recolours(rng: np.random.Generator, config: RandomisationConfig,
+                   objects: list[Recolourable]) -> tuple[Recolour, ...]:
+    """A material variant for each of ``objects`` whose class the config recolours (in prim-path order): a
+    colour of its class's palette (for a textured material, its texture tinted towards that colour), or a
+    tint of its own colour for ground classes; brightness scaled by 1 ± ``value_jitter``."""
+    materials = config.materials
+    out = []
+    for obj in sorted(objects, key=lambda o: o.prim_path):
+        if obj.class_name not in materials.classes or obj.class_name not in RECOLOUR_PALETTES:
+            continue
+        kind, palette = RECOLOUR_PALETTES[obj.class_name]
+        value = 1.0 + float(rng.uniform(-materials.value_jitter, materials.value_jitter))
+        chosen = np.asarray(_pick(rng, palette), float)
+        if kind == "tint":
+            out.append(Recolour(obj.prim_path, obj.class_name, obj.material, tint=tuple(float(v) for v in chosen * value)))
+        elif obj.textured:
+            # the texture's detail kept, its mean colour moved towards the palette colour
+            own = np.maximum(np.asarray(obj.base_color, float), 1e-3)
+            tint = np.clip(chosen / own, 0.2, 5.0) * value
+            out.append(Recolour(obj.prim_path, obj.class_name, obj.material, tint=tuple(float(v) for v in tint)))
+        else:
+            colour = np.clip(chosen * value, 0.0, 1.0)
+            out.append(Recolour(obj.prim_path, obj.class_name, obj.material, base_color=tuple(float(v) for v in colour)))
+    return tuple(out)
+
+
+def draw_scene(rng: np.random.Generator, config: RandomisationConfig, scene_seed: int, *, walkable_area_m2: float,
+               seats: list[SeatPlace], objects: list[Recolourable], district_seed: int | None) -> SceneDraw:
+    """The scene of ``scene_seed``: its cast (when the crowd is randomised) then its recolours (when materials
+    are), drawn from ``rng`` in that order."""
+    density = aid_share = None
+    cast: tuple[CastMember, ...] = ()
+    if config.crowd.enabled:
+        density, aid_share, cast = draw_cast(rng, config, walkable_area_m2, seats)
+    recolours = draw_recolours(rng, config, objects) if config.materials.enabled else ()
+    return SceneDraw(scene_seed=scene_seed, district_seed=district_seed, density_per_m2=density, aid_share=aid_share,
+                     cast=cast, recolours=recolours)
