@@ -1,0 +1,143 @@
+"""Scene randomisation applied to a loaded stage: an image is the same whatever the stage showed before, its
+labels agree with an independent ray cast, the scenario's crowd gives way to the scene's, people placed for the
+camera are seen, and the layers written out compose to the same scene."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from conftest import SCENARIO
+from reference_raycast import reference_labels
+from snapshot_checks import assert_same_snapshot
+from synthua_usd.backends.mitsuba.session import RenderSession
+from synthua_usd.conditions import Condition
+from synthua_usd.pipeline.randomiser import Randomiser
+from synthua_usd.randomisation.config import RandomisationConfig
+from synthua_usd.render_config import RenderConfig
+from synthua_usd.usd.agents_writer import AGENTS_ROOT
+from synthua_usd.usd.cameras import read_camera
+from synthua_usd.usd.conditions import read_condition
+from synthua_usd.usd.randomisation_layer import CROWD_ROOT, LOOKS_ROOT
+from synthua_usd.usd.reader import StageReader, read_snapshot
+from synthua_usd.usd.stage_io import open_stage
+
+W, H = 96, 72
+CCTV, EYE = "/World/Cameras/CCTV", "/World/Cameras/PedestrianEye"
+CONFIG = RandomisationConfig(seed=3)
+
+
+def randomised(class_map):
+    stage = open_stage(SCENARIO)
+    return stage, StageReader(stage, class_map), Randomiser(stage, CONFIG, class_map, (W, H))
+
+
+def test_an_image_is_the_same_whatever_came_before(class_map, variant):
+    """The stage, its reader and a render session carried through other scenes and views give the image what a
+    fresh stage, reader and session give it: the same snapshot (points bit for bit) and the same bytes of labels
+    and RGB (the session updated in place, not reloaded)."""
+    stage, reader, randomiser = randomised(class_map)
+    session = RenderSession(RenderConfig(width=W, height=H, spp=2, variant=variant, denoise=False))
+    for seed, camera, condition in ((0, CCTV, "clear_day"), (1, EYE, "sunset"), (1, CCTV, "clear_day"),
+                                    (0, EYE, "clear_day")):
+        drawn = randomiser.apply(seed, camera, 24.0, condition)
+        session.render(reader.snapshot(24.0), read_camera(stage, camera, 24.0), condition=read_condition(stage, condition),
+                       seed=seed)
+    loads = session.loads
+    drawn = randomiser.apply(1, EYE, 24.0, "clear_day")
+    carried = session.render(reader.snapshot(24.0), read_camera(stage, EYE, 24.0),
+                             condition=read_condition(stage, "clear_day"), seed=1)
+    assert session.loads == loads + 1  # seed 1 after seed 0: a new scene, loaded once
+
+    fresh_stage, fresh_reader, fresh_randomiser = randomised(class_map)
+    again = fresh_randomiser.apply(1, EYE, 24.0, "clear_day")
+    assert again == drawn
+    assert_same_snapshot(reader.snapshot(24.0), fresh_reader.snapshot(24.0))
+    fresh = RenderSession(RenderConfig(width=W, height=H, spp=2, variant=variant, denoise=False)).render(
+        fresh_reader.snapshot(24.0), read_camera(fresh_stage, EYE, 24.0),
+        condition=read_condition(fresh_stage, "clear_day"), seed=1)
+    assert np.array_equal(carried.instance_ids, fresh.instance_ids) and np.array_equal(carried.class_ids,
+                                                                                        fresh.class_ids)
+    assert np.array_equal(carried.rgb, fresh.rgb)
+    # a view of the same scene only moves things: updated in place
+    randomiser.apply(1, CCTV, 24.0, "clear_day")
+    session.render(reader.snapshot(24.0), read_camera(stage, CCTV, 24.0), condition=read_condition(stage, "clear_day"),
+                   seed=1)
+    assert session.loads == loads + 1
+
+
+def test_randomised_labels_agree_with_an_independent_ray_cast(class_map):
+    stage, reader, randomiser = randomised(class_map)
+    session = RenderSession(RenderConfig(width=160, height=120, spp=1))
+    for seed, camera in ((0, CCTV), (2, EYE), (2, CCTV)):
+        randomiser.apply(seed, camera, 24.0, None)
+        snapshot, cam = reader.snapshot(24.0), read_camera(stage, camera, 24.0)
+        frame = session.render(snapshot, cam, rgb=False)
+        ref_class, ref_inst = reference_labels(snapshot, cam, 160, 120)
+        assert np.mean(ref_class == frame.class_ids) >= 0.9999 and np.mean(ref_inst == frame.instance_ids) >= 0.9999
+        people = {i.id for i in snapshot.instances if i.prim_path.startswith(CROWD_ROOT) and i.class_name == "person"}
+        assert people & set(np.unique(frame.instance_ids).tolist())  # the new crowd is in the picture
+
+
+def test_the_scenes_crowd_replaces_the_scenarios(class_map):
+    """The scenario's agents are gone; every cast member is a labelled person, an aid user's device is its own
+    instance of its class linked by synthua:uses and carrying its contact points; clothes are the cast's; the
+    recoloured twin objects render with their variants."""
+    stage, reader, randomiser = randomised(class_map)
+    drawn = randomiser.apply(4, CCTV, 24.0, None)
+    snapshot = reader.snapshot(24.0)
+    assert not any(i.prim_path.startswith(AGENTS_ROOT + "/") for i in snapshot.instances)
+    by_path = {i.prim_path: i for i in snapshot.instances}
+    cast = drawn.scene.cast
+    persons = [p for p in by_path if p.startswith(CROWD_ROOT) and p.endswith("/Person")]
+    assert len(persons) == len(cast)
+    for k, member in enumerate(cast):
+        person = by_path[f"{CROWD_ROOT}/Agent_{k:04d}/Person"]
+        assert person.class_name == "person" and person.id in snapshot.keypoints
+        relations = dict(person.relations)
+        if member.aid is None:
+            assert "uses" not in relations
+            continue
+        device = by_path[relations["uses"]]
+        assert device.class_name == member.aid and device.id in snapshot.keypoints
+        frame = snapshot.materials[f"{LOOKS_ROOT}/Agent_{k:04d}_Frame"]
+        assert frame.base_color == pytest.approx(member.device.frame.base_color, abs=1e-6)
+    for k, member in enumerate(cast[:3]):
+        assert snapshot.materials[f"{LOOKS_ROOT}/Agent_{k:04d}_Upper"].base_color == pytest.approx(member.upper, abs=1e-6)
+    recoloured = {m.prim_path: m.material_key for m in snapshot.meshes if m.material_key.startswith(LOOKS_ROOT + "/Twin_")}
+    assert len(set(recoloured.values())) == len(drawn.scene.recolours) > 0
+    for k, recolour in enumerate(drawn.scene.recolours):
+        material = snapshot.materials[f"{LOOKS_ROOT}/Twin_{k:04d}"]
+        if recolour.base_color is not None:
+            assert material.base_color == pytest.approx(recolour.base_color, abs=1e-6)
+
+
+def test_aid_users_placed_for_the_camera_are_seen(class_map):
+    stage, reader, randomiser = randomised(class_map)
+    session = RenderSession(RenderConfig(width=320, height=240, spp=1))
+    placed = seen = 0
+    for seed in range(4):
+        drawn = randomiser.apply(seed, CCTV, 24.0, None)
+        snapshot = reader.snapshot(24.0)
+        ids = set(np.unique(session.render(snapshot, read_camera(stage, CCTV, 24.0), rgb=False).instance_ids).tolist())
+        by_path = {i.prim_path: i.id for i in snapshot.instances}
+        for k, place in enumerate(drawn.view.placements):
+            if place.in_view:
+                placed += 1
+                seen += by_path[f"{CROWD_ROOT}/Agent_{k:04d}/Person"] in ids
+    assert placed >= 4 and seen >= 0.75 * placed, (placed, seen)  # another person may stand in front
+
+
+def test_exported_layers_compose_the_same_scene(class_map, tmp_path):
+    stage, reader, randomiser = randomised(class_map)
+    randomiser.apply(5, EYE, 24.0, "sunset")
+    files = randomiser.export(tmp_path / "layer.usda")
+    assert [p.name for p in files] == ["layer.usda", "layer.scene.usda", "layer.prototypes.usdc"]
+    over = open_stage(SCENARIO, layers=[tmp_path / "layer.usda"])
+    assert_same_snapshot(reader.snapshot(24.0), read_snapshot(over, 24.0, class_map))
+    camera, again = read_camera(stage, EYE, 24.0), read_camera(over, EYE, 24.0)
+    assert np.allclose(camera.camera_to_world, again.camera_to_world) and camera.exposure_ev == again.exposure_ev
+    assert read_condition(over, None) == read_condition(stage, "sunset")
+    assert isinstance(read_condition(over, None), Condition)
+    randomiser.close()  # the stage as composed before: the scenario's crowd is back
+    assert any(i.prim_path.startswith(AGENTS_ROOT + "/") for i in reader.snapshot(24.0).instances)
