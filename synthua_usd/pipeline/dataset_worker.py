@@ -55,6 +55,8 @@ class WorkerJob:
     layer_stack: str = ""
     #: Class id -> YOLO class index (:func:`synthua_usd.dataset.formats.yolo.class_index`).
     yolo_classes: dict = field(default_factory=dict)
+    #: With randomised districts: district seed -> the scenario of that district in the dataset.
+    scenes: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -67,6 +69,8 @@ class WorkerState:
     conditions: dict = field(default_factory=dict)
     #: Gives each image its randomisation layers (None when the config randomises nothing).
     randomiser: object = None
+    #: The district seed whose scenario ``stage`` is (None: the job's scenario).
+    district: int | None = None
     #: Writes the previous image (its files, then its record) while the next one renders.
     writer: BackgroundWriter = field(default_factory=BackgroundWriter)
     seconds: dict = field(default_factory=lambda: {"render": 0.0, "annotate": 0.0, "write": 0.0})
@@ -86,18 +90,30 @@ class WorkerState:
 def init_worker(job: WorkerJob) -> WorkerState:
     """Open the scenario and make the render session (the scene itself loads with the first image)."""
     from synthua_usd.backends.mitsuba.session import RenderSession
+
+    class_map = ClassMap.from_document(job.class_map_document, source="class_map.json")
+    state = WorkerState(job=job, stage=None, reader=None, session=RenderSession(job.render), class_map=class_map)
+    _open(state, job.scenario, None)
+    return state
+
+
+def _open(state: WorkerState, scenario: str, district: int | None) -> None:
+    """Make ``scenario`` (the job's, or a district's of the dataset) the stage the worker renders."""
     from synthua_usd.usd.reader import StageReader
     from synthua_usd.usd.stage_io import open_stage
 
-    class_map = ClassMap.from_document(job.class_map_document, source="class_map.json")
-    stage = open_stage(job.scenario, job.allow_external_assets)
-    randomiser = None
+    job = state.job
+    if state.randomiser is not None:
+        state.randomiser.close()
+    # a district's scenario is the dataset's own copy, checked when it was written
+    stage = open_stage(scenario, job.allow_external_assets or district is not None)
+    state.stage, state.reader, state.district, state.conditions = stage, StageReader(stage, state.class_map), district, {}
+    state.randomiser = None
     if job.config.randomise is not None:
         from synthua_usd.pipeline.randomiser import Randomiser
 
-        randomiser = Randomiser(stage, job.config.randomise, class_map, (job.render.width, job.render.height))
-    return WorkerState(job=job, stage=stage, reader=StageReader(stage, class_map), session=RenderSession(job.render),
-                       class_map=class_map, randomiser=randomiser)
+        state.randomiser = Randomiser(stage, job.config.randomise, state.class_map,
+                                      (job.render.width, job.render.height))
 
 
 def work(state: WorkerState, item) -> list[dict]:
@@ -129,7 +145,13 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     t0 = time.perf_counter()
     randomised = None
     if state.randomiser is not None:
-        randomised = state.randomiser.apply(planned.seed, planned.camera_path, planned.time_code, planned.condition)
+        from synthua_usd.pipeline.districts import district_of
+
+        district = district_of(job.config.randomise, planned.seed)
+        if district != state.district:
+            _open(state, job.scenes[district] if district is not None else job.scenario, district)
+        randomised = state.randomiser.apply(planned.seed, planned.camera_path, planned.time_code, planned.condition,
+                                            district)
     t_randomise = time.perf_counter() - t0
     snapshot = state.reader.snapshot(planned.time_code)
     camera = read_camera(state.stage, planned.camera_path, planned.time_code)

@@ -41,6 +41,7 @@ from synthua_usd.errors import InputError, OutputError, StageError, echo
 from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, work
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.resources import check_frame_memory
+from synthua_usd.scenario import ROOT_FILE
 from synthua_usd.taxonomy import ClassMap
 
 log = logging.getLogger(__name__)
@@ -126,37 +127,48 @@ def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: 
 
 
 def score_views(stage, pool, render: RenderConfig, output_size: tuple[int, int], class_map: ClassMap,
-                show_progress: bool, randomise=None) -> list[sampling.ViewScore]:
+                show_progress: bool, randomise=None, scenes: dict | None = None) -> list[sampling.ViewScore]:
     """The sampler's view scores: every mobility-aid user (:func:`synthua_usd.dataset.qa.aid_users`, the one
     definition QA and coverage use too) visible in each (camera, time code) view, from one label pass each
     at the render size, pixel counts scaled to the written size (``output_size``). With ``randomise`` (a
     :class:`RandomisationConfig`), each (seed, camera, time code) view of the pool is scored in its own
-    randomised scene, as a worker will render it."""
+    randomised scene, as a worker will render it: in the district scenario of ``scenes`` (district seed ->
+    scenario path) that the seed draws, when districts are randomised."""
     from tqdm import tqdm
 
     from synthua_usd.backends.mitsuba.session import RenderSession
+    from synthua_usd.pipeline.districts import district_of
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.reader import StageReader
+    from synthua_usd.usd.stage_io import open_stage
 
-    randomiser = None
-    if randomise is not None:
-        from synthua_usd.pipeline.randomiser import Randomiser
-
-        randomiser = Randomiser(stage, randomise, class_map, (render.width, render.height))
-    reader = StageReader(stage, class_map)
     session = RenderSession(RenderConfig(width=render.width, height=render.height, spp=1, variant=render.variant))
     scale = output_size[0] * output_size[1] / (render.width * render.height)
-    scores = []
-    if randomiser is None:
-        views = [(None, tc, path) for tc, path in sorted(dict.fromkeys((c.time_code, c.camera_path) for c in pool))]
+    if randomise is None:
+        views = [(None, None, tc, path) for tc, path in
+                 sorted(dict.fromkeys((c.time_code, c.camera_path) for c in pool))]
     else:
-        views = sorted(dict.fromkeys((c.seed, c.time_code, c.camera_path) for c in pool))
+        views = sorted(dict.fromkeys((district_of(randomise, c.seed) if scenes else None, c.seed, c.time_code,
+                                      c.camera_path) for c in pool), key=lambda v: (v[0] is not None, v))
+    scores = []
+    current, reader, randomiser = object(), None, None
     try:
-        for seed, tc, path in tqdm(views, desc="score views", unit="view", disable=not show_progress):
+        for district, seed, tc, path in tqdm(views, desc="score views", unit="view", disable=not show_progress):
+            if district != current:
+                if randomiser is not None:
+                    randomiser.close()
+                view_stage = stage if district is None else open_stage(scenes[district], allow_external_assets=True)
+                reader = StageReader(view_stage, class_map)
+                randomiser = None
+                if randomise is not None:
+                    from synthua_usd.pipeline.randomiser import Randomiser
+
+                    randomiser = Randomiser(view_stage, randomise, class_map, (render.width, render.height))
+                current = district
             if randomiser is not None:
-                randomiser.apply(seed, path, tc, None)
+                randomiser.apply(seed, path, tc, None, district)
             snapshot = reader.snapshot(tc)
-            counts = np.bincount(session.quick_labels(snapshot, read_camera(stage, path, tc)).ravel(),
+            counts = np.bincount(session.quick_labels(snapshot, read_camera(reader.stage, path, tc)).ravel(),
                                  minlength=len(snapshot.instances) + 1)
             class_of = {inst.prim_path: inst.class_name for inst in snapshot.instances}
             visible = []
@@ -174,6 +186,25 @@ def score_views(stage, pool, render: RenderConfig, output_size: tuple[int, int],
         if randomiser is not None:
             randomiser.close()
     return scores
+
+
+def write_scenes(request: GenerateRequest, config: GenerationConfig, pool, class_map: ClassMap,
+                 out: Path) -> dict[int, Path]:
+    """With randomised districts: every district the pool's seeds draw, written into the dataset's ``scenes/``
+    (kept from an earlier run of the job); district seed -> its scenario. Empty otherwise."""
+    from synthua_usd.pipeline.districts import (check_district_scenario, clear_partial_scenes, district_of,
+                                                scene_folder, write_district_scene)
+
+    randomise = config.randomise
+    if randomise is None or not randomise.district.enabled:
+        return {}
+    try:
+        check_district_scenario(request.scenario)
+    except InputError as exc:
+        raise InputError(f"{request.config_path}: {exc}") from None
+    clear_partial_scenes(out)
+    districts = sorted({district_of(randomise, c.seed) for c in pool})
+    return {d: write_district_scene(request.scenario, d, out / scene_folder(d), class_map) for d in districts}
 
 
 def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateSummary:
@@ -210,8 +241,9 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
         raise OutputError(f"{out}: holds a dataset generated from another scenario, config, class map or Mitsuba "
                           f"variant (its generate.json differs); expected an empty folder or the same job to "
                           f"resume: pick another --out or remove it")
+    scenes = write_scenes(request, config, pool, class_map, out)
     if job_document is None:
-        scores = score_views(stage, pool, render, output_size, class_map, show_progress, config.randomise)
+        scores = score_views(stage, pool, render, output_size, class_map, show_progress, config.randomise, scenes)
         plan = sampling.plan(pool, scores, config)
         job_document = {"synthua": __version__, "job_key": job_key, "job_key_digest": document_digest(job_key),
                         "scenario": str(Path(request.scenario).resolve()),
@@ -297,16 +329,23 @@ def _dataset_bytes(out: Path) -> int:
 
 
 def worker_job_from_document(document: dict, out_dir: Path, scenario: Path | None = None,
-                             allow_external_assets: bool | None = None) -> WorkerJob:
+                             allow_external_assets: bool | None = None, dataset: Path | None = None) -> WorkerJob:
     """The workers' job from a run's ``generate.json``: the one place a :class:`WorkerJob` is made, for a
     run, its resumption and ``synthua replay`` alike. ``scenario`` and ``allow_external_assets`` default to
-    what the run that planned the dataset used."""
+    what the run that planned the dataset used; ``dataset`` is where its districts are (default ``out_dir``:
+    replay writes elsewhere)."""
     key = document["job_key"]
     config = GenerationConfig.from_document(key["config"], source=Layout.CONFIG)
     class_map = ClassMap.from_document(key["class_map"], source=Layout.CONFIG)
     render = RenderConfig.from_dict(document["render"])
     cameras = [tuple(c) for c in document["cameras"]]
     size = config.output_size(render.width, render.height)
+    from synthua_usd.pipeline.districts import scene_folder
+
+    scenes = {}
+    if config.randomise is not None and config.randomise.district.enabled:
+        scenes = {d: str((Path(dataset or out_dir) / scene_folder(d) / ROOT_FILE).resolve())
+                  for d in config.randomise.district.seeds}
     return WorkerJob(scenario=str(Path(scenario).resolve()) if scenario is not None else document["scenario"],
                      out_dir=str(Path(out_dir).resolve()), render=render, config=config,
                      class_map_document=key["class_map"],
@@ -314,7 +353,8 @@ def worker_job_from_document(document: dict, out_dir: Path, scenario: Path | Non
                                             if allow_external_assets is None else allow_external_assets),
                      output_size=None if size == (render.width, render.height) else size,
                      city=cityscapes_city(config.name), camera_index={p: i for i, (p, _, _) in enumerate(cameras)},
-                     layer_stack=document["layer_stack"]["digest"], yolo_classes=yolo.class_index(class_map))
+                     layer_stack=document["layer_stack"]["digest"], yolo_classes=yolo.class_index(class_map),
+                     scenes=scenes)
 
 
 def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, workers: int, collect, out: Path) -> None:
@@ -324,9 +364,13 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
 
     # a shard's images follow one another in the order that changes least in its loaded scene: the condition
     # first (wetness and a sun below the horizon mean a reload), then camera and time code; with randomisation
-    # the seed comes first (each seed is a scene of its own, loaded once)
+    # the district and the seed come first (each seed is a scene of its own, loaded once)
     if job.config.randomise is not None:
-        order = lambda p: (p.seed, p.condition or "", p.camera_path, p.time_code, p.id)  # noqa: E731
+        from synthua_usd.pipeline.districts import district_of
+
+        def order(p):
+            district = district_of(job.config.randomise, p.seed)
+            return (-1 if district is None else district, p.seed, p.condition or "", p.camera_path, p.time_code, p.id)
     else:
         order = lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id)  # noqa: E731
     while todo:
@@ -359,7 +403,10 @@ def _read_job(out: Path) -> dict | None:
     if not path.exists():
         if out.exists() and not out.is_dir():
             raise OutputError(f"{out}: is a file; expected a dataset folder or a path that does not exist")
-        if out.is_dir() and any(not p.name.startswith(".") for p in out.iterdir()):
+        from synthua_usd.pipeline.districts import SCENES_FOLDER
+
+        # a run killed before its plan was written may have left the districts it writes first
+        if out.is_dir() and any(not p.name.startswith(".") and p.name != SCENES_FOLDER for p in out.iterdir()):
             raise OutputError(f"{out}: is not empty and holds no generate.json; expected an empty folder, a "
                               f"path that does not exist, or a dataset to resume")
         return None
@@ -435,6 +482,10 @@ def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: G
                + [file_entry(root, Layout.record(r["name"]))]} for r in records]
     dataset_files = [file_entry(root, p.relative_to(root).as_posix()) for p in written]
     dataset_files.append(file_entry(root, Layout.CONFIG))
+    from synthua_usd.pipeline.districts import SCENES_FOLDER
+
+    dataset_files += [file_entry(root, p.relative_to(root).as_posix()) for p in sorted((root / SCENES_FOLDER).rglob("*"))
+                      if p.is_file()] if (root / SCENES_FOLDER).is_dir() else []
     _write_json(layout.path(Layout.MANIFEST), manifest_document(provenance=provenance, images=images,
                                                                 dataset_files=sorted(dataset_files,
                                                                                      key=lambda e: e["path"])))

@@ -131,10 +131,12 @@ class Randomiser:
         self._scene, self._cast = draw, cast
         return draw
 
-    def apply(self, seed: int, camera_path: str, time_code: float, condition: str | None) -> ImageRandomisation:
+    def apply(self, seed: int, camera_path: str, time_code: float, condition: str | None,
+              district_seed: int | None = None) -> ImageRandomisation:
         """Give the stage the randomisation of the image (``seed``, ``camera_path``, ``time_code``, ``condition``
-        name or None for the stage's own lights) and return what it drew."""
-        scene = self.scene(seed)
+        name or None for the stage's own lights; ``district_seed`` the district the stage is, recorded) and
+        return what it drew."""
+        scene = self.scene(seed, district_seed)
         cast = self._cast
         base_camera = read_camera(self.base, camera_path, time_code)
         rng = stream(self.config.seed, seed, "view", camera_path, time_code)

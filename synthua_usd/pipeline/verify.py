@@ -266,7 +266,7 @@ def replay(root: Path, image: str) -> Replay:
     layout = Layout(root)
     scratch = Path(tempfile.mkdtemp(prefix=".replay-", dir=root.parent))
     try:
-        job = worker_job_from_document(job_doc, scratch)
+        job = worker_job_from_document(job_doc, scratch, dataset=root)
         state = init_worker(job)
         results = work(state, planned) + work(state, FLUSH)
         record = results[-1]["record"]
