@@ -27,6 +27,7 @@ KIND_OPTIONS = {
     "up_axis": ("mesh",), "scale": ("mesh",),
     "lod": ("cityjson",), "crs": ("cityjson", "pointcloud"), "units": ("cityjson", "pointcloud"),
     "max_deviation_m": ("pointcloud",), "plane_threshold_m": ("pointcloud",), "max_residual_m": ("pointcloud",),
+    "max_hull_residual_m": ("pointcloud",),
     "storey_height_m": ("footprints",),
 }
 
@@ -78,6 +79,11 @@ def _refuse_population_options(ctx: click.Context, populate: bool) -> None:
 @click.option("--max-residual-m", type=InRange(importer_limits.MAX_RESIDUAL), default=0.10, show_default=True,
               help="pointcloud: a segment whose 95th-percentile point-to-surface distance exceeds this (metres) is "
                    "reported as a finding.")
+@click.option("--max-hull-residual-m", type=InRange(importer_limits.MAX_HULL_RESIDUAL), default=1.0,
+              show_default=True,
+              help="pointcloud: the same bound for a tree's convex hull (metres). A hull encloses its points (trunk, "
+                   "branches, the far side of the crown lie inside it), so its bound is looser; past it the hull "
+                   "wraps mostly empty space (trees merged into one cluster, or a cluster that is no tree).")
 @click.option("--strict", is_flag=True, help="Exit 1 when the import has findings (residuals over their bound, "
                                              "automatic cameras that see too few labelled pixels).")
 @click.option("--populate", is_flag=True,
@@ -95,6 +101,7 @@ def _refuse_population_options(ctx: click.Context, populate: bool) -> None:
 def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, rules: Path | None,
                 class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, crs: str | None,
                 units: str | None, max_deviation_m: float, plane_threshold_m: float, max_residual_m: float,
+                max_hull_residual_m: float,
                 strict: bool, populate: bool, density: float, aid_share: float, frames: int,
                 storey_height_m: float) -> int:
     """Import real city data of KIND from INPUT as labelled twin layers plus a renderable scenario.
@@ -127,7 +134,7 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     t0 = time.perf_counter()
     model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod, crs=crs,
                               units=units, max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
-                              max_residual_m=max_residual_m,
+                              max_residual_m=max_residual_m, max_hull_residual_m=max_hull_residual_m,
                               storey_height_m=storey_height_m, show_progress=sys.stderr.isatty())
     seconds = time.perf_counter() - t0
     from synthua_usd.pipeline.twin_import import write_import  # USD and the writers: only once the input is good

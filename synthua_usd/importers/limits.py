@@ -21,6 +21,9 @@ PLANE_THRESHOLD = Range(1e-4, 10, "m")
 #: pointcloud: bound on the 95th percentile of a segment's point-to-surface distances before it is a finding;
 #: 1 mm is below any scanner's noise, 100 m explains nothing.
 MAX_RESIDUAL = Range(1e-3, 100, "m")
+#: pointcloud: the same bound for a tree's convex hull, whose points lie inside it (trunk, branches, the far
+#: side of the crown), so that the depth of a crown is no finding but a hull around empty space is.
+MAX_HULL_RESIDUAL = Range(1e-3, 100, "m")
 #: footprints: metres per level when a footprint gives levels.
 STOREY_HEIGHT = Range(1, 20, "m")
 
