@@ -132,8 +132,9 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
 
     Geometry no rule matches is labelled 'unlabelled' (class 0) and listed in import_report.json.
     The scenario stands on a generated ground (unlabelled, 20 km out) and has automatic Overview (densest
-    cluster) and Street (1.6 m above a road) cameras; each camera's label pass must show the twin in 10 %
-    of its pixels, else a finding is printed (exit 1 with --strict).
+    cluster) and Street (1.6 m above a road) cameras, placed in free space outdoors (rays from the eye: not
+    inside a closed surface, open sky above, a free view of 5 m ahead); a camera that finds no such spot,
+    or whose label pass shows the twin in under 10 % of its pixels, is a finding (exit 1 with --strict).
     Options of one kind (--lod, --scale, ...) are refused for the others. Nothing in --out changes
     unless the whole import is written.
     """
