@@ -148,7 +148,7 @@ def building_height(tags: dict, where: str, storey_height_m: float, default_heig
         if top is not None:
             source = "height"
             break
-    roof = read.length("roof:height", MIN_HEIGHT)
+    roof = read.length("roof:height", MIN_HEIGHT) if top is None else None
     if top is None:
         for key in LEVEL_KEYS:
             levels = read.count(key, LEVELS)

@@ -44,6 +44,7 @@ def test_unusable_values_are_skipped_and_recorded_or_refused_when_strict():
     assert h.ignored == ("tag height: 'tall' is not a length; expected a number in [0.1, 1000] m (a number of metres, "
                          "or with a unit: '12.5 m', '12,5', '40 ft')",)
     assert _height({"height": "-5", "building:levels": "many"}).source == "default"
+    assert _height({"height": "12", "roof:height": "steep"}, strict=True).ignored == ()  # not needed: not read
     with pytest.raises(InputError, match=r"^city.osm: way/7: tag height: 'tall' is not a length"):
         _height({"height": "tall", "building:levels": "3"}, strict=True)
     with pytest.raises(InputError, match="no height"):
