@@ -10,6 +10,12 @@
   :data:`STREET_RADIUS_M`) in the direction with the longer free view. Without street surfaces it stands on
   the generated ground (:mod:`synthua_usd.ground`) and looks at the cluster.
 
+Every camera stands in free space outdoors (:mod:`synthua_usd.free_space`: not inside a closed surface, open
+sky above, clear of every surface, a free view of several metres towards what it looks at): the overview
+takes the tightest of its directions that does, the street camera the first such spot; when no street
+spot is free, spots on rings round the cluster on the generated ground. A camera that finds none keeps the
+least enclosed spot, and its report's ``placement`` says why (the import pipeline makes it a finding).
+
 Whether each camera's label pass sees enough of the twin is checked by the import pipeline
 (:mod:`synthua_usd.pipeline.twin_import`), which renders it.
 """
@@ -22,7 +28,8 @@ import numpy as np
 
 from synthua_usd.cameras import CameraSpec
 from synthua_usd.errors import InputError
-from synthua_usd.ground import REACH_M, is_ground
+from synthua_usd.free_space import check_eyes, first_hits
+from synthua_usd.ground import REACH_M, height_at, is_ground
 from synthua_usd.twin import TwinModel, TwinObject
 
 #: Classes a street-level camera may stand on.
@@ -103,16 +110,25 @@ def fit_view(points: np.ndarray, forward: np.ndarray, tan_half: float = FIT_TAN)
 OVERVIEW_DIRECTIONS = tuple((az, pitch) for pitch in (45.0, 60.0) for az in range(0, 360, 45))
 
 
-def overview_view(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-    """(eye, target, distance) of the tightest overview of ``points`` (n, 3) among :data:`OVERVIEW_DIRECTIONS`."""
-    best = None
+def overview_views(points: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """(eye, target, distance) of the overview of ``points`` (n, 3) from every one of
+    :data:`OVERVIEW_DIRECTIONS`, the tightest (least distance) first."""
+    views = []
     for az, pitch in OVERVIEW_DIRECTIONS:
         a, p = np.radians(az), np.radians(pitch)
         forward = np.array([np.cos(p) * np.cos(a), np.cos(p) * np.sin(a), -np.sin(p)])
         target, dist = fit_view(points, forward)
-        if best is None or dist < best[2] - 1e-9:
-            best = (target - forward * dist, target, dist)
-    return best
+        views.append((target - forward * dist, target, dist))
+    best = 0
+    for k, view in enumerate(views):  # ties (within 1 nm): the first direction
+        if view[2] < views[best][2] - 1e-9:
+            best = k
+    return [views[best]] + sorted((v for k, v in enumerate(views) if k != best), key=lambda v: v[2])
+
+
+def overview_view(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """(eye, target, distance) of the tightest overview of ``points`` (n, 3) among :data:`OVERVIEW_DIRECTIONS`."""
+    return overview_views(points)[0]
 
 
 def automatic_cameras(model: TwinModel, ground: TwinObject) -> Framing:
@@ -129,13 +145,18 @@ def automatic_cameras(model: TwinModel, ground: TwinObject) -> Framing:
     lo, hi = boxes[members, 0].min(axis=0), boxes[members, 1].max(axis=0)
     corners = np.array([[b[i, 0], b[j, 1], b[k, 2]] for b in boxes[members] for i in (0, 1) for j in (0, 1)
                         for k in (0, 1)])
-    eye, target, dist = overview_view(corners)
+    mesh, street, paths = _scene(model, ground)
+    views = overview_views(corners)
+    checks = check_eyes(mesh, np.array([v[0] for v in views]), np.array([v[1] - v[0] for v in views]))
+    k = next((i for i, c in enumerate(checks) if c.ok), 0)  # the tightest view from free space
+    (eye, target, dist), check = views[k], checks[k]
     overview = CameraSpec("Overview", tuple(eye), tuple(target), *LENS_MM,
                           f"Oblique overview of the densest cluster of objects ({len(members)} of {len(standing)}).",
                           clip_near_m=max(0.05, dist / 1000), clip_far_m=REACH_M * 1.5)
-    street, street_report = _street_camera(model, ground, lo, hi)
+    street, street_report = _street_camera(mesh, street, paths, ground, lo, hi)
     report = {"overview": {"cluster_objects": int(len(members)), "objects": len(standing),
-                           "cluster_box_m": [lo.tolist(), hi.tolist()], "distance_m": dist},
+                           "cluster_box_m": [lo.tolist(), hi.tolist()], "distance_m": dist,
+                           "placement": check.as_report()},
               "street": street_report}
     return Framing((overview, street), report)
 
@@ -156,77 +177,130 @@ def _scene(model: TwinModel, ground: TwinObject):
     return mesh, np.concatenate(street), np.array(paths, dtype=object)
 
 
-def _first_hits(mesh, origins: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(n,) distance to the first hit along each ray (inf for none) and (n,) face index (-1 for none)."""
-    dist = np.full(len(origins), np.inf)
-    face = np.full(len(origins), -1)
-    if not len(origins):
-        return dist, face
-    locations, ray_idx, tri_idx = mesh.ray.intersects_location(origins, directions, multiple_hits=False)
-    d = np.linalg.norm(locations - origins[ray_idx], axis=1)
-    dist[ray_idx], face[ray_idx] = d, tri_idx
-    return dist, face
-
-
-def _street_camera(model: TwinModel, ground: TwinObject, lo: np.ndarray, hi: np.ndarray):
-    mesh, street, paths = _scene(model, ground)
+def _street_camera(mesh, street: np.ndarray, paths: np.ndarray, ground: TwinObject, lo: np.ndarray,
+                   hi: np.ndarray):
+    """The ``Street`` camera (a :class:`CameraSpec`) and its report: the first spot in free space
+    (:mod:`synthua_usd.free_space`) of :func:`_street_spots`, else of :func:`_ground_ring`; when none is, the
+    spot least inside geometry, whose report's ``placement`` says why it is not free."""
     centre = (lo + hi) / 2
+    small = np.linalg.norm(hi[:2] - lo[:2]) < 2 * GOOD_VIEW_M
+    candidates = _street_spots(mesh, street, paths, ground, centre)
+    best, invalid, tried = None, None, 0
+    for eye, dirs, path, foot in candidates:
+        free, _ = first_hits(mesh, np.tile(eye, (len(dirs), 1)), dirs)
+        j = int(np.argmax(free))
+        view = _street_target(eye, dirs[j]) - eye
+        check = check_eyes(mesh, eye[None], view[None])[0]
+        tried += 1
+        found = (eye, dirs[j], min(free[j], 1e6), path, foot, check)
+        if not check.ok:
+            invalid = found if invalid is None or check.rank() < invalid[5].rank() else invalid
+            continue
+        if best is None or found[2] > best[2]:
+            best = found
+        if best[2] >= GOOD_VIEW_M:
+            break
+    if best is None:  # nothing free on the street surfaces: ring the cluster on the generated ground
+        best, ring_invalid, tried = _ground_ring(mesh, ground, centre, lo, hi, tried)
+        if invalid is None or (ring_invalid is not None and ring_invalid[5].rank() < invalid[5].rank()):
+            invalid = ring_invalid
+    if best is None and invalid is None:  # nothing found by ray casting: the ground under the cluster's centre
+        foot = np.array([centre[0], centre[1], float(height_at(ground, centre[None, :2])[0])])
+        eye = foot + [0.0, 0.0, EYE_HEIGHT_M]
+        d = np.array([1.0, 0.0, 0.0])
+        invalid = (eye, d, 0.0, ground.path, foot, check_eyes(mesh, eye[None], d[None])[0])
+    eye, d, _, path, foot, check = best if best is not None else invalid
+    target = _street_target(eye, d)
+    stepped = False
+    if small and check.ok:
+        # A small model: at eye level on it one sees over it. Step back until its box fits (at most 10 degrees
+        # down), stand on the surface there and look at its centre: along the view first, then from 7 other
+        # sides, the first spot in free space.
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        heading = np.arctan2(d[1], d[0])
+        for turn in np.radians(np.arange(0, 360, 45)):
+            horizontal = np.array([np.cos(heading + turn), np.sin(heading + turn), 0.0])
+            aim, dist = fit_view(corners, horizontal - [0.0, 0.0, np.tan(np.radians(10.0))])
+            back = aim[:2] - horizontal[:2] * dist
+            stand = max(float(height_at(ground, back[None])[0]), float(lo[2]))
+            back_eye = np.array([back[0], back[1], stand + EYE_HEIGHT_M])
+            back_check = check_eyes(mesh, back_eye[None], (aim - back_eye)[None])[0]
+            tried += 1
+            if back_check.ok:
+                eye, target, path, check = back_eye, aim, ground.path, back_check
+                foot, stepped = np.array([back[0], back[1], stand]), True
+                break
+    camera = CameraSpec("Street", tuple(float(v) for v in eye), tuple(float(v) for v in target), *LENS_MM,
+                        f"Eye level ({EYE_HEIGHT_M} m) on {path}, looking along it.", clip_near_m=0.05,
+                        clip_far_m=REACH_M * 1.5)
+    return camera, {"stands_on": str(path), "surface_z_m": float(foot[2]),
+                    "free_view_m": float(min(check.free_view_m, 1e6)),
+                    "on_street_surface": bool(np.any(street)) and path != ground.path, "stepped_back": stepped,
+                    "spots_tried": tried, "placement": check.as_report()}
+
+
+def _street_target(eye: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """The point a street camera at ``eye`` looking along the horizontal ``d`` aims at: 10 m on, 0.5 m down."""
+    return eye + 10.0 * d - [0.0, 0.0, 0.5]
+
+
+def _street_spots(mesh, street: np.ndarray, paths: np.ndarray, ground: TwinObject, centre: np.ndarray):
+    """Candidate street-camera spots nearest the cluster's ``centre`` first: (eye, (k, 3) view directions, path
+    stood on, foot). On street surfaces whose first surface from above is a street surface, looking both ways
+    along the street; without street surfaces, on the generated ground's faces, looking at the centre."""
     tris = mesh.triangles
-    normals = mesh.face_normals
-    candidates = np.flatnonzero(street & (normals[:, 2] > 0.7))
+    candidates = np.flatnonzero(street & (mesh.face_normals[:, 2] > 0.7))
     on_street = len(candidates) > 0
-    if not on_street:  # no street surfaces: stand on the generated ground (its last faces) inside the cluster
+    if not on_street:
         candidates = np.flatnonzero(paths == ground.path)
     spots = tris[candidates].mean(axis=1)
-    near = np.linalg.norm(spots[:, :2] - centre[:2], axis=1)
-    order = np.argsort(near, kind="stable")[:MAX_SPOTS]
+    order = np.argsort(np.linalg.norm(spots[:, :2] - centre[:2], axis=1), kind="stable")[:MAX_SPOTS]
     top = float(mesh.bounds[1][2]) + 10.0
     origins = np.column_stack([spots[order, :2], np.full(len(order), top)])
-    down, face = _first_hits(mesh, origins, np.tile([0.0, 0.0, -1.0], (len(order), 1)))
+    down, face = first_hits(mesh, origins, np.tile([0.0, 0.0, -1.0], (len(order), 1)))
     standing = street[face] if on_street else paths[face] == ground.path
-    best = None
     for k in np.flatnonzero((face >= 0) & standing):
         foot = origins[k] - [0.0, 0.0, down[k]]
-        eye = foot + [0.0, 0.0, EYE_HEIGHT_M]
         if on_street:
             same = candidates[paths[candidates] == paths[face[k]]]
             local = tris[same].mean(axis=1)
             local = local[np.linalg.norm(local[:, :2] - foot[:2], axis=1) <= STREET_RADIUS_M][:, :2]
             axis = (np.linalg.svd(local - local.mean(axis=0), full_matrices=False)[2][0] if len(local) > 2
                     else np.array([1.0, 0.0]))
-        else:
+            dirs = np.array([[axis[0], axis[1], 0.0], [-axis[0], -axis[1], 0.0]])
+        else:  # look at the cluster, not away from it
             axis = centre[:2] - foot[:2]
             axis = axis / (np.linalg.norm(axis) or 1.0)
-        dirs = np.array([[axis[0], axis[1], 0.0], [-axis[0], -axis[1], 0.0]])
-        free, _ = _first_hits(mesh, np.tile(eye, (2, 1)), dirs)
-        if not on_street:
-            free = np.array([free[0], -1.0])  # look at the cluster, not away from it
-        j = int(np.argmax(free))
-        if best is None or min(free[j], 1e6) > best[2]:
-            best = (eye, dirs[j], min(free[j], 1e6), paths[face[k]], foot)
-        if best[2] >= GOOD_VIEW_M:
-            break
-    if best is None:  # nothing found by ray casting: the ground under the cluster's centre
-        from synthua_usd.ground import height_at
+            dirs = np.array([[axis[0], axis[1], 0.0]])
+        yield foot + [0.0, 0.0, EYE_HEIGHT_M], dirs, paths[face[k]], foot
 
-        foot = np.array([centre[0], centre[1], float(height_at(ground, centre[None, :2])[0])])
-        best = (foot + [0.0, 0.0, EYE_HEIGHT_M], np.array([1.0, 0.0, 0.0]), 0.0, ground.path, foot)
-    eye, d, free, path, foot = best
-    target = eye + 10.0 * d - [0.0, 0.0, 0.5]
-    if np.linalg.norm(hi[:2] - lo[:2]) < 2 * GOOD_VIEW_M:
-        # A small model: at eye level on it one sees over it. Step back along the view until its box fits
-        # (at most 10 degrees down), stand on the surface there and look at its centre.
-        from synthua_usd.ground import height_at
 
-        horizontal = np.array([d[0], d[1], 0.0]) / (np.linalg.norm(d[:2]) or 1.0)
-        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-        aim, dist = fit_view(corners, horizontal - [0.0, 0.0, np.tan(np.radians(10.0))])
-        back = aim[:2] - horizontal[:2] * dist
-        stand = max(float(height_at(ground, back[None])[0]), float(lo[2]))
-        eye = np.array([back[0], back[1], stand + EYE_HEIGHT_M])
-        target, path, foot = aim, ground.path, np.array([back[0], back[1], stand])
-    camera = CameraSpec("Street", tuple(float(v) for v in eye), tuple(float(v) for v in target), *LENS_MM,
-                        f"Eye level ({EYE_HEIGHT_M} m) on {path}, looking along it.", clip_near_m=0.05,
-                        clip_far_m=REACH_M * 1.5)
-    return camera, {"stands_on": str(path), "surface_z_m": float(foot[2]), "free_view_m": float(free),
-                    "on_street_surface": bool(on_street)}
+#: Distances beyond the cluster's box (metres) and azimuths of the spots on the generated ground tried when no
+#: street spot is in free space.
+RING_MARGINS_M = (3.0, 8.0, 15.0, 30.0)
+RING_AZIMUTHS = 16
+
+
+def _ground_ring(mesh, ground: TwinObject, centre: np.ndarray, lo: np.ndarray, hi: np.ndarray, tried: int):
+    """The first spot in free space on rings round the cluster's box, on the generated ground, looking at the
+    cluster's centre, as (eye, direction, free view, path, foot, check), or None; the least enclosed spot that is
+    not free (or None); and the spots tried so far."""
+    radius = float(np.linalg.norm(hi[:2] - lo[:2])) / 2
+    invalid = None
+    for margin in RING_MARGINS_M:
+        a = np.linspace(0.0, 2 * np.pi, RING_AZIMUTHS, endpoint=False)
+        xy = centre[:2] + (radius + margin) * np.column_stack([np.cos(a), np.sin(a)])
+        feet = np.column_stack([xy, height_at(ground, xy)])
+        eyes = feet + [0.0, 0.0, EYE_HEIGHT_M]
+        views = np.column_stack([centre[:2] - xy, np.zeros(len(xy))])
+        views /= np.linalg.norm(views, axis=1, keepdims=True)
+        checks = check_eyes(mesh, eyes, np.array([_street_target(e, v) for e, v in zip(eyes, views)]) - eyes)
+        tried += len(eyes)
+        free = [k for k, c in enumerate(checks) if c.ok]
+        if free:
+            k = max(free, key=lambda i: min(checks[i].free_view_m, 1e6))
+            return (eyes[k], views[k], checks[k].free_view_m, ground.path, feet[k], checks[k]), None, tried
+        k = min(range(len(checks)), key=lambda i: checks[i].rank())
+        if invalid is None or checks[k].rank() < invalid[5].rank():
+            invalid = (eyes[k], views[k], checks[k].free_view_m, ground.path, feet[k], checks[k])
+    return None, invalid, tried

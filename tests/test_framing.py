@@ -132,3 +132,34 @@ def test_ground_follows_the_model_and_reaches_past_it():
     tri = pts[ground.parts[0].triangles]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     assert (n[:, 2] > 0).all()
+
+
+def _inside_any(point, boxes):
+    return any(np.all(point > lo) and np.all(point < hi) for lo, hi in boxes)
+
+
+def test_street_camera_of_a_dense_block_without_streets_stands_outside(tmp_path, class_map):
+    """A 5 x 5 block of 10 m houses 1 m apart, no street surfaces: every ground spot near the centre is under a
+    roof. Before, the camera fell back to the ground under the centre, inside a house (free view 0 m, the
+    interior 'labelled' and no finding); now it stands on a ring round the block, in free space."""
+    boxes = [((x, y, 0.0), (x + 10, y + 10, 8.0)) for x in range(0, 55, 11) for y in range(0, 55, 11)]
+    objects = [_obj(f"B/h{k}", "building", box(lo, hi)) for k, (lo, hi) in enumerate(boxes)]
+    report = _written(_model(objects), tmp_path, class_map)
+    street = report["cameras"]["Street"]
+    _, cam, classes = _reference(tmp_path, class_map, "Street")
+    assert not _inside_any(cam.origin, boxes) and street["placement"]["free_space"]
+    assert street["free_view_m"] >= 5.0 and street["stands_on"] == "Ground/Surroundings"
+    assert np.mean(classes == class_map.resolve("building").id) > 0.1  # it sees the block from outside
+    assert not [f for f in report["findings"] if f["rule"] == "camera-placement"]
+
+
+def test_a_camera_with_no_free_spot_is_a_finding(tmp_path, class_map):
+    """The whole twin inside a closed, unlabelled hall 400 m wide: no spot is outdoors, and both cameras say why."""
+    objects = [_obj("B/house", "building", box((0, 0, 0), (10, 10, 8))),
+               _obj("R/road", "road", _slab(-30, -8, 40, -2)),
+               _obj("X/hall", "unlabelled", box((-200, -200, -1), (200, 200, 60)))]
+    report = _written(_model(objects), tmp_path, class_map)
+    placement = {f["where"]: f["message"] for f in report["findings"] if f["rule"] == "camera-placement"}
+    assert sorted(placement) == ["/World/Cameras/Overview", "/World/Cameras/Street"]
+    assert all("inside a closed surface" in m for m in placement.values())
+    assert report["cameras"]["Street"]["placement"]["free_space"] is False

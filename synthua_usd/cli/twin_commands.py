@@ -27,7 +27,8 @@ KIND_OPTIONS = {
     "up_axis": ("mesh",), "scale": ("mesh",),
     "lod": ("cityjson",), "crs": ("cityjson", "pointcloud"), "units": ("cityjson", "pointcloud"),
     "max_deviation_m": ("pointcloud",), "plane_threshold_m": ("pointcloud",), "max_residual_m": ("pointcloud",),
-    "storey_height_m": ("footprints",),
+    "max_hull_residual_m": ("pointcloud",),
+    "storey_height_m": ("footprints", "osm"), "default_height_m": ("footprints", "osm"),
 }
 
 
@@ -51,7 +52,7 @@ def _refuse_population_options(ctx: click.Context, populate: bool) -> None:
 
 
 @twin.command("import")
-@click.argument("kind", type=click.Choice(["mesh", "cityjson", "pointcloud", "footprints"]))
+@click.argument("kind", type=click.Choice(["mesh", "cityjson", "pointcloud", "footprints", "osm"]))
 @click.argument("input_path", metavar="INPUT", type=click.Path(path_type=Path))
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True,
               help="Folder for twin.usdc, semantics.usda, cameras/environment/render layers, scenario.usda "
@@ -78,8 +79,16 @@ def _refuse_population_options(ctx: click.Context, populate: bool) -> None:
 @click.option("--max-residual-m", type=InRange(importer_limits.MAX_RESIDUAL), default=0.10, show_default=True,
               help="pointcloud: a segment whose 95th-percentile point-to-surface distance exceeds this (metres) is "
                    "reported as a finding.")
+@click.option("--max-hull-residual-m", type=InRange(importer_limits.MAX_HULL_RESIDUAL), default=1.0,
+              show_default=True,
+              help="pointcloud: the same bound for a tree's convex hull (metres). A hull encloses its points (trunk, "
+                   "branches, the far side of the crown lie inside it), so its bound is looser; past it the hull "
+                   "wraps mostly empty space (trees merged into one cluster, or a cluster that is no tree).")
 @click.option("--strict", is_flag=True, help="Exit 1 when the import has findings (residuals over their bound, "
-                                             "automatic cameras that see too few labelled pixels).")
+                                             "automatic cameras that see too few labelled pixels or stand where no "
+                                             "free view was found, buildings without a height). footprints, osm: "
+                                             "refuse (exit 2) a building without a usable height instead of taking "
+                                             "the next source or --default-height-m.")
 @click.option("--populate", is_flag=True,
               help="Also write an agents layer: people walking (and using mobility aids) on the twin's roads, "
                    "sidewalks, crosswalks and curb ramps, composed into the scenario.")
@@ -89,14 +98,20 @@ def _refuse_population_options(ctx: click.Context, populate: bool) -> None:
               help="With --populate: share of people using a mobility aid.")
 @click.option("--frames", type=click.IntRange(1, 10_000), default=48, show_default=True,
               help="With --populate: time codes of the animation (24 per second).")
-@click.option("--storey-height-m", type=InRange(importer_limits.STOREY_HEIGHT), default=3.0, show_default=True,
-              help="footprints: metres per level when a footprint gives levels, not height.")
+@click.option("--storey-height-m", type=InRange(importer_limits.STOREY_HEIGHT),
+              default=importer_limits.DEFAULT_STOREY_HEIGHT_M, show_default=True,
+              help="footprints, osm: metres per level when a building gives levels (building:levels), not a height.")
+@click.option("--default-height-m", type=InRange(importer_limits.DEFAULT_HEIGHT),
+              default=importer_limits.DEFAULT_HEIGHT_M, show_default=True,
+              help="footprints, osm: the height of a building with no height, levels or roof height (recorded as "
+                   "source 'default' in import_report.json; refused with --strict).")
 @click.pass_context
 def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, rules: Path | None,
                 class_map: Path | None, up_axis: str | None, scale: float, lod: str | None, crs: str | None,
                 units: str | None, max_deviation_m: float, plane_threshold_m: float, max_residual_m: float,
+                max_hull_residual_m: float,
                 strict: bool, populate: bool, density: float, aid_share: float, frames: int,
-                storey_height_m: float) -> int:
+                storey_height_m: float, default_height_m: float) -> int:
     """Import real city data of KIND from INPUT as labelled twin layers plus a renderable scenario.
 
     \b
@@ -105,12 +120,21 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     cityjson   CityJSON 1.1 or 2.0 (units from metadata.referenceSystem, --crs or --units)
     pointcloud .las .laz .ply; units from the LAS CRS (WKT or GeoTIFF keys), --crs or --units;
                ground, connected planes, tree hulls; simplification within --max-deviation-m
-    footprints GeoJSON polygons with 'height' or 'levels' -> extruded LoD1 buildings
+    footprints GeoJSON polygons -> extruded LoD1 buildings (heights as for osm)
+    osm        OpenStreetMap .osm or .osm.pbf (pyosmium): building and building:part areas -> extruded
+               LoD1 buildings, lon/lat projected to a local transverse Mercator (metres)
+
+    \b
+    Building heights (footprints, osm), each building's source in import_report.json (heights):
+    'height' (metres, or with a unit: '12.13 m', '12,5', '40 ft'), else building:levels x
+    --storey-height-m (plus roof:height or roof:levels), else roof:height, else --default-height-m.
+    Values that are not lengths are skipped for the next source (refused with --strict).
 
     Geometry no rule matches is labelled 'unlabelled' (class 0) and listed in import_report.json.
     The scenario stands on a generated ground (unlabelled, 20 km out) and has automatic Overview (densest
-    cluster) and Street (1.6 m above a road) cameras; each camera's label pass must show the twin in 10 %
-    of its pixels, else a finding is printed (exit 1 with --strict).
+    cluster) and Street (1.6 m above a road) cameras, placed in free space outdoors (rays from the eye: not
+    inside a closed surface, open sky above, a free view of 5 m ahead); a camera that finds no such spot,
+    or whose label pass shows the twin in under 10 % of its pixels, is a finding (exit 1 with --strict).
     Options of one kind (--lod, --scale, ...) are refused for the others. Nothing in --out changes
     unless the whole import is written.
     """
@@ -127,8 +151,9 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     t0 = time.perf_counter()
     model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod, crs=crs,
                               units=units, max_deviation_m=max_deviation_m, plane_threshold_m=plane_threshold_m,
-                              max_residual_m=max_residual_m,
-                              storey_height_m=storey_height_m, show_progress=sys.stderr.isatty())
+                              max_residual_m=max_residual_m, max_hull_residual_m=max_hull_residual_m,
+                              storey_height_m=storey_height_m, default_height_m=default_height_m, strict=strict,
+                              show_progress=sys.stderr.isatty())
     seconds = time.perf_counter() - t0
     from synthua_usd.pipeline.twin_import import write_import  # USD and the writers: only once the input is good
 
@@ -150,6 +175,9 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
                        f"{seg['simplification_deviation_m'] * 1000:.3f} mm, point-to-surface distance p50 "
                        f"{seg['residual_p50_m'] * 1000:.1f} / p95 {seg['residual_p95_m'] * 1000:.1f} / max "
                        f"{seg['residual_max_m'] * 1000:.1f} mm")
+    if "heights" in model.report:
+        sources = ", ".join(f"{n} from {s}" for s, n in model.report["heights"]["sources"].items() if n)
+        click.echo(f"  building heights: {sources}")
     unmatched = model.report.get("unmatched") or model.report.get("unlabelled_types")
     if unmatched:
         click.echo(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")

@@ -16,8 +16,9 @@ Importer = Callable[..., "TwinModel"]
 
 def importers() -> dict[str, Importer]:
     """Kind name → importer function. The modules are imported on first use: each pulls in heavy
-    libraries of its own (laspy, pymeshlab, pyproj, shapely) that other commands need not load."""
-    from synthua_usd.importers import cityjson, footprints, mesh, pointcloud
+    libraries of its own (laspy, pymeshlab, pyproj, shapely, osmium) that other commands need not load."""
+    from synthua_usd.importers import cityjson, footprints, mesh, osm, pointcloud
 
     return {"mesh": mesh.import_mesh, "cityjson": cityjson.import_cityjson,
-            "pointcloud": pointcloud.import_pointcloud, "footprints": footprints.import_footprints}
+            "pointcloud": pointcloud.import_pointcloud, "footprints": footprints.import_footprints,
+            "osm": osm.import_osm}

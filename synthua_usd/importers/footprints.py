@@ -1,7 +1,9 @@
 """Building footprints (GeoJSON polygons with a height or a number of levels) → LoD1 extruded blocks.
 
-Heights: ``height`` (metres above ground) or ``levels`` / ``building:levels`` × ``storey_height_m``;
-optional ``min_height``; all within the ranges of :mod:`synthua_usd.importers.limits`. Coordinates are
+Heights (:mod:`synthua_usd.importers.heights`): ``height`` (metres, or text with a unit), else ``levels`` /
+``building:levels`` × ``storey_height_m`` (plus the roof), else ``roof:height``, else ``default_height_m``;
+optional ``min_height``; within the ranges of :mod:`synthua_usd.importers.limits`. Each building's height
+and its source are in the report (``heights``). Coordinates are
 WGS84 lon/lat (RFC 7946) and are projected to a local transverse Mercator, or, when the file names a
 projected CRS in a legacy ``crs`` member, used as metres. A footprint must be a valid polygon (no
 self-intersections, holes inside their shell) of at least 0.01 m²: invalid footprints are refused with
@@ -11,6 +13,7 @@ and ``Roof`` parts, in the palette's materials.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -18,16 +21,15 @@ import trimesh
 
 from synthua_usd.errors import InputError, echo
 from synthua_usd.importers.crs import local_tmerc, lonlat_to, require_projected_metres
-from synthua_usd.importers.limits import (HEIGHT, LEVELS, MAX_EXTENT_M, MIN_BLOCK_HEIGHT_M, MIN_FOOTPRINT_AREA_M2,
-                                          MIN_HEIGHT, STOREY_HEIGHT)
+from synthua_usd.importers.heights import BuildingHeight, building_height, heights_report
+from synthua_usd.importers.limits import (DEFAULT_HEIGHT, DEFAULT_HEIGHT_M, DEFAULT_STOREY_HEIGHT_M, MAX_EXTENT_M,
+                                          MIN_FOOTPRINT_AREA_M2, STOREY_HEIGHT)
 from synthua_usd.input_files import shown
 from synthua_usd.materials import class_material, subset
 from synthua_usd.ranges import COORDINATE, number_field
 from synthua_usd.schemas import read_json, type_name
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 
-HEIGHT_KEYS = ("height",)
-LEVEL_KEYS = ("levels", "building:levels")
 #: Palette keys of the two parts of every block.
 WALL_MATERIAL = class_material("building").key
 ROOF_MATERIAL = class_material("roof").key
@@ -72,31 +74,7 @@ def _rings(geometry, where: str) -> list[list[np.ndarray]]:
     return out
 
 
-def _height(props: dict, where: str, storey_height_m: float) -> tuple[float, float]:
-    """(base, top) metres above ground of one footprint, checked against the stated ranges."""
-    base = 0.0
-    if props.get("min_height") not in (None, ""):
-        base = number_field(props["min_height"], f"{where}: properties.min_height", MIN_HEIGHT, text=True)
-    for key in HEIGHT_KEYS:
-        if props.get(key) not in (None, ""):
-            top = number_field(props[key], f"{where}: properties.{key}", HEIGHT, text=True)
-            break
-    else:
-        for key in LEVEL_KEYS:
-            if props.get(key) not in (None, ""):
-                levels = number_field(props[key], f"{where}: properties.{key}", LEVELS, text=True)
-                top = HEIGHT.check(levels * storey_height_m, f"{where}: properties.{key} x storey height "
-                                                             f"{storey_height_m:g} m")
-                break
-        else:
-            raise InputError(f"{where}: no height; expected a 'height' (m) or 'levels' property")
-    if not top - base >= MIN_BLOCK_HEIGHT_M:
-        raise InputError(f"{where}: properties.min_height {base:g} m is not below the height {top:g} m; expected "
-                         f"min_height at least {MIN_BLOCK_HEIGHT_M:g} m below the height")
-    return base, top
-
-
-def _footprint(rings: list[np.ndarray], where: str):
+def footprint_polygon(rings: list[np.ndarray], where: str):
     """The shapely polygon of projected rings (metres), refused unless valid and of some area."""
     from shapely.geometry import Polygon
     from shapely.validation import explain_validity
@@ -145,11 +123,51 @@ def _crs_member(doc: dict, where: str) -> str | None:
     return name
 
 
-def import_footprints(path: str | Path, storey_height_m: float = 3.0, **_ignored) -> TwinModel:
-    """Extrude every footprint polygon of a GeoJSON FeatureCollection into a labelled building."""
+@dataclass(frozen=True)
+class Footprint:
+    """One building to extrude: its prim ``name``, ``polygons`` (valid shapely polygons in local metres, see
+    :func:`footprint_polygon`), its ``height``, the ``attributes`` its object keeps and ``where`` it came from
+    (for messages)."""
+
+    name: str
+    polygons: list
+    height: BuildingHeight
+    attributes: dict
+    where: str
+
+
+def extruded_model(footprints: list[Footprint], source: str, where: str, origin_offset_m: tuple, crs: str,
+                   storey_height_m: float, default_height_m: float, report: dict) -> TwinModel:
+    """The blocks of ``footprints`` as a :class:`TwinModel` whose report holds ``report``, the buildings'
+    ``heights`` (:func:`synthua_usd.importers.heights.heights_report`) and their findings."""
+    objects = []
+    for fp in footprints:
+        parts = []
+        for k, polygon in enumerate(fp.polygons):
+            mesh, roof, wall = _extrude(polygon, fp.height.base_m, fp.height.top_m)
+            suffix = f"_{k}" if len(fp.polygons) > 1 else ""
+            parts += [_part(f"Walls{suffix}", mesh, wall, "wall"), _part(f"Roof{suffix}", mesh, roof, "roof")]
+        objects.append(TwinObject(f"Buildings/{fp.name}", "building", tuple(parts),
+                                  {**fp.attributes, "height_m": fp.height.top_m, "min_height_m": fp.height.base_m,
+                                   "height_source": fp.height.source}))
+    objects = unique_paths(objects)
+    heights, findings = heights_report({o.path: fp.height for o, fp in zip(objects, footprints)}, where,
+                                       storey_height_m, default_height_m)
+    findings = report.get("findings", []) + findings
+    return TwinModel(objects=tuple(objects), materials=subset([WALL_MATERIAL, ROOF_MATERIAL]), source=source,
+                     origin_offset_m=origin_offset_m, crs=crs,
+                     report={"buildings": len(objects), **report, "heights": heights, "findings": findings})
+
+
+def import_footprints(path: str | Path, storey_height_m: float = DEFAULT_STOREY_HEIGHT_M,
+                      default_height_m: float = DEFAULT_HEIGHT_M, strict: bool = False, **_ignored) -> TwinModel:
+    """Extrude every footprint polygon of a GeoJSON FeatureCollection into a labelled building; heights as the
+    module says, every building's source in the report. With ``strict``, a footprint without a usable height
+    is refused instead of taking the next source or ``default_height_m`` (metres)."""
     path = Path(path)
     where = shown(path)
     STOREY_HEIGHT.check(storey_height_m, "storey_height_m")
+    DEFAULT_HEIGHT.check(default_height_m, "default_height_m")
     doc = read_json(path, "a GeoJSON FeatureCollection")
     if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection":
         found = (f"\"type\": {echo(doc.get('type'))}" if isinstance(doc, dict) else type_name(doc))
@@ -168,7 +186,8 @@ def import_footprints(path: str | Path, storey_height_m: float = 3.0, **_ignored
             raise InputError(f"{where}: features[{i}].properties: {type_name(props)}; expected an object or null")
         label = props.get("name")
         fw = f"{where}: features[{i}]" + (f" ({echo(label)})" if isinstance(label, str) and label else "")
-        parsed.append((i, props, fw, _rings(feat.get("geometry"), fw), _height(props, fw, storey_height_m)))
+        parsed.append((i, props, fw, _rings(feat.get("geometry"), fw),
+                       building_height(props, fw, storey_height_m, default_height_m, strict=strict)))
     all_xy = np.concatenate([r for *_, polys, _ in parsed for rings in polys for r in rings])
     crs_member = _crs_member(doc, where)
     if crs_member:
@@ -184,24 +203,22 @@ def import_footprints(path: str | Path, storey_height_m: float = 3.0, **_ignored
         origin = np.zeros(2)
         project = lambda xy: lonlat_to(crs_text, xy)
     projected = [[[project(r) for r in rings] for rings in polys] for *_, polys, _ in parsed]
-    flat = np.concatenate([r for polys in projected for rings in polys for r in rings])
+    check_projected(np.concatenate([r for polys in projected for rings in polys for r in rings]), where)
+    footprints = []
+    for (i, props, fw, polys, height), rings_m in zip(parsed, projected):
+        polygons = [footprint_polygon(rings, f"{fw}: polygon {k}" if len(rings_m) > 1 else fw)
+                    for k, rings in enumerate(rings_m)]
+        footprints.append(Footprint(prim_name(props.get("name") or props.get("id") or f"Building_{i:04d}", "Building"),
+                                    polygons, height, {"source_feature": i}, fw))
+    return extruded_model(footprints, str(path), where, (float(origin[0]), float(origin[1]), 0.0), crs_text,
+                          storey_height_m, default_height_m, {})
+
+
+def check_projected(flat: np.ndarray, where: str) -> None:
+    """Refuse projected coordinates (n, 2) metres that are not finite or span more than one import may."""
     if not np.all(np.isfinite(flat)):
         raise InputError(f"{where}: coordinates cannot be projected to metres (non-finite results); expected lon/lat "
                          f"degrees or a projected CRS")
     extent = float((flat.max(axis=0) - flat.min(axis=0)).max())
     if extent > MAX_EXTENT_M:
         raise InputError(f"{where}: footprints span {extent:.3g} m; expected at most {MAX_EXTENT_M:g} m (split the file)")
-    objects = []
-    for (i, props, fw, polys, (base, top)), rings_m in zip(parsed, projected):
-        name = prim_name(props.get("name") or props.get("id") or f"Building_{i:04d}", "Building")
-        parts = []
-        for k, rings in enumerate(rings_m):
-            pw = f"{fw}: polygon {k}" if len(rings_m) > 1 else fw
-            mesh, roof, wall = _extrude(_footprint(rings, pw), base, top)
-            suffix = f"_{k}" if len(polys) > 1 else ""
-            parts += [_part(f"Walls{suffix}", mesh, wall, "wall"), _part(f"Roof{suffix}", mesh, roof, "roof")]
-        objects.append(TwinObject(f"Buildings/{name}", "building", tuple(parts),
-                                  {"source_feature": i, "height_m": top, "min_height_m": base}))
-    return TwinModel(objects=tuple(unique_paths(objects)), materials=subset([WALL_MATERIAL, ROOF_MATERIAL]),
-                     source=str(path), origin_offset_m=(float(origin[0]), float(origin[1]), 0.0), crs=crs_text,
-                     report={"buildings": len(objects)})

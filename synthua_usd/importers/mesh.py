@@ -20,7 +20,7 @@ from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.errors import InputError, echo
 from synthua_usd.importers.limits import MAX_MESH_BYTES, MAX_TRIANGLES, SCALE
 from synthua_usd.input_files import check_input_file, shown
-from synthua_usd.importers.mesh_materials import geometry_material
+from synthua_usd.importers.mesh_materials import ImageFailures, geometry_material, obj_texture_problems
 from synthua_usd.scene import Material
 from synthua_usd.ranges import COORDINATE
 from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
@@ -51,12 +51,13 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
         raise InputError(f"up_axis: {echo(repr(up_axis))}; expected Y or Z")
     check_input_file(path, MAX_MESH_BYTES, f"a {kind.upper()} mesh")
     try:
-        with warnings.catch_warnings():  # numpy's overflow warnings on absurd coordinates: refused below
+        with warnings.catch_warnings(), ImageFailures() as failures:  # numpy's overflow warnings: refused below
             warnings.simplefilter("ignore", RuntimeWarning)
             scene = trimesh.load(str(path), force="scene", split_objects=True, split_groups=False)
     except Exception as exc:  # trimesh raises many types for malformed files (MemoryError included)
         raise InputError(f"{where}: cannot read as {kind.upper()}: {echo(exc) or type(exc).__name__}; expected a "
                          f"valid {kind.upper()} file") from None
+    _warn_unread_textures(path, kind, failures.reasons)
     # Object name -> class -> parts, in file order.
     grouped: dict[str, dict[str, list[TwinPart]]] = defaultdict(lambda: defaultdict(list))
     materials: dict[str, Material] = {}
@@ -117,6 +118,20 @@ def import_mesh(path: str | Path, rules: AssignmentRules, up_axis: str | None = 
                       report={"meshes": len(meshes), "unmatched": unmatched, "matched_by": dict(matched_by),
                               "rules": rules.source, "textures": sorted(images)}, images=images)
     return model
+
+
+def _warn_unread_textures(path: Path, kind: str, reasons: list[str]) -> None:
+    """One warning per texture image the file names that could not be read (its material renders its colour):
+    an OBJ's by material and file (:func:`obj_texture_problems`), other formats' with trimesh's reason."""
+    where = shown(path)
+    if kind == "obj":
+        for material, name, reason in obj_texture_problems(path):
+            log.warning("%s: material '%s': texture '%s' cannot be read: %s; the material renders its colour "
+                        "without it", where, echo(material), echo(name), echo(reason))
+        return
+    for reason in reasons:
+        log.warning("%s: a texture image of the file cannot be read (%s); its material renders its colour without "
+                    "it", where, echo(reason))
 
 
 def _object_name(node: str, geom_name: str, material: str, kind: str, path: Path) -> str:

@@ -10,6 +10,9 @@ texture coordinates per vertex with v up (OBJ's convention; it flips glTF's on l
 
 from __future__ import annotations
 
+import logging
+from pathlib import Path
+
 import numpy as np
 import trimesh
 
@@ -107,3 +110,56 @@ def geometry_material(geom: trimesh.Trimesh, fallback: str
     if not np.all(np.isfinite(uvs)):
         return name, material, images, None
     return name, material, images, uvs.astype(np.float32)
+
+
+class ImageFailures(logging.Handler):
+    """Collects trimesh's own notes of texture images it could not load (it logs them at debug level and goes
+    on without the texture): ``reasons`` holds each one's exception, as text. Use as a context manager around
+    ``trimesh.load``."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.DEBUG)
+        self.reasons: list[str] = []
+        self._logger = logging.getLogger("trimesh")
+        self._level = self._logger.level
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if record.getMessage().startswith("failed to load image") and record.exc_info and record.exc_info[1]:
+            exc = record.exc_info[1]
+            self.reasons.append(f"{type(exc).__name__}: {exc}")
+
+    def __enter__(self) -> "ImageFailures":
+        self._logger.addHandler(self)
+        if self._logger.getEffectiveLevel() > logging.DEBUG:
+            self._logger.setLevel(logging.DEBUG)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._logger.removeHandler(self)
+        self._logger.setLevel(self._level)
+
+
+def obj_texture_problems(path: Path) -> list[tuple[str, str, str]]:
+    """(material, texture file as the MTL writes it, why it cannot be read) for every ``map_Kd`` of the MTL files
+    an OBJ names (``mtllib``, beside the OBJ) whose image is missing or not one OpenImageIO opens."""
+    from synthua_usd.texture_files import unreadable
+
+    problems = []
+    with open(path, "rb") as fh:
+        libraries = [line.split(None, 1)[1].strip().decode("utf-8", "replace") for line in fh
+                     if line.startswith(b"mtllib") and len(line.split(None, 1)) == 2]
+    for library in libraries:
+        mtl = path.parent / library
+        if not mtl.is_file():
+            continue
+        material = ""
+        for line in mtl.read_text("utf-8", "replace").splitlines():
+            key, _, rest = line.strip().partition(" ")
+            if key.lower() == "newmtl":
+                material = rest.strip()
+            elif key.lower() == "map_kd" and rest.strip():
+                name = rest.strip().split()[-1]  # options (-s 1 1 1) come before the file name
+                reason = unreadable(str(path.parent / name))
+                if reason is not None:
+                    problems.append((material, name, reason))
+    return problems

@@ -3,7 +3,8 @@
 
 Each automatic camera's label pass is rendered (exact pixel-centre labels, :data:`CHECK_SIZE`) on the written
 scenario; a camera whose pixels show less than :data:`MIN_LABELLED_SHARE` of the twin's labelled geometry (the
-generated ground is unlabelled and does not count) is a finding in the report.
+generated ground is unlabelled and does not count) is a finding in the report; so is a camera that could not be
+placed in free space outdoors (:mod:`synthua_usd.free_space`), with the reason.
 """
 
 from __future__ import annotations
@@ -106,6 +107,13 @@ def write_import(model: TwinModel, out_dir: str | Path, class_map: ClassMap, rep
         written = write_scenario(spec, staging, class_map)
         shares = labelled_shares(staging / ROOT_FILE, class_map, [c.name for c in spec.cameras])
         findings = list(report.get("findings", []))
+        for name in shares:
+            placement = framing.report[name.lower()]["placement"]
+            if not placement["free_space"]:
+                findings.append(Finding(
+                    "camera-placement", f"{CAMERAS_ROOT}/{name}",
+                    f"no spot in free space outdoors was found for it: {placement['reason']} (move it with "
+                    f"'synthua cameras' or author your own)", Severity.WARNING).to_dict())
         for name, share in shares.items():
             if share < MIN_LABELLED_SHARE:
                 findings.append(Finding(

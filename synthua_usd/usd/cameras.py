@@ -115,8 +115,28 @@ def camera_rig_type(stage: Usd.Stage, path: str) -> str | None:
 AUTO_CAMERA_PATH = "/SynthuaAutoCamera"
 
 
+def rendered_bound(stage: Usd.Stage, time_code: float) -> Gf.Range3d:
+    """The world bounds (stage units) of what the reader renders at ``time_code``: every renderable gprim's
+    extent computed from its own points or size (an authored ``extent`` may be stale), placed by its
+    transform. Not ``BBoxCache`` of the root: for a ``SkelRoot`` it bounds the skeleton's animated pose, while
+    skinned meshes render in their bind pose (the reader does not apply UsdSkel skinning), so a walking figure
+    was framed where it is not drawn."""
+    from synthua_usd.usd.semantics import renderable_gprims
+
+    t = Usd.TimeCode(time_code)
+    xcache = UsdGeom.XformCache(t)
+    total = Gf.Range3d()
+    for prim in renderable_gprims(stage, time_code):
+        extent = UsdGeom.Boundable.ComputeExtentFromPlugins(UsdGeom.Boundable(prim), t)
+        if extent is None or len(extent) != 2:
+            continue
+        box = Gf.BBox3d(Gf.Range3d(Gf.Vec3d(*extent[0]), Gf.Vec3d(*extent[1])), xcache.GetLocalToWorldTransform(prim))
+        total.UnionWith(box.ComputeAlignedRange())
+    return total
+
+
 def author_auto_camera(stage: Usd.Stage, time_code: float) -> str:
-    """Author a camera framing the stage's whole world bounds (the overview rule of
+    """Author a camera framing what the stage renders at ``time_code`` (:func:`rendered_bound`; the overview rule of
     :func:`synthua_usd.framing.overview_view`: every corner inside a full-frame 24 mm view, from the tightest
     of 16 directions) into the stage's session layer at :data:`AUTO_CAMERA_PATH`; returns the path. Y-up and
     any ``metersPerUnit`` are honoured. Raises :class:`StageError` when the stage has no bounded geometry."""
@@ -124,8 +144,7 @@ def author_auto_camera(stage: Usd.Stage, time_code: float) -> str:
     from synthua_usd.geometry import look_at
 
     t = Usd.TimeCode(time_code)
-    bound = UsdGeom.BBoxCache(t, [UsdGeom.Tokens.default_, UsdGeom.Tokens.render]).ComputeWorldBound(
-        stage.GetPseudoRoot()).ComputeAlignedRange()
+    bound = rendered_bound(stage, time_code)
     if bound.IsEmpty():
         raise StageError(f"{stage.GetRootLayer().identifier}: --camera auto: the stage has no geometry with bounds; "
                          f"expected gprims to frame")

@@ -9,7 +9,12 @@ graphs and interface inputs (``UsdShade.Utils.GetValueProducingAttributes``) to 
   ``wrapS``/``wrapT``, ``scale``, ``bias``, the output used) on the input;
 * for diffuseColor, a ``UsdPrimvarReader_float3``: the gprim's primvar (:class:`Materials`);
 * anything else (``UsdTransform2d``, other shaders, node graphs without a value): the input's constant,
-  after a one-line warning naming the prim. So is a texture whose file is missing.
+  after a one-line warning naming the prim. So is a texture whose file is missing or cannot be read (the
+  warning names the file and OpenImageIO's reason; only its header is read here).
+
+A texture inside a ``.usdz`` package resolves (OpenUSD's Ar) to a package-relative path,
+``/a/car.usdz[textures/body.png]``, which :class:`Texture` keeps as its ``path``; the image is read from the
+package (:mod:`synthua_usd.texture_files`).
 
 Supported textured inputs: diffuseColor, roughness, metallic, normal, opacity.
 """
@@ -27,6 +32,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 
 from synthua_usd.errors import echo
 from synthua_usd.scene import Material, Texture
+from synthua_usd.texture_files import is_packaged, unreadable
 
 log = logging.getLogger(__name__)
 
@@ -203,9 +209,14 @@ def _texture(shader: UsdShade.Shader, output: str, where: str) -> tuple[Texture,
                     echo(authored))
         return None
     resolved = asset.resolvedPath if isinstance(asset, Sdf.AssetPath) else ""
-    if not authored or not resolved or not Path(resolved).is_file():
+    if not authored or not resolved:
         log.warning("%s: texture file '%s' of %s was not found; using the input's constant", where, echo(authored),
                     path)
+        return None
+    reason = unreadable(resolved)
+    if reason is not None:
+        log.warning("%s: texture file '%s' of %s (%s) cannot be read: %s; using the input's constant", where,
+                    echo(authored), path, echo(resolved), echo(reason))
         return None
     primvar = _st_primvar(shader, where)
     if primvar is None:
@@ -233,7 +244,8 @@ def _texture(shader: UsdShade.Shader, output: str, where: str) -> tuple[Texture,
                         "constant", where, path, name, echo(numbers))
             return None
         factors[name] = numbers
-    return Texture(str(Path(resolved).resolve()), channel=channel, color_space=COLOR_SPACE.get(space, "auto"),
+    return Texture(resolved if is_packaged(resolved) else str(Path(resolved).resolve()), channel=channel,
+                   color_space=COLOR_SPACE.get(space, "auto"),
                    wrap_s=wrap[0], wrap_t=wrap[1], **factors), primvar
 
 

@@ -111,7 +111,8 @@ def test_huge_height(space):
     d = doc(GEOJSON)
     d["features"][0]["properties"]["height"] = 1e308
     path = write(space / "b.geojson", d)
-    _refused(space, "twin", "import", "footprints", path, "--out", space / "out", mentions=("b.geojson", "height"))
+    _refused(space, "twin", "import", "footprints", path, "--out", space / "out", "--strict",
+             mentions=("b.geojson", "height"))
 
 
 def test_non_utf8_class_map(space):

@@ -23,12 +23,27 @@ def test_extrudes_heights_and_levels():
 
 @pytest.mark.parametrize("name,text", [
     ("footprint_point", "features[1] (Casa): geometry type 'Point' is not a footprint; expected Polygon or MultiPolygon"),
-    ("footprint_no_height", "features[1] (Casa): no height; expected a 'height' (m) or 'levels' property"),
+    ("footprint_no_height", "features[1] (Casa): no height; expected a 'height' (m), 'building:levels' or "
+                            "'roof:height' property (without --strict, --default-height-m is used)"),
     ("footprint_nan", "NaN is not JSON; expected finite numbers (NaN and Infinity are not allowed)"),
     ("footprint_empty", "the FeatureCollection has no features"),
 ])
 def test_broken_footprints(name, text):
     path = DATA / "invalid" / f"{name}.geojson"
     with pytest.raises(InputError) as err:
-        import_footprints(path)
+        import_footprints(path, strict=True)
     assert str(err.value) == f"{path}: {text}"
+
+
+def test_a_footprint_without_a_height_takes_the_default_and_says_so():
+    """One building without a height does not refuse the import: it takes --default-height-m, and the report
+    gives every building's source and one finding naming the defaulted ones."""
+    model = import_footprints(DATA / "invalid" / "footprint_no_height.geojson", default_height_m=7.5)
+    church, house = model.objects
+    assert house.parts[1].points[:, 2] == pytest.approx(7.5) and church.parts[1].points[:, 2] == pytest.approx(14.0)
+    heights = model.report["heights"]
+    assert heights["sources"] == {"height": 1, "building:levels": 0, "roof:height": 0, "default": 1}
+    assert heights["buildings"]["Buildings/Casa"] == {"height_m": 7.5, "min_height_m": 0.0, "height_source": "default"}
+    assert (church.attributes["height_source"], house.attributes["height_source"]) == ("height", "default")
+    (finding,) = model.report["findings"]
+    assert finding["rule"] == "building-height" and "1 of 2 buildings (e.g. Buildings/Casa)" in finding["message"]

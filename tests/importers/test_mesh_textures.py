@@ -119,3 +119,32 @@ def test_a_mesh_without_textures_writes_no_texture_folder(tmp_path, rules, class
     assert model.images == {} and model.report["textures"] == []
     write_import(model, tmp_path / "twin", class_map, model.report)
     assert not (tmp_path / "twin" / "textures").exists()
+
+
+@pytest.mark.parametrize("content, reason", [(None, "not found"), (b"not an image", "Not a PNG file")])
+def test_a_texture_the_mtl_names_but_cannot_be_read_is_named_with_the_reason(tmp_path, rules, caplog, content,
+                                                                            reason):
+    """trimesh drops such an image silently (a debug note): the import names the material, the file and why."""
+    (tmp_path / "wall.obj").write_text(OBJ)
+    (tmp_path / "wall.mtl").write_text(MTL)
+    if content is not None:
+        (tmp_path / "brick.png").write_bytes(content)
+    with caplog.at_level("WARNING"):
+        model = import_mesh(tmp_path / "wall.obj", rules)
+    assert not model.materials["brick"].textures
+    assert f"wall.obj: material 'brick': texture 'brick.png' cannot be read: {reason}; the material renders" in caplog.text
+
+
+def test_trimesh_notes_of_images_it_could_not_load_are_collected():
+    import logging
+
+    from synthua_usd.importers.mesh_materials import ImageFailures
+
+    with ImageFailures() as failures:
+        try:
+            raise OSError("cannot identify image file")
+        except OSError:
+            logging.getLogger("trimesh.exchange.gltf").debug("failed to load image!", exc_info=True)
+    assert failures.reasons == ["OSError: cannot identify image file"]
+    assert not logging.getLogger("trimesh").handlers or all(not isinstance(h, ImageFailures)
+                                                           for h in logging.getLogger("trimesh").handlers)

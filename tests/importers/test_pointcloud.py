@@ -187,3 +187,29 @@ def test_residual_distribution_is_reported_and_a_segment_over_its_bound_is_a_fin
     findings = model.report["findings"]
     assert [f["rule"] for f in findings] == ["residual-bound"] and seg["name"] in findings[0]["where"]
     assert not import_pointcloud(path, max_residual_m=1.0).report["findings"]
+
+
+def _ground_and_crown(rng, hollow: bool) -> np.ndarray:
+    """A 20 x 20 m flat ground and a tree crown of radius 2.5 m, 5 m up: points on its sphere (hollow) or
+    filling its ball (inner branches)."""
+    ground = np.column_stack([rng.uniform(0, 20, 1600), rng.uniform(0, 20, 1600), rng.normal(0, 0.005, 1600)])
+    crown = rng.normal(size=(900, 3))
+    crown /= np.linalg.norm(crown, axis=1, keepdims=True)
+    crown *= 2.5 if hollow else 2.5 * rng.random((900, 1)) ** (1 / 3)
+    return np.concatenate([ground, crown + [10, 10, 5]]) + [500, 500, 10]
+
+
+def test_a_tree_hull_is_reported_against_its_own_bound(tmp_path):
+    """A filled crown's points lie up to its radius inside its hull (p95 about 0.63 x 2.5 m = 1.6 m): over the
+    hull bound, a finding; a hollow crown's hull explains its points, and the looser bound admits the filled one."""
+    rng = np.random.default_rng(4)
+    filled = import_pointcloud(write_las(tmp_path / "filled.las", _ground_and_crown(rng, hollow=False)))
+    (tree,) = [s for s in filled.report["segments"] if s.get("kind") == "tree"]
+    assert tree["surface"] == "convex hull" and tree["residual_bound_m"] == 1.0
+    assert tree["residual_p95_m"] == pytest.approx(1.58, abs=0.15)
+    assert [f["where"].rsplit(" ", 1)[-1] for f in filled.report["findings"]] == [tree["name"]]
+    assert "--max-hull-residual-m" in filled.report["findings"][0]["message"]
+    hollow = import_pointcloud(write_las(tmp_path / "hollow.las", _ground_and_crown(rng, hollow=True)))
+    assert [s["kind"] for s in hollow.report["segments"]].count("tree") == 1 and not hollow.report["findings"]
+    looser = import_pointcloud(tmp_path / "filled.las", max_hull_residual_m=2.5)
+    assert not looser.report["findings"]

@@ -11,6 +11,7 @@ import pytest
 from pxr import Gf, Sdf, UsdGeom, UsdShade
 
 from conftest import DATA
+from texture_checks import TEXELS, write_png
 from synthua_usd.usd.reader import read_snapshot
 from synthua_usd.usd.stage_checks import validate_stage
 from synthua_usd.usd.stage_io import open_stage
@@ -22,7 +23,7 @@ LOOKS = "/World/Looks/Quadrants"
 def quads(tmp_path):
     shutil.copy(DATA / "valid" / "textured_quads.usda", tmp_path / "quads.usda")
     (tmp_path / "textures").mkdir()
-    (tmp_path / "textures" / "quadrants.png").write_bytes(b"")  # existence is all the reader checks
+    write_png(tmp_path / "textures" / "quadrants.png", TEXELS)  # the reader opens its header
     return open_stage(tmp_path / "quads.usda")
 
 
@@ -121,7 +122,7 @@ def test_written_materials_read_back_with_their_textures(tmp_path, class_map):
                 np.array([[0, 0], [1, 0], [1, 1]], np.float32))
     (tmp_path / "textures").mkdir()
     for name in ("a.png", "n.png"):
-        (tmp_path / "textures" / name).write_bytes(b"")
+        write_png(tmp_path / "textures" / name, TEXELS)
     stage.GetRootLayer().Export(str(tmp_path / "m.usda"))
     read = read_snapshot(open_stage(tmp_path / "m.usda"), 1.0, class_map)
     got = read.materials["/World/Looks/M"]
@@ -138,7 +139,7 @@ def test_a_texture_outside_the_scenario_folder_is_refused_unless_allowed(tmp_pat
     from synthua_usd.errors import StageError
 
     (tmp_path / "elsewhere").mkdir()
-    (tmp_path / "elsewhere" / "quadrants.png").write_bytes(b"")
+    write_png(tmp_path / "elsewhere" / "quadrants.png", TEXELS)
     (tmp_path / "scenario").mkdir()
     text = (DATA / "valid" / "textured_quads.usda").read_text().replace("@./textures/quadrants.png@",
                                                                          "@../elsewhere/quadrants.png@")

@@ -1,6 +1,7 @@
 """Time-sampled skinned characters cannot be posed by the reader: it says so instead of showing the bind pose
 silently."""
 
+import numpy as np
 from pxr import Gf, Usd, UsdGeom, UsdSkel, Vt
 
 from synthua_usd.usd.reader import StageReader, animated_skins
@@ -50,3 +51,16 @@ def test_animated_skin_is_reported(tmp_path, class_map, caplog):
 def test_a_still_skin_is_not_reported(tmp_path):
     stage, _ = _skinned_stage(tmp_path / "still.usda", animated=False)
     assert animated_skins(stage) == []
+
+
+def test_camera_auto_frames_the_bind_pose_that_renders(tmp_path, class_map):
+    """At time code 2 the animation moves the skeleton 1 m along x; the mesh renders in its bind pose. The auto
+    camera frames the mesh as rendered (before: the skeleton's animated bound, a point at (1, 0, 0))."""
+    from synthua_usd.usd.cameras import author_auto_camera, read_camera
+
+    stage, _ = _skinned_stage(tmp_path / "walk.usda", animated=True)
+    camera = read_camera(stage, author_auto_camera(stage, 2), 2)
+    points = StageReader(stage, class_map).snapshot(2).meshes[0].points
+    pixels, depth = camera.project(points, 64, 48)
+    assert (depth > 0).all() and (pixels >= 0).all() and (pixels[:, 0] < 64).all() and (pixels[:, 1] < 48).all()
+    assert np.ptp(pixels[:, 0]) > 20  # the triangle fills the view, not a corner of it

@@ -2,7 +2,7 @@
 ``normalmap`` and a ``mask`` when the material has a normal map or an opacity below one.
 
 Texture files are decoded here, once per file and colour space per translation (:class:`TextureImages`), with
-OpenImageIO: 8-bit sRGB images (and ``sRGB`` textures) through the exact sRGB transfer function, alpha never;
+OpenImageIO (files inside USDZ packages too: :mod:`synthua_usd.texture_files`): 8-bit sRGB images (and ``sRGB`` textures) through the exact sRGB transfer function, alpha never;
 raw images as stored. Then UsdUVTexture's ``scale`` and ``bias`` and the chosen channel, and the result goes
 to Mitsuba as a float bitmap with ``raw=True``: Mitsuba never converts it again, and a single channel stays
 single (Mitsuba would take an RGB bitmap's luminance for a roughness, not its green). Mitsuba's bitmap puts
@@ -20,14 +20,13 @@ import numpy as np
 from synthua_usd import srgb
 from synthua_usd.errors import InputError, echo
 from synthua_usd.scene import Material, Texture
+from synthua_usd.texture_files import MAX_TEXELS, TextureFileError, open_image
 
 log = logging.getLogger(__name__)
 
 #: Our wrap modes → Mitsuba's. Mitsuba's bitmap has no black border: 'black' clamps (with a warning).
 WRAP = {"repeat": "repeat", "mirror": "mirror", "clamp": "clamp", "black": "clamp"}
 CHANNEL = {"r": 0, "g": 1, "b": 2, "a": 3}
-#: The largest texture read: decoded to float RGBA it takes 1 GiB.
-MAX_TEXELS = 8192 * 8192
 
 
 def srgb_to_linear(values: np.ndarray) -> np.ndarray:
@@ -60,18 +59,16 @@ class TextureImages:
         key = (path, color_space)
         if key in self._rgba:
             return self._rgba[key]
-        image = oiio.ImageInput.open(path)
-        if image is None:
-            raise InputError(f"{path}: cannot read the texture image: {echo(oiio.geterror())}; expected a PNG, JPEG, "
-                             f"EXR or another image OpenImageIO reads")
         try:
-            spec = image.spec()
-            if spec.width * spec.height > MAX_TEXELS or spec.nchannels < 1:
-                raise InputError(f"{path}: texture image of {spec.width}x{spec.height} pixels, {spec.nchannels} "
-                                 f"channels; expected at most {MAX_TEXELS} pixels (8192 x 8192) and a channel")
-            pixels = image.read_image(0, 0, 0, min(spec.nchannels, 4), "float")
-        finally:
-            image.close()
+            with open_image(path) as image:
+                spec = image.spec()
+                if spec.width * spec.height > MAX_TEXELS or spec.nchannels < 1:
+                    raise InputError(f"{path}: texture image of {spec.width}x{spec.height} pixels, {spec.nchannels} "
+                                     f"channels; expected at most {MAX_TEXELS} pixels (8192 x 8192) and a channel")
+                pixels = image.read_image(0, 0, 0, min(spec.nchannels, 4), "float")
+        except TextureFileError as exc:
+            raise InputError(f"{path}: cannot read the texture image: {echo(exc)}; expected a PNG, JPEG, EXR or "
+                             f"another image OpenImageIO reads") from None
         if pixels is None:
             raise InputError(f"{path}: cannot decode the texture image; expected a readable image file")
         channels = min(spec.nchannels, 4)

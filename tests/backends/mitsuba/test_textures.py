@@ -103,13 +103,12 @@ def test_an_oversized_texture_is_refused_before_it_is_decoded(quads, class_map, 
         mitsuba_albedo(variants.activate("scalar_rgb"), snap, read_camera(open_stage(quads), "/World/Cam", 1.0), W, H)
 
 
-def test_a_texture_that_is_no_image_is_an_input_error(quads, class_map, run_cli):
+def test_a_texture_that_is_no_image_renders_the_constant_after_a_warning(quads, class_map, run_cli):
     (quads.parent / "textures" / "quadrants.png").write_text("not an image")
     code, _, err = run_cli("render", quads, "--camera", "/World/Cam", "--width", 16, "--height", 12, "--spp", 1,
                            "--variant", "scalar_rgb", "--out", quads.parent / "out")
-    assert code == 2
-    assert "quadrants.png: cannot read the texture image" in err and "expected a PNG, JPEG, EXR" in err
-    assert not (quads.parent / "out").exists()
+    assert code == 0
+    assert "quadrants.png" in err and "cannot be read" in err and (quads.parent / "out").is_dir()
 
 
 def test_wet_weathering_darkens_every_texel(quads, class_map):
@@ -257,3 +256,39 @@ def test_teapot_labels_are_the_same_with_its_textures_split_seams(class_map):
     assert textured.instance_ids.tobytes() == flat.instance_ids.tobytes()
     assert textured.hits.mesh_index.tobytes() == flat.hits.mesh_index.tobytes()
     assert textured.hits.distance_m.tobytes() == flat.hits.distance_m.tobytes()
+
+
+def _packaged(quads):
+    """``quads`` packed into quads.usdz (OpenUSD's own packager), its loose texture removed."""
+    from pxr import UsdUtils
+
+    package = quads.parent / "quads.usdz"
+    assert UsdUtils.CreateNewUsdzPackage(Sdf.AssetPath(str(quads)), str(package))
+    shutil.rmtree(quads.parent / "textures")
+    return package
+
+
+def test_a_texture_inside_a_usdz_package_renders(quads, class_map, variant, caplog):
+    """Ar resolves the packed texture to quads.usdz[...]: read from the package, not reported missing."""
+    package = _packaged(quads)
+    stage = open_stage(package)
+    with caplog.at_level(logging.WARNING):
+        snap = read_snapshot(stage, 1.0, class_map)
+    assert "texture" not in caplog.text
+    texture = snap.materials["/World/Looks/Quadrants"].base_color_texture
+    assert texture is not None and texture.path.startswith(f"{package}[") and texture.path.endswith("quadrants.png]")
+    cam = read_camera(stage, "/World/Cam", 1.0)
+    expected, hit_ref = reference_albedo(snap, cam, srgb_decoded(TEXELS), W, H)
+    got, hit = mitsuba_albedo(variants.activate(variant), snap, cam, W, H)
+    assert np.array_equal(hit, hit_ref) and np.abs(got[hit] - expected[hit]).max() < 2e-3
+
+
+def test_a_texture_that_cannot_be_read_is_named_with_the_reason(quads, class_map, caplog):
+    (quads.parent / "textures" / "quadrants.png").write_text("not an image")
+    with caplog.at_level(logging.WARNING):
+        snap = read_snapshot(open_stage(quads), 1.0, class_map)
+    assert snap.materials["/World/Looks/Quadrants"].base_color_texture is None
+    (line,) = [r.getMessage() for r in caplog.records if "cannot be read" in r.getMessage()]
+    assert "texture file './textures/quadrants.png' of /World/Looks/Quadrants/Image" in line
+    assert str(quads.parent / "textures" / "quadrants.png") in line and "using the input's constant" in line
+    assert "format" in line.lower() or "not" in line.lower()  # OpenImageIO's own reason follows the file
