@@ -33,6 +33,10 @@ LAYER_FILE = dict(LAYERS)
 ROOT_FILE = "scenario.usda"
 CAMERAS_ROOT = "/World/Cameras"
 ENVIRONMENT_PATH = "/World/Environment"
+#: Where a randomised image's scene lives (synthua_usd.usd.randomisation_layer): its crowd, its materials, the
+#: crowd's prototypes.
+RANDOM_ROOT = "/World/Randomisation"
+CROWD_ROOT = f"{RANDOM_ROOT}/Crowd"
 
 
 @dataclass(frozen=True)

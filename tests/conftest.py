@@ -123,6 +123,18 @@ def generate_dataset(out: Path, config: Path = TINY_CONFIG, scenario: Path = SCE
     return generate(GenerateRequest(scenario=scenario, config_path=config, out_dir=out, **options))
 
 
+#: A randomised generation config: the demo street, 6 images of 96x72 over 3 seeds (scenes) and 2 conditions.
+RANDOM_CONFIG = DATA / "configs" / "random.json"
+
+
+@pytest.fixture(scope="session")
+def generated_random(tmp_path_factory) -> Path:
+    """A randomised dataset of the demo street made with tests/data/configs/random.json (do not modify it)."""
+    out = tmp_path_factory.mktemp("random") / "dataset"
+    generate_dataset(out, config=RANDOM_CONFIG)
+    return out
+
+
 @pytest.fixture(scope="session")
 def generated(tmp_path_factory) -> Path:
     """A dataset of the demo street made with tests/data/configs/tiny.json (do not modify it: copy it)."""

@@ -37,6 +37,13 @@ class ImageSummary:
     class_pixels: dict[str, int]
     segments: tuple[tuple[int, int], ...]
     aid_users: tuple[AidUser, ...] = field(default=())
+    camera_path: str = ""
+    time_code: float = 0.0
+    seed: int = 0
+    #: Prim paths of the instances the image shows.
+    visible: tuple[str, ...] = field(default=())
+    #: What scene randomisation drew for the image (its record's ``randomisation``), or None.
+    randomisation: dict | None = field(default=None, repr=False)
 
     @property
     def rgb(self) -> str:
@@ -89,7 +96,10 @@ def _summary(record: dict, verdict: str, where: str) -> ImageSummary:
             rig_type=str(camera.get("rig_type") or "none"), width=int(record["width"]), height=int(record["height"]),
             verdict=verdict, class_pixels={str(k): int(v) for k, v in record["class_pixel_counts"].items()},
             segments=tuple((int(s["category_id"]), int(s["area"])) for s in record["panoptic_segments"]),
-            aid_users=tuple(aid_users(record.get("instances", ()))))
+            aid_users=tuple(aid_users(record.get("instances", ()))), camera_path=str(camera.get("prim_path", "")),
+            time_code=float(record.get("time_code", 0.0)), seed=int(record.get("seed", 0)),
+            visible=tuple(str(i["prim_path"]) for i in record.get("instances", ()) if i.get("area", 0) > 0),
+            randomisation=record.get("randomisation") if isinstance(record.get("randomisation"), dict) else None)
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"{where}: {type(exc).__name__} {exc}; expected an image record written by "
                          f"`synthua generate`") from None

@@ -157,3 +157,37 @@ def confusion_heatmap(names, matrix: np.ndarray, path: Path) -> Path:
     fig.colorbar(im, ax=ax, label="share of the ground-truth class's pixels")
     ax.set_title("Confusion matrix")
     return _save(fig, path)
+
+
+def diversity(figures: dict, path: Path) -> Path:
+    """Six bar charts of a randomised dataset's diversity (:mod:`synthua_usd.analytics.diversity`): the people
+    shown by age, build and Monk skin tone, their upper garments' colours, the sun's elevation and the cameras'
+    heights above the ground."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 3, figsize=(14, 7))
+    people, sun = figures["people"], figures["sun"]
+
+    def ranges(hist, unit=""):
+        e = hist["edges"]
+        return [f"{e[i]:g}–{e[i + 1]:g}{unit}" if e[i + 1] < 1e8 else f"≥ {e[i]:g}{unit}" for i in range(len(e) - 1)]
+
+    panels = [
+        (ranges(people["age_years"]), people["age_years"]["counts"], "age (years)", "people shown"),
+        (["< 18.5", "18.5–25", "25–30", "≥ 30"], people["body_mass_index"]["counts"], "body-mass index", "people shown"),
+        (list(people["monk_skin_tone"]), list(people["monk_skin_tone"].values()), "Monk skin tone", "people shown"),
+        (list(people["upper_garment_colour"]), list(people["upper_garment_colour"].values()), "upper garment",
+         "people shown"),
+        (ranges(sun["elevation_deg"]), sun["elevation_deg"]["counts"], "sun elevation (degrees)", "images"),
+        (ranges(figures["camera_height_m"], " m"), figures["camera_height_m"]["counts"], "camera height above ground",
+         "images"),
+    ]
+    for ax, (ticks, counts, label, unit) in zip(axes.ravel(), panels):
+        keep = [k for k, c in enumerate(counts) if c] or list(range(len(counts)))
+        ax.bar(np.arange(len(keep)), [counts[k] for k in keep], color="#4477aa")
+        ax.set_xticks(np.arange(len(keep)), [ticks[k] for k in keep], rotation=45, ha="right", fontsize=8)
+        ax.set_xlabel(label)
+        ax.set_ylabel(unit)
+    fig.suptitle(f"Scene diversity: {figures['distinct_scenes']} scenes, {figures['distinct_view_layers']} view layers, "
+                 f"{people['count']} people shown")
+    fig.tight_layout()
+    return _save(fig, path)

@@ -128,6 +128,8 @@ def write_report(index: DatasetIndex, stats: DatasetStatistics, out_dir: str | P
                        [c.color for c in aids], p / "aid_area.png")
         plots.aid_users(s["aid_users"]["occlusion"]["histogram"], s["aid_users"]["visible_pixels"]["histogram"],
                         p / "aid_users.png")
+        if s["diversity"]["randomised_images"]:
+            plots.diversity(s["diversity"], p / "diversity.png")
         (stage / "gallery").mkdir()
         from synthua_usd.backends.images import write_color_png
 
@@ -183,6 +185,18 @@ def _html(index: DatasetIndex, stats: DatasetStatistics, chosen: list[ImageSumma
         ("images per condition", ", ".join(f"{k} {v}" for k, v in s["images_per_condition"].items())),
         ("images per rig type", ", ".join(f"{k} {v}" for k, v in s["images_per_rig_type"].items())),
     ]
+    d = s["diversity"]
+    disagree = d["class_map_disagreement"]
+    summary_rows.append(("randomised images / distinct scenes / districts / view layers",
+                         f"{d['randomised_images']} / {d['distinct_scenes']} / {d['distinct_districts']} / "
+                         f"{d['distinct_view_layers']}"))
+    summary_rows.append(("class-map disagreement of images sharing camera and time code (pairs: mean)",
+                         f"{disagree['pairs']}: {_fmt(disagree['mean'], 3)}" if disagree["pairs"] else "no such pairs"))
+    if d["randomised_images"]:
+        people, devices = d["people"], d["devices"]
+        summary_rows.append(("people shown / devices shown (finishes)",
+                             f"{people['count']} / {devices['count']} ("
+                             + ", ".join(f"{k} {v}" for k, v in devices["finish"].items()) + ")"))
     if seconds is not None:
         summary_rows.append(("statistics computed in", f"{seconds:.2f} s"))
     out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
@@ -214,6 +228,10 @@ def _html(index: DatasetIndex, stats: DatasetStatistics, chosen: list[ImageSumma
     for name in PLOTS:
         out.append(f'<figure><img src="plots/{name}.png" alt="{e(titles[name])}"><figcaption>{e(titles[name])}'
                    f"</figcaption></figure>")
+    d = s["diversity"]
+    if d["randomised_images"]:
+        out.append('<figure><img src="plots/diversity.png" alt="scene diversity"><figcaption>scene diversity'
+                   "</figcaption></figure>")
     out.append("</div><h2>Classes</h2><table><tr><th>class</th><th>group</th><th>objects</th><th>share %</th>"
                "<th>IR</th><th>area mean</th><th>median</th><th>std</th><th>max</th><th>IQR</th>"
                "<th>pixel share %</th><th>images</th></tr>")

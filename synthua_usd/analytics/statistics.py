@@ -13,6 +13,8 @@ What is counted, once for every statistic:
 * Mobility-aid classes are the device classes of :data:`synthua_usd.assets.devices.DEVICES` in the class map;
   an *aid user* is a visible person whose ``uses`` relation names a device
   (:func:`synthua_usd.dataset.qa.aid_users`).
+* ``diversity``: how different the images' scenes are (:mod:`synthua_usd.analytics.diversity`; the one figure
+  that reads label maps, the class-map disagreement of images sharing camera and time code).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import numpy as np
 
 from synthua_usd.analytics import measures as m
 from synthua_usd.analytics.dataset_index import DatasetIndex
+from synthua_usd.analytics.diversity import diversity
 from synthua_usd.assets.devices import DEVICES
 from synthua_usd.errors import InputError
 from synthua_usd.input_files import shown
@@ -176,5 +179,6 @@ def compute(index: DatasetIndex) -> DatasetStatistics:
             "visible_pixels": _distribution(sizes) | {
                 "histogram": _histogram(sizes, SIZE_EDGES)}},
     }
+    summary["diversity"] = diversity(index)
     return DatasetStatistics(classes=rows, areas=areas, instances_per_image=[int(v) for v in ipi],
                              cooccurrence=m.cooccurrence(presence), summary=summary)

@@ -172,6 +172,8 @@ class CameraJitter:
     yaw_deg: float
     pitch_deg: float
     focal_factor: float
+    #: Above the surface under the camera after the move (None when nothing is below it).
+    height_m: float | None = None
 
     def camera(self, base: PinholeCamera) -> PinholeCamera:
         """``base`` moved to this pose and focal length."""
@@ -223,7 +225,8 @@ def draw_camera(rng: np.random.Generator, camera: PinholeCamera, rig_type: str |
     m = np.eye(4)
     m[:3, :3] = rot
     m[:3, 3] = origin + np.array([0.0, 0.0, dh])
-    return CameraJitter(tuple(map(tuple, m.tolist())), float(focal), dh, yaw, pitch, factor)
+    height = None if ground_z is None else float(origin[2] + dh - ground_z)
+    return CameraJitter(tuple(map(tuple, m.tolist())), float(focal), dh, yaw, pitch, factor, height)
 
 
 def _free(xy: np.ndarray, radius: float, taken: list[tuple[float, float, float]]) -> bool:

@@ -41,7 +41,7 @@ from synthua_usd.materials import PALETTE
 from synthua_usd.randomisation.poses import posture_of, pose_member
 from synthua_usd.randomisation.scene import CastMember, Recolour, Recolourable, SceneDraw
 from synthua_usd.randomisation.view import Placement
-from synthua_usd.scenario import ENVIRONMENT_PATH, StageMetadata
+from synthua_usd.scenario import CROWD_ROOT, ENVIRONMENT_PATH, RANDOM_ROOT, StageMetadata
 from synthua_usd.scene import Material, SceneSnapshot
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, PrototypeLibrary, instance, posture_name, prim_name, quat
 from synthua_usd.usd.authoring import (apply_label, apply_metadata, bind_material_path, define_preview_material,
@@ -49,8 +49,6 @@ from synthua_usd.usd.authoring import (apply_label, apply_metadata, bind_materia
 from synthua_usd.usd.conditions import SUN, VARIANT_SET, attribute_name
 from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR
 
-RANDOM_ROOT = "/World/Randomisation"
-CROWD_ROOT = f"{RANDOM_ROOT}/Crowd"
 LOOKS_ROOT = f"{RANDOM_ROOT}/Looks"
 PROTOTYPES_ROOT = f"{RANDOM_ROOT}/Prototypes"
 #: Palette keys of device parts that keep their palette material (tyres, the white cane's colours).

@@ -11,21 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import DATA, SCENARIO, generate_dataset
+from conftest import DATA, RANDOM_CONFIG, SCENARIO, generate_dataset
 from hostile import assert_refused, run_synthua
 from synthua_usd.backends.images import read_image
 from synthua_usd.pipeline.verify import verify
 from test_generate import _kill_when, records, tree_bytes
-
-RANDOM_CONFIG = DATA / "configs" / "random.json"
-
-
-@pytest.fixture(scope="module")
-def generated_random(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("random") / "dataset"
-    generate_dataset(out, config=RANDOM_CONFIG)
-    return out
-
 
 def _files(dataset: Path, record: dict) -> dict[str, Path]:
     return {k: dataset / v["path"] for k, v in record["checksums"].items()}
