@@ -43,9 +43,8 @@ from synthua_usd.randomisation.scene import CastMember, Recolour, Recolourable, 
 from synthua_usd.randomisation.view import Placement
 from synthua_usd.scenario import CROWD_ROOT, ENVIRONMENT_PATH, RANDOM_ROOT, StageMetadata
 from synthua_usd.scene import Material, SceneSnapshot
-from synthua_usd.usd.agents_writer import AGENTS_ROOT, PrototypeLibrary, instance, posture_name, prim_name, quat
-from synthua_usd.usd.authoring import (apply_label, apply_metadata, bind_material_path, define_preview_material,
-                                       define_xform, set_kind)
+from synthua_usd.usd.agents_writer import AGENTS_ROOT, PrototypeLibrary, posture_name, prim_name, quat
+from synthua_usd.usd.authoring import apply_metadata, bind_material_path, define_preview_material, define_xform
 from synthua_usd.usd.conditions import SUN, VARIANT_SET, attribute_name
 from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR
 
@@ -167,20 +166,9 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
             shared[key] = _material(stage, f"{LOOKS_ROOT}/{key}", key, spec.base_color, spec.roughness, spec.metallic)
         return shared[key]
 
-    agents, persons, device_paths = [], [], []
+    # materials and prototypes through the Usd API first; then the crowd's ~20 prims a person as plain specs
+    plans = []
     for k, member in enumerate(scene.cast):
-        root = define_xform(stage, agent_path(k), kind=Kind.Tokens.group)
-        prim = root.GetPrim()
-        prim.CreateAttribute("synthua:profile", Sdf.ValueTypeNames.String, custom=True).Set(member.profile)
-        if member.seat is not None:
-            prim.CreateAttribute("synthua:behaviour", Sdf.ValueTypeNames.String, custom=True).Set("sits_on_bench")
-        if member.group is not None:
-            prim.CreateAttribute("synthua:group", Sdf.ValueTypeNames.Int, custom=True).Set(member.group)
-        person = define_xform(stage, f"{agent_path(k)}/Person").GetPrim()
-        set_kind(person, Kind.Tokens.component)
-        apply_label(person, taxonomy, "person")
-        person.CreateAttribute(KEYPOINT_NAMES_ATTR, Sdf.ValueTypeNames.TokenArray, custom=True,
-                               variability=Sdf.VariabilityUniform).Set(list(KEYPOINT_CLASSES["person"].names))
         name = f"Agent_{k:04d}"
         looks = {"skin": palette_material(member.skin)}
         for region, rough in (("upper", 0.85), ("lower", 0.85), ("shoes", 0.5)):
@@ -188,17 +176,15 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
                                       member.region_colour(region), rough)
         posture, fit = posture_of(member)
         fit, _, parts = bodies.get(member.body, posture, fit)
+        instances = []
         for seg in SEGMENTS:
-            seg_path = f"{person.GetPath()}/{seg}"
-            define_xform(stage, seg_path)
             for region in REGIONS:
-                if (seg, region) not in parts:
-                    continue
-                shape = f"Body{member.body:02d}{posture_name(posture)}{seg}{region.title()}"
-                part = instance(stage, f"{seg_path}/{region.title()}", library.part(shape, parts[(seg, region)]))
-                colour = member.region_colour(region)
-                bind_material_path(part, looks["skin"] if isinstance(colour, str) else looks[
-                    {"forearm": "upper", "shin": "lower"}.get(region, region)])
+                if (seg, region) in parts:
+                    shape = f"Body{member.body:02d}{posture_name(posture)}{seg}{region.title()}"
+                    colour = member.region_colour(region)
+                    look = looks["skin"] if isinstance(colour, str) else looks[
+                        {"forearm": "upper", "shin": "lower"}.get(region, region)]
+                    instances.append((seg, region.title(), library.part(shape, parts[(seg, region)]), look))
         device = None
         if member.aid is not None and member.device is not None:
             look = member.device
@@ -209,17 +195,38 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
             keys = {p.material for p in DEVICE_MODELS[member.aid][look.model](fit)}
             bindings = {key: finish[_DEVICE_ROLES[key]] if key in _DEVICE_ROLES else palette_material(key)
                         for key in sorted(keys)}
-            prototype = library.device(member.aid, fit, look.model, bindings, name=f"{name}_{prim_name(member.aid)}")
-            aid = instance(stage, f"{agent_path(k)}/{prim_name(member.aid)}", prototype)
-            set_kind(aid, Kind.Tokens.component)
-            apply_label(aid, taxonomy, member.aid)
-            aid.CreateAttribute(KEYPOINT_NAMES_ATTR, Sdf.ValueTypeNames.TokenArray, custom=True,
-                                variability=Sdf.VariabilityUniform).Set(list(KEYPOINT_CLASSES[member.aid].names))
-            person.CreateRelationship("synthua:uses", custom=True).SetTargets([aid.GetPath()])
-            device = str(aid.GetPath())
-        agents.append(agent_path(k))
-        persons.append(str(person.GetPath()))
-        device_paths.append(device)
+            device = library.device(member.aid, fit, look.model, bindings, name=f"{name}_{prim_name(member.aid)}")
+        plans.append((member, instances, device))
+    agents, persons, device_paths = [], [], []
+    with Sdf.ChangeBlock():
+        for k, (member, instances, prototype) in enumerate(plans):
+            root = _define(layer, agent_path(k), kind=Kind.Tokens.group)
+            _attr(root, "synthua:profile", Sdf.ValueTypeNames.String, member.profile, custom=True)
+            if member.seat is not None:
+                _attr(root, "synthua:behaviour", Sdf.ValueTypeNames.String, "sits_on_bench", custom=True)
+            if member.group is not None:
+                _attr(root, "synthua:group", Sdf.ValueTypeNames.Int, member.group, custom=True)
+            person_path = f"{agent_path(k)}/Person"
+            person = _define(layer, person_path, kind=Kind.Tokens.component)
+            _label(person, taxonomy, "person")
+            _attr(person, KEYPOINT_NAMES_ATTR, Sdf.ValueTypeNames.TokenArray, list(KEYPOINT_CLASSES["person"].names),
+                  uniform=True, custom=True)
+            for seg in SEGMENTS:
+                _define(layer, f"{person_path}/{seg}")
+            for seg, region, part, look in instances:
+                _instance_spec(layer, f"{person_path}/{seg}/{region}", part, look)
+            device = None
+            if prototype is not None:
+                device = f"{agent_path(k)}/{prim_name(member.aid)}"
+                aid = _instance_spec(layer, device, prototype, None, kind=Kind.Tokens.component)
+                _label(aid, taxonomy, member.aid)
+                _attr(aid, KEYPOINT_NAMES_ATTR, Sdf.ValueTypeNames.TokenArray,
+                      list(KEYPOINT_CLASSES[member.aid].names), uniform=True, custom=True)
+                uses = Sdf.RelationshipSpec(person, "synthua:uses", True)
+                uses.targetPathList.explicitItems = [Sdf.Path(device)]
+            agents.append(agent_path(k))
+            persons.append(person_path)
+            device_paths.append(device)
     for k, recolour in enumerate(scene.recolours):
         path = f"{LOOKS_ROOT}/Twin_{k:04d}"
         define_preview_material(stage, path, recoloured(materials[recolour.material], recolour, path))
@@ -228,7 +235,41 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
     return prototypes, layer, CastPrims(tuple(agents), tuple(persons), tuple(device_paths), scene.cast)
 
 
-# --- the view layer: Sdf specs, the same structure for every view of a scene -----------------------------
+# --- plain specs: the crowd of the scene layer, and the view layer (the same structure for every view) -----
+
+def _define(layer: Sdf.Layer, path: str, type_name: str = "Xform", kind: str | None = None) -> Sdf.PrimSpec:
+    spec = Sdf.CreatePrimInLayer(layer, path)
+    spec.specifier = Sdf.SpecifierDef
+    spec.typeName = type_name
+    if kind:
+        spec.kind = kind
+    return spec
+
+
+def _apply_api(spec: Sdf.PrimSpec, schema: str) -> None:
+    """Prepend an applied API schema, as ``Usd.Prim.ApplyAPI`` authors it."""
+    ops = spec.GetInfo("apiSchemas") if spec.HasInfo("apiSchemas") else Sdf.TokenListOp()
+    spec.SetInfo("apiSchemas", Sdf.TokenListOp.Create(prependedItems=[*ops.prependedItems, schema]))
+
+
+def _label(spec: Sdf.PrimSpec, taxonomy: str, label: str) -> None:
+    """The class ``label`` of ``taxonomy`` (UsdSemantics.LabelsAPI), as :func:`authoring.apply_label` authors it."""
+    _apply_api(spec, f"SemanticsLabelsAPI:{taxonomy}")
+    _attr(spec, f"semantics:labels:{taxonomy}", Sdf.ValueTypeNames.TokenArray, [label])
+
+
+def _instance_spec(layer: Sdf.Layer, path: str, prototype, material: str | None, kind: str | None = None
+                   ) -> Sdf.PrimSpec:
+    """An instanceable Xform referencing ``prototype``, bound to ``material`` when given."""
+    spec = _define(layer, path, kind=kind)
+    spec.referenceList.Prepend(Sdf.Reference(primPath=Sdf.Path(str(prototype))))
+    spec.instanceable = True
+    if material is not None:
+        _apply_api(spec, "MaterialBindingAPI")
+        rel = Sdf.RelationshipSpec(spec, "material:binding", False)
+        rel.targetPathList.explicitItems = [Sdf.Path(material)]
+    return spec
+
 
 def _over(layer: Sdf.Layer, path: str) -> Sdf.PrimSpec:
     spec = layer.GetPrimAtPath(path)

@@ -306,27 +306,40 @@ class StageReader:
         return self._under.get(path, [])
 
     def _forget(self, keys, geometry: bool) -> None:
-        """Drop the placed items (and with ``geometry`` the local gprims) of gprim ``keys``, and what was
-        memoised of their transforms' variation."""
+        """Drop the placed items of gprim ``keys``; with ``geometry`` also their local gprims and their variation
+        (an attribute of theirs may have become time-varying)."""
         for key in keys:
             self._static.pop(key, None)
-            self._varying.pop(key, None)
             if geometry:
                 self._local.pop(key, None)
-        if geometry:
+                self._varying.pop(key, None)
+        if geometry and keys:
             self._rigid_layout = None
+            self._entries = None
 
     def _forget_transforms(self, prim_path: Sdf.Path, keys) -> None:
-        """A transform at ``prim_path`` changed: the variation memo of it and of every prim between it and the
-        gprims ``keys`` below it goes."""
+        """A transform at ``prim_path`` changed: the gprims ``keys`` below it are placed again. Whether their
+        transforms vary over time changes only if ``prim_path``'s own does (a value set anew keeps it): then the
+        variation memo of every prim between it and them goes too."""
+        self._forget(keys, geometry=False)
         top = str(prim_path)
+        if top not in self._xform_memo:
+            return
+        prim = self.stage.GetPrimAtPath(prim_path)
+        parent = prim.GetParent() if prim else None
+        own = bool(prim) and prim.IsA(UsdGeom.Xformable) and UsdGeom.Xformable(prim).TransformMightBeTimeVarying()
+        now = own or (bool(parent) and not parent.IsPseudoRoot() and _might_vary(parent, self._xform_memo))
+        if now == self._xform_memo[top]:
+            return
         for key in keys:
+            self._varying.pop(key, None)
             path = Sdf.Path(key)
             while True:
                 self._xform_memo.pop(str(path), None)
                 if str(path) == top or path.IsAbsoluteRootPath():
                     break
                 path = path.GetParentPath()
+        self._entries = None
 
     def _forget_materials(self, prim_path: Sdf.Path, below: bool = False) -> None:
         """Something at ``prim_path`` changed that may be part of a material network: every material at or
@@ -339,7 +352,7 @@ class StageReader:
     def _changes_structure(self, prim_path: Sdf.Path, name: str) -> bool:
         """Whether a change of property ``name`` on ``prim_path`` may change which gprims render, the labelled
         instances or their relations, or which prims carry keypoints."""
-        if name in ("", "visibility", "purpose", KEYPOINT_NAMES_ATTR) or name.startswith("semantics:"):
+        if name in ("visibility", "purpose", KEYPOINT_NAMES_ATTR) or name.startswith("semantics:"):
             return True
         if name.startswith("synthua:"):
             prim = self.stage.GetPrimAtPath(prim_path)
@@ -363,10 +376,11 @@ class StageReader:
         structural = sorted(p for p in resynced if not p.IsPropertyPath())
         properties: dict[Sdf.Path, set[str]] = {}
         for path in resynced | changed:
+            # info-only changes of a prim itself (its documentation, custom data; USD also lists instances whose
+            # ancestors' values changed) change nothing a snapshot holds: what would (activation, instancing,
+            # references, specifiers) resyncs it
             if path.IsPropertyPath():
                 properties.setdefault(path.GetPrimPath(), set()).add(path.name)
-            elif path not in resynced:
-                properties.setdefault(path, set()).add("")  # prim metadata
         for path in structural:
             if path.IsAbsoluteRootPath():
                 self._forget(list(self._local), geometry=True)
@@ -387,7 +401,6 @@ class StageReader:
             if any(self._changes_structure(path, n) for n in names):
                 structure = True
             if any(n.startswith("xformOp") for n in names):
-                self._forget(keys, geometry=False)
                 self._forget_transforms(path, keys)
             if str(path) in self._gprim_keys and any(not n.startswith("xformOp") for n in names):
                 self._forget([str(path)], geometry=True)
@@ -395,7 +408,6 @@ class StageReader:
                 self._forget(keys, geometry=True)
         if structure:
             self._refresh_structure()
-        self._entries = None  # variations may have changed with the transforms
 
     def _relabel(self) -> None:
         """New instance ids (labelled prims came or went): the cached gprims keep their geometry and take the

@@ -195,6 +195,14 @@ def test_reader_follows_edits_of_the_stage_as_a_fresh_reader_reads_them(class_ma
     ground = edit(lambda: UsdGeom.Xformable(stage.GetPrimAtPath("/World/Ground")).AddTranslateOp().Set(
         Gf.Vec3d(0.0, 0.0, -0.25)))
     assert np.allclose(ground["/World/Ground"].points[:, 2], -0.25)
+    def animate():  # the group's transform becomes time-varying: the box must now move between time codes
+        translate = stage.GetPrimAtPath("/World/Group").GetAttribute("xformOp:translate")
+        translate.Set(Gf.Vec3d(4, 1, 0), 1.0)
+        translate.Set(Gf.Vec3d(6, 1, 0), 3.0)
+    edit(animate)
+    for t in (3.0, 1.0):
+        assert_same_snapshot(reader.snapshot(t), read_snapshot(stage, t, class_map))
+    assert reader.snapshot(3.0).meshes[-1].points[:, 0].min() > reader.snapshot(1.0).meshes[-1].points[:, 0].min()
     resized = edit(lambda: UsdGeom.Cube(stage.GetPrimAtPath("/World/Group/Box")).GetSizeAttr().Set(3.0))
     assert np.ptp(resized["/World/Group/Box"].points[:, 0]) == pytest.approx(3.0)
 
