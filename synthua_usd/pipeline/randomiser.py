@@ -69,6 +69,17 @@ def _metadata(stage: Usd.Stage) -> StageMetadata:
                          default_prim="World")
 
 
+def _replace_subtree(target: Sdf.Layer, fresh: Sdf.Layer) -> None:
+    """Replace ``target``'s :data:`RANDOM_ROOT` subtree and documentation with ``fresh``'s."""
+    root = Sdf.Path(RANDOM_ROOT)
+    parent = target.GetPrimAtPath(root.GetParentPath())
+    if parent is not None and root.name in parent.nameChildren:
+        del parent.nameChildren[root.name]
+    if fresh.GetPrimAtPath(root):
+        Sdf.CopySpec(fresh, root, target, root)
+    target.documentation = fresh.documentation
+
+
 class Randomiser:
     """Randomises ``stage`` image by image under ``config``: ``size`` (width, height) is the render size (where a
     person counts as seen), ``time_code`` the one the twin is read at (it does not move)."""
@@ -121,13 +132,20 @@ class Randomiser:
                           district_seed=district_seed)
         prototypes, scene, cast = scene_layers(draw, self.meta, self.class_map.taxonomy, self.bodies, self.materials,
                                                self.bound, deactivate_agents=self.has_agents and self.config.crowd.enabled)
-        linked = Sdf.Layer.CreateAnonymous("scene.usda")
-        linked.TransferContent(scene)
-        linked.subLayerPaths.clear()
-        linked.subLayerPaths.append(self.prototypes.identifier)
         with Sdf.ChangeBlock():  # both at once: the stage never composes the old instances over new prototypes
-            self.prototypes.TransferContent(prototypes)
-            self.scene_layer.TransferContent(linked)
+            if self._scene is None:
+                linked = Sdf.Layer.CreateAnonymous("scene.usda")
+                linked.TransferContent(scene)
+                linked.subLayerPaths.clear()
+                linked.subLayerPaths.append(self.prototypes.identifier)
+                self.prototypes.TransferContent(prototypes)
+                self.scene_layer.TransferContent(linked)
+            else:
+                # Everything outside RANDOM_ROOT (the scenario's crowd deactivated, the recoloured objects'
+                # bindings to Looks/Twin_<k>) is the same for every scene of a randomiser: only the subtree is
+                # swapped, so USD resyncs the crowd and its materials and nothing of the twin.
+                _replace_subtree(self.prototypes, prototypes)
+                _replace_subtree(self.scene_layer, scene)
         self._scene, self._cast = draw, cast
         return draw
 

@@ -257,7 +257,7 @@ class StageReader:
     layer of its stack: what scene randomisation does between images) reach the reader through USD's
     ``ObjectsChanged`` notices, and the next snapshot re-reads only what they touched: a changed transform
     re-places the gprims below it (their local triangles kept), a changed gprim or binding re-reads it, a
-    changed shader re-reads its material and the gprims bound to it, and a resynced prim (added, removed,
+    changed shader re-reads its material (the gprims bound to it keep their triangles), and a resynced prim (added, removed,
     activated, recomposed) refreshes the list of gprims, labels, keypoints and lights and re-reads what lies
     below it. A snapshot after edits equals, array for array, the snapshot a new reader of the edited stage
     gives.
@@ -280,6 +280,8 @@ class StageReader:
         self._gprim_keys: set[str] = set()
         self._resynced: set[Sdf.Path] = set()
         self._changed: set[Sdf.Path] = set()
+        #: Gprims whose material changed: read it again with their next placement.
+        self._rematerial: set[str] = set()
         self._notice = Tf.Notice.Register(Usd.Notice.ObjectsChanged, self._on_objects_changed, stage)
         #: The rigidly moving gprims placed last: (their paths, local points of all (n, 3), owner per point (n,),
         #: bounds (k + 1,) of each gprim's points), kept while the same gprims move.
@@ -347,7 +349,8 @@ class StageReader:
         dropped = self._materials.forget(str(prim_path), below)
         if dropped:
             bound = [k for k, local in self._local.items() if local is not None and local.material_base in dropped]
-            self._forget(bound, geometry=True)
+            self._forget(bound, geometry=False)
+            self._rematerial.update(bound)
 
     def _changes_structure(self, prim_path: Sdf.Path, name: str) -> bool:
         """Whether a change of property ``name`` on ``prim_path`` may change which gprims render, the labelled
@@ -381,16 +384,20 @@ class StageReader:
             # references, specifiers) resyncs it
             if path.IsPropertyPath():
                 properties.setdefault(path.GetPrimPath(), set()).add(path.name)
+        # the outermost resynced prims only (USD also lists prims below one it resyncs)
+        resynced_prims = {str(p) for p in structural}
+        structural = [p for p in structural if not any(a in resynced_prims for a in list(_prefixes(str(p)))[1:])]
         for path in structural:
             if path.IsAbsoluteRootPath():
                 self._forget(list(self._local), geometry=True)
                 self._xform_memo.clear()
                 self._materials.forget("/", below=True)
                 continue
-            keys = self._keys_under(str(path))
-            self._forget(keys, geometry=True)
+            self._forget(self._keys_under(str(path)), geometry=True)
             self._forget_materials(path, below=True)
-            for memo in [k for k in self._xform_memo if Sdf.Path(k).HasPrefix(path)]:
+        if structural and not structural[0].IsAbsoluteRootPath():
+            tops = {str(p) for p in structural}
+            for memo in [k for k in self._xform_memo if any(a in tops for a in _prefixes(k))]:
                 del self._xform_memo[memo]
         structure = bool(structural)
         for path, names in sorted(properties.items()):
@@ -471,10 +478,24 @@ class StageReader:
         sites = label_sites(prim, self.class_map.taxonomy)
         inst = self.instances.get(sites[0].prim_path) if sites else None
         return _LocalGprim(points=points, triangles=tris, uvs=uvs, material_key=material.key,
-                           material_base=self._materials.base_of(material.key),
+                           material_base=self._materials.base_of(material.key), textured=bool(material.textures),
                            instance_path=sites[0].prim_path if sites else None,
                            instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0,
                            lamp=_lamp_role(prim), double_sided=bool(UsdGeom.Gprim(prim).GetDoubleSidedAttr().Get()))
+
+    def _rematerialised(self, prim: Usd.Prim, t: Usd.TimeCode, local: "_LocalGprim | None") -> "_LocalGprim | None":
+        """``local`` with its material read again when that material changed (its geometry kept while the material
+        keeps having textures or not: the texture coordinates read depend on that), else as it is."""
+        key = str(prim.GetPath())
+        if key not in self._rematerial:
+            return local
+        self._rematerial.discard(key)
+        if local is None:
+            return self._local_gprim(prim, t)
+        material = self._materials.of(prim, t)
+        if bool(material.textures) != local.textured:
+            return self._local_gprim(prim, t)
+        return replace(local, material_key=material.key, material_base=self._materials.base_of(material.key))
 
     def _placed(self, prim: Usd.Prim, local: "_LocalGprim", t: Usd.TimeCode, xcache: UsdGeom.XformCache) -> MeshItem:
         """``local`` in world metres with ``prim``'s transform at ``t``."""
@@ -495,7 +516,7 @@ class StageReader:
         local gprim is kept (and taken when kept), for a constant gprim that an edit may move."""
         key = str(prim.GetPath())
         if keep and key in self._local:
-            local = self._local[key]
+            local = self._local[key] = self._rematerialised(prim, t, self._local[key])
         else:
             local = self._local_gprim(prim, t)
             if keep:
@@ -580,6 +601,8 @@ class StageReader:
             if variation == "transform":  # placed below, all together
                 if key not in self._local:
                     self._local[key] = self._local_gprim(prim, t)
+                else:
+                    self._local[key] = self._rematerialised(prim, t, self._local[key])
                 if self._local[key] is not None:
                     rigid.append((len(meshes), prim, key, self._local[key]))
                     meshes.append(None)
@@ -637,11 +660,20 @@ class _LocalGprim:
     material_key: str
     #: The bound material's own key (``material_key`` less a per-gprim colour), and the labelled prim above.
     material_base: str
+    #: Whether the material had textures when the gprim was read (``uvs`` were read for them).
+    textured: bool
     instance_path: str | None
     instance_id: int
     class_id: int
     lamp: str
     double_sided: bool
+
+
+def _prefixes(path: str):
+    """``/A/B/C``, ``/A/B``, ``/A``: the prim path string and those of its ancestors."""
+    while path and path != "/":
+        yield path
+        path = path.rsplit("/", 1)[0]
 
 
 def _same_uvs(a: np.ndarray | None, b: np.ndarray | None) -> bool:

@@ -96,9 +96,12 @@ class RenderSession:
         old = self._snapshot
         # the lights the scene was built with (with a condition, the environment's own sun and sky stand in for
         # it in viewers only: a view layer may turn them)
+        # and the materials' values: BSDFs are built with the scene (a material recoloured means a reload)
         return (self._translation.condition_key == weather_scene.scene_key(condition)
                 and len(old.meshes) == len(snapshot.meshes)
                 and weather_scene.own_lights(old, condition) == weather_scene.own_lights(snapshot, condition)
+                and (old.materials is snapshot.materials
+                     or all(old.materials[k] == snapshot.materials.get(k) for k in {m.material_key for m in old.meshes}))
                 and all(a is b or (a.prim_path == b.prim_path and a.material_key == b.material_key
                                    and a.points.shape == b.points.shape
                                    and (a.triangles is b.triangles or np.array_equal(a.triangles, b.triangles)))
