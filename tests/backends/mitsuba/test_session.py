@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from conftest import SCENARIO
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
@@ -94,3 +95,27 @@ def test_time_code_updates_give_the_labels_of_a_fresh_load(class_map, variant):
     # Not vacuous: the images change between time codes, so a stale scene would show.
     assert (frames[1].instance_ids != frames[2].instance_ids).sum() > 0
     assert (frames[2].instance_ids != frames[3].instance_ids).sum() > 0
+
+
+def test_a_recoloured_material_reloads_and_renders_the_new_colour(class_map, variant):
+    """A material edited after the scene loaded (its diffuseColor set in a layer of the session's stage): the
+    session must not keep the old BSDF; its render equals a fresh session's of the edited stage."""
+    from pxr import Gf, Sdf, Usd, UsdShade
+
+    from synthua_usd.usd.stage_io import open_stage
+
+    stage = open_stage(SCENARIO)
+    reader = StageReader(stage, class_map)
+    config = RenderConfig(width=SIZE[0], height=SIZE[1], spp=4, variant=variant, denoise=False)
+    session = RenderSession(config)
+    cam = read_camera(stage, "/World/Cameras/CCTV", 1.0)
+    before = session.render(reader.snapshot(1.0), cam)
+    shader = stage.GetPrimAtPath("/World/Looks/Asphalt/PreviewSurface")
+    layer = Sdf.Layer.CreateAnonymous("edit.usda")
+    stage.GetSessionLayer().subLayerPaths.insert(0, layer.identifier)
+    with Usd.EditContext(stage, layer):
+        UsdShade.Shader(shader).CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(0.9, 0.05, 0.05))
+    after = session.render(reader.snapshot(1.0), cam)
+    assert session.reloads == 1
+    fresh = RenderSession(config).render(StageReader(stage, class_map).snapshot(1.0), cam)
+    assert np.array_equal(after.rgb, fresh.rgb) and not np.array_equal(after.rgb, before.rgb)
