@@ -13,7 +13,8 @@ DISTRICT := stages/district/scenario.usda
 
 ## Validate the shipped scenarios, render the demo street's CCTV and pedestrian-eye cameras and the
 ## Largo da Ordem district's largo CCTV into out/demo/, then generate and verify a small dataset of the
-## demo street (configs/demo.json) in out/demo/dataset/ and write its statistics report to out/demo/dataset_report/.
+## demo street (configs/demo.json) in out/demo/dataset/ and write its statistics report to out/demo/dataset_report/,
+## and a randomised one (configs/demo_random.json: every image a new scene) in out/demo/dataset_random/.
 demo: setup
 	$(BIN)/synthua validate stage $(SCENARIO)
 	$(BIN)/synthua inspect $(SCENARIO)
@@ -26,7 +27,11 @@ demo: setup
 	$(BIN)/synthua generate $(SCENARIO) --config configs/demo.json --out $(DEMO_OUT)/dataset
 	$(BIN)/synthua verify $(DEMO_OUT)/dataset
 	$(BIN)/synthua stats $(DEMO_OUT)/dataset --out $(DEMO_OUT)/dataset_report
-	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}; a dataset (COCO, panoptic, Cityscapes, YOLO) in $(DEMO_OUT)/dataset, its statistics in $(DEMO_OUT)/dataset_report/report.html"
+	rm -rf $(DEMO_OUT)/dataset_random
+	$(BIN)/synthua generate $(SCENARIO) --config configs/demo_random.json --out $(DEMO_OUT)/dataset_random
+	$(BIN)/synthua verify $(DEMO_OUT)/dataset_random
+	$(BIN)/synthua stats $(DEMO_OUT)/dataset_random --out $(DEMO_OUT)/dataset_random_report
+	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}; a dataset (COCO, panoptic, Cityscapes, YOLO) in $(DEMO_OUT)/dataset, its statistics in $(DEMO_OUT)/dataset_report/report.html; a randomised one (every image a new scene) in $(DEMO_OUT)/dataset_random, its statistics and diversity in $(DEMO_OUT)/dataset_random_report/report.html"
 
 ## The whole test suite (slow tests included).
 test: setup
@@ -44,7 +49,8 @@ stages: setup
 
 ## Benchmarks (not tests: ratios and timings measured side by side in one run): rendering through a
 ## render session (first load, per-frame update, labels, RGB), building the district, imports and agents, the
-## amodal pass, dataset workers' memory over 500 images, denoised RGB against 512-spp references, and issue 11's
+## amodal pass, dataset workers' memory over 500 images, denoised RGB against 512-spp references, what scene
+## randomisation costs per image against a default-quality frame, and issue 11's
 ## targets against the raw ray bound and Blender Cycles (tools/setup_cycles.sh installs PyPI bpy into
 ## $(CYCLES_VENV) first; without it the table says Blender is not installed and the rest is measured).
 CYCLES_VENV ?= $(VENV)-cycles
@@ -63,6 +69,7 @@ bench: setup
 	$(BIN)/python tools/bench_amodal.py
 	$(BIN)/python tools/bench_generate.py --memory 500
 	$(BIN)/python tools/bench_denoise.py
+	$(BIN)/python tools/bench_randomise.py
 
 clean:
 	rm -rf out .pytest_cache

@@ -25,7 +25,7 @@ from synthua_usd.ranges import Range
 @click.option("--time-code", "--frame", "time_code", type=InRange(Range(-1e9, 1e9)),
               help="Time code of the image [default: the stage's start time code].")
 @click.option("--condition", help="Condition the image is rendered under (its light is drawn within it) [default: "
-                                  "none: the stage's own lights, only the exposure drawn].")
+                                  "none: the stage's own lights, nothing of the light drawn].")
 @click.option("--out", "out", type=click.Path(path_type=Path), required=True,
               help="The image's layer, e.g. layer.usda; layer.scene.usda and layer.prototypes.usdc go beside it.")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
