@@ -55,6 +55,10 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
     COCO instances (with keypoints) and panoptic JSON, Cityscapes gtFine, YOLO labels and data.yaml,
     metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
     \b
+    With a randomise block (configs/district_random.json) every image is a scene of its own: a new crowd, looks,
+    material variants and district per seed, the crowd placed anew and the camera moved per view, the light
+    drawn per image, all as USD layers composed over SCENARIO (synthua randomise writes an image's layers).
+    \b
     Killed or failed runs resume: run the same command again; finished images are kept.
     The same config, scenario and variant give the same bytes (check one image: synthua replay).
     """

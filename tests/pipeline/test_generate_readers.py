@@ -3,7 +3,7 @@ COCOeval), panopticapi (pq_compute), cityscapesScripts (getCsFileInfo, pixel-lev
 (YOLO loader), pyarrow and csv (metadata), hashlib (manifest). The unit tests in tests/dataset/formats/ check
 each writer on hand-made records; these check the files of one whole run and that they agree with each other.
 
-The ``generated`` fixture is shared by the session: tests that need a reader to write copy the dataset first.
+The ``generated`` and ``generated_random`` datasets are shared by the session: tests that need a reader to write copy the dataset first.
 """
 
 from __future__ import annotations
@@ -55,6 +55,12 @@ def dataset_class_map(root: Path) -> ClassMap:
     return ClassMap.from_document(read_json(root, Layout.CLASS_MAP), source=Layout.CLASS_MAP)
 
 
+@pytest.fixture(params=["generated", "generated_random"])
+def dataset(request) -> Path:
+    """Each test reads both the tiny dataset and the randomised one (every image a new scene)."""
+    return request.getfixturevalue(request.param)
+
+
 def quiet():
     """pycocotools, panopticapi and cityscapesScripts print their progress and tables."""
     return contextlib.redirect_stdout(io.StringIO())
@@ -63,15 +69,15 @@ def quiet():
 # ---------------------------------------------------------------------------------------------------- COCO
 
 
-def test_pycocotools_loads_every_split_and_cocoeval_of_gt_against_itself_is_one(generated):
+def test_pycocotools_loads_every_split_and_cocoeval_of_gt_against_itself_is_one(dataset):
     from pycocotools.coco import COCO
 
     evaluated = 0
-    for split in splits_with_images(generated):
+    for split in splits_with_images(dataset):
         with quiet():
-            gt = COCO(str(generated / Layout.coco_instances(split)))
+            gt = COCO(str(dataset / Layout.coco_instances(split)))
         for image in gt.loadImgs(gt.getImgIds()):
-            assert (generated / "images" / split / image["file_name"]).is_file(), image
+            assert (dataset / "images" / split / image["file_name"]).is_file(), image
         anns = gt.loadAnns(gt.getAnnIds())
         if not anns:
             continue
@@ -82,7 +88,7 @@ def test_pycocotools_loads_every_split_and_cocoeval_of_gt_against_itself_is_one(
     assert evaluated >= 1, "no split has COCO annotations"
 
 
-def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_instance_maps(generated):
+def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_instance_maps(dataset):
     """OKS AP of the keypoints against themselves is 1.0 for every category with labelled keypoints (people
     and the street's manual wheelchair); a visible keypoint (v = 2) has its instance's id in the written
     instance map within WINDOW_PX pixels, a labelled one lies inside the image, an unlabelled one is 0, 0."""
@@ -90,11 +96,11 @@ def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_i
 
     from synthua_usd.dataset.keypoints import WINDOW_PX
 
-    names = {m["id"]: m["name"] for m in manifest_images(generated)}
+    names = {m["id"]: m["name"] for m in manifest_images(dataset)}
     evaluated, flags = set(), Counter()
-    for split in splits_with_images(generated):
+    for split in splits_with_images(dataset):
         with quiet():
-            gt = COCO(str(generated / Layout.coco_instances(split)))
+            gt = COCO(str(dataset / Layout.coco_instances(split)))
         for category, ap in coco_keypoint_self_evaluation(gt).items():
             assert ap == pytest.approx(1.0), (split, category)
             evaluated.add(category)
@@ -102,7 +108,7 @@ def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_i
             if "keypoints" not in ann:
                 continue
             image = gt.imgs[ann["image_id"]]
-            ids = read_png(generated / Layout.frame_file(names[ann["image_id"]], "instance.png"))
+            ids = read_png(dataset / Layout.frame_file(names[ann["image_id"]], "instance.png"))
             for x, y, v in np.array(ann["keypoints"], float).reshape(-1, 3):
                 flags[int(v)] += 1
                 if v == 0:
@@ -117,13 +123,13 @@ def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_i
     assert flags[2] > 0
 
 
-def test_coco_ids_categories_and_images_agree_with_the_manifest_and_class_map(generated):
-    class_map = dataset_class_map(generated)
+def test_coco_ids_categories_and_images_agree_with_the_manifest_and_class_map(dataset):
+    class_map = dataset_class_map(dataset)
     things = {c.id for c in class_map.classes if c.isthing and c.id >= 1}
-    manifest = {m["id"]: m for m in manifest_images(generated)}
+    manifest = {m["id"]: m for m in manifest_images(dataset)}
     image_ids, ann_ids = [], []
     for split in SPLITS:
-        doc = coco_split(generated, split)
+        doc = coco_split(dataset, split)
         assert {c["id"] for c in doc["categories"]} == things, split
         assert all(c["name"] == class_map.by_id(c["id"]).name for c in doc["categories"])
         for image in doc["images"]:
@@ -139,12 +145,12 @@ def test_coco_ids_categories_and_images_agree_with_the_manifest_and_class_map(ge
     assert sorted(image_ids) == sorted(i for i, m in manifest.items() if m["qa"] != "rejected")
 
 
-def test_coco_amodal_masks_contain_the_visible_ones_and_occlusion_is_their_ratio(generated):
+def test_coco_amodal_masks_contain_the_visible_ones_and_occlusion_is_their_ratio(dataset):
     from pycocotools import mask as mask_utils
 
     relations = occluded = 0
     for split in SPLITS:
-        doc = coco_split(generated, split)
+        doc = coco_split(dataset, split)
         by_id = {a["id"]: a for a in doc["annotations"]}
         for a in doc["annotations"]:
             for key in ("amodal_segmentation", "amodal_area", "amodal_bbox", "occlusion", "truncation", "relations"):
@@ -159,10 +165,13 @@ def test_coco_amodal_masks_contain_the_visible_ones_and_occlusion_is_their_ratio
             occluded += a["amodal_area"] > a["area"]
             ys, xs = np.nonzero(visible)
             assert a["bbox"] == [xs.min(), ys.min(), xs.max() - xs.min() + 1, ys.max() - ys.min() + 1], (split, a["id"])
-            if a["relations"]:
+            if a["relations"].get("uses_annotation_id") is not None:
                 used = by_id[a["relations"]["uses_annotation_id"]]
                 assert used["image_id"] == a["image_id"] and used["prim_path"] == a["relations"]["uses"]
                 relations += 1
+            elif a["relations"]:  # the device it uses is not in the picture (hidden, out of frame)
+                assert not any(b["image_id"] == a["image_id"] and b.get("prim_path") == a["relations"]["uses"]
+                               for b in doc["annotations"]), (split, a["id"])
     assert occluded >= 1, "no annotation is occluded: the amodal checks above would be vacuous"
     assert relations >= 1, "the demo street has mobility-aid users: some annotation should carry a 'uses' relation"
 
@@ -170,12 +179,12 @@ def test_coco_amodal_masks_contain_the_visible_ones_and_occlusion_is_their_ratio
 # ------------------------------------------------------------------------------------------------ panoptic
 
 
-def test_panopticapi_pq_of_gt_against_itself_is_100_for_every_split(generated, tmp_path, monkeypatch):
+def test_panopticapi_pq_of_gt_against_itself_is_100_for_every_split(dataset, tmp_path, monkeypatch):
     from panopticapi import evaluation
 
     # pq_compute writes nothing, but the dataset is shared: evaluate a copy all the same.
     root = tmp_path / "dataset"
-    shutil.copytree(generated / "annotations", root / "annotations")
+    shutil.copytree(dataset / "annotations", root / "annotations")
     # One worker: panopticapi starts a pool of cpu_count() processes and never closes it.
     monkeypatch.setattr(multiprocessing, "cpu_count", lambda: 1)
     evaluated = 0
@@ -195,20 +204,20 @@ def test_panopticapi_pq_of_gt_against_itself_is_100_for_every_split(generated, t
     assert evaluated >= 1
 
 
-def test_panoptic_segments_match_their_pngs_exactly(generated):
+def test_panoptic_segments_match_their_pngs_exactly(dataset):
     from panopticapi.utils import rgb2id
 
-    class_map = dataset_class_map(generated)
+    class_map = dataset_class_map(dataset)
     checked = 0
-    for split in splits_with_images(generated):
-        doc = read_json(generated, Layout.coco_panoptic(split))
+    for split in splits_with_images(dataset):
+        doc = read_json(dataset, Layout.coco_panoptic(split))
         categories = {c["id"]: c for c in doc["categories"]}
         for c in class_map.classes:
             if c.id >= 1:
                 assert categories[c.id]["isthing"] == int(c.isthing), c.name
         assert sorted(a["image_id"] for a in doc["annotations"]) == sorted(i["id"] for i in doc["images"])
         for ann in doc["annotations"]:
-            ids = rgb2id(read_png(generated / "annotations" / f"panoptic_{split}" / ann["file_name"]))
+            ids = rgb2id(read_png(dataset / "annotations" / f"panoptic_{split}" / ann["file_name"]))
             found, areas = np.unique(ids, return_counts=True)
             in_png = {int(i): int(n) for i, n in zip(found, areas) if i != 0}
             in_json = {s["id"]: s["area"] for s in ann["segments_info"]}
@@ -229,16 +238,16 @@ def cityscapes_files(root: Path, folder: str) -> list[Path]:
 
 
 def test_cityscapes_scripts_parses_every_name_and_its_evaluation_of_gt_against_itself_is_iou_one(
-        generated, monkeypatch):
+        dataset, monkeypatch):
     from cityscapesscripts.helpers import csHelpers
 
-    class_map = dataset_class_map(generated)
+    class_map = dataset_class_map(dataset)
     ev, labels = cityscapes_evaluation(monkeypatch, class_map)
-    gt_files = cityscapes_files(generated, "gtFine")
+    gt_files = cityscapes_files(dataset, "gtFine")
     assert gt_files
-    for path in gt_files + cityscapes_files(generated, "leftImg8bit"):
+    for path in gt_files + cityscapes_files(dataset, "leftImg8bit"):
         info = csHelpers.getCsFileInfo(str(path))
-        split, city = path.relative_to(generated).parts[1:3]
+        split, city = path.relative_to(dataset).parts[1:3]
         assert split in SPLITS and info.city == city, path
         assert path.name == f"{info.city}_{info.sequenceNb}_{info.frameNb}_{info.type}" + (
             f"_{info.type2}.png" if info.type == "gtFine" else ".png")
@@ -264,14 +273,14 @@ def test_cityscapes_scripts_parses_every_name_and_its_evaluation_of_gt_against_i
     assert evaluated >= 1
 
 
-def test_cityscapes_instance_ids_are_class_times_1000_plus_k_and_agree_with_coco(generated):
-    class_map = dataset_class_map(generated)
+def test_cityscapes_instance_ids_are_class_times_1000_plus_k_and_agree_with_coco(dataset):
+    class_map = dataset_class_map(dataset)
     things = {c.id for c in class_map.classes if c.isthing}
     checked = 0
-    for split in splits_with_images(generated):
-        coco = coco_split(generated, split)
+    for split in splits_with_images(dataset):
+        coco = coco_split(dataset, split)
         for image in coco["images"]:
-            stems = list((generated / "gtFine" / split).rglob(f"*_{image['id']:06d}_gtFine_labelIds.png"))
+            stems = list((dataset / "gtFine" / split).rglob(f"*_{image['id']:06d}_gtFine_labelIds.png"))
             assert len(stems) == 1, (split, image["id"], stems)
             label_path = stems[0]
             label_ids = read_png(label_path)
@@ -289,28 +298,28 @@ def test_cityscapes_instance_ids_are_class_times_1000_plus_k_and_agree_with_coco
             # leftImg8bit is the very RGB file of images/
             left = label_path.parents[3] / "leftImg8bit" / split / label_path.parent.name / label_path.name.replace(
                 "_gtFine_labelIds.png", "_leftImg8bit.png")
-            assert left.read_bytes() == (generated / "images" / split / image["file_name"]).read_bytes(), left
+            assert left.read_bytes() == (dataset / "images" / split / image["file_name"]).read_bytes(), left
             checked += 1
     assert checked >= 1
-    assert len(cityscapes_files(generated, "leftImg8bit")) == checked  # no Cityscapes image without COCO image
+    assert len(cityscapes_files(dataset, "leftImg8bit")) == checked  # no Cityscapes image without COCO image
 
 
 # ---------------------------------------------------------------------------------------------------- YOLO
 
 
-def test_supervision_loads_every_split_with_the_coco_boxes(generated):
+def test_supervision_loads_every_split_with_the_coco_boxes(dataset):
     import supervision as sv
 
-    class_map = dataset_class_map(generated)
+    class_map = dataset_class_map(dataset)
     compared = 0
-    for split in splits_with_images(generated):
-        ds = sv.DetectionDataset.from_yolo(images_directory_path=str(generated / "images" / split),
-                                           annotations_directory_path=str(generated / "labels" / split),
-                                           data_yaml_path=str(generated / Layout.DATA_YAML))
+    for split in splits_with_images(dataset):
+        ds = sv.DetectionDataset.from_yolo(images_directory_path=str(dataset / "images" / split),
+                                           annotations_directory_path=str(dataset / "labels" / split),
+                                           data_yaml_path=str(dataset / Layout.DATA_YAML))
         names = list(ds.classes)
         assert names == [c.name for c in class_map.classes if c.isthing and c.id >= 1]  # COCO's categories
         ids = {c.name: c.id for c in class_map.classes}
-        coco = coco_split(generated, split)
+        coco = coco_split(dataset, split)
         detections = {Path(path).name: dets for path, dets in ds.annotations.items()}
         assert sorted(detections) == sorted(i["file_name"] for i in coco["images"]), split
         for image in coco["images"]:
@@ -332,14 +341,14 @@ def test_supervision_loads_every_split_with_the_coco_boxes(generated):
 # ------------------------------------------------------------------------------------------------ metadata
 
 
-def test_metadata_tables_have_one_row_per_image_with_its_camera_condition_and_counts(generated):
+def test_metadata_tables_have_one_row_per_image_with_its_camera_condition_and_counts(dataset):
     import pyarrow.parquet as pq
 
-    class_map = dataset_class_map(generated)
-    manifest = {m["id"]: m for m in manifest_images(generated)}
-    sweep = read_json(generated, Layout.MANIFEST)["provenance"]["config"]  # the run's config, as it recorded it
-    table = pq.read_table(generated / Layout.METADATA_PARQUET).to_pylist()
-    with open(generated / Layout.METADATA_CSV, newline="", encoding="utf-8") as f:
+    class_map = dataset_class_map(dataset)
+    manifest = {m["id"]: m for m in manifest_images(dataset)}
+    sweep = read_json(dataset, Layout.MANIFEST)["provenance"]["config"]  # the run's config, as it recorded it
+    table = pq.read_table(dataset / Layout.METADATA_PARQUET).to_pylist()
+    with open(dataset / Layout.METADATA_CSV, newline="", encoding="utf-8") as f:
         text_rows = list(csv.DictReader(f))
     assert sorted(r["image_id"] for r in table) == sorted(manifest)
     assert [int(r["image_id"]) for r in text_rows] == [r["image_id"] for r in table]
@@ -352,7 +361,7 @@ def test_metadata_tables_have_one_row_per_image_with_its_camera_condition_and_co
     assert wanted <= columns, sorted(wanted - columns)
     annotations = Counter()
     for split in SPLITS:
-        annotations.update((a["image_id"], a["category_id"]) for a in coco_split(generated, split)["annotations"])
+        annotations.update((a["image_id"], a["category_id"]) for a in coco_split(dataset, split)["annotations"])
     for row, text in zip(table, text_rows):
         image = manifest[row["image_id"]]
         assert row["qa_verdict"] == text["qa_verdict"] == image["qa"] and row["name"] == image["name"]
@@ -365,7 +374,7 @@ def test_metadata_tables_have_one_row_per_image_with_its_camera_condition_and_co
         if image["qa"] != "accepted":  # rejected and flagged images are listed with their reasons
             assert row["qa_reasons"] and text["qa_reasons"] == row["qa_reasons"], row["image_id"]
         # pixel counts add up to the image and match its class-id PNG
-        classes = read_png(generated / Layout.frame_file(image["name"], "class.png"))
+        classes = read_png(dataset / Layout.frame_file(image["name"], "class.png"))
         counts = np.bincount(classes.ravel(), minlength=len(class_map.classes))
         for c in class_map.classes:
             assert row[f"pixels.{c.name}"] == counts[c.id] == int(text[f"pixels.{c.name}"]), (row["image_id"], c.name)
@@ -376,17 +385,17 @@ def test_metadata_tables_have_one_row_per_image_with_its_camera_condition_and_co
 # ------------------------------------------------------------------------------------------------ manifest
 
 
-def test_manifest_lists_every_file_with_its_sha256_and_nothing_else(generated):
-    manifest = read_json(generated, Layout.MANIFEST)
+def test_manifest_lists_every_file_with_its_sha256_and_nothing_else(dataset):
+    manifest = read_json(dataset, Layout.MANIFEST)
     entries = [f for image in manifest["images"] for f in image["files"]] + manifest["dataset_files"]
     paths = [e["path"] for e in entries]
     assert len(set(paths)) == len(paths), [p for p, n in Counter(paths).items() if n > 1]
     for entry in entries:
-        data = (generated / entry["path"]).read_bytes()
+        data = (dataset / entry["path"]).read_bytes()
         assert hashlib.sha256(data).hexdigest() == entry["sha256"], entry["path"]
         assert len(data) == entry["bytes"], entry["path"]
-    on_disk = {p.relative_to(generated).as_posix() for p in generated.rglob("*") if p.is_file()}
+    on_disk = {p.relative_to(dataset).as_posix() for p in dataset.rglob("*") if p.is_file()}
     listed = set(paths) | {Layout.MANIFEST}
     assert on_disk == listed, sorted(on_disk ^ listed)
     assert sorted(m["id"] for m in manifest["images"]) == sorted(
-        read_json(generated, Layout.record(m["name"]))["id"] for m in manifest["images"])
+        read_json(dataset, Layout.record(m["name"]))["id"] for m in manifest["images"])
