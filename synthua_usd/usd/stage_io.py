@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdGeom
@@ -11,6 +12,13 @@ from pxr import Sdf, Tf, Usd, UsdGeom
 from synthua_usd.errors import StageError, echo
 
 USD_SUFFIXES = (".usda", ".usdc", ".usd", ".usdz")
+
+
+def tf_message(exc: Exception) -> str:
+    """The message of a Tf error (``Error in '...' at line N in file ... : 'message'``) on one line."""
+    text = _first_line(exc)
+    m = re.search(r" : '(.*)'$", text)
+    return m.group(1) if m else text
 
 
 def _first_line(exc: Exception) -> str:

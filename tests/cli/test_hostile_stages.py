@@ -11,7 +11,6 @@ variation of a stage that renders.
 from __future__ import annotations
 
 import os
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import DATA, SCENARIO
-from hostile import assert_refused, run_synthua, tree_state
+from hostile import assert_refused, run_synthua, small_disk, tree_state
 
 TINY = (DATA / "valid" / "tiny_scene.usda").read_text()
 CAM = "/World/Cam"
@@ -248,22 +247,8 @@ def test_a_file_that_became_a_folder_fails_before_anything_is_replaced(corpus, t
     assert sorted(os.listdir(tmp_path)) == ["out"]
 
 
-def _mount(tmp: Path, options: str) -> Path:
-    where = tmp / "mnt"
-    where.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(where)], capture_output=True)
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a small tmpfs here ({done.stderr.decode().strip()}); CI runs as root and can")
-    return where
-
-
-def _unmount(where: Path) -> None:
-    subprocess.run(["umount", str(where)], check=False)
-
-
 def test_a_full_disk_leaves_the_earlier_results(corpus, tmp_path):
-    disk = _mount(tmp_path, "size=160k")
-    try:
+    with small_disk(tmp_path, "size=160k") as disk:
         out = disk / "out"
         first = run_synthua("render", corpus / "tiny.usda", "--camera", CAM, "--width", "16", "--height", "12",
                             "--spp", "1", "--out", out)
@@ -274,18 +259,13 @@ def test_a_full_disk_leaves_the_earlier_results(corpus, tmp_path):
         assert_refused(result, "no space left on device")
         assert tree_state(out) == before
         assert sorted(os.listdir(disk)) == ["out"]  # the staging folder is gone too
-    finally:
-        _unmount(disk)
 
 
 def test_a_read_only_disk_is_one_line(corpus, tmp_path):
-    disk = _mount(tmp_path, "size=64k,ro")
-    try:
+    with small_disk(tmp_path, "size=64k,ro") as disk:
         result = run_synthua("render", corpus / "tiny.usda", "--camera", CAM, "--width", "8", "--height", "6",
                              "--spp", "1", "--out", disk / "out")
         assert_refused(result, "read-only")
-    finally:
-        _unmount(disk)
 
 
 def test_native_usd_diagnostics_become_one_line_warnings(tmp_path):
