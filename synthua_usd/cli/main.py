@@ -102,8 +102,9 @@ def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: b
     """Validate a USD STAGE: OpenUSD's UsdValidation validators plus synthua's rules.
 
     synthua's rules: every renderable gprim has exactly one class (directly or from one ancestor), every
-    label is in the class map, cameras have valid physical lens values, stage metadata is stated, and
-    render settings name a real camera.
+    label is in the class map, cameras have valid physical lens values, stage metadata is stated, render
+    settings name a real camera, every authored number is finite, Cube/Sphere/Cylinder/Cone/Capsule sizes
+    are > 0; when none finds an error, the stage is read as render reads it.
     """
     from synthua_usd.usd.stage_checks import validate_stage as run_rules
     from synthua_usd.usd.stage_io import open_stage

@@ -108,7 +108,8 @@ def check_textures_inside(stage: Usd.Stage, path: Path) -> None:
 
 
 def check_stage_metadata(stage: Usd.Stage, path: Path) -> None:
-    """metersPerUnit finite and > 0, upAxis Y or Z: every length and direction depends on them."""
+    """metersPerUnit finite and > 0, upAxis Y or Z, timeCodesPerSecond finite and > 0, a finite time range with
+    start <= end: every length, direction and time code depends on them."""
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
     if not (math.isfinite(mpu) and mpu > 0):
         raise StageError(f"{path}: metersPerUnit is {mpu!r}; expected a finite number > 0 (1 for metres)")
@@ -118,6 +119,12 @@ def check_stage_metadata(stage: Usd.Stage, path: Path) -> None:
     fps = stage.GetTimeCodesPerSecond()
     if not (math.isfinite(fps) and fps > 0):
         raise StageError(f"{path}: timeCodesPerSecond is {fps!r}; expected a finite number > 0")
+    start, end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
+    if not (math.isfinite(start) and math.isfinite(end)):
+        raise StageError(f"{path}: the time range is [{start!r}, {end!r}] (startTimeCode, endTimeCode); expected "
+                         f"finite time codes")
+    if stage.HasAuthoredTimeCodeRange() and start > end:
+        raise StageError(f"{path}: startTimeCode {start:g} is after endTimeCode {end:g}; expected start <= end")
 
 
 def _check_file(path: Path) -> None:

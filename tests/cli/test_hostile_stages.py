@@ -76,6 +76,15 @@ BROKEN_STAGES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "upAxis X": (_variant('upAxis = "Z"', 'upAxis = "X"'), ("upAxis",)),
     "label not in the class map": (_variant('["road"]', '["spaceship"]'), ("/World/Ground", "spaceship")),
     "two labels": (_variant('["road"]', '["road", "sidewalk"]'), ("/World/Ground", "2 labels")),
+    "NaN translate": (_variant("(0, 0, 0.5)", "(nan, 0, 0.5)"), ("/World/Box", "finite")),
+    "NaN cube size": (_variant("double size = 1", "double size = nan"), ("/World/Box", "size")),
+    "negative sphere radius": (_variant('def Cube "Box"', 'def Sphere "Box"').replace("double size = 1",
+                                                                                    "double radius = -1"),
+                               ("/World/Box", "radius")),
+    "NaN startTimeCode": (_variant("startTimeCode = 1", "startTimeCode = nan"), ("time range",)),
+    "lens in millimetres on a metre stage": (_variant("focalLength = 0.2", "focalLength = 24").replace(
+        "horizontalAperture = 0.36", "horizontalAperture = 36").replace("verticalAperture = 0.24", "verticalAperture = 24"),
+        (CAM, "tenths of a scene unit")),
 }
 
 #: Cases `validate stage` reports as findings (exit 1) rather than refusing to read (exit 2).
@@ -85,7 +94,8 @@ FINDINGS = {"NaN points": "mesh-topology", "face counts do not match": "mesh-top
             "unsupported light": "supported-prim", "camera with a zero transform": "camera-lens",
             "camera focal length 0": "camera-lens", "orthographic camera": "camera-lens",
             "label not in the class map": "label-in-class-map", "two labels": "gprim-has-one-class",
-            "no geometry": "renderable"}
+            "no geometry": "renderable", "NaN translate": "finite-values", "NaN cube size": "gprim-shape",
+            "negative sphere radius": "gprim-shape", "lens in millimetres on a metre stage": "camera-lens"}
 
 
 @pytest.fixture(scope="module")
