@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, say
 
 
 def worker_time_shares(seconds: dict[str, float]) -> str:
@@ -66,16 +66,16 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
                                            class_map_path=class_map, allow_external_assets=allow_external_assets),
                            show_progress=sys.stderr.isatty())
     s = summary
-    click.echo(f"dataset {s.out_dir}: {s.planned - s.rejected} images ({s.flagged} flagged by QA) and {s.rejected} "
+    say(f"dataset {s.out_dir}: {s.planned - s.rejected} images ({s.flagged} flagged by QA) and {s.rejected} "
                f"rejected by QA, replaced where the pool allowed (rejected.csv); {s.rendered} rendered now, "
                f"{s.resumed} found from an earlier run")
     if s.rendered:
         shares = worker_time_shares(s.seconds)
         peak = max(s.peak_rss_mib.values()) if s.peak_rss_mib else 0.0
-        click.echo(f"{s.rendered / s.wall_seconds * 60:.1f} images/min over {s.wall_seconds:.0f} s; worker time: "
+        say(f"{s.rendered / s.wall_seconds * 60:.1f} images/min over {s.wall_seconds:.0f} s; worker time: "
                    f"{shares}; peak memory per worker {peak:.0f} MiB; {s.bytes_per_image / 2**20:.2f} MiB per image")
     for line in s.shortfalls:
-        click.echo(f"quota not met: {line}")
+        say(f"quota not met: {line}")
     return EXIT_OK
 
 
@@ -89,11 +89,11 @@ def verify(dataset: Path) -> int:
 
     result = run_verify(dataset, show_progress=sys.stderr.isatty())
     for problem in result.problems[:MAX_LISTED]:
-        click.echo(f"problem: {problem}")
+        say(f"problem: {problem}")
     if len(result.problems) > MAX_LISTED:
-        click.echo(f"... and {len(result.problems) - MAX_LISTED} more problems")
+        say(f"... and {len(result.problems) - MAX_LISTED} more problems")
     verdict = "ok" if result.ok else f"{len(result.problems)} problems"
-    click.echo(f"{dataset}: {result.images} images, {result.files} files checked: {verdict}")
+    say(f"{dataset}: {result.images} images, {result.files} files checked: {verdict}")
     return EXIT_OK if result.ok else EXIT_FINDINGS
 
 
@@ -107,8 +107,8 @@ def replay(dataset: Path, image: str) -> int:
 
     result = run_replay(dataset, image)
     for path in result.different:
-        click.echo(f"differs: {path}")
+        say(f"differs: {path}")
     verdict = "byte-identical" if result.ok else f"{len(result.different)} of " \
               f"{len(result.different) + len(result.identical)} files differ"
-    click.echo(f"image {result.image_id} ({result.name}): {verdict}")
+    say(f"image {result.image_id} ({result.name}): {verdict}")
     return EXIT_OK if result.ok else EXIT_FINDINGS

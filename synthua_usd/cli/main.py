@@ -18,7 +18,7 @@ from synthua_usd import __version__
 from synthua_usd.cli.agents_commands import agents
 from synthua_usd.cli.analytics_commands import evaluate, stats
 from synthua_usd.cli.cameras_commands import cameras
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map, say
 from synthua_usd.cli.common import parse_time_codes as _time_codes
 from synthua_usd.cli.dataset_commands import generate, replay, verify
 from synthua_usd.cli.sheet_commands import contact_sheet
@@ -35,7 +35,7 @@ def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
         click.echo(json.dumps([f.to_dict() for f in findings], indent=2))
     else:
         for f in findings:
-            click.echo(f.format())
+            say(f.format())
         counts = {s: sum(1 for f in findings if f.severity is s) for s in Severity}
         click.echo(f"{counts[Severity.ERROR]} errors, {counts[Severity.WARNING]} warnings, {counts[Severity.INFO]} notes",
                    err=True)
@@ -132,7 +132,7 @@ def compose(out: Path, layers: tuple[Path, ...]) -> int:
     from synthua_usd.usd.compose import compose_layers
 
     path = compose_layers(out, list(layers))
-    click.echo(f"wrote {path} ({len(layers)} sublayers)")
+    say(f"wrote {path} ({len(layers)} sublayers)")
     return EXIT_OK
 
 
@@ -164,7 +164,7 @@ def create_street(out_dir: Path) -> int:
     from synthua_usd.usd.scenario_writer import write_scenario
 
     for path in write_scenario(street_scenario(), out_dir):
-        click.echo(f"wrote {path}")
+        say(f"wrote {path}")
     return EXIT_OK
 
 
@@ -183,7 +183,7 @@ def create_district(out_dir: Path, seed: int) -> int:
     paths, rigs = write_scenario_with_rigs(district.district_scenario(seed), district.district_aimed_rigs(), out_dir)
     click.echo(format_table(rigs.report))
     for path in paths:
-        click.echo(f"wrote {path}")
+        say(f"wrote {path}")
     return EXIT_OK
 
 
@@ -246,12 +246,12 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
         doc = frame.document
         visible = sum(1 for i in doc["instances"] if i["pixel_count"])
         condition = f"condition {doc['condition']['name']}, " if doc["condition"] else ""
-        click.echo(f"rendered {doc['camera']['prim_path']} at time code {doc['time_code']:g}: "
+        say(f"rendered {doc['camera']['prim_path']} at time code {doc['time_code']:g}: "
                    f"{doc['image']['width']}x{doc['image']['height']}, {doc['render']['spp']} spp"
                    f"{' denoised' if doc['render'].get('denoise') else ''}, "
                    f"{doc['render']['variant']}, {condition}{visible} visible instances -> {frame.out_dir}")
     files = sum(len(f.files) for f in run.frames)
-    click.echo(f"wrote {files} files for {len(run.frames)} frames to {out_dir} in {time.perf_counter() - t0:.1f} s "
+    say(f"wrote {files} files for {len(run.frames)} frames to {out_dir} in {time.perf_counter() - t0:.1f} s "
                f"({run.loads} scene load{'s' if run.loads != 1 else ''})")
     return EXIT_OK
 

@@ -141,6 +141,25 @@ def _check_file(path: Path) -> None:
         raise StageError(f"{path}: cannot read ({exc.strerror})") from None
 
 
+_CONTROL_OR_SPACE = re.compile(r"[\x00-\x20\x7f]")
+
+
+def prim_path(text: str, where: str, what: str) -> Sdf.Path:
+    """``text`` as an absolute prim path, exactly as written: refused (a :class:`StageError` naming ``where`` and
+    ``what``, e.g. ``--camera``) when it holds control characters or spaces, is not an absolute prim path
+    (a relative path, a property or a variant selection), or is not the path SdfPath reads from it (SdfPath
+    stops reading at a newline: ``/World/Cam\\nX`` would name ``/World/Cam``)."""
+    refused = StageError(f"{where}: {what} '{echo(text)}' is not a prim path; expected an absolute prim path such "
+                         f"as /World/Cameras/CCTV")
+    if _CONTROL_OR_SPACE.search(text) or not text.startswith("/") or not Sdf.Path.IsValidPathString(text):
+        raise refused
+    path = Sdf.Path(text)
+    if not (path.IsPrimPath() and path.IsAbsolutePath()) or path.ContainsPrimVariantSelection() \
+            or str(path) != text:
+        raise refused
+    return path
+
+
 def time_range(stage: Usd.Stage) -> tuple[float, float] | None:
     """(start, end) time codes when the stage states them, else None (a static stage)."""
     if stage.HasAuthoredTimeCodeRange():

@@ -175,6 +175,12 @@ def test_external_layers_are_accepted_when_allowed(corpus, run_cli):
 BAD_PARAMETERS = {
     "unknown camera": (["--camera", "/World/Nope"], ("/World/Nope",)),
     "camera path with a newline": (["--camera", "/World/Ca\nm"], ("\\n",)),
+    "a camera's path, a newline and more": (["--camera", "/World/Cam\nX"], ("/World/Cam\\nX", "not a prim path")),
+    "camera path with a trailing slash": (["--camera", "/World/Cam/"], ("/World/Cam/", "not a prim path")),
+    "camera path with a space": (["--camera", "/World/Cam "], ("not a prim path",)),
+    "relative camera path": (["--camera", "World/Cam"], ("World/Cam", "not a prim path")),
+    "camera path of a property": (["--camera", "/World/Cam.focalLength"], ("not a prim path",)),
+    "camera path with a variant selection": (["--camera", "/World{v=a}Cam"], ("not a prim path",)),
     "time code out of range": (["--time-code", "500"], ("time code 500",)),
     "time code NaN": (["--time-code", "nan"], ("--time-code",)),
     "time code infinite": (["--time-code", "inf"], ("--time-code",)),
@@ -187,6 +193,23 @@ BAD_PARAMETERS = {
     "unknown variant": (["--variant", "teapot_rgb"], ("teapot_rgb",)),
     "class map is not JSON": (["--class-map", str(DATA / "invalid" / "not_json.json")], ("not_json.json",)),
 }
+
+
+def test_paths_echoed_on_stdout_are_escaped(corpus, tmp_path, run_cli):
+    """What stdout echoes of the user's input is escaped as the error messages are: one line each, no control
+    characters (a newline in --out cannot forge a line, an escape sequence cannot reach the terminal)."""
+    stage = tmp_path / "ti\x1b[2Jny.usda"
+    stage.write_text(TINY)
+    runs = [run_cli("render", corpus / "tiny.usda", "--camera", CAM, "--width", "8", "--height", "6", "--spp", "1",
+                    "--out", tmp_path / "o\nut"),
+            run_cli("compose", tmp_path / "ro\not.usda", corpus / "tiny.usda"),
+            run_cli("inspect", stage)]
+    for code, out, err in runs:
+        assert code == 0, err
+        assert not any(c in out.replace("\n", "") for c in "\x1b\r\x00"), out
+        assert "o\\nut" in out or "ro\\not.usda" in out or "ti\\x1b[2Jny.usda" in out, out
+    assert all(line.startswith(("rendered ", "wrote ")) for line in runs[0][1].splitlines()), runs[0][1]
+    assert runs[1][1].count("\n") == 1, runs[1][1]
 
 
 @pytest.mark.parametrize("name", sorted(BAD_PARAMETERS))
