@@ -333,3 +333,14 @@ def test_populate_refuses_nonsense(corpus, tmp_path, run_cli):
 def test_populate_on_a_surface_nobody_walks_on_ends(tmp_path):
     result = run_synthua("agents", "populate", SCENARIO, "--walk-on", "door", "--out", tmp_path / "a.usdc", timeout=60)
     assert_refused(result, "walkable surface")
+
+
+@pytest.mark.parametrize("args", [
+    ["render", "{corpus}/NaN_translate.usda", "--camera", CAM, "--width", "8", "--height", "6", "--spp", "1"],
+    ["cameras", "author", str(SCENARIO), "--rig", "cctv:k1=1e308", "--width", "16", "--height", "16"],
+], ids=["NaN translate", "k1=1e308"])
+def test_numpy_warnings_about_the_refused_value_do_not_come_before_the_error(args, corpus, tmp_path):
+    """numpy's "invalid value encountered" about the NaN being refused would only repeat the error line."""
+    result = run_synthua(*[a.format(corpus=corpus) for a in args], "--out", tmp_path / "out.usda")
+    assert_refused(result)
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
