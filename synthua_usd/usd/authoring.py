@@ -13,6 +13,7 @@ import numpy as np
 from pxr import Gf, Kind, Sdf, Tf, Usd, UsdGeom, UsdSemantics, UsdShade, Vt
 
 from synthua_usd.atomic import atomic_path, write_failure
+from synthua_usd.errors import InputError, echo
 from synthua_usd.scenario import StageMetadata
 from synthua_usd.scene import Material
 from synthua_usd.usd.stage_io import tf_message
@@ -36,6 +37,20 @@ def apply_metadata(stage: Usd.Stage, meta: StageMetadata) -> None:
     stage.GetRootLayer().defaultPrim = meta.default_prim
 
 
+#: The extensions a layer is written under: OpenUSD picks the format by them (``.usd`` is a crate) and
+#: writes text under any other name, a USDA that no USD tool opens as ``out.txt``. (``.usdz`` is a package.)
+LAYER_SUFFIXES = (".usda", ".usdc", ".usd")
+
+
+def check_layer_path(path: str | Path, what: str = "the layer") -> Path:
+    """``path`` when its extension is one of :data:`LAYER_SUFFIXES`, else an :class:`InputError` naming it."""
+    path = Path(path)
+    if path.suffix.lower() not in LAYER_SUFFIXES:
+        raise InputError(f"{echo(path)}: {what} needs a USD file name (.usda text, .usdc binary or .usd); found the "
+                         f"extension '{echo(path.suffix)}'")
+    return path
+
+
 def save_layer_atomic(layer: Sdf.Layer, path: str | Path) -> Path:
     """Export ``layer`` to ``path`` through a temporary file and a rename; the suffix picks the format
     (``.usda`` text, ``.usdc`` binary crate)."""
@@ -50,6 +65,7 @@ def export_layer(layer: Sdf.Layer, tmp: Path, path: Path) -> None:
     """Write ``layer`` to the temporary file ``tmp`` of the output ``path``. OpenUSD reports a failed write
     (a full disk, a file-size limit) as a Tf error or a False without an errno: either becomes the
     ``OSError`` naming ``path`` that :func:`synthua_usd.atomic.write_failure` finds (ENOSPC on a full disk)."""
+    check_layer_path(path)
     try:
         written = layer.Export(str(tmp))
         reason = "OpenUSD could not write the layer"

@@ -317,6 +317,10 @@ def test_compose_refuses_nonsense(corpus, tmp_path, run_cli):
     assert code == 2 and "itself" in err, err
     code, _, err = run_cli("compose", tmp_path / "y.usda", tmp_path / "nope.usda")
     assert code == 2 and "nope.usda" in err and not (tmp_path / "y.usda").exists()
+    for name in ("out.txt", "out", "out.usdz", "out.usda.bak"):  # OpenUSD wrote USDA text under any of them
+        code, _, err = run_cli("compose", tmp_path / name, corpus / "tiny.usda")
+        assert code == 2 and name in err and "USD file name" in err, err
+        assert not (tmp_path / name).exists()
 
 
 def test_populate_refuses_nonsense(corpus, tmp_path, run_cli):
