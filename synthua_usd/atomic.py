@@ -23,6 +23,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
+from synthua_usd.dataset.layout import check_outside_datasets
 from synthua_usd.errors import OutputError, SynthuaError
 
 
@@ -117,11 +118,13 @@ def output_set(out_dir: str | Path) -> Iterator[Path]:
     On success, when ``out_dir`` does not exist the staging folder is renamed to it (one atomic step);
     otherwise every staged file replaces its counterpart in ``out_dir`` (files of ``out_dir`` that the set
     does not hold are kept). Every target is checked before the first move, so a file that would land on
-    a folder, or below a file, fails with nothing moved. On any error the staging folder is removed.
+    a folder, or below a file, fails with nothing moved. On any error the staging folder is removed. An
+    ``out_dir`` in a dataset folder is refused (:func:`synthua_usd.dataset.layout.check_outside_datasets`).
     """
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise OutputError(f"{out_dir}: output folder is a file; expected a folder or a path that does not exist")
+    check_outside_datasets(out_dir)
     parent = out_dir.parent
     try:
         parent.mkdir(parents=True, exist_ok=True)

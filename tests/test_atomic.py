@@ -132,3 +132,15 @@ def test_write_failure_tells_a_full_file_from_another_failure(tmp_path):
     other = write_failure(tmp_path / "x.usdc", tmp, f"could not open {tmp}")
     assert other.errno == errno.EIO and other.strerror == f"could not open {tmp_path / 'x.usdc'}"
     assert write_failure(tmp_path / "x.usdc", tmp, "", size=2**62).errno == errno.ENOSPC
+
+
+@pytest.mark.parametrize("marker", ["manifest.json", "generate.json"])
+def test_no_output_set_lands_in_a_dataset(tmp_path, marker):
+    """Only generate writes into a dataset: a render or a report there would be files its manifest does not
+    list."""
+    dataset = folder(tmp_path / "ds", **{marker: "{}"})
+    for out in (dataset, dataset / "frames" / "mine"):
+        with pytest.raises(OutputError, match="dataset folder"):
+            with output_set(out):
+                pass
+    assert [p.name for p in dataset.iterdir()] == [marker]

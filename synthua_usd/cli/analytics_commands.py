@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK, say
+from synthua_usd.dataset.layout import check_outside_datasets
 from synthua_usd.errors import InputError
 
 
@@ -38,6 +39,8 @@ def stats(dataset: Path, out_dir: Path, samples: int) -> int:
     """
     from synthua_usd.analytics.dataset_index import load_index
     from synthua_usd.analytics.report import write_report
+
+    check_outside_datasets(out_dir)  # before the work: write_report would refuse it at the end
     from synthua_usd.analytics.statistics import compute
 
     t0 = time.perf_counter()
@@ -82,6 +85,7 @@ def evaluate(gt_dir: Path, pred: Path, out_dir: Path, split: str | None) -> int:
     from synthua_usd.analytics.evaluation_report import write_evaluation
     from synthua_usd.input_files import shown
 
+    check_outside_datasets(out_dir)  # before the work: write_evaluation would refuse it at the end
     if pred.suffix.lower() == ".json":
         coco = evaluate_coco(gt_dir, pred, split)
         write_evaluation(out_dir, None, coco)

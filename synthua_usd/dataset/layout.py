@@ -136,3 +136,15 @@ def inside(root: Path, relative: str) -> Path:
         raise OutputError(f"{escape(relative)!r}: a path that leaves the dataset folder or hides in it; expected a "
                           f"plain relative path inside the dataset folder")
     return Path(root).joinpath(*parts)
+
+
+def check_outside_datasets(out_dir: Path) -> None:
+    """Refuse an output folder that is a dataset folder (one holding ``manifest.json`` or ``generate.json``)
+    or lies inside one: a report or a render written there would be files its manifest does not list, and
+    could replace files it does. Only ``synthua generate`` writes into a dataset."""
+    target = Path(out_dir).resolve()
+    for folder in (target, *target.parents):
+        if (folder / Layout.MANIFEST).is_file() or (folder / Layout.CONFIG).is_file():
+            where = "is the dataset folder" if folder == target else "lies inside the dataset folder"
+            raise OutputError(f"{escape(out_dir)}: the output folder {where} {escape(folder)}; expected a folder "
+                              f"outside every dataset (only `synthua generate` writes into one)")
