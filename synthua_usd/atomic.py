@@ -41,13 +41,13 @@ def atomic_path(path: str | Path, mode: int = 0o644) -> Iterator[Path]:
         os.replace(tmp, path)
     except OSError as exc:
         # mkstemp names its own random file; the writer and os.replace name ``tmp``
-        raise _renamed(exc, Path(tmp) if tmp else path.parent, path, whole=tmp is None) from None
+        raise renamed(exc, Path(tmp) if tmp else path.parent, path, whole=tmp is None) from None
     finally:
         if tmp is not None and os.path.exists(tmp):
             os.unlink(tmp)
 
 
-def _renamed(exc: OSError, old: Path, new: Path, whole: bool = False) -> OSError:
+def renamed(exc: OSError, old: Path, new: Path, whole: bool = False) -> OSError:
     """``exc`` naming ``new`` wherever it named ``old`` or a path below it (``whole``: any path directly
     in the folder ``old`` is ``new`` itself, as mkstemp's random names are); ``exc`` itself when it names
     neither."""
@@ -71,6 +71,20 @@ def _renamed(exc: OSError, old: Path, new: Path, whole: bool = False) -> OSError
         return type(exc)(*args)
     except TypeError:
         return OSError(*args)
+
+
+@contextmanager
+def named_as(folder: Path, shown: Path) -> Iterator[None]:
+    """Failures of the block that name ``folder`` (a staging or scratch folder the user never asked for) or a
+    path below it name ``shown`` instead: an ``OSError``'s file names, a :class:`SynthuaError`'s text."""
+    try:
+        yield
+    except OSError as exc:
+        raise renamed(exc, folder, shown) from None
+    except SynthuaError as exc:
+        if str(folder) not in str(exc):
+            raise
+        raise type(exc)(str(exc).replace(str(folder), str(shown))) from None
 
 
 def write_failure(path: str | Path, tmp: str | Path, reason: str, size: int = 0) -> OSError:
@@ -133,14 +147,9 @@ def output_set(out_dir: str | Path) -> Iterator[Path]:
     except FileExistsError:
         raise OutputError(f"{out_dir}: a parent of the output folder is a file; expected folders") from None
     try:
-        yield staging
-        _move_into_place(staging, out_dir)
-    except OSError as exc:
-        raise _renamed(exc, staging, out_dir) from None
-    except SynthuaError as exc:
-        if str(staging) not in str(exc):
-            raise
-        raise type(exc)(str(exc).replace(str(staging), str(out_dir))) from None
+        with named_as(staging, out_dir):
+            yield staging
+            _move_into_place(staging, out_dir)
     finally:
         if staging.exists():
             shutil.rmtree(staging, ignore_errors=True)
