@@ -52,8 +52,8 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
     per condition and per rig type) and splits them train/val/test by camera. Per image: RGB, class ids,
     class colours, instance ids and a coloured preview, panoptic PNG, depth, amodal masks, occlusion and
     truncation, person keypoints and device contact points with visibility flags, QA verdicts. Per dataset:
-    COCO instances (with keypoints) and panoptic JSON, Cityscapes gtFine, YOLO labels and data.yaml,
-    metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
+    COCO instances (with keypoints), person keypoints and panoptic JSON, Cityscapes gtFine, YOLO labels and
+    data.yaml, metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
     \b
     Killed or failed runs resume: run the same command again; finished images are kept.
     The same config, scenario and variant give the same bytes (check one image: synthua replay).
@@ -82,9 +82,11 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
 @click.command()
 @click.argument("dataset", type=click.Path(path_type=Path))
 def verify(dataset: Path) -> int:
-    """Check DATASET against its manifest: every file present with its size and SHA-256, every planned
-    image complete, every COCO annotation equal to its instance's pixels (a visible keypoint within 2
-    pixels of them), every panoptic segment equal to its PNG, Cityscapes and YOLO files consistent. Exit 1 on any problem, listed one per line."""
+    """Check DATASET against its manifest: every file present with its size and SHA-256 and no file it does
+    not list, every planned image complete, every COCO annotation equal to its instance's pixels (a visible
+    keypoint within 2 pixels of them), every panoptic segment equal to its PNG, Cityscapes and YOLO files
+    consistent. Exit 1 on any problem, listed one per line; 2 when the manifest or generate.json is
+    malformed."""
     from synthua_usd.pipeline.verify import MAX_LISTED, verify as run_verify
 
     result = run_verify(dataset, show_progress=sys.stderr.isatty())
@@ -102,7 +104,8 @@ def verify(dataset: Path) -> int:
 @click.argument("image")
 def replay(dataset: Path, image: str) -> int:
     """Render IMAGE (an image id or name) of DATASET again, as its generate.json says, and compare every
-    file with the dataset's byte for byte. Exit 0 when all are identical, 1 otherwise."""
+    file with the dataset's file on disk byte for byte (each one that differs or is missing is listed).
+    Exit 0 when all are identical, 1 otherwise."""
     from synthua_usd.pipeline.verify import replay as run_replay
 
     result = run_replay(dataset, image)

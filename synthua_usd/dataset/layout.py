@@ -7,6 +7,7 @@ One layout serves every format at once, so that the RGB image is written once::
       labels/{split}/{name}.txt                  YOLO segmentation labels (Ultralytics convention)
       data.yaml                                  YOLO dataset file
       annotations/instances_{split}.json         COCO instances, RLE masks
+      annotations/person_keypoints_{split}.json  COCO person keypoints (the person category only)
       annotations/panoptic_{split}.json          COCO panoptic
       annotations/panoptic_{split}/{name}.png    COCO panoptic PNGs (id = R + 256 G + 256² B)
       gtFine/{split}/{city}/{city}_{seq}_{frame}_gtFine_{labelIds,instanceIds,color}.png   Cityscapes
@@ -112,6 +113,10 @@ class Layout:
     @staticmethod
     def coco_instances(split: str) -> str:
         return f"annotations/instances_{split}.json"
+
+    @staticmethod
+    def coco_person_keypoints(split: str) -> str:
+        return f"annotations/person_keypoints_{split}.json"
 
     @staticmethod
     def coco_panoptic(split: str) -> str:

@@ -390,8 +390,9 @@ def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: G
     root = layout.root
     written = []
     for split in SPLITS:
-        written.append(_write_json(layout.path(Layout.coco_instances(split)),
-                                   coco.coco_instances(records, class_map, split)))
+        instances = coco.coco_instances(records, class_map, split)
+        written.append(_write_json(layout.path(Layout.coco_instances(split)), instances))
+        written.append(_write_json(layout.path(Layout.coco_person_keypoints(split)), coco.person_keypoints(instances)))
         written.append(_write_json(layout.path(Layout.coco_panoptic(split)),
                                    panoptic.coco_panoptic(records, class_map, split)))
     written.append(write_text_atomic(layout.path(Layout.DATA_YAML), yolo.data_yaml(class_map)))

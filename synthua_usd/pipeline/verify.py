@@ -4,7 +4,7 @@
 and the plan (every planned image has a record), every file's size and SHA-256 against the manifest, that
 the folder holds no file the manifest does not list, and cross-file consistency: every COCO annotation's
 mask is its instance's pixels in ``instance.png`` (area and box included) and every visible thing instance
-has one; every panoptic segment matches its PNG exactly; the Cityscapes label ids are the class map's ids of
+has one; the person keypoints file is the person part of the instances file; every panoptic segment matches its PNG exactly; the Cityscapes label ids are the class map's ids of
 ``class.png``; YOLO has one line per annotated instance. A record or an annotation document that is not
 what generate writes is a problem of the dataset, never a crash.
 
@@ -163,6 +163,7 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         coco_images.update({img["id"]: split for img in images})
         for ann in annotations:
             coco_by_image.setdefault(ann["image_id"], []).append(ann)
+        _check_person_keypoints(layout, split, document, result)
     kept = {r["id"]: r for r in records if not is_rejected(r)}
     for image_id in sorted(set(coco_by_image) - set(kept), key=str):
         result.add(f"COCO annotations of image {echo(image_id)}: no such image kept in the dataset (unknown or "
@@ -193,6 +194,21 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
             result.add(f"image {record['id']} ({record['name']}): cannot be checked: {type(exc).__name__}: "
                        f"{echo(exc)}")
     return result
+
+
+def _check_person_keypoints(layout: Layout, split: str, instances: dict, result: Verification) -> None:
+    """``person_keypoints_{split}.json`` is the person part of the split's (checked) instances document."""
+    from synthua_usd.dataset.formats.coco import person_keypoints
+
+    relative = Layout.coco_person_keypoints(split)
+    document = _document(layout, relative, "COCO person keypoints", result)
+    try:
+        expected = person_keypoints(instances)
+    except (KeyError, TypeError):
+        expected = None
+    if document is not None and document != expected:
+        result.add(f"{relative}: differs from the person category and annotations of "
+                   f"{Layout.coco_instances(split)}")
 
 
 def _check_file(layout: Layout, entry: dict, result: Verification) -> bool:
