@@ -60,3 +60,14 @@ def test_a_usd_layer_past_the_file_size_limit_is_one_line_and_leaves_nothing(nam
     message = assert_refused(result, "file too large", str(tmp_path))
     assert ".partial" not in message and "/." not in message, message
     assert os.listdir(tmp_path) == []
+
+
+def test_an_output_folder_that_cannot_take_the_files_is_named_not_the_staging_folder(tmp_path):
+    """The output folder is a read-only mount in a writable folder: the staging folder is made beside it, and
+    moving the files in fails; the message names out/<file>, never .out.partial-XXXX/<file>."""
+    with small_disk(tmp_path, "size=64k,ro") as disk:
+        result = run_synthua("render", TINY, "--camera", "/World/Cam", "--width", "8", "--height", "6", "--spp", "1",
+                             "--out", disk)
+        message = assert_refused(result, str(disk))
+        assert ".partial" not in message, message
+        assert sorted(os.listdir(tmp_path)) == ["mnt"]
