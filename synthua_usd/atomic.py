@@ -55,9 +55,9 @@ def renamed(exc: OSError, old: Path, new: Path, whole: bool = False) -> OSError:
         if name is None:
             return None
         name = Path(os.fsdecode(name))
-        if whole and name.parent == old:
-            return new
-        if name == old or name.is_relative_to(old):
+        if whole:
+            return new if name.parent == old else None
+        if name.is_relative_to(old):
             return new / name.relative_to(old)
         return None
 

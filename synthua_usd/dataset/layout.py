@@ -143,13 +143,21 @@ def inside(root: Path, relative: str) -> Path:
     return Path(root).joinpath(*parts)
 
 
+def is_dataset_folder(folder: Path) -> bool:
+    """Whether ``folder`` holds a dataset of ``synthua generate``: its ``records/`` folder beside its
+    ``manifest.json`` or ``generate.json`` (either name alone is common among other tools' files)."""
+    folder = Path(folder)
+    return (folder / "records").is_dir() and ((folder / Layout.MANIFEST).is_file() or
+                                              (folder / Layout.CONFIG).is_file())
+
+
 def check_outside_datasets(out_dir: Path) -> None:
-    """Refuse an output folder that is a dataset folder (one holding ``manifest.json`` or ``generate.json``)
-    or lies inside one: a report or a render written there would be files its manifest does not list, and
-    could replace files it does. Only ``synthua generate`` writes into a dataset."""
+    """Refuse an output folder that is a dataset folder (:func:`is_dataset_folder`) or lies inside one: a
+    report or a render written there would be files its manifest does not list, and could replace files it
+    does. Only ``synthua generate`` writes into a dataset."""
     target = Path(out_dir).resolve()
     for folder in (target, *target.parents):
-        if (folder / Layout.MANIFEST).is_file() or (folder / Layout.CONFIG).is_file():
+        if is_dataset_folder(folder):
             where = "is the dataset folder" if folder == target else "lies inside the dataset folder"
             raise OutputError(f"{escape(out_dir)}: the output folder {where} {escape(folder)}; expected a folder "
                               f"outside every dataset (only `synthua generate` writes into one)")
