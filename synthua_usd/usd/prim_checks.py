@@ -60,22 +60,22 @@ def mesh_topology(prim: Usd.Prim, t: Usd.TimeCode, rule: str = "mesh-topology") 
     return out, (points, counts, indices)
 
 
-#: The size parameters of the implicit gprims, each > 0 (a Capsule's height, its cylinder part, may be 0).
-SHAPE_PARAMETERS = {"Cube": (("size", 0.0, False),), "Sphere": (("radius", 0.0, False),),
-                    "Cylinder": (("radius", 0.0, False), ("height", 0.0, False)),
-                    "Cone": (("radius", 0.0, False), ("height", 0.0, False)),
-                    "Capsule": (("radius", 0.0, False), ("height", 0.0, True))}
+#: The size parameters of the implicit gprims and whether 0 is allowed (a Capsule's height, its cylinder
+#: part, may be 0: a sphere); every other must be > 0.
+SHAPE_PARAMETERS = {"Cube": (("size", False),), "Sphere": (("radius", False),),
+                    "Cylinder": (("radius", False), ("height", False)), "Cone": (("radius", False), ("height", False)),
+                    "Capsule": (("radius", False), ("height", True))}
 
 
 def shape_findings(prim: Usd.Prim, t: Usd.TimeCode, rule: str = "gprim-shape") -> list[Finding]:
     """An implicit gprim's (Cube, Sphere, Cylinder, Cone, Capsule) size, radius and height at ``t``: finite
-    and > 0 (scene units). Other prims have none."""
+    and > 0 (scene units; see :data:`SHAPE_PARAMETERS`). Other prims have none."""
     out = []
-    for name, low, closed in SHAPE_PARAMETERS.get(prim.GetTypeName(), ()):
+    for name, zero_allowed in SHAPE_PARAMETERS.get(prim.GetTypeName(), ()):
         value = prim.GetAttribute(name).Get(t)
-        if value is None or not math.isfinite(value) or not (value >= low if closed else value > low):
+        if value is None or not math.isfinite(value) or value < 0 or (value == 0 and not zero_allowed):
             out.append(Finding(rule, str(prim.GetPath()), f"{name} is {value}; expected a finite value "
-                                                          f"{'>=' if closed else '>'} {low:g}"))
+                                                          f"{'>=' if zero_allowed else '>'} 0"))
     return out
 
 

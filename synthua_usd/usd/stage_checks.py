@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from pxr import Gf, Usd, UsdGeom, UsdLux, UsdRender, UsdValidation
 
-from synthua_usd.errors import StageError
+from synthua_usd.errors import SynthuaError
 from synthua_usd.findings import Finding, Severity
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.prim_checks import (SHAPE_PARAMETERS, camera_findings, label_findings, mesh_topology,
@@ -153,10 +153,9 @@ def _numbers(value) -> np.ndarray | None:
     if isinstance(value, (Gf.Quatd, Gf.Quatf, Gf.Quath)):
         return np.array([value.GetReal(), *value.GetImaginary()], float)
     try:
-        numbers = np.asarray(value, dtype=float)
+        return np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         return None
-    return numbers
 
 
 class FiniteValuesRule:
@@ -170,22 +169,27 @@ class FiniteValuesRule:
     def check(self, ctx: RuleContext) -> list[Finding]:
         out = []
         for prim in ctx.prims():
-            shape = {name for name, _, _ in SHAPE_PARAMETERS.get(prim.GetTypeName(), ())}  # GprimShapeRule's
+            shape = {name for name, _ in SHAPE_PARAMETERS.get(prim.GetTypeName(), ())}  # GprimShapeRule's
             for attr in prim.GetAttributes():
                 if attr.GetTypeName().isArray or not attr.HasAuthoredValue() or attr.GetName() in shape:
                     continue
-                # A custom attribute may say "unbounded" with infinity (synthua:condition:fogVisibilityM = inf:
-                # no fog); a schema attribute, and NaN anywhere, may not.
-                custom = attr.IsCustom()
-                times = [Usd.TimeCode.Default()] + [Usd.TimeCode(t) for t in attr.GetTimeSamples()]
-                for t in times:
-                    numbers = _numbers(attr.Get(t))
-                    if numbers is not None and (np.isnan(numbers).any() if custom else not np.isfinite(numbers).all()):
-                        when = "by default" if t.IsDefault() else f"at time code {t.GetValue():g}"
-                        out.append(Finding(self.name, str(prim.GetPath()), f"{attr.GetName()} is {attr.Get(t)} {when}; "
-                                                                           f"expected {'numbers' if custom else 'finite numbers'}"))
-                        break
+                finding = self._first_bad_value(attr)
+                if finding:
+                    out.append(Finding(self.name, str(prim.GetPath()), finding))
         return out
+
+    @staticmethod
+    def _first_bad_value(attr: Usd.Attribute) -> str | None:
+        # A custom attribute may say "unbounded" with infinity (synthua:condition:fogVisibilityM = inf: no fog);
+        # a schema attribute, and NaN anywhere, may not.
+        custom = attr.IsCustom()
+        for t in [Usd.TimeCode.Default()] + [Usd.TimeCode(t) for t in attr.GetTimeSamples()]:
+            value = attr.Get(t)
+            numbers = _numbers(value)
+            if numbers is not None and (np.isnan(numbers).any() if custom else not np.isfinite(numbers).all()):
+                when = "by default" if t.IsDefault() else f"at time code {t.GetValue():g}"
+                return f"{attr.GetName()} is {value} {when}; expected {'numbers' if custom else 'finite numbers'}"
+        return None
 
 
 class SupportedPrimRule:
@@ -247,7 +251,7 @@ class RenderReadsRule:
     def check(self, ctx: RuleContext) -> list[Finding]:
         try:
             read_snapshot(ctx.stage, ctx.stage.GetStartTimeCode(), ctx.class_map)
-        except StageError as exc:
+        except SynthuaError as exc:
             text = str(exc)
             where, _, message = text.partition(": ") if text.startswith("/") else (ctx.root, "", text)
             return [Finding(self.name, where, message or text)]
