@@ -14,6 +14,7 @@ from synthua_usd.dataset.layout import Layout
 from synthua_usd.dataset.qa import AidUser, aid_users
 from synthua_usd.errors import InputError
 from synthua_usd.input_files import shown
+from synthua_usd.dataset.manifest import read_manifest
 from synthua_usd.schemas import read_json
 from synthua_usd.taxonomy import ClassMap
 
@@ -75,16 +76,7 @@ def manifest_images(root: Path) -> list[dict]:
     root = Path(root)
     if not root.is_dir():
         raise InputError(f"{shown(root)}: not a folder; expected a dataset folder written by `synthua generate`")
-    manifest_path = root / Layout.MANIFEST
-    if not manifest_path.exists():
-        raise InputError(f"{shown(manifest_path)}: file not found; expected a complete dataset written by "
-                         f"`synthua generate` (the manifest is written last)")
-    manifest = read_json(manifest_path, "a dataset manifest")
-    images = manifest.get("images") if isinstance(manifest, dict) else None
-    if not isinstance(images, list) or not all(isinstance(i, dict) and "name" in i and "split" in i for i in images):
-        raise InputError(f"{shown(manifest_path)}: images: not a list of image entries with name and split; "
-                         f"expected a manifest written by `synthua generate`")
-    return images
+    return read_manifest(root / Layout.MANIFEST)["images"]
 
 
 def _summary(record: dict, verdict: str, where: str) -> ImageSummary:

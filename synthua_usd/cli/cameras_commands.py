@@ -8,7 +8,8 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, parse_time_codes
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, parse_time_codes, say
+from synthua_usd.errors import escape_controls
 
 
 @click.group()
@@ -90,7 +91,7 @@ def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_ta
                                     class_map_path=class_map, allow_external_assets=allow_external_assets),
                          show_progress=sys.stderr.isatty())
     click.echo(format_table(result.report))
-    click.echo(f"wrote {result.layer_path} ({result.accepted} camera{'s' if result.accepted != 1 else ''}) and "
+    say(f"wrote {result.layer_path} ({result.accepted} camera{'s' if result.accepted != 1 else ''}) and "
                f"{result.report_path}")
     if result.rejected:
         click.echo(f"{result.rejected} camera(s) rejected: their target covers fewer than {min_target_px} visible "
@@ -101,7 +102,7 @@ def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_ta
 
 def format_table(report: dict) -> str:
     """One row per camera: rig, target, the target's fewest and most visible pixels over the report's time
-    codes, its largest occluded share, status."""
+    codes, its largest occluded share, status; one line each, control characters escaped."""
     size = report["image"]
     head = (f"{'camera':28s} {'rig':14s} {'target':34s} {'min px':>8s} {'max px':>8s} {'occluded':>9s}  status"
             f"   ({size['width']}x{size['height']}, {len(report['time_codes'])} time codes)")
@@ -116,5 +117,5 @@ def format_table(report: dict) -> str:
         else:
             what, numbers = "-", f"{'-':>8s} {'-':>8s} {'-':>9s}"
         status = cam["status"] + (" (on road)" if cam.get("on_road") else "")
-        lines.append(f"{cam['name']:28s} {cam['rig']:14s} {what:34s} {numbers}  {status}")
+        lines.append(escape_controls(f"{cam['name']:28s} {cam['rig']:14s} {what:34s} {numbers}  {status}"))
     return "\n".join(lines)

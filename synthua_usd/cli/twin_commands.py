@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map, say
 from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
 from synthua_usd.errors import echo
 from synthua_usd.importers import limits as importer_limits
@@ -167,11 +167,11 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
 
         crowd = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=frames, walkable=IMPORT_WALKABLE)
     written, report = write_import(model, out_dir, cmap, report, crowd)
-    click.echo(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
+    say(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
                f"{model.triangle_count()} triangles, classes {model.label_counts()}")
     for seg in model.report.get("segments", []):
         if not seg.get("skipped"):
-            click.echo(f"  {seg['name']}: {seg['points']} points -> {seg['faces']} faces, simplification deviation "
+            say(f"  {seg['name']}: {seg['points']} points -> {seg['faces']} faces, simplification deviation "
                        f"{seg['simplification_deviation_m'] * 1000:.3f} mm, point-to-surface distance p50 "
                        f"{seg['residual_p50_m'] * 1000:.1f} / p95 {seg['residual_p95_m'] * 1000:.1f} / max "
                        f"{seg['residual_max_m'] * 1000:.1f} mm")
@@ -180,14 +180,14 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
         click.echo(f"  building heights: {sources}")
     unmatched = model.report.get("unmatched") or model.report.get("unlabelled_types")
     if unmatched:
-        click.echo(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
+        say(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
     if "population" in report:
         p = report["population"]
-        click.echo(f"  people: {p['placed']} placed ({p['aid_users']} with mobility aids) on "
+        say(f"  people: {p['placed']} placed ({p['aid_users']} with mobility aids) on "
                    f"{p['walkable_area_m2']:.0f} m² walkable, {frames} time codes")
     for name, cam in report["cameras"].items():
-        click.echo(f"  camera {name}: label pass shows the twin in {cam['labelled_share']:.1%} of its pixels")
-    click.echo(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "
+        say(f"  camera {name}: label pass shows the twin in {cam['labelled_share']:.1%} of its pixels")
+    say(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "
                f"--out OUT")
     findings = report.get("findings", [])
     for f in findings:
@@ -208,8 +208,8 @@ def twin_demo(seed: int, out_dir: Path) -> int:
 
     model = build_district(seed)
     files = write_twin_layers(model, out_dir, load_class_map(None), META)
-    click.echo(f"district seed {seed}: {len(model.objects)} objects, {model.triangle_count()} triangles, "
+    say(f"district seed {seed}: {len(model.objects)} objects, {model.triangle_count()} triangles, "
                f"{len(model.label_counts())} classes")
     for path in files:
-        click.echo(f"wrote {path}")
+        say(f"wrote {path}")
     return EXIT_OK

@@ -93,6 +93,45 @@ def rle_from_runs(starts: np.ndarray, lengths: np.ndarray, shape: tuple[int, int
     return {"size": [int(rle["size"][0]), int(rle["size"][1])], "counts": rle["counts"].decode("ascii")}
 
 
+def rle_problem(rle, shape: tuple[int, int]) -> str | None:
+    """Why ``rle`` is not a COCO compressed RLE mask of ``shape`` (H, W), or None when it is one.
+
+    pycocotools decodes ``counts`` without checking it: characters outside '0'..'o', a last character that
+    announces more, a negative run or runs that do not add up to H x W pixels make it read past the string or
+    write past the mask. So the string is decoded here first, as pycocotools' ``rleFrString`` does (5 bits a
+    character, 0x20 continues, 0x10 the sign of the last; from the third count on, a delta from the count
+    two before)."""
+    h, w = shape
+    if not isinstance(rle, dict) or rle.get("size") != [h, w]:
+        return f"{str(rle)[:80]} is not {{'size': [{h}, {w}], 'counts': ...}}, an RLE mask of its image's size"
+    text = rle.get("counts")
+    if not isinstance(text, str):
+        return f"counts is {type(text).__name__}; expected pycocotools' compressed counts (a string)"
+    counts: list[int] = []
+    x = k = 0
+    for p, char in enumerate(text):
+        c = ord(char) - 48
+        if not 0 <= c < 64:
+            return f"counts[{p}] is {char!r}; expected characters '0' to 'o' (compressed counts)"
+        x |= (c & 0x1F) << (5 * k)
+        k += 1
+        if c & 0x20:
+            continue
+        if c & 0x10:
+            x -= 1 << (5 * k)
+        if len(counts) > 2:
+            x += counts[-2]
+        if x < 0:
+            return f"counts decode to a negative run ({x}) at character {p}; expected run lengths >= 0"
+        counts.append(x)
+        x = k = 0
+    if k:
+        return "counts end inside a run length (the last character continues); expected complete counts"
+    if sum(counts) != h * w:
+        return f"counts decode to runs of {sum(counts)} pixels in all; expected {h} x {w} = {h * w}"
+    return None
+
+
 def runs_of_indices(column_major: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(starts, lengths)`` of the maximal runs of sorted, unique column-major flat indices."""
     if not column_major.size:

@@ -42,6 +42,7 @@ from synthua_usd.schemas import validate_document
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd import targets as usd_targets
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
+from synthua_usd.usd.authoring import check_layer_path, export_layer
 from synthua_usd.usd.cameras import camera_paths
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.rig_layer import PlacedRig, build_rig_layer
@@ -163,9 +164,7 @@ def default_time_codes(start: float, end: float, n: int = DEFAULT_REPORT_TIME_CO
 
 
 def _check_request(request: RigRequest) -> None:
-    out = Path(request.out_path)
-    if out.suffix.lower() not in (".usda", ".usdc", ".usd"):
-        raise InputError(f"{echo(out)}: the cameras layer needs a USD file name (.usda, .usdc or .usd)")
+    out = check_layer_path(request.out_path, "the cameras layer")
     if out.exists() and out.resolve() == Path(request.stage_path).resolve():
         raise InputError(f"{echo(out)}: --out is the input stage itself; expected a new layer file")
     if not request.rigs:
@@ -325,6 +324,5 @@ def _write_pair(layer, layer_path: Path, report: dict, report_path: Path) -> Non
     """Both files through temporary files beside them, renamed only when both are complete."""
     layer_path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(report_path) as tmp_report, atomic_path(layer_path) as tmp_layer:
-        if not layer.GetRootLayer().Export(str(tmp_layer)):
-            raise OSError(f"{layer_path}: USD could not write the layer")
+        export_layer(layer.GetRootLayer(), tmp_layer, layer_path)
         tmp_report.write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")

@@ -204,7 +204,8 @@ def write_scenes(request: GenerateRequest, config: GenerationConfig, pool, class
         raise InputError(f"{request.config_path}: {exc}") from None
     clear_partial_scenes(out)
     districts = sorted({district_of(randomise, c.seed) for c in pool})
-    return {d: write_district_scene(request.scenario, d, out / scene_folder(d), class_map) for d in districts}
+    return {d: write_district_scene(request.scenario, d, out / scene_folder(d), class_map, dataset_part=True)
+            for d in districts}
 
 
 def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateSummary:
@@ -461,8 +462,9 @@ def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: G
     root = layout.root
     written = []
     for split in SPLITS:
-        written.append(_write_json(layout.path(Layout.coco_instances(split)),
-                                   coco.coco_instances(records, class_map, split)))
+        instances = coco.coco_instances(records, class_map, split)
+        written.append(_write_json(layout.path(Layout.coco_instances(split)), instances))
+        written.append(_write_json(layout.path(Layout.coco_person_keypoints(split)), coco.person_keypoints(instances)))
         written.append(_write_json(layout.path(Layout.coco_panoptic(split)),
                                    panoptic.coco_panoptic(records, class_map, split)))
     written.append(write_text_atomic(layout.path(Layout.DATA_YAML), yolo.data_yaml(class_map)))

@@ -13,7 +13,7 @@ from synthua_usd.errors import InputError
 from synthua_usd.scenario import StageMetadata
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, build_agents_layer
-from synthua_usd.usd.authoring import save_layer_atomic
+from synthua_usd.usd.authoring import check_layer_path, save_layer_atomic
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.stage_io import open_stage, time_range
 
@@ -34,9 +34,7 @@ def populate(request: PopulateRequest) -> tuple[Crowd, Path, float]:
     them. Everything else, parked devices of the twin included, is terrain or obstacle. Returns the crowd,
     the layer written and the seconds it took."""
     t0 = time.perf_counter()
-    out = Path(request.out_path)
-    if out.suffix.lower() not in (".usda", ".usdc", ".usd"):
-        raise InputError(f"{out}: the agents layer needs a USD file name (.usda, .usdc or .usd)")
+    out = check_layer_path(request.out_path, "the agents layer")
     if out.exists() and out.resolve() == Path(request.stage_path).resolve():
         raise InputError(f"{out}: --out is the input stage itself; expected a new layer file beside it")
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()

@@ -9,7 +9,7 @@ from pathlib import Path
 from pxr import Sdf, UsdGeom
 
 from synthua_usd.errors import StageError, echo
-from synthua_usd.usd.authoring import save_layer_atomic
+from synthua_usd.usd.authoring import check_layer_path, save_layer_atomic
 from synthua_usd.usd.stage_io import open_layer
 
 # Metadata that only the root layer of a stage decides: sublayers' values are ignored on composition,
@@ -22,9 +22,10 @@ def compose_layers(out_path: str | Path, layer_paths: list[str | Path], doc: str
 
     Sublayer paths are written relative to the root's folder. The root takes upAxis, metersPerUnit and
     timeCodesPerSecond from the layers (which must agree), the union of their time ranges, and the
-    first defaultPrim stated. Raises :class:`StageError` for a missing layer or disagreeing metadata.
+    first defaultPrim stated. Raises :class:`StageError` for a missing layer or disagreeing metadata, and
+    :class:`InputError` for an ``out_path`` without a USD layer's extension.
     """
-    out_path = Path(out_path)
+    out_path = check_layer_path(out_path, "the scenario root")
     if not layer_paths:
         raise StageError(f"{out_path}: no layers to compose; give at least one layer file")
     layers = [(Path(p), open_layer(p)) for p in layer_paths]

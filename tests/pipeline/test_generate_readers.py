@@ -123,6 +123,44 @@ def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_i
     assert flags[2] > 0
 
 
+def _default_keypoint_cocoeval(gt, dets: list[dict]) -> list[float]:
+    """COCOeval(gt, dt, "keypoints") exactly as its users call it: every category, the default sigmas."""
+    from pycocotools.cocoeval import COCOeval
+
+    with quiet():
+        ev = COCOeval(gt, gt.loadRes(dets), "keypoints")
+        ev.evaluate()
+        ev.accumulate()
+        ev.summarize()
+    return [float(v) for v in ev.stats]
+
+
+def test_cocoevals_default_keypoint_call_reads_instances_and_person_keypoints(dataset):
+    """The default call reads ``num_keypoints`` of every annotation of every category: on instances_{split}.json
+    (person detections) it runs, on COCO's person_keypoints_{split}.json (the person category only, COCO's
+    sigmas) the person keypoints against themselves give AP 1.0."""
+    from pycocotools.coco import COCO
+
+    evaluated = 0
+    for split in splits_with_images(dataset):
+        with quiet():
+            instances = COCO(str(dataset / Layout.coco_instances(split)))
+            people = COCO(str(dataset / Layout.coco_person_keypoints(split)))
+        person = [c["id"] for c in people.dataset["categories"]]
+        assert [c["name"] for c in people.dataset["categories"]] == ["person"]
+        assert all("num_keypoints" in a for a in instances.dataset["annotations"])
+        dets = [{"image_id": a["image_id"], "category_id": a["category_id"], "keypoints": a["keypoints"], "score": 1.0}
+                for a in people.dataset["annotations"] if a["num_keypoints"]]
+        assert people.dataset["annotations"] == [a for a in instances.dataset["annotations"]
+                                                 if a["category_id"] in person]
+        if not dets:
+            continue
+        assert len(_default_keypoint_cocoeval(instances, dets)) == 10
+        assert _default_keypoint_cocoeval(people, dets)[0] == pytest.approx(1.0), split
+        evaluated += 1
+    assert evaluated >= 1, "no split has labelled person keypoints"
+
+
 def test_coco_ids_categories_and_images_agree_with_the_manifest_and_class_map(dataset):
     class_map = dataset_class_map(dataset)
     things = {c.id for c in class_map.classes if c.isthing and c.id >= 1}
