@@ -77,6 +77,12 @@ def write_color_png(path: Path, rgb8: np.ndarray) -> Path:
     return _write(path, rgb8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE})
 
 
+def write_color_jpeg(path: Path, rgb8: np.ndarray, quality: int = 95) -> Path:
+    """(H, W, 3) uint8 sRGB values as a baseline JPEG of ``quality`` (1..100): MOTChallenge's frame format."""
+    return _write(path, rgb8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE,
+                                                         "compression": f"jpeg:{int(quality)}"})
+
+
 def write_id_png(path: Path, ids: np.ndarray) -> Path:
     """(H, W) uint8 or uint16 ids written raw: no colour conversion, one channel."""
     fmt = "uint8" if ids.dtype == np.uint8 else "uint16"

@@ -59,6 +59,10 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
     material variants and district per seed, the crowd placed anew and the camera moved per view, the light
     drawn per image, all as USD layers composed over SCENARIO (synthua randomise writes an image's layers).
     \b
+    With a sequences block (configs/district_sequences.json) it also renders tracking sequences: each camera x
+    condition x seed for duration_s at fps from one loaded scene, in the MOTChallenge layout (img1/, gt/gt.txt,
+    seqinfo.ini) with tracks.csv, per-frame instance maps, a preview video and COCO video annotations.
+    \b
     Killed or failed runs resume: run the same command again; finished images are kept.
     The same config, scenario and variant give the same bytes (check one image: synthua replay).
     """
@@ -78,6 +82,9 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
         peak = max(s.peak_rss_mib.values()) if s.peak_rss_mib else 0.0
         say(f"{s.rendered / s.wall_seconds * 60:.1f} images/min over {s.wall_seconds:.0f} s; worker time: "
                    f"{shares}; peak memory per worker {peak:.0f} MiB; {s.bytes_per_image / 2**20:.2f} MiB per image")
+    if s.sequences:
+        say(f"{s.sequences} tracking sequences of {s.frames} frames: {s.frames_rendered} rendered now, "
+            f"{s.frames_resumed} found from an earlier run (MOTChallenge layout in {s.out_dir / 'sequences'})")
     for line in s.shortfalls:
         say(f"quota not met: {line}")
     return EXIT_OK
@@ -99,7 +106,8 @@ def verify(dataset: Path) -> int:
     if len(result.problems) > MAX_LISTED:
         say(f"... and {len(result.problems) - MAX_LISTED} more problems")
     verdict = "ok" if result.ok else f"{len(result.problems)} problems"
-    say(f"{dataset}: {result.images} images, {result.files} files checked: {verdict}")
+    sequences = (f", {result.sequences} sequences of {result.frames} frames" if result.sequences else "")
+    say(f"{dataset}: {result.images} images{sequences}, {result.files} files checked: {verdict}")
     return EXIT_OK if result.ok else EXIT_FINDINGS
 
 

@@ -15,6 +15,11 @@ One layout serves every format at once, so that the RGB image is written once::
       frames/{name}/...                          everything else of one image (class, semantic, instance
                                                  ids and preview, depth, optional EXR and one-hot tensor)
       records/{name}.json                        the image's record, written last: the image is complete
+      sequences/{seq}/img1/{frame:06d}.jpg       a tracking sequence in the MOTChallenge layout (seqinfo.ini,
+      sequences/{seq}/gt/gt.txt                  gt/gt.txt), with tracks.csv, instances/{frame:06d}.png (16-bit
+                                                 instance ids), records/{frame:06d}.json (written last) and
+                                                 preview.mp4; sequences/crowds/seed_{s}.usdc its crowd;
+                                                 annotations/sequences.json every sequence as COCO video
       metadata.csv, metadata.parquet, coverage.json, rejected.csv, class_map.json, manifest.json,
       generate.json (the configuration of the run)
 
@@ -108,6 +113,26 @@ class Layout:
     @staticmethod
     def record(name: str) -> str:
         return f"records/{name}.json"
+
+    # per sequence
+    SEQUENCES = "sequences"
+
+    @staticmethod
+    def sequence_file(sequence: str, file_name: str) -> str:
+        """A file of one sequence: ``seqinfo.ini``, ``tracks.csv``, ``preview.mp4``, ``gt/gt.txt``."""
+        return f"sequences/{sequence}/{file_name}"
+
+    @staticmethod
+    def sequence_frame(sequence: str, frame: int, kind: str = "img1") -> str:
+        """Frame ``frame`` (1-based) of a sequence: ``img1`` (JPEG), ``instances`` (PNG) or ``records`` (JSON)."""
+        suffix = {"img1": "jpg", "instances": "png", "records": "json"}[kind]
+        return f"sequences/{sequence}/{kind}/{frame:06d}.{suffix}"
+
+    @staticmethod
+    def sequence_crowd(seed: int) -> str:
+        return f"sequences/crowds/seed_{int(seed)}.usdc"
+
+    SEQUENCES_COCO = "annotations/sequences.json"
 
     # per dataset
     @staticmethod

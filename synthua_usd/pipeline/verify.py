@@ -40,6 +40,9 @@ class Verification:
     images: int = 0
     files: int = 0
     problems: list[str] = field(default_factory=list)
+    #: Tracking sequences checked and their frames.
+    sequences: int = 0
+    frames: int = 0
 
     def add(self, problem: str) -> None:
         self.problems.append(problem)
@@ -193,7 +196,64 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         except Exception as exc:  # noqa: BLE001 - whatever a broken file raises, it is a problem of the dataset
             result.add(f"image {record['id']} ({record['name']}): cannot be checked: {type(exc).__name__}: "
                        f"{echo(exc)}")
+    if isinstance(job.get("sequences"), list):
+        try:
+            _check_sequences(layout, job["sequences"], ClassMap.load(root / Layout.CLASS_MAP), damaged, result)
+        except InputError as exc:
+            result.add(f"{Layout.CLASS_MAP}: {exc}")
     return result
+
+
+def _check_sequences(layout: Layout, planned: list, class_map, damaged: set, result: Verification) -> None:
+    """Every planned frame of every sequence is there; its record's tracked instances have, in its instance map,
+    the pixels the record says; a track keeps one prim, class and link over the sequence; ``gt/gt.txt`` and
+    ``tracks.csv`` are what the records make, and ``seqinfo.ini`` counts the frames."""
+    from synthua_usd.dataset.formats import mot
+    from synthua_usd.dataset.sequences import PlannedSequence
+
+    for document in planned:
+        try:
+            seq = PlannedSequence.from_dict(document)
+        except (TypeError, KeyError, ValueError) as exc:
+            result.add(f"{Layout.CONFIG}: sequences: {echo(exc)}; expected the sequences generate plans")
+            continue
+        result.sequences += 1
+        pairs, tracks = [], {}
+        for k in range(1, seq.frames + 1):
+            relative = Layout.sequence_frame(seq.name, k, "records")
+            record = _document(layout, relative, "a sequence frame's record", result)
+            if record is None:
+                continue
+            result.frames += 1
+            try:
+                instances = record["instances"]
+                pairs.append((k, instances))
+                ids_path = record["files"]["instances"]
+                ids = None if ids_path in damaged else _read(layout, ids_path)
+                for entry in instances:
+                    tid = int(entry["id"])
+                    seen = (entry["prim_path"], entry["class_name"], (entry.get("relations") or {}).get("uses"))
+                    if tracks.setdefault(tid, seen) != seen:
+                        result.add(f"sequence {seq.name} frame {k}: track {tid} is {echo(seen)}, earlier "
+                                   f"{echo(tracks[tid])}; expected a track to keep its prim, class and link")
+                    if ids is not None and int((ids == tid).sum()) != int(entry["area"]):
+                        result.add(f"sequence {seq.name} frame {k}: track {tid} has {int((ids == tid).sum())} "
+                                   f"pixels in {ids_path}, the record says {entry['area']}")
+            except (KeyError, TypeError, ValueError) as exc:
+                result.add(f"{relative}: {type(exc).__name__} {echo(exc)}; expected the record generate writes")
+        if len(pairs) != seq.frames:
+            result.add(f"sequence {seq.name}: {len(pairs)} of {seq.frames} frames have a record (run generate "
+                       f"again to finish it)")
+            continue
+        expected = {"gt/gt.txt": mot.gt_text(mot.gt_rows(pairs, class_map)),
+                    "tracks.csv": mot.tracks_text(pairs, class_map)}
+        for name, text in expected.items():
+            path = layout.path(Layout.sequence_file(seq.name, name))
+            if not path.is_file() or path.read_text(encoding="utf-8") != text:
+                result.add(f"{Layout.sequence_file(seq.name, name)}: missing or not what the frames' records make")
+        info = layout.path(Layout.sequence_file(seq.name, "seqinfo.ini"))
+        if not info.is_file() or f"seqLength={seq.frames}\n" not in info.read_text(encoding="utf-8"):
+            result.add(f"{Layout.sequence_file(seq.name, 'seqinfo.ini')}: missing or not seqLength={seq.frames}")
 
 
 def _check_person_keypoints(layout: Layout, split: str, instances: dict, result: Verification) -> None:
