@@ -9,7 +9,8 @@ Both through the workers `synthua generate` runs (render, amodal masks, annotati
 * a sequence: one worker renders --frames consecutive frames (a crowd populated for them, 10 fps) from one loaded
   scene: the first frame loads it, every later one only updates the sensor and what moved;
 * lone images: --images times, a fresh worker (a new stage, reader and render session) renders one frame of the same
-  view, as a dataset image does when it is the only one of its shard.
+  view, as a dataset image does when it is the only one of its shard; interleaved with the sequence's frames, so
+  that a change of the machine's load touches both alike.
 
 Reported: the mean frame after the first, the mean lone image, their ratio, and where the time went. Not a test:
 the numbers depend on the machine; the ratio comes from one run.
@@ -66,8 +67,12 @@ def main() -> int:
         job = seqs.sequence_job(worker, crowds, plan.time_codes[-1])
         print(f"{args.scenario.name} {args.camera} {args.width}x{args.height} {args.spp} spp + OIDN; the sequence's crowd "
               f"populated and authored in {crowd_s:.1f} s ({args.frames} frames at 10 fps)")
-        frames = []
+        frames, lone = [], []
         state = seqs.init_sequence_worker(job)
+        # Lone images interleaved with the sequence's frames (after frames 2, 2 + step, ...): a change of the
+        # machine's load touches both alike.
+        step = max(1, (args.frames - 1) // max(args.images, 1))
+        lone_after = {2 + j * step for j in range(args.images)}
         for k in range(1, args.frames + 1):
             t0 = time.perf_counter()
             seqs.work_frame(state, PlannedFrame(plan, k))
@@ -75,14 +80,15 @@ def main() -> int:
                 seqs.work_frame(state, FLUSH)
             frames.append(time.perf_counter() - t0)
             print(f"sequence frame {k:3d}: {frames[-1]:6.2f} s", flush=True)
-        lone = []
-        for k in range(args.images):
-            t0 = time.perf_counter()
-            fresh = seqs.init_sequence_worker(job)
-            seqs.work_frame(fresh, PlannedFrame(plan, 1 + k))
-            seqs.work_frame(fresh, FLUSH)
-            lone.append(time.perf_counter() - t0)
-            print(f"lone image {k + 1}: {lone[-1]:6.2f} s (a fresh worker: stage, reader, scene load)", flush=True)
+            if k in lone_after or (k == args.frames and len(lone) < args.images):
+                t0 = time.perf_counter()
+                fresh = seqs.init_sequence_worker(job)
+                seqs.work_frame(fresh, PlannedFrame(plan, k))
+                seqs.work_frame(fresh, FLUSH)
+                lone.append(time.perf_counter() - t0)
+                del fresh
+                print(f"lone image {len(lone)}: {lone[-1]:6.2f} s (a fresh worker: stage, reader, scene load)",
+                      flush=True)
     steady = statistics.mean(frames[1:]) if len(frames) > 1 else frames[0]
     alone = statistics.mean(lone)
     print(f"\nmean sequence frame after the first: {steady:.2f} s; mean lone image: {alone:.2f} s; a frame costs "

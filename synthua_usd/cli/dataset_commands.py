@@ -77,6 +77,11 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
     say(f"dataset {s.out_dir}: {s.planned - s.rejected} images ({s.flagged} flagged by QA) and {s.rejected} "
                f"rejected by QA, replaced where the pool allowed (rejected.csv); {s.rendered} rendered now, "
                f"{s.resumed} found from an earlier run")
+    if s.splits:
+        asked = "/".join(f"{v['share']:g}" for v in s.splits.values())
+        say("split by camera: " + ", ".join(f"{split} {v['images']} images from {v['cameras']} camera"
+                                            f"{'s' if v['cameras'] != 1 else ''}" for split, v in s.splits.items())
+            + f" (asked {asked})")
     if s.rendered:
         shares = worker_time_shares(s.seconds)
         peak = max(s.peak_rss_mib.values()) if s.peak_rss_mib else 0.0

@@ -119,20 +119,24 @@ def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: b
 @cli.command()
 @click.argument("out", type=click.Path(path_type=Path))
 @click.argument("layers", nargs=-1, required=True, type=click.Path(path_type=Path))
-def compose(out: Path, layers: tuple[Path, ...]) -> int:
+@click.option("--allow-external-assets", is_flag=True,
+              help="Compose layers outside OUT's folder tree (refused by default: validate, render and generate "
+                   "then need the same flag).")
+def compose(out: Path, layers: tuple[Path, ...], allow_external_assets: bool) -> int:
     """Write scenario root OUT that sublayers LAYERS (strongest first).
 
     The root states upAxis, metersPerUnit and timeCodesPerSecond (the layers must agree), the union of
-    their time ranges and the first defaultPrim. Paths are stored relative to OUT.
+    their time ranges and the first defaultPrim. Paths are stored relative to OUT. LAYERS lie in OUT's
+    folder tree (a scenario that reaches outside its folder is refused by the commands that open it).
 
     \b
     Example:
-      synthua compose my.usda stages/render.usda stages/environment.usda stages/cameras.usda \\
+      synthua compose stages/my.usda stages/render.usda stages/environment.usda stages/cameras.usda \\
           stages/agents.usdc stages/semantics.usda stages/twin.usdc
     """
     from synthua_usd.usd.compose import compose_layers
 
-    path = compose_layers(out, list(layers))
+    path = compose_layers(out, list(layers), allow_external_assets=allow_external_assets)
     say(f"wrote {path} ({len(layers)} sublayers)")
     return EXIT_OK
 
@@ -239,8 +243,8 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     \b
     Files per frame (the stage's UsdRender vars choose; all when it names none): rgb.exr
     (scene-linear Rec.709) and rgb.png (display sRGB), class.png (8-bit class ids) and semantic.png
-    (class colours), instance.png (16-bit instance ids, 0 = none), depth.exr (z-depth in metres,
-    0 = no hit), and always frame.json (camera intrinsics/extrinsics, class map, instances with pixel
+    (class colours), instance.png (16-bit instance ids, 0 = none) and instance_preview.png (a colour per
+    id), depth.exr (z-depth in metres, 0 = no hit), and always frame.json (camera intrinsics/extrinsics, class map, instances with pixel
     counts, the condition and the exposure rgb.png was made with). Nothing is written unless every input checks out, and nothing is replaced unless every
     frame rendered.
     """

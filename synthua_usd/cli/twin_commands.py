@@ -199,17 +199,33 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
 @click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Layout seed.")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder.")
 def twin_demo(seed: int, out_dir: Path) -> int:
-    """Write the procedural Largo da Ordem demo district (twin.usdc, semantics.usda) for SEED.
+    """Write the procedural Largo da Ordem demo district for SEED as a renderable scenario, without people.
 
+    \b
+    Files: twin.usdc (geometry, materials, textures/), semantics.usda (labels), cameras.usda (CCTV_Largo,
+    CCTV_Street, PedestrianEye_Street, WheelchairEye_Largo, UAV_Oblique), environment.usda (the conditions,
+    clear day selected), render.usda (through CCTV_Largo) and scenario.usda, which composes them.
     The same seed writes byte-identical layers; another seed another plausible layout.
-    """
-    from synthua_usd.demo.district import META, build_district
-    from synthua_usd.usd.scenario_writer import write_twin_layers
 
-    model = build_district(seed)
-    files = write_twin_layers(model, out_dir, load_class_map(None), META)
-    say(f"district seed {seed}: {len(model.objects)} objects, {model.triangle_count()} triangles, "
-               f"{len(model.label_counts())} classes")
+    \b
+    From here to a dataset (the README's "Your own scene"):
+      synthua agents populate my_district/scenario.usda --out my_district/agents.usdc
+      synthua cameras author my_district/scenario.usda --layer my_district/agents.usdc \\
+          --rig cctv:aim=aid_user,name=AidCCTV --out my_district/rigs.usda
+      synthua compose my_district/with_people.usda my_district/rigs.usda my_district/agents.usdc \\
+          my_district/scenario.usda
+      synthua render my_district/with_people.usda --camera /World/Cameras/AidCCTV --out out/frame
+    (`synthua create district` writes all of it, people and aimed rigs included, in one step.)
+    """
+    from synthua_usd.demo.district import district_scenario
+    from synthua_usd.usd.scenario_writer import write_scenario
+
+    spec = district_scenario(seed, agents=False)
+    files = write_scenario(spec, out_dir, load_class_map(None))
+    say(f"district seed {seed}: {len(spec.twin.objects)} objects, {spec.twin.triangle_count()} triangles, "
+        f"{len(spec.twin.label_counts())} classes, {len(spec.cameras)} cameras")
     for path in files:
         say(f"wrote {path}")
+    say(f"render with: synthua render {out_dir / 'scenario.usda'} --out OUT; add people with: synthua agents "
+        f"populate {out_dir / 'scenario.usda'} --out {out_dir / 'agents.usdc'}")
     return EXIT_OK

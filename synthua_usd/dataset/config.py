@@ -246,6 +246,8 @@ class GenerationConfig:
     outputs: Outputs = field(default_factory=Outputs)
     resample: Resample | None = None
     amodal_groups: tuple[str, ...] = ("person", "accessibility", "vehicle", "furniture", "animal")
+    #: Thing instances with fewer visible pixels are ignore regions in every format (the schema says how).
+    min_instance_px: int = 32
     workers: int | None = None
     #: Scene randomisation (None: the scenario rendered as composed).
     randomise: RandomisationConfig | None = None
@@ -287,6 +289,7 @@ class GenerationConfig:
             "outputs": dict(vars(self.outputs)),
             "resample": None if self.resample is None else dict(vars(self.resample)),
             "amodal_groups": list(self.amodal_groups),
+            "min_instance_px": self.min_instance_px,
             "workers": self.workers,
             # absent when off, so that configs without it keep the documents (and job keys) they had
             **({} if self.randomise is None else {"randomise": self.randomise.to_document()}),
@@ -355,6 +358,7 @@ class _Builder:
             sampling_seed=doc.get("sampling_seed", GenerationConfig.sampling_seed),
             quotas=quotas, split=split, qa=qa, outputs=outputs, resample=resample,
             amodal_groups=tuple(doc.get("amodal_groups", GenerationConfig.amodal_groups)),
+            min_instance_px=doc.get("min_instance_px", GenerationConfig.min_instance_px),
             workers=doc.get("workers"), randomise=self.randomise(doc.get("randomise")),
             sequences=self.sequences(doc.get("sequences"), images))
 

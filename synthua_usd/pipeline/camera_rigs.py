@@ -74,6 +74,9 @@ class RigRequest:
     variant: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
+    #: Layer files composed over the stage for the placement (strongest first; see ``open_stage``), e.g. the
+    #: agents layer of a twin scenario that does not compose it yet.
+    layers: tuple[Path, ...] = ()
 
     @property
     def report_path(self) -> Path:
@@ -96,7 +99,7 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
     """Place, score, verify and write every rig of ``request`` (see the module docstring)."""
     _check_request(request)
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
-    stage = open_stage(request.stage_path, request.allow_external_assets)
+    stage = open_stage(request.stage_path, request.allow_external_assets, request.layers)
     if UsdGeom.GetStageUpAxis(stage) != UsdGeom.Tokens.z:
         raise StageError(f"{request.stage_path}: upAxis is {UsdGeom.GetStageUpAxis(stage)!r}; camera rigs expect a "
                          f"Z-up stage (heights are along +Z)")
@@ -143,6 +146,8 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
         # Relative to the layer's folder: the pair stays right when the folder moves (or is staged).
         "stage": os.path.relpath(Path(request.stage_path).resolve(), Path(request.out_path).resolve().parent),
         "layer": Path(request.out_path).name,
+        **({"layers": [os.path.relpath(Path(p).resolve(), Path(request.out_path).resolve().parent)
+                       for p in request.layers]} if request.layers else {}),
         "image": {"width": request.width, "height": request.height},
         "time_codes": report_tcs,
         "min_target_px": request.min_target_px,

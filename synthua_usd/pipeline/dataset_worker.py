@@ -23,10 +23,10 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.atomic import atomic_path, write_json_atomic, write_text_atomic
-from synthua_usd.backends import images
+from synthua_usd.backends import images, previews
 from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
-from synthua_usd.dataset.formats import cityscapes, onehot, previews, yolo
+from synthua_usd.dataset.formats import cityscapes, onehot, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.outputs import DEPTH_DEFINITION
@@ -218,6 +218,7 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
         amodal = {i: resample.resample_pixel_set(pixels, (height, width), index) for i, pixels in amodal.items()}
         width, height = out_w, out_h
     instances = annotations.annotate(class_ids, instance_ids, snapshot.instances, amodal, truncated)
+    annotations.mark_ignored(instances, job.config.min_instance_px)
     keypoints.annotate_keypoints(instances, snapshot.keypoints, camera, (job.render.width, job.render.height),
                                  instance_ids, depth)
     by_path = {inst.prim_path: inst for inst in snapshot.instances}
@@ -240,7 +241,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     rgb, class_ids, instance_ids, depth = frame.rgb, frame.class_ids, frame.instance_ids, frame.depth
     instances, width, height, seconds, randomised = (frame.instances, frame.width, frame.height, frame.seconds,
                                                      frame.randomised)
-    panoptic_png, segments = annotations.panoptic(class_ids, instance_ids, snapshot.instances, class_map)
+    ignored = {entry["id"] for entry in instances if entry["ignore"]}
+    panoptic_png, segments = annotations.panoptic(class_ids, instance_ids, snapshot.instances, class_map, ignored)
     display = frame.display()
     measures = qa.measure(display, instances)
     verdict, reasons = qa.verdict(measures, job.config.qa)
@@ -257,7 +259,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
               "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
     if verdict != "rejected":
         labels, instance_cs, colour = cityscapes.cityscapes_arrays(class_ids, instance_ids, snapshot.instances,
-                                                                  class_map)
+                                                                  class_map, ignored)
         files.update({"panoptic": Layout.panoptic_png(split, name),
                       "cs_labelIds": Layout.cityscapes(split, cs, "labelIds"),
                       "cs_instanceIds": Layout.cityscapes(split, cs, "instanceIds"),

@@ -85,6 +85,9 @@ class GenerateSummary:
     shortfalls: list = field(default_factory=list)
     #: (images rendered so far, worker, its peak resident memory in MiB) after each result: memory over a run.
     rss_trace: list = field(default_factory=list)
+    #: Per split (train, val, test): the config's share, the images kept (QA rejections left out) and the cameras
+    #: they come from.
+    splits: dict = field(default_factory=dict)
     #: Tracking sequences: how many, their frames, frames rendered now and found complete.
     sequences: int = 0
     frames: int = 0
@@ -322,7 +325,32 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     summary.wall_seconds = time.perf_counter() - started
     summary.bytes_per_image = _dataset_bytes(out) / max(1, len(records))
     summary.shortfalls = json.loads(layout.path(Layout.COVERAGE).read_text(encoding="utf-8")).get("shortfalls", [])
+    summary.splits = achieved_splits(records, config)
+    _warn_empty_splits(summary.splits)
     return summary
+
+
+def achieved_splits(records: list[dict], config: GenerationConfig) -> dict[str, dict]:
+    """Per split: the config's share, the images kept (not rejected by QA) and the distinct cameras they come
+    from."""
+    out = {}
+    for split in SPLITS:
+        kept = [r for r in records if r["split"] == split and not is_rejected(r)]
+        out[split] = {"share": config.split.ratios[split], "images": len(kept),
+                      "cameras": len({r["camera"]["prim_path"] for r in kept})}
+    return out
+
+
+def _warn_empty_splits(splits: dict[str, dict]) -> None:
+    """A split the config gives a share that ends up with no image: the split is by camera, so fewer cameras
+    than splits (or a camera whose every image was rejected) leave one empty."""
+    cameras = sum(v["cameras"] for v in splits.values())
+    for split, counts in splits.items():
+        share = counts["share"]
+        if share > 0 and counts["images"] == 0:
+            log.warning(f"split {split}: no image, though the config gives it {share:g}; expected a camera of its "
+                        f"own (images are split by camera, and {cameras} camera(s) have kept images): add cameras "
+                        f"or set split.{split} to 0")
 
 
 def _config_document(config: GenerationConfig) -> dict:

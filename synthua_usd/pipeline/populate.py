@@ -51,9 +51,31 @@ def populate(request: PopulateRequest) -> tuple[Crowd, Path, float]:
     meshes = [m for m in snapshot.meshes if not m.prim_path.startswith(AGENTS_ROOT + "/")]
     verts, faces, owner = snapshot.world_triangles(meshes)
     names = np.array([class_map.by_id(m.class_id).name for m in meshes], object)
+    _check_walkable_classes(request.stage_path, set(names), walkable)
     crowd = populate_crowd(verts, faces, names[owner] if len(owner) else np.zeros(0, object), params)
     meta = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=fps, start_time_code=start,
                          end_time_code=start + params.time_codes - 1, default_prim="World")
     layer = build_agents_layer(crowd, meta, class_map.taxonomy)
     save_layer_atomic(layer.GetRootLayer(), out)  # one file: atomic by itself
     return crowd, out, time.perf_counter() - t0
+
+
+def _check_walkable_classes(stage_path: Path, classes: set[str], walkable: tuple[str, ...]) -> None:
+    """Name the real cause when nothing of the stage is walkable: its gprims carry no labels at all (a twin layer
+    opened without its semantics layer), or none of the walkable classes."""
+    if classes & set(walkable):
+        return
+    labelled = sorted(classes - {"unlabelled"})
+    path = Path(stage_path)
+    if not labelled:
+        scenario = path.parent / "scenario.usda"
+        fix = (f"pass the scenario ({scenario}) or compose its semantics layer over it" if scenario.exists()
+               and scenario.resolve() != path.resolve() else
+               "compose the twin's semantics layer (semantics.usda, written beside twin.usdc by `synthua twin`) "
+               "over it with `synthua compose`, or pass the scenario that does")
+        raise InputError(f"{path}: none of its gprims has a 'synthua' label (all are class 0, unlabelled), so "
+                         f"nothing is walkable; expected labelled surfaces: {fix}")
+    fix = ("add --walk-on road when its roads include their sidewalks (CityJSON often does), or name the classes "
+           "people walk on with --walk-on" if "road" in labelled else "name the classes people walk on with --walk-on")
+    raise InputError(f"{path}: has none of the walkable classes ({', '.join(walkable)}); its classes are "
+                     f"{', '.join(labelled)}; expected one to walk on: {fix}")

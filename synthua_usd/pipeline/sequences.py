@@ -221,22 +221,25 @@ def assemble_sequences(layout: Layout, sequences: list[PlannedSequence], records
     return written
 
 
-def _preview(layout: Layout, seq: PlannedSequence, frames: list[dict], fps: float, class_map: ClassMap) -> Path:
+def boxed_frame(layout: Layout, record: dict, class_map: ClassMap) -> np.ndarray:
+    """(H, W, 3) uint8: a sequence frame's image with the amodal box, id and class of every tracked object drawn,
+    a device in its user's colour (what the preview video shows)."""
     from synthua_usd.backends.images import read_image
-    from synthua_usd.backends.video import draw_boxes, write_preview
+    from synthua_usd.backends.video import draw_boxes
 
     mot_classes = mot.tracked(class_map)
+    instances = [e for e in record["instances"] if e["class_name"] in mot_classes]
+    user_of = {(e.get("relations") or {}).get("uses"): e["id"] for e in instances}
+    boxes = [(*(int(v) for v in (e.get("amodal_bbox") or e["bbox"])), user_of.get(e["prim_path"], e["id"]),
+              f"{e['id']} {e['class_name']}") for e in instances]
+    return draw_boxes(read_image(layout.path(record["files"]["img1"]))[0][..., :3], boxes)
 
-    def images():
-        for record in frames:
-            instances = [e for e in record["instances"] if e["class_name"] in mot_classes]
-            # a device in its user's colour
-            user_of = {(e.get("relations") or {}).get("uses"): e["id"] for e in instances}
-            boxes = [(*(int(v) for v in (e.get("amodal_bbox") or e["bbox"])), user_of.get(e["prim_path"], e["id"]),
-                      f"{e['id']} {e['class_name']}") for e in instances]
-            yield draw_boxes(read_image(layout.path(record["files"]["img1"]))[0][..., :3], boxes)
 
-    return write_preview(layout.path(Layout.sequence_file(seq.name, "preview.mp4")), images(), fps)
+def _preview(layout: Layout, seq: PlannedSequence, frames: list[dict], fps: float, class_map: ClassMap) -> Path:
+    from synthua_usd.backends.video import write_preview
+
+    images = (boxed_frame(layout, record, class_map) for record in frames)
+    return write_preview(layout.path(Layout.sequence_file(seq.name, "preview.mp4")), images, fps)
 
 
 def sequence_files(layout: Layout, sequences: list[PlannedSequence], records: dict) -> list[dict]:

@@ -187,12 +187,14 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
             continue
         for ann in annotations:
             panoptic_by_image[ann["image_id"]] = ann
+    config = (job.get("job_key") or {}).get("config") or {}
+    min_px = config.get("min_instance_px", 0) if isinstance(config, dict) else 0
     for record in tqdm(records, desc="consistency", unit="image", disable=not show_progress):
         if is_rejected(record) or damaged & set(record["files"].values()):
             continue  # a damaged file is reported already; its image is not read
         try:
             _check_image(layout, record, coco_by_image.get(record["id"], []), panoptic_by_image.get(record["id"]),
-                         yolo_classes, result)
+                         yolo_classes, result, min_px)
         except Exception as exc:  # noqa: BLE001 - whatever a broken file raises, it is a problem of the dataset
             result.add(f"image {record['id']} ({record['name']}): cannot be checked: {type(exc).__name__}: "
                        f"{echo(exc)}")
@@ -298,7 +300,9 @@ def _read(layout: Layout, relative: str) -> np.ndarray:
 
 
 def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], panoptic_annotation: dict | None,
-                 yolo_classes: dict[int, int], result: Verification) -> None:
+                 yolo_classes: dict[int, int], result: Verification, min_px: int = 0) -> None:
+    """The image's annotations against its label maps; an instance with fewer than ``min_px`` pixels in
+    ``instance.png`` must be an ignore region (COCO iscrowd 1, no YOLO line) and every other one must not."""
     from pycocotools import mask as mask_utils
 
     where = f"image {record['id']} ({record['name']})"
@@ -328,6 +332,9 @@ def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], pan
             result.add(f"{where}: COCO annotation {ann['id']}: bbox {ann['bbox']}; the mask's box is {box}")
         if "keypoints" in ann:
             _check_keypoints(where, ann, truth, result)
+        if int(ann.get("iscrowd", 0)) != int(truth.sum() < min_px):
+            result.add(f"{where}: COCO annotation {ann['id']}: iscrowd {ann.get('iscrowd')} for {int(truth.sum())} "
+                       f"pixels; expected iscrowd 1 below min_instance_px = {min_px}, else 0")
         seen.add(inst)
     for missing in sorted(set(things) - seen):
         result.add(f"{where}: instance {missing} ({things[missing]['class_name']}) is visible but has no COCO "
@@ -348,10 +355,12 @@ def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], pan
         result.add(f"{where}: {files['cs_labelIds']} differs from {files['class']}")
     if "yolo_label" in files:
         lines = [ln for ln in layout.path(files["yolo_label"]).read_text(encoding="utf-8").splitlines() if ln.strip()]
-        expected = sum(1 for i in record["instances"] if i["category_id"] in yolo_classes)
+        pixels = np.bincount(instance_ids.reshape(-1).astype(np.int64))
+        expected = sum(1 for i in record["instances"] if i["category_id"] in yolo_classes
+                       and (pixels[i["id"]] if i["id"] < len(pixels) else 0) >= min_px)
         if len(lines) != expected:
             result.add(f"{where}: {files['yolo_label']} has {len(lines)} lines; the image has {expected} instances "
-                       f"of YOLO classes")
+                       f"of YOLO classes with at least min_instance_px = {min_px} pixels")
 
 
 def _check_keypoints(where: str, ann: dict, truth: np.ndarray, result: Verification) -> None:

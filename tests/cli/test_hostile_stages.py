@@ -202,7 +202,7 @@ def test_paths_echoed_on_stdout_are_escaped(corpus, tmp_path, run_cli):
     stage.write_text(TINY)
     runs = [run_cli("render", corpus / "tiny.usda", "--camera", CAM, "--width", "8", "--height", "6", "--spp", "1",
                     "--out", tmp_path / "o\nut"),
-            run_cli("compose", tmp_path / "ro\not.usda", corpus / "tiny.usda"),
+            run_cli("compose", tmp_path / "ro\not.usda", corpus / "tiny.usda", "--allow-external-assets"),
             run_cli("inspect", stage)]
     for code, out, err in runs:
         assert code == 0, err

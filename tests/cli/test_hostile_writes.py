@@ -24,7 +24,7 @@ TINY = DATA / "valid" / "tiny_scene.usda"
 LAYER_WRITERS = {
     "create street": lambda out: ["create", "street", out],
     "twin import mesh": lambda out: ["twin", "import", "mesh", OBJ, "--rules", RULES, "--out", out],
-    "compose": lambda out: ["compose", out.parent / "root.usda", TINY],
+    "compose": lambda out: ["compose", out.parent / "root.usda", TINY, "--allow-external-assets"],
 }
 
 

@@ -60,7 +60,7 @@ def test_minimal_document_takes_the_defaults():
 
 
 @pytest.mark.parametrize("changes, message", [
-    ({"images": 0}, "gen.json: images: 0 is less than the minimum of 1; expected a document matching generate.schema.json"),
+    ({"images": 0}, "gen.json: images: 0 without a sequences block; expected at least 1 image, or sequences"),
     ({"colour": 1}, "gen.json: (document): Additional properties are not allowed ('colour' was unexpected)"),
     ({"render": {"pixel_filter": "gaussian"}}, "gen.json: render.pixel_filter: 'box' was expected"),
     ({"cameras": ["World/Cam"]}, "gen.json: cameras[0]: "),

@@ -1,7 +1,9 @@
 """COCO instances (``annotations/instances_{split}.json``) from the per-image records.
 
 pycocotools reads it as it is: RLE masks, ``bbox`` as floats ``[x, y, w, h]`` (pixel-edge box), ``area`` in
-pixels, ``iscrowd`` 0. Only thing classes are annotated (COCO's instances task has no stuff); stuff is in
+pixels, ``iscrowd`` 0, or 1 for an instance too small to learn from (fewer visible pixels than the config's
+``min_instance_px``): COCOeval then neither rewards nor penalises detections on it, and detectron2 and
+MMDetection leave it out of training. Only thing classes are annotated (COCO's instances task has no stuff); stuff is in
 the panoptic and Cityscapes formats. Extra fields per annotation, which COCO readers ignore:
 ``amodal_segmentation``, ``amodal_bbox``, ``amodal_area``, ``occlusion``, ``truncation``, ``prim_path``,
 ``instance_id`` (the pixel value in the image's instance map) and ``relations`` (``{"uses": prim path,
@@ -109,7 +111,7 @@ def coco_instances(records: Iterable[dict], class_map: ClassMap, split: str) -> 
             annotations.append({
                 "id": ann_id, "image_id": int(record["id"]), "category_id": int(inst["category_id"]),
                 "segmentation": inst["segmentation"], "area": int(inst["area"]),
-                "bbox": [float(v) for v in inst["bbox"]], "iscrowd": 0,
+                "bbox": [float(v) for v in inst["bbox"]], "iscrowd": int(bool(inst.get("ignore"))),
                 "amodal_segmentation": inst["amodal_segmentation"], "amodal_area": int(inst["amodal_area"]),
                 "amodal_bbox": [float(v) for v in inst["amodal_bbox"]],
                 "occlusion": float(inst["occlusion"]), "truncation": float(inst["truncation"]),

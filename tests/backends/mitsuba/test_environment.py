@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from conftest import DISTRICT, SCENARIO
+from frame_checks import black_shares
 from synthua_usd.backends.mitsuba import weather_scene
 from synthua_usd.conditions import SHIPPED
 from test_sun import plane_radiance
@@ -78,18 +79,6 @@ def test_below_the_horizon_is_the_ground_a_real_plain_would_show(variant, name):
         np.testing.assert_allclose(ground[0], lit, rtol=0.03)
     else:  # a uniform night sky of radiance L gives E = pi L
         np.testing.assert_allclose(ground[0], albedo * lighting.airlight, rtol=1e-5)
-
-
-def black_shares(frame) -> tuple[float, float]:
-    """(share of all pixels, share of the pixels whose centre ray hits nothing) that are black in a rendered
-    frame's rgb.png; depth.exr says which rays escaped (0: no hit)."""
-    import OpenImageIO as oiio
-    from PIL import Image
-
-    black = np.asarray(Image.open(frame / "rgb.png").convert("RGB")).max(axis=2) == 0
-    escaped = oiio.ImageBuf(str(frame / "depth.exr")).get_pixels(oiio.FLOAT)[..., 0] == 0
-    assert escaped.any()  # the view does look past the modelled ground
-    return float(black.mean()), float(black[escaped].mean())
 
 
 DAY = [c.name for c in SHIPPED if c.sun_up]
