@@ -110,3 +110,15 @@ def read_image(path: str | Path) -> tuple[np.ndarray, oiio.ImageSpec]:
     finally:
         inp.close()
     return np.asarray(pixels), spec
+
+
+def image_size(path: str | Path) -> tuple[int, int]:
+    """(width, height) in pixels of an image file, from its header (no pixels are read)."""
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise OSError(f"{path}: OpenImageIO cannot read it: {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        return int(spec.width), int(spec.height)
+    finally:
+        inp.close()
