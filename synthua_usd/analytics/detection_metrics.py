@@ -46,13 +46,14 @@ class Detection:
 
 @dataclass(frozen=True)
 class Miss:
-    """A false negative at the fixed confidence: the missed box, its image, and the best IoU any detection of its
-    class reached on it (at any score: 0 when none overlaps) with that detection's score."""
+    """A false negative at the fixed confidence: the missed box, its image, and the detection of its class (at any
+    score) that overlaps it most: its IoU (0 when none overlaps), score and box (x, y, w, h; None when none)."""
 
     image_id: int
     box: Box
     best_iou: float
     best_score: float | None
+    best_box: tuple[float, float, float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -210,6 +211,7 @@ def _rank_misses(misses, gt_boxes: dict[int, Box], merged: list[Detection], cat_
         iou = _xywh_iou(np.array([[d.x, d.y, d.w, d.h] for d in candidates]).reshape(-1, 4),
                         np.array([[box.x, box.y, box.w, box.h]])).ravel()
         best = int(np.argmax(iou)) if len(iou) and iou.max() > 0 else None
-        out.append(Miss(image_id, box, float(iou[best]) if best is not None else 0.0,
-                        candidates[best].score if best is not None else None))
+        near = candidates[best] if best is not None else None
+        out.append(Miss(image_id, box, float(iou[best]) if near else 0.0, near.score if near else None,
+                        (near.x, near.y, near.w, near.h) if near else None))
     return sorted(out, key=lambda m: (-m.box.area, m.image_id, m.box.x, m.box.y))

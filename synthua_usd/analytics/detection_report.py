@@ -52,7 +52,7 @@ def crop_around(rgb: np.ndarray, box: tuple[float, float, float, float]) -> tupl
     return rgb[y0:y1, x0:x1], x0, y0
 
 
-def _panels(test: DetectionSet, misses: tuple[Miss, ...], detections: list[Detection], test_of: dict[str, str]):
+def _panels(test: DetectionSet, misses: tuple[Miss, ...]):
     from synthua_usd.backends.images import read_image
 
     by_id = {im.id: im for im in test.images}
@@ -62,12 +62,8 @@ def _panels(test: DetectionSet, misses: tuple[Miss, ...], detections: list[Detec
         rgb = _rgb8(read_image(image.path)[0])
         b = miss.box
         crop, x0, y0 = crop_around(rgb, (b.x, b.y, b.w, b.h))
-        best = None
-        if miss.best_score is not None:
-            same = [d for d in detections if d.image_id == miss.image_id and test_of.get(d.label) == b.label
-                    and abs(d.score - miss.best_score) < 1e-9]
-            if same:
-                best = (same[0].x - x0, same[0].y - y0, same[0].w, same[0].h)
+        near = miss.best_box
+        best = None if near is None else (near[0] - x0, near[1] - y0, near[2], near[3])
         caption = (f"{image.path.name[:28]}\n{b.label} {b.w:.0f}x{b.h:.0f} px, best IoU {miss.best_iou:.2f}"
                    + (f" @ {miss.best_score:.2f}" if miss.best_score is not None else ", no detection"))
         panels.append((crop, (b.x - x0, b.y - y0, b.w, b.h), best, caption))
@@ -109,10 +105,10 @@ def _html(ev: DetectionEvaluation, about: dict, misses_shown: int) -> str:
 
 
 def write_detection_report(out_dir: str | Path, test: DetectionSet, ev: DetectionEvaluation,
-                           detections: list[Detection], test_of: dict[str, str], about: dict) -> Path:
-    """Write the report of ``ev`` (``detections`` in model classes; ``test_of`` model class -> test class;
-    ``about``: what was scored with what, for metrics.json) into ``out_dir`` as a set."""
-    panels = _panels(test, ev.misses, detections, test_of)   # reads images: a missing one fails before writing
+                           detections: list[Detection], about: dict) -> Path:
+    """Write the report of ``ev`` (``detections`` as predicted, in the model's classes; ``about``: what was scored
+    with what, for metrics.json) into ``out_dir`` as a set."""
+    panels = _panels(test, ev.misses)   # reads images: a missing one fails before writing
     by_id = {im.id: im for im in test.images}
     with output_set(out_dir) as stage:
         document = about | ev.document() | {"false_negatives": len(ev.misses)}

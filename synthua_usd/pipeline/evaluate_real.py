@@ -109,5 +109,5 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
                        "merge_iou": request.merge_iou},
         "versions": result["versions"], "downloaded": result["downloaded"],
     }
-    write_detection_report(request.out_dir, test, evaluation, detections, mapping.test_class_of(), document)
+    write_detection_report(request.out_dir, test, evaluation, detections, document)
     return EvaluateResult(evaluation, document | evaluation.document(), Path(request.out_dir))

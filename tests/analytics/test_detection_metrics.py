@@ -47,7 +47,8 @@ def test_ap_worked_out_by_hand():
     # the misses, largest first (equal sizes: by image, then x); the one at x = 120 has no overlapping detection
     assert [(m.box.x, m.best_iou) for m in ev.misses] == [(120, 0.0)]
     assert [m.box.x for m in high.misses] == [10, 120] and high.misses[0].best_iou == pytest.approx(1.0)
-    assert high.misses[0].best_score == pytest.approx(0.8)
+    assert high.misses[0].best_score == pytest.approx(0.8) and high.misses[0].best_box == (10, 10, 20, 40)
+    assert ev.misses[0].best_box is None
 
 
 def test_class_without_boxes_has_no_ap_and_ignored_boxes_cost_nothing():
