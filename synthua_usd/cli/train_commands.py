@@ -82,8 +82,9 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
                            python=python))
     final = doc["final"] or {}
     losses = ", ".join(f"{k.split('/')[-1]} {float(v):.3f}" for k, v in final.items() if k.startswith("train/"))
-    click.echo(f"trained {', '.join(doc['classes'])} on {sum(doc['train_set']['images'].values())} images "
-               f"({doc['train_set']['images']['train']} train) for {doc['epochs_done']} epochs in {doc['seconds']:.0f} s "
+    images = doc["train_set"]["images"]
+    click.echo(f"trained {', '.join(doc['classes'])} on {images['train']} images (validated on {images['val']}) "
+               f"for {doc['epochs_done']} epochs in {doc['seconds']:.0f} s "
                f"on {doc['device']} (Ultralytics {doc['versions']['ultralytics']}, torch {doc['versions']['torch']})"
                f"{': ' + losses if losses else ''}")
     click.echo(f"-> {out_dir}")

@@ -118,7 +118,7 @@ def _splits(request: TrainRequest) -> tuple[dict[str, DetectionSet], DetectionSe
     try:
         val = read("val")
     except InputError as exc:  # no val split: Ultralytics validates the last epoch on the train split
-        log.warning("no val split (%s); Ultralytics validates on the train split", exc)
+        log.warning("%s; Ultralytics validates on the train split instead", str(exc).split("; expected")[0])
         val = train
     return {"train": train, "val": val}, train
 
