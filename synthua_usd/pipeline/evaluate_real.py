@@ -22,7 +22,7 @@ from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluati
 from synthua_usd.analytics.detection_report import write_detection_report
 from synthua_usd.analytics.detection_sources import detect_format, manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
-from synthua_usd.backends.detector.runner import find_detector_python, run_job
+from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.errors import InputError
 from synthua_usd.pipeline.train import DEVICES, run_weights
 
@@ -85,8 +85,11 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
         job = {"action": "predict", "weights": str(weights.resolve()),
                "images": [str(Path(im.path).resolve()) for im in test.images],
                "imgsz": imgsz, "conf": PREDICT_CONFIDENCE, "iou": PREDICT_IOU, "max_det": MAX_DETECTIONS,
-               "device": request.device, "threads": threads, "batch": 8}
-        result = run_job(python, job, Path(scratch), "predict")
+               "device": request.device, "threads": threads, "batch": 8,
+               "progress": str(Path(scratch) / "predicted.txt")}
+        result = run_job(python, job, Path(scratch), "predict",
+                         progress={"total": len(test.images), "unit": "image",
+                                   "done": lambda seconds: count_in(job["progress"])})
     predicted = {str(v) for v in result["names"].values()}
     if predicted != set(model_classes):
         raise InputError(f"{weights}: predicts {', '.join(sorted(predicted))}; expected the classes of its train.json "

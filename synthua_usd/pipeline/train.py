@@ -35,7 +35,7 @@ from synthua_usd.analytics.detection_sets import DetectionSet
 from synthua_usd.analytics.detection_sources import manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
 from synthua_usd.atomic import output_set, write_json_atomic
-from synthua_usd.backends.detector.runner import find_detector_python, run_job
+from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
 from synthua_usd.errors import InputError
 from synthua_usd.input_files import shown
@@ -151,8 +151,10 @@ def train(request: TrainRequest) -> dict:
                "imgsz": b.imgsz, "epochs": b.epochs, "minutes": b.minutes, "batch": b.batch, "workers": request.workers,
                "device": request.device, "seed": request.seed, "threads": threads,
                "project": str(Path(scratch) / "runs")}
-        progress = ({"seconds": b.minutes * 60} if b.minutes is not None else
-                    {"epochs": b.epochs, "results_csv": str(Path(scratch) / "runs" / "train" / "results.csv")})
+        results = Path(scratch) / "runs" / "train" / "results.csv"
+        progress = ({"total": round(b.minutes * 60), "unit": "s", "done": lambda seconds: round(seconds)}
+                    if b.minutes is not None else
+                    {"total": b.epochs, "unit": "epoch", "done": lambda seconds: count_in(results)})
         result = run_job(python, job, Path(scratch), "train", progress=progress)
         shutil.copyfile(result["weights"], stage / "weights.pt")
         results_csv = Path(result["weights"]).parents[1] / "results.csv"

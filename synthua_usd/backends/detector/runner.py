@@ -62,9 +62,11 @@ def _environment(folder: Path) -> dict[str, str]:
     return env
 
 
-def _rows(path: Path) -> int:
+def count_in(path: str | Path) -> int:
+    """Progress a job reports in a file: the lines of ``path`` less a header (results.csv: epochs done), 0 while
+    it does not exist."""
     try:
-        return max(0, len(path.read_text(encoding="utf-8").splitlines()) - 1)
+        return max(0, len(Path(path).read_text(encoding="utf-8").splitlines()) - 1)
     except OSError:
         return 0
 
@@ -74,7 +76,8 @@ def run_job(python: Path, job: dict, folder: Path, name: str, timeout_s: float |
     """Run ``job`` (a :mod:`.yolo_job` document without ``result``) in ``python``, its files in ``folder``
     (``{name}.json``, ``{name}.log``, ``{name}_result.json``); return the result document.
 
-    ``progress``: {"seconds": budget} or {"epochs": n, "results_csv": path} shows a progress bar on stderr."""
+    ``progress``: {"total": n, "unit": "s" | "epoch" | "image", "done": callable} shows a progress bar on stderr,
+    ``done(seconds since the start)`` polled twice a second."""
     folder = Path(folder).resolve()
     folder.mkdir(parents=True, exist_ok=True)
     result_path = folder / f"{name}_result.json"
@@ -88,16 +91,13 @@ def run_job(python: Path, job: dict, folder: Path, name: str, timeout_s: float |
                                 env=_environment(folder), cwd=folder)
         bar = None
         if progress is not None:
-            total = progress.get("seconds") or progress.get("epochs")
-            unit = "s" if progress.get("seconds") else "epoch"
-            bar = tqdm(total=total, unit=unit, desc=f"detector {name}", disable=not sys.stderr.isatty(),
-                       leave=False)
+            bar = tqdm(total=progress["total"], unit=progress["unit"], desc=f"detector {name}",
+                       disable=not sys.stderr.isatty(), leave=False)
         try:
             while proc.poll() is None:
                 time.sleep(0.5)
                 if bar is not None:
-                    done = (time.monotonic() - t0) if progress.get("seconds") else _rows(Path(progress["results_csv"]))
-                    bar.update(min(bar.total, done) - bar.n)
+                    bar.update(min(bar.total, progress["done"](time.monotonic() - t0)) - bar.n)
                 if timeout_s is not None and time.monotonic() - t0 > timeout_s:
                     proc.kill()
                     proc.wait()
