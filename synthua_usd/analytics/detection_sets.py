@@ -136,7 +136,13 @@ def _split_images(root: Path, entry, where: str) -> list[Path]:
             raise InputError(f"{where}: {str(item)[:80]!r}; expected a folder, a .txt list or an image path")
         path = Path(item) if Path(item).is_absolute() else root / item
         if path.is_dir():
-            out += sorted(p for p in path.rglob("*") if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file())
+            found = []
+            for p in path.rglob("*"):   # counted as found: a split of "/" must not walk the whole disk first
+                if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file():
+                    found.append(p)
+                    if len(out) + len(found) > MAX_IMAGES:
+                        break
+            out += sorted(found)
         elif path.suffix.lower() == ".txt" and path.is_file():
             for line in read_input_text(path, MAX_DOCUMENT_BYTES, "a list of image paths").splitlines():
                 line = line.strip()

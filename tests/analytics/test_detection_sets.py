@@ -59,6 +59,15 @@ def test_yolo_split_as_list_file(tmp_path):
     assert [im.path.name for im in s.images] == ["a.jpg"] and len(s.images[0].boxes) == 2
 
 
+def test_a_split_with_too_many_images_is_refused_early(tmp_path, monkeypatch):
+    import synthua_usd.analytics.detection_sets as ds
+
+    root = yolo_folder(tmp_path / "set")
+    monkeypatch.setattr(ds, "MAX_IMAGES", 1)
+    with pytest.raises(InputError, match="more than 1 images"):
+        read_yolo(root)
+
+
 def test_label_path_replaces_the_last_images_folder():
     assert label_path(Path("/d/images/x/images/test/a.jpg")) == Path("/d/images/x/labels/test/a.txt")
 
