@@ -25,6 +25,7 @@ from synthua_usd.assets.devices import DEVICES
 from synthua_usd.dataset.layout import SPLITS, Layout
 from synthua_usd.errors import InputError
 from synthua_usd.input_files import shown
+from synthua_usd.detection_limits import DEFAULT_MIN_HEIGHT_PX, MIN_HEIGHT_PX
 from synthua_usd.schemas import read_json
 
 PERSON = "person"
@@ -44,15 +45,14 @@ class DetectionTargets:
     classes: tuple[str, ...] = DEFAULT_CLASSES
     aid_box: str = "with_user"
     aid_users_as_person: bool = True
-    min_height_px: float = 8.0
+    min_height_px: float = DEFAULT_MIN_HEIGHT_PX
 
     def __post_init__(self):
         if not self.classes or len(set(self.classes)) != len(self.classes):
             raise InputError(f"--classes: {','.join(self.classes)}; expected class names, each once")
         if self.aid_box not in AID_BOXES:
             raise InputError(f"--aid-box: {self.aid_box!r}; expected one of {', '.join(AID_BOXES)}")
-        if not 0 <= self.min_height_px <= 10_000:
-            raise InputError(f"--min-height-px: {self.min_height_px}; expected a number in [0, 10000] pixels")
+        MIN_HEIGHT_PX.check(self.min_height_px, "--min-height-px")
 
     def document(self) -> dict:
         return {"classes": list(self.classes), "aid_box": self.aid_box,

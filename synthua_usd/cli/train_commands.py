@@ -8,28 +8,30 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK
+from synthua_usd import detection_limits as L
+from synthua_usd.cli.options import InRange
 
 _FORMAT = click.Choice(["auto", "yolo", "coco", "synthua"])
-_DEVICE = click.Choice(["auto", "cpu", "cuda"])
+_DEVICE = click.Choice(L.DEVICES)
 
 
 @click.command()
 @click.argument("train_set", type=click.Path(path_type=Path))
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True,
               help="Run folder (weights.pt, train.json, results.csv, train.log), written when training ends.")
-@click.option("--minutes", type=click.FloatRange(0.05, 10080), default=30.0, show_default=True,
+@click.option("--minutes", type=InRange(L.MINUTES), default=L.DEFAULT_MINUTES, show_default=True,
               help="Training budget in wall-clock minutes (Ultralytics stops mid-epoch when it is spent and fits its "
                    "learning-rate schedule to it).")
-@click.option("--epochs", type=click.IntRange(1, 100000),
+@click.option("--epochs", type=InRange(L.EPOCHS),
               help="Train this many epochs instead of a time budget (--minutes is then ignored).")
-@click.option("--imgsz", type=click.IntRange(32, 4096), default=320, show_default=True,
+@click.option("--imgsz", type=InRange(L.IMGSZ), default=L.DEFAULT_IMGSZ, show_default=True,
               help="Training image size in pixels (long side; a multiple of 32).")
-@click.option("--batch", type=click.IntRange(1, 1024), default=16, show_default=True, help="Images per step.")
+@click.option("--batch", type=InRange(L.BATCH), default=L.DEFAULT_BATCH, show_default=True, help="Images per step.")
 @click.option("--device", type=_DEVICE, default="auto", show_default=True,
               help="auto: CUDA when torch sees a GPU, else the CPU.")
 @click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True,
               help="Ultralytics' seed (deterministic mode on).")
-@click.option("--model", default="yolo26n.yaml", show_default=True,
+@click.option("--model", default=L.DEFAULT_MODEL, show_default=True,
               help="Architecture shipped inside the Ultralytics wheel, trained from scratch (e.g. yolo26s.yaml, "
                    "yolo11n.yaml); no weights are downloaded.")
 @click.option("--init", "init", type=click.Path(path_type=Path),
@@ -42,7 +44,7 @@ _DEVICE = click.Choice(["auto", "cpu", "cuda"])
                    "covers); device the aid alone (as our COCO instances).")
 @click.option("--aid-users-as-person/--no-aid-users-as-person", default=True, show_default=True,
               help="Whether a mobility-aid user is also a person box.")
-@click.option("--min-height-px", type=click.FloatRange(0, 10000), default=8.0, show_default=True,
+@click.option("--min-height-px", type=InRange(L.MIN_HEIGHT_PX), default=L.DEFAULT_MIN_HEIGHT_PX, show_default=True,
               help="Boxes lower than this (pixels of the generated image) are not trained on, nor scored.")
 @click.option("--format", "fmt", type=_FORMAT, default="auto", show_default=True,
               help="How TRAIN_SET is read: auto picks synthua for a generated dataset, coco for a .json, yolo for a "
@@ -107,9 +109,9 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
               help="Split of a YOLO set or generated dataset [default: test, else val; a generated dataset: test].")
 @click.option("--images", "images_dir", type=click.Path(path_type=Path),
               help="Folder of a COCO set's images [default: the .json's folder].")
-@click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.25,
+@click.option("--confidence", type=InRange(L.CONFIDENCE), default=L.DEFAULT_CONFIDENCE,
               show_default=True, help="Confidence of precision, recall and the false negatives (AP uses every score).")
-@click.option("--imgsz", type=click.IntRange(32, 4096), help="Prediction image size [default: the training's].")
+@click.option("--imgsz", type=InRange(L.IMGSZ), help="Prediction image size [default: the training's].")
 @click.option("--device", type=_DEVICE, default="auto", show_default=True, help="auto: CUDA when present, else CPU.")
 @click.option("--python", "python", type=click.Path(path_type=Path),
               help="Interpreter holding Ultralytics [default: $SYNTHUA_TRAIN_PYTHON, else .venv-train/bin/python].")

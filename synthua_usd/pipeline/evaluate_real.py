@@ -17,14 +17,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from synthua_usd import __version__
-from synthua_usd.analytics.class_mapping import build_mapping
+from synthua_usd.analytics.class_mapping import build_mapping, parse_map_options
 from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluation, evaluate_detections
 from synthua_usd.analytics.detection_report import write_detection_report
 from synthua_usd.analytics.detection_sources import detect_format, manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
+from synthua_usd import detection_limits as L
 from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.errors import InputError
-from synthua_usd.pipeline.train import DEVICES, run_weights
+from synthua_usd.pipeline.train import check_imgsz, run_weights
 
 #: Confidence below which predictions are dropped before scoring (COCO's AP ranks every detection).
 PREDICT_CONFIDENCE = 0.001
@@ -45,7 +46,7 @@ class EvaluateRequest:
     fmt: str = "auto"
     split: str | None = None
     images_dir: Path | None = None
-    confidence: float = 0.25
+    confidence: float = L.DEFAULT_CONFIDENCE
     merge_iou: float = 0.7
     imgsz: int | None = None
     device: str = "auto"
@@ -54,10 +55,11 @@ class EvaluateRequest:
 
     def __post_init__(self):
         for name, value in (("--confidence", self.confidence), ("--merge-iou", self.merge_iou)):
-            if not 0.0 < value < 1.0:
-                raise InputError(f"{name}: {value}; expected a number in (0, 1)")
-        if self.device not in DEVICES:
-            raise InputError(f"--device: {self.device!r}; expected one of {', '.join(DEVICES)}")
+            if not L.CONFIDENCE.contains(value) or value >= 1.0:
+                raise InputError(f"{name}: {value:g}; expected a number in (0, 1)")
+        if self.device not in L.DEVICES:
+            raise InputError(f"--device: {self.device!r}; expected one of {', '.join(L.DEVICES)}")
+        parse_map_options(self.maps)    # the syntax before anything is read; the names once the classes are known
 
 
 @dataclass(frozen=True)
@@ -76,9 +78,7 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
     test = read_detection_set(request.test_set, fmt, split, request.images_dir, targets)
     model_classes = tuple(about["classes"])
     mapping = build_mapping(request.maps, test.names, model_classes)
-    imgsz = request.imgsz or int(about["budget"]["imgsz"])
-    if not 32 <= imgsz <= 4096 or imgsz % 32:
-        raise InputError(f"--imgsz: {imgsz}; expected a multiple of 32 in [32, 4096] (the model's stride)")
+    imgsz = check_imgsz(request.imgsz or int(about["budget"]["imgsz"]))
     python = find_detector_python(request.python)
     threads = request.threads or len(os.sched_getaffinity(0))
     with tempfile.TemporaryDirectory(prefix="synthua-predict-") as scratch:

@@ -35,6 +35,7 @@ from synthua_usd.analytics.detection_sets import DetectionSet
 from synthua_usd.analytics.detection_sources import manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
 from synthua_usd.atomic import output_set, write_json_atomic
+from synthua_usd import detection_limits as L
 from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
 from synthua_usd.errors import InputError
@@ -43,10 +44,14 @@ from synthua_usd.schemas import read_json
 
 log = logging.getLogger(__name__)
 
-#: The architecture trained by default: Ultralytics' smallest current detector (YOLO26 nano, 2.5 M parameters).
-DEFAULT_MODEL = "yolo26n.yaml"
-RUN_FILES = ("weights.pt", "train.json")
-DEVICES = ("auto", "cpu", "cuda")
+
+
+def check_imgsz(imgsz: int) -> int:
+    """``imgsz`` when it is in :data:`IMGSZ` and a multiple of 32 (the model's stride), else :class:`InputError`."""
+    L.IMGSZ.check(imgsz, "--imgsz")
+    if imgsz % 32:
+        raise InputError(f"--imgsz: {imgsz}; expected a multiple of 32 in [32, 4096] (the model's stride)")
+    return imgsz
 
 
 @dataclass(frozen=True)
@@ -55,20 +60,17 @@ class Budget:
     and fits its learning-rate schedule to it), or ``epochs`` when ``minutes`` is None; images resized to ``imgsz``
     pixels (long side), ``batch`` images a step."""
 
-    minutes: float | None = 30.0
+    minutes: float | None = L.DEFAULT_MINUTES
     epochs: int = 300
-    imgsz: int = 320
-    batch: int = 16
+    imgsz: int = L.DEFAULT_IMGSZ
+    batch: int = L.DEFAULT_BATCH
 
     def __post_init__(self):
-        if self.minutes is not None and not 0.05 <= self.minutes <= 10_080:
-            raise InputError(f"--minutes: {self.minutes}; expected a number in [0.05, 10080]")
-        if not 1 <= self.epochs <= 100_000:
-            raise InputError(f"--epochs: {self.epochs}; expected an integer in [1, 100000]")
-        if not 32 <= self.imgsz <= 4096 or self.imgsz % 32:
-            raise InputError(f"--imgsz: {self.imgsz}; expected a multiple of 32 in [32, 4096] (the model's stride)")
-        if not 1 <= self.batch <= 1024:
-            raise InputError(f"--batch: {self.batch}; expected an integer in [1, 1024]")
+        if self.minutes is not None:
+            L.MINUTES.check(self.minutes, "--minutes")
+        L.EPOCHS.check(self.epochs, "--epochs")
+        check_imgsz(self.imgsz)
+        L.BATCH.check(self.batch, "--batch")
 
     def document(self) -> dict:
         return {"minutes": self.minutes, "epochs": None if self.minutes is not None else self.epochs,
@@ -85,7 +87,7 @@ class TrainRequest:
     out_dir: Path
     budget: Budget = field(default_factory=Budget)
     targets: DetectionTargets = field(default_factory=DetectionTargets)
-    model: str = DEFAULT_MODEL
+    model: str = L.DEFAULT_MODEL
     init: Path | None = None
     fmt: str = "auto"
     images_dir: Path | None = None
@@ -137,8 +139,8 @@ def _set_document(dataset: DetectionSet, splits: dict[str, DetectionSet]) -> dic
 
 def train(request: TrainRequest) -> dict:
     """Train, write the run folder (see the module's docstring) and return its train.json document."""
-    if request.device not in DEVICES:
-        raise InputError(f"--device: {request.device!r}; expected one of {', '.join(DEVICES)}")
+    if request.device not in L.DEVICES:
+        raise InputError(f"--device: {request.device!r}; expected one of {', '.join(L.DEVICES)}")
     splits, train_set = _splits(request)
     init_weights, init_about = run_weights(request.init) if request.init is not None else (None, None)
     python = find_detector_python(request.python)
