@@ -3,7 +3,8 @@
 
   (a) synthetic only: `synthua train` on a generated dataset (its train split);
   (b) real only (with ``--real-train``): the same model from scratch on a few real images;
-  (c) synthetic, then fine-tuned on those real images: (a)'s weights trained on (b)'s set with (b)'s budget.
+  (c) synthetic, then fine-tuned on those real images: (a)'s weights trained on (b)'s set with (b)'s budget
+      (``--real-minutes``, default ``--minutes``).
 
 Each model is scored by `synthua evaluate-real` on ``--test`` (a YOLO folder or COCO .json of real photos; with
 ``--map`` for (a), whose classes are ours, while (b) and (c) learn the real set's own names), and (a) also on the
@@ -121,6 +122,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--stand-in-test-split", default="test", help="the stand-in's split used as --test [test]")
     p.add_argument("--map", dest="maps", action="append", default=[], help="--map of evaluate-real for (a) on --test")
     p.add_argument("--minutes", type=float, default=30.0, help="budget of every training [30]")
+    p.add_argument("--real-minutes", type=float, help="budget of (b) and (c), the same for both [--minutes]")
     p.add_argument("--imgsz", type=int, default=320)
     p.add_argument("--batch", type=int, default=16)
     p.add_argument("--seed", type=int, default=0)
@@ -129,6 +131,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--table", type=Path, help="also write the markdown table here")
     args = p.parse_args(argv)
     budget = Budget(minutes=args.minutes, imgsz=args.imgsz, batch=args.batch)
+    real_budget = Budget(minutes=args.real_minutes or args.minutes, imgsz=args.imgsz, batch=args.batch)
     work = args.work
     runs, rows = {}, []
     commands = [" ".join(["python tools/sim2real.py"] + (sys.argv[1:] if argv is None else argv))]
@@ -136,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.stand_in:
         args.real_train, args.test = stand_in(args.stand_in, work / "stand_in", args.stand_in_test_split)
 
-    def trained(name: str, train_set: Path, init: Path | None = None) -> Path:
+    def trained(name: str, train_set: Path, init: Path | None = None, budget: Budget = budget) -> Path:
         out = work / "runs" / name
         if not (out / "train.json").is_file():          # a finished run is kept: rerun to redo the scoring only
             train(TrainRequest(train_set, out, budget, DetectionTargets(), init=init, seed=args.seed))
@@ -149,8 +152,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.test:
         rows.append(score("(a) synthetic", synthetic, args.test, work / "eval" / "a_on_test", args.maps, args.confidence))
     if args.real_train:
-        real = trained("b_real", args.real_train)
-        tuned = trained("c_finetuned", args.real_train, init=synthetic)
+        real = trained("b_real", args.real_train, budget=real_budget)
+        tuned = trained("c_finetuned", args.real_train, init=synthetic, budget=real_budget)
         if args.test:
             rows.append(score("(b) real only", real, args.test, work / "eval" / "b_on_test", [], args.confidence))
             rows.append(score("(c) synthetic + fine-tuned", tuned, args.test, work / "eval" / "c_on_test", [],
