@@ -89,12 +89,18 @@ class DetectionSet:
 
 
 def _image_size(path: Path) -> tuple[int, int]:
+    """(width, height) of an image stored upright. A photo whose EXIF orientation turns it would be read turned by
+    the detector (OpenCV applies it) and as stored here: refused rather than scored on boxes that do not fit."""
     from synthua_usd.backends.images import image_size
 
     try:
-        return image_size(path)
+        width, height, orientation = image_size(path)
     except OSError:
         raise InputError(f"{shown(path)}: not an image OpenImageIO can read; expected an image of the set") from None
+    if orientation != 1:
+        raise InputError(f"{shown(path)}: EXIF orientation {orientation}; expected images stored upright (orientation "
+                         f"1): rotate them as stored first, e.g. with ImageMagick's mogrify -auto-orient")
+    return width, height
 
 
 # --- Ultralytics YOLO ----------------------------------------------------------------------------------------

@@ -68,6 +68,15 @@ def test_a_split_with_too_many_images_is_refused_early(tmp_path, monkeypatch):
         read_yolo(root)
 
 
+def test_a_photo_turned_by_its_exif_orientation_is_refused(tmp_path):
+    root = yolo_folder(tmp_path / "set")
+    exif = Image.Exif()
+    exif[0x0112] = 6                                   # Orientation: turn 90 degrees to view
+    Image.fromarray(np.zeros((20, 40, 3), np.uint8)).save(root / "images" / "test" / "a.jpg", exif=exif)
+    with pytest.raises(InputError, match="EXIF orientation 6; expected images stored upright"):
+        read_yolo(root)
+
+
 def test_label_path_replaces_the_last_images_folder():
     assert label_path(Path("/d/images/x/images/test/a.jpg")) == Path("/d/images/x/labels/test/a.txt")
 
