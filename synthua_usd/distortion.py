@@ -103,6 +103,21 @@ class BrownConrady:
         x, y = xd.copy(), yd.copy()
         if self.is_zero:
             return x, y
+        # Coefficients such as k1 = 1e308 overflow to inf and NaN along the way: the residual check below
+        # refuses them in one line, so numpy's warnings about the same points would only repeat it.
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            x, y, err = self._newton(x, y, xd, yd)
+        bad = ~(err <= UNDISTORT_TOL)
+        if bad.any():
+            k = int(np.flatnonzero(bad.ravel())[0])
+            raise InputError(f"{where}: Brown-Conrady distortion ({self}) has no inverse at normalised image point "
+                             f"({xd.ravel()[k]:.4g}, {yd.ravel()[k]:.4g}) (residual {err.ravel()[k]:.2g}); expected "
+                             f"coefficients whose forward map is one-to-one over the image")
+        self._check_one_to_one(x, y, where)
+        return x, y
+
+    def _newton(self, x: np.ndarray, y: np.ndarray, xd: np.ndarray, yd: np.ndarray) -> tuple:
+        """Damped Newton iterations from (x, y) towards distort(x, y) = (xd, yd): (x, y, max-norm residual)."""
         fx, fy = self.distort(x, y)
         rx, ry = fx - xd, fy - yd
         err = np.maximum(np.abs(rx), np.abs(ry))
@@ -127,14 +142,7 @@ class BrownConrady:
             x, y = np.where(todo, nx, x), np.where(todo, ny, y)
             rx, ry = np.where(todo, fx - xd, rx), np.where(todo, fy - yd, ry)
             err = np.where(todo, new_err, err)
-        bad = ~(err <= UNDISTORT_TOL)
-        if bad.any():
-            k = int(np.flatnonzero(bad.ravel())[0])
-            raise InputError(f"{where}: Brown-Conrady distortion ({self}) has no inverse at normalised image point "
-                             f"({xd.ravel()[k]:.4g}, {yd.ravel()[k]:.4g}) (residual {err.ravel()[k]:.2g}); expected "
-                             f"coefficients whose forward map is one-to-one over the image")
-        self._check_one_to_one(x, y, where)
-        return x, y
+        return x, y, err
 
     def _check_one_to_one(self, x: np.ndarray, y: np.ndarray, where: str) -> None:
         """The solutions lie where the map is one-to-one: the radial curve r (1 + k1 r^2 + k2 r^4 + k3 r^6)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from synthua_usd.errors import escape_controls
+
 
 class Severity(enum.IntEnum):
     """How bad a finding is; ordered so that ``max()`` gives the worst."""
@@ -28,7 +30,8 @@ class Finding:
     severity: Severity = Severity.ERROR
 
     def format(self) -> str:
-        return f"{self.severity.name.lower()}: {self.where}: {self.message} ({self.rule})"
+        """One line: control characters of ``where`` and ``message`` (a layer path, a value) escaped."""
+        return escape_controls(f"{self.severity.name.lower()}: {self.where}: {self.message} ({self.rule})")
 
     def to_dict(self) -> dict:
         return {"rule": self.rule, "where": self.where, "message": self.message,

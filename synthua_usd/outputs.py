@@ -51,7 +51,9 @@ OUTPUTS: tuple[RenderOutput, ...] = (
         OutputFile("class", "class.png", {"dtype": "uint8", "meaning": "class id (class_map), 0 = unlabelled"}),
         OutputFile("semantic", "semantic.png", {"colorspace": "srgb_rec709_scene", "meaning": "class colour"}))),
     RenderOutput("instance_id", "synthua:instance_id", "primvar", "int", (
-        OutputFile("instance", "instance.png", {"dtype": "uint16", "meaning": "instance id (instances), 0 = none"}),)),
+        OutputFile("instance", "instance.png", {"dtype": "uint16", "meaning": "instance id (instances), 0 = none"}),
+        OutputFile("instance_preview", "instance_preview.png",
+                   {"colorspace": "srgb_rec709_scene", "meaning": "instance colour (a distinct colour per id, black = none)"}))),
     RenderOutput("depth", "depth", "raw", "float", (
         OutputFile("depth", "depth.exr", {"dtype": "float32", "channel": "Z", "kind": "z", "meaning": DEPTH_DEFINITION}),)),
 )

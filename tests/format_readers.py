@@ -63,9 +63,10 @@ def coco_self_evaluation(gt, annotations: list[dict]) -> dict[str, list[float]]:
 
 def coco_keypoint_self_evaluation(gt) -> dict[str, float]:
     """COCOeval's keypoint AP (OKS) of ``gt`` (a pycocotools COCO) against its own keypoints as detections
-    with score 1, per category that has labelled keypoints, each with its own OKS sigmas
-    (:func:`synthua_usd.keypoint_classes.sigmas`: COCOeval takes one sigma array for all the categories it
-    evaluates); 1.0 for each when the format is right."""
+    with score 1, per category that has labelled keypoints on an annotation that is not a crowd (an ignore
+    region, iscrowd 1: the detections on those are passed too, and COCOeval must neither reward nor penalise
+    them), each with its own OKS sigmas (:func:`synthua_usd.keypoint_classes.sigmas`: COCOeval takes one
+    sigma array for all the categories it evaluates); 1.0 for each when the format is right."""
     from pycocotools.cocoeval import COCOeval
 
     from synthua_usd.keypoint_classes import sigmas
@@ -77,7 +78,8 @@ def coco_keypoint_self_evaluation(gt) -> dict[str, float]:
         if not dets:
             return out
         dt = gt.loadRes(dets)
-        for cat in gt.loadCats(sorted({d["category_id"] for d in dets})):
+        scored = {a["category_id"] for a in gt.dataset["annotations"] if a.get("num_keypoints") and not a["iscrowd"]}
+        for cat in gt.loadCats(sorted(scored)):
             ev = COCOeval(gt, dt, "keypoints")
             ev.params.catIds = [cat["id"]]
             ev.params.kpt_oks_sigmas = sigmas(cat["name"])

@@ -8,6 +8,7 @@ folder is written; an existing output folder is left byte for byte as it was.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import subprocess
@@ -15,6 +16,7 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
 #: Every case must finish within this many seconds (a hang is a failure, not a slow test).
 CASE_TIMEOUT_S = 60
@@ -78,3 +80,32 @@ def tree_state(root: Path) -> dict[str, tuple]:
             else:
                 out[rel] = ("file", hashlib.sha256(path.read_bytes()).hexdigest(), path.stat().st_mode & 0o777)
     return out
+
+
+@contextlib.contextmanager
+def small_disk(tmp: Path, options: str) -> Iterator[Path]:
+    """A tmpfs mounted at ``tmp/mnt`` with ``options`` (``size=160k``, ``size=64k,ro``), unmounted afterwards;
+    skips the test where mounting is not allowed (CI runs as root and can)."""
+    import pytest
+
+    where = tmp / "mnt"
+    where.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(where)], capture_output=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a small tmpfs here ({done.stderr.decode().strip()}); CI runs as root and can")
+    try:
+        yield where
+    finally:
+        subprocess.run(["umount", str(where)], check=False)
+
+
+def size_limited(limit_bytes: int):
+    """A ``preexec_fn`` for a subprocess whose files may not grow past ``limit_bytes`` (RLIMIT_FSIZE: writes
+    fail with EFBIG, as on a full disk), without needing a mount."""
+    def limit() -> None:
+        import resource
+        import signal
+
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit_bytes, limit_bytes))
+    return limit

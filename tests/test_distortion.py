@@ -72,3 +72,13 @@ def test_a_fold_beyond_the_image_is_accepted_and_one_inside_refused():
 def test_bad_values_are_refused(data, text):
     with pytest.raises(InputError, match=text):
         BrownConrady.from_dict(data)
+
+
+def test_overflowing_coefficients_are_refused_without_numpy_warnings():
+    """k1 = 1e308 overflows inside the Newton iterations: refused in one line, numpy silent about it."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InputError, match="has no inverse"):
+            BrownConrady(k1=1e308).check_field(0.8, 0.6)

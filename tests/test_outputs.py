@@ -13,7 +13,8 @@ def test_every_file_has_one_key_and_one_name():
 
 
 def test_file_names_end_with_the_frame_document():
-    assert file_names() == ("rgb.exr", "rgb.png", "class.png", "semantic.png", "instance.png", "depth.exr",
+    assert file_names() == ("rgb.exr", "rgb.png", "class.png", "semantic.png", "instance.png", "instance_preview.png",
+                            "depth.exr",
                             FRAME_DOCUMENT)
     assert file_names(select_outputs(["depth"])) == ("depth.exr", FRAME_DOCUMENT)
 

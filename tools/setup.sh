@@ -71,6 +71,9 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ constraints.txt -nt
   # cocodataset/panopticapi code but declares numpy<2, which the rest of the stack cannot meet; its code runs
   # on NumPy 2, and what it needs (numpy, pillow) comes with the test extra.
   "$VENV/bin/python" -m pip install -q -c constraints.txt --no-deps panopticapi-lite
+  # TrackEval (the MOTChallenge reader of the tests' tracking sequences) declares opencv-python, which only its J&F
+  # metric imports (and which needs libGL): its other needs come with the package and the test extra.
+  "$VENV/bin/python" -m pip install -q -c constraints.txt --no-deps trackeval tabulate
   touch "$stamp"
 fi
 "$VENV/bin/synthua" --version

@@ -10,10 +10,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from synthua_usd.dataset.annotations import CROWD_ID_BASE, STUFF_ID_BASE
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.dataset.qa import AidUser, aid_users
 from synthua_usd.errors import InputError
 from synthua_usd.input_files import shown
+from synthua_usd.dataset.manifest import read_manifest
 from synthua_usd.schemas import read_json
 from synthua_usd.taxonomy import ClassMap
 
@@ -23,7 +25,8 @@ class ImageSummary:
     """One image as the statistics see it.
 
     ``class_pixels``: class name -> visible pixels (``unlabelled`` included); ``segments``: (class id, area in
-    pixels) of each panoptic segment (one per thing instance, one per stuff class present);
+    pixels) of each object: every visible thing instance (those too small to annotate included, which panoptic
+    merges into one crowd segment per class) and each stuff class present (its panoptic segment);
     ``aid_users``: the image's mobility-aid users (:func:`synthua_usd.dataset.qa.aid_users`)."""
 
     id: int
@@ -75,16 +78,17 @@ def manifest_images(root: Path) -> list[dict]:
     root = Path(root)
     if not root.is_dir():
         raise InputError(f"{shown(root)}: not a folder; expected a dataset folder written by `synthua generate`")
-    manifest_path = root / Layout.MANIFEST
-    if not manifest_path.exists():
-        raise InputError(f"{shown(manifest_path)}: file not found; expected a complete dataset written by "
-                         f"`synthua generate` (the manifest is written last)")
-    manifest = read_json(manifest_path, "a dataset manifest")
-    images = manifest.get("images") if isinstance(manifest, dict) else None
-    if not isinstance(images, list) or not all(isinstance(i, dict) and "name" in i and "split" in i for i in images):
-        raise InputError(f"{shown(manifest_path)}: images: not a list of image entries with name and split; "
-                         f"expected a manifest written by `synthua generate`")
-    return images
+    return read_manifest(root / Layout.MANIFEST)["images"]
+
+
+def _objects(record: dict) -> tuple[tuple[int, int], ...]:
+    """(class id, area) of the record's visible thing instances and of its stuff segments (panoptic ids from
+    STUFF_ID_BASE up to CROWD_ID_BASE)."""
+    things = [(int(i["category_id"]), int(i["area"])) for i in record.get("instances", ())
+              if i.get("isthing") and i.get("area", 0) > 0]
+    stuff = [(int(s["category_id"]), int(s["area"])) for s in record["panoptic_segments"]
+             if STUFF_ID_BASE <= int(s["id"]) < CROWD_ID_BASE]
+    return tuple(things + stuff)
 
 
 def _summary(record: dict, verdict: str, where: str) -> ImageSummary:
@@ -95,7 +99,7 @@ def _summary(record: dict, verdict: str, where: str) -> ImageSummary:
             id=int(record["id"]), name=str(record["name"]), split=str(record["split"]), condition=str(condition),
             rig_type=str(camera.get("rig_type") or "none"), width=int(record["width"]), height=int(record["height"]),
             verdict=verdict, class_pixels={str(k): int(v) for k, v in record["class_pixel_counts"].items()},
-            segments=tuple((int(s["category_id"]), int(s["area"])) for s in record["panoptic_segments"]),
+            segments=_objects(record),
             aid_users=tuple(aid_users(record.get("instances", ()))), camera_path=str(camera.get("prim_path", "")),
             time_code=float(record.get("time_code", 0.0)), seed=int(record.get("seed", 0)),
             visible=tuple(str(i["prim_path"]) for i in record.get("instances", ()) if i.get("area", 0) > 0),

@@ -20,8 +20,9 @@ import numpy as np
 
 from synthua_usd.analytics import segmentation_metrics as sm
 from synthua_usd.analytics.dataset_index import load_class_map, manifest_images
+from synthua_usd.dataset.annotations import rle_problem
 from synthua_usd.dataset.layout import SPLITS, Layout, inside
-from synthua_usd.errors import InputError
+from synthua_usd.errors import InputError, echo
 from synthua_usd.input_files import check_input_file, shown
 from synthua_usd.schemas import read_json
 from synthua_usd.taxonomy import ClassMap
@@ -156,11 +157,10 @@ def _check_detection(r: dict, image: dict, where: str) -> None:
                             and r["bbox"][2] >= 0 and r["bbox"][3] >= 0):
         raise InputError(f"{where}.bbox: {str(r['bbox'])[:80]}; expected [x, y, width, height], finite, sizes >= 0")
     if "segmentation" in r:
-        seg = r["segmentation"]
-        size = [image["height"], image["width"]]
-        if not (isinstance(seg, dict) and seg.get("size") == size and isinstance(seg.get("counts"), str)):
-            raise InputError(f"{where}.segmentation: {str(seg)[:80]}; expected an RLE mask {{'size': {size}, "
-                             f"'counts': '...'}} (pycocotools' compressed counts) of its image's size")
+        problem = rle_problem(r["segmentation"], (image["height"], image["width"]))
+        if problem:
+            raise InputError(f"{where}.segmentation: {echo(problem, 240)}; expected an RLE mask (pycocotools' "
+                             f"compressed counts) of its image's size")
 
 
 def evaluate_coco(gt_dir: Path, results_path: Path, split: str | None = None) -> dict:

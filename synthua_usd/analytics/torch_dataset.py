@@ -6,7 +6,8 @@ Item ``i`` is ``(image, target)``:
 * ``image``: (3, H, W) float32 in [0, 1], the display sRGB image (``images/{split}/{name}.png``);
 * ``target`` (torchvision's detection / instance-segmentation target, plus the semantic map):
   ``boxes`` (N, 4) float32 XYXY pixel edges; ``labels`` (N,) int64 class ids; ``masks`` (N, H, W) uint8;
-  ``area`` (N,) float32 visible pixels; ``iscrowd`` (N,) int64 zeros; ``image_id`` int; ``semantic`` (H, W)
+  ``area`` (N,) float32 visible pixels; ``iscrowd`` (N,) int64, 1 for an instance too small to learn from (the config's ``min_instance_px``,
+  iscrowd 1 in COCO too; torchvision's detection references leave those out of training); ``image_id`` int; ``semantic`` (H, W)
   int64 class ids of ``frames/{name}/class.png`` (0 = unlabelled); ``name`` str.
 
 Instances are the image's visible thing instances as in its COCO annotations (decoded from the record's RLE
@@ -72,7 +73,7 @@ class SynthuaDataset(torch.utils.data.Dataset):
                   "labels": torch.tensor([int(inst["category_id"]) for inst in things], dtype=torch.int64),
                   "masks": torch.from_numpy(np.ascontiguousarray(masks, np.uint8)),
                   "area": torch.tensor([float(inst["area"]) for inst in things], dtype=torch.float32),
-                  "iscrowd": torch.zeros(len(things), dtype=torch.int64),
+                  "iscrowd": torch.tensor([int(bool(inst.get("ignore"))) for inst in things], dtype=torch.int64),
                   "image_id": int(record["id"]),
                   "semantic": torch.from_numpy(semantic.astype(np.int64)),
                   "name": name}

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.atomic import write_json_atomic
-from synthua_usd.backends import images
+from synthua_usd.backends import images, previews
 from synthua_usd.outputs import DEPTH_DEFINITION, FRAME_DOCUMENT, RenderOutput
 from synthua_usd.schemas import validate_document
 
@@ -29,7 +29,8 @@ def _jobs(output: RenderOutput, out_dir: Path, *, rgb, class_ids, instance_ids, 
         return [(images.write_id_png, out_dir / "class.png", class_ids),
                 (images.write_color_png, out_dir / "semantic.png", palette[class_ids])]
     if output.var == "instance_id":
-        return [(images.write_id_png, out_dir / "instance.png", instance_ids)]
+        return [(images.write_id_png, out_dir / "instance.png", instance_ids),
+                (images.write_color_png, out_dir / "instance_preview.png", previews.instance_preview(instance_ids))]
     if output.var == "depth":
         return [(lambda path, data: images.write_depth_exr(path, data, DEPTH_DEFINITION), out_dir / "depth.exr", z_depth)]
     raise ValueError(f"output '{output.var}' has no writer")

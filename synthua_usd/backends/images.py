@@ -8,15 +8,12 @@ Every write goes to a temporary file in the target folder and is renamed into pl
 
 from __future__ import annotations
 
-import errno
-import os
-import shutil
 from pathlib import Path
 
 import numpy as np
 import OpenImageIO as oiio
 
-from synthua_usd.atomic import atomic_path
+from synthua_usd.atomic import atomic_path, write_failure
 
 LINEAR_SPACE = "lin_rec709_scene"
 DISPLAY_SPACE = "srgb_rec709_scene"
@@ -39,25 +36,18 @@ def _write(path: Path, pixels: np.ndarray, fmt: str, attributes: dict[str, str] 
     with atomic_path(path) as tmp:
         out = oiio.ImageOutput.create(str(tmp))
         if out is None or not out.open(str(tmp), spec):
-            raise _write_error(path, tmp, pixels.nbytes, oiio.geterror())
+            raise write_failure(path, tmp, _oiio_reason(oiio.geterror()), pixels.nbytes)
         # ImageBuf/ImageOutput want (H, W, C); a 2-D array would be read as the wrong shape.
         ok = out.write_image(np.ascontiguousarray(pixels))
         message = out.geterror() if not ok else ""
         ok = out.close() and ok
         if not ok:
-            raise _write_error(path, tmp, pixels.nbytes, message or out.geterror())
+            raise write_failure(path, tmp, _oiio_reason(message or out.geterror()), pixels.nbytes)
     return path
 
 
-def _write_error(path: Path, tmp: Path, size: int, message: str) -> OSError:
-    """OpenImageIO reports no errno: tell a full disk (less free space than the raw pixels) from the rest."""
-    try:
-        full = shutil.disk_usage(tmp.parent).free < size
-    except OSError:
-        full = False
-    if full:
-        return OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
-    return OSError(errno.EIO, f"OpenImageIO could not write it ({message.strip() or 'no reason given'})", str(path))
+def _oiio_reason(message: str) -> str:
+    return f"OpenImageIO could not write it ({message.strip() or 'no reason given'})"
 
 
 def write_linear_exr(path: Path, rgb: np.ndarray) -> Path:
@@ -85,6 +75,12 @@ def write_display_png(path: Path, rgb: np.ndarray) -> Path:
 def write_color_png(path: Path, rgb8: np.ndarray) -> Path:
     """(H, W, 3) uint8 sRGB values written as they are (class colours)."""
     return _write(path, rgb8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE})
+
+
+def write_color_jpeg(path: Path, rgb8: np.ndarray, quality: int = 95) -> Path:
+    """(H, W, 3) uint8 sRGB values as a baseline JPEG of ``quality`` (1..100): MOTChallenge's frame format."""
+    return _write(path, rgb8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE,
+                                                         "compression": f"jpeg:{int(quality)}"})
 
 
 def write_id_png(path: Path, ids: np.ndarray) -> Path:

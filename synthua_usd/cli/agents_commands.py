@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_OK
+from synthua_usd.cli.common import EXIT_OK, say
 from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
 from synthua_usd.ranges import Range
 
@@ -55,10 +55,10 @@ def agents_populate(stage: Path, density: float, aid_share: float, time_codes: i
                          walkable=walkable)
     crowd, path, seconds = populate(PopulateRequest(stage, out_path, params, class_map, allow_external_assets))
     r = crowd.report
-    click.echo(f"walkable area {r['walkable_area_m2']:.0f} m², expected {r['expected']:.1f} agents, sampled "
+    say(f"walkable area {r['walkable_area_m2']:.0f} m², expected {r['expected']:.1f} agents, sampled "
                f"{r['sampled']}, placed {r['placed']} ({r['aid_users']} with mobility aids), dropped "
                f"{r['dropped']} (no collision-free start)")
-    click.echo(f"profiles {r['by_profile']}")
-    click.echo(f"minimum gap between agents over {time_codes} time codes: {r['min_separation_m']:.3f} m; {seconds:.1f} s")
-    click.echo(f"wrote {path}")
+    say(f"profiles {r['by_profile']}")
+    say(f"minimum gap between agents over {time_codes} time codes: {r['min_separation_m']:.3f} m; {seconds:.1f} s")
+    say(f"wrote {path}")
     return EXIT_OK

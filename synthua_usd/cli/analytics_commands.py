@@ -8,7 +8,8 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_OK
+from synthua_usd.cli.common import EXIT_OK, say
+from synthua_usd.dataset.layout import check_outside_datasets
 from synthua_usd.errors import InputError
 
 
@@ -38,6 +39,8 @@ def stats(dataset: Path, out_dir: Path, samples: int) -> int:
     """
     from synthua_usd.analytics.dataset_index import load_index
     from synthua_usd.analytics.report import write_report
+
+    check_outside_datasets(out_dir)  # before the work: write_report would refuse it at the end
     from synthua_usd.analytics.statistics import compute
 
     t0 = time.perf_counter()
@@ -46,11 +49,11 @@ def stats(dataset: Path, out_dir: Path, samples: int) -> int:
     seconds = time.perf_counter() - t0
     files = write_report(index, result, out_dir, samples=samples, seconds=seconds)
     s = result.summary
-    click.echo(f"{s['images']} images ({s['rejected_images_left_out']} QA-rejected left out), {s['objects']} objects: "
+    say(f"{s['images']} images ({s['rejected_images_left_out']} QA-rejected left out), {s['objects']} objects: "
                f"Gini {s['gini_pixel_area']:.4f}, entropy {s['shannon_entropy_bits']:.4f} bits (normalised "
                f"{s['normalised_entropy']:.4f}), {s['classes_for_coverage']} classes cover 80 % of the area, "
                f"{100 * s['share_images_with_aid_user']:.1f} % of images show a mobility-aid user")
-    click.echo(f"statistics in {seconds:.2f} s, report in {time.perf_counter() - t0:.2f} s -> {files.html}")
+    say(f"statistics in {seconds:.2f} s, report in {time.perf_counter() - t0:.2f} s -> {files.html}")
     return EXIT_OK
 
 
@@ -82,33 +85,34 @@ def evaluate(gt_dir: Path, pred: Path, out_dir: Path, split: str | None) -> int:
     from synthua_usd.analytics.evaluation_report import write_evaluation
     from synthua_usd.input_files import shown
 
+    check_outside_datasets(out_dir)  # before the work: write_evaluation would refuse it at the end
     if pred.suffix.lower() == ".json":
         coco = evaluate_coco(gt_dir, pred, split)
         write_evaluation(out_dir, None, coco)
         for iou_type, result in coco["iou_types"].items():
             st = result["stats"]
-            click.echo(f"{iou_type}: mAP {st['AP']:.4f}, AP50 {st['AP50']:.4f}, AP75 {st['AP75']:.4f} "
+            say(f"{iou_type}: mAP {st['AP']:.4f}, AP50 {st['AP50']:.4f}, AP75 {st['AP75']:.4f} "
                        f"({coco['detections']} detections on {coco['images']} images)")
-        click.echo(f"-> {out_dir}")
+        say(f"-> {out_dir}")
         return EXIT_OK
     if not pred.exists():
         raise InputError(f"{shown(pred)}: not found; expected a folder of predictions or a COCO results .json")
     ev = evaluate_semantic(gt_dir, pred, split)
     write_evaluation(out_dir, ev, None)
     s = ev.summary
-    click.echo(f"{ev.images} images, {s['pixels']:,} pixels evaluated: pixel accuracy {s['pixel_accuracy']:.4f}, "
+    say(f"{ev.images} images, {s['pixels']:,} pixels evaluated: pixel accuracy {s['pixel_accuracy']:.4f}, "
                f"mean IoU {s['mean_iou'] if s['mean_iou'] is None else format(s['mean_iou'], '.4f')} "
                f"({s['mean_iou_classes']} classes), frequency-weighted IoU {s['frequency_weighted_iou']:.4f}")
-    click.echo(f"{'class':22s} {'gt px':>9s} {'IoU':>7s} {'prec':>7s} {'recall':>7s} {'F1':>7s}")
+    say(f"{'class':22s} {'gt px':>9s} {'IoU':>7s} {'prec':>7s} {'recall':>7s} {'F1':>7s}")
     gt_px = ev.matrix.sum(axis=1)
     for c in ev.class_map.classes:
         m = ev.per_class[c.id]
         if c.id == 0 or (gt_px[c.id] == 0 and m.fp == 0):
             continue
         f = [("–" if v is None else f"{v:.4f}") for v in (m.iou, m.precision, m.recall, m.f1)]
-        click.echo(f"{c.name:22s} {gt_px[c.id]:9d} {f[0]:>7s} {f[1]:>7s} {f[2]:>7s} {f[3]:>7s}")
+        say(f"{c.name:22s} {gt_px[c.id]:9d} {f[0]:>7s} {f[1]:>7s} {f[2]:>7s} {f[3]:>7s}")
     if ev.ignored_predictions:
-        click.echo(f"ignored {len(ev.ignored_predictions)} prediction files not among the evaluated images, e.g. "
+        say(f"ignored {len(ev.ignored_predictions)} prediction files not among the evaluated images, e.g. "
                    f"{ev.ignored_predictions[0]}")
-    click.echo(f"-> {out_dir}")
+    say(f"-> {out_dir}")
     return EXIT_OK

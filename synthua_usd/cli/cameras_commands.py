@@ -8,7 +8,8 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, parse_time_codes
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, parse_time_codes, say
+from synthua_usd.errors import escape_controls
 
 
 @click.group()
@@ -51,11 +52,15 @@ def cameras_types() -> int:
               help="Image height the pixel counts are for.")
 @click.option("--variant", help="Mitsuba variant for the label passes [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
+@click.option("--layer", "layers", multiple=True, type=click.Path(path_type=Path),
+              help="A layer composed over SCENARIO for the placement only (no file is edited), e.g. an agents layer "
+                   "`synthua agents populate` wrote that SCENARIO does not compose yet; repeat for several, "
+                   "strongest first.")
 @click.option("--allow-external-assets", is_flag=True,
               help="Accept layers outside the stage's folder tree (refused by default).")
 def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_target_px: int,
                    time_codes: tuple[float, ...], width: int, height: int, variant: str | None,
-                   class_map: Path | None, allow_external_assets: bool) -> int:
+                   class_map: Path | None, layers: tuple[Path, ...], allow_external_assets: bool) -> int:
     """Place camera rigs in SCENARIO, aim them, and write them as a cameras layer with a report.
 
     \b
@@ -78,6 +83,9 @@ def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_ta
           --rig cctv:aim=electric_wheelchair,count=2 --rig dashcam --rig uav_oblique:height_m=30 \\
           --rig pedestrian_eye:ride=auto,aim=crossing --rig wheelchair_eye:k1=-0.2,k2=0.05
       synthua compose with-rigs.usda rigs.usda stages/district/scenario.usda
+    A twin scenario without people (synthua twin demo) and an agents layer written for it:
+      synthua cameras author my_district/scenario.usda --layer my_district/agents.usdc \\
+          --rig cctv:aim=aid_user,name=AidCCTV --out my_district/rigs.usda
     Distortion (k1, k2, k3, p1, p2; OpenCV's convention) is stored on the camera as synthua:distortion:*
     attributes and applied to RGB and labels alike by `synthua render`.
     """
@@ -87,10 +95,11 @@ def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_ta
     specs = tuple(RigSpec.parse(text) for text in rigs)
     result = author_rigs(RigRequest(stage_path=scenario, out_path=out_path, rigs=specs, width=width, height=height,
                                     time_codes=time_codes, min_target_px=min_target_px, variant=variant,
-                                    class_map_path=class_map, allow_external_assets=allow_external_assets),
+                                    class_map_path=class_map, allow_external_assets=allow_external_assets,
+                                    layers=layers),
                          show_progress=sys.stderr.isatty())
     click.echo(format_table(result.report))
-    click.echo(f"wrote {result.layer_path} ({result.accepted} camera{'s' if result.accepted != 1 else ''}) and "
+    say(f"wrote {result.layer_path} ({result.accepted} camera{'s' if result.accepted != 1 else ''}) and "
                f"{result.report_path}")
     if result.rejected:
         click.echo(f"{result.rejected} camera(s) rejected: their target covers fewer than {min_target_px} visible "
@@ -101,7 +110,7 @@ def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_ta
 
 def format_table(report: dict) -> str:
     """One row per camera: rig, target, the target's fewest and most visible pixels over the report's time
-    codes, its largest occluded share, status."""
+    codes, its largest occluded share, status; one line each, control characters escaped."""
     size = report["image"]
     head = (f"{'camera':28s} {'rig':14s} {'target':34s} {'min px':>8s} {'max px':>8s} {'occluded':>9s}  status"
             f"   ({size['width']}x{size['height']}, {len(report['time_codes'])} time codes)")
@@ -116,5 +125,5 @@ def format_table(report: dict) -> str:
         else:
             what, numbers = "-", f"{'-':>8s} {'-':>8s} {'-':>9s}"
         status = cam["status"] + (" (on road)" if cam.get("on_road") else "")
-        lines.append(f"{cam['name']:28s} {cam['rig']:14s} {what:34s} {numbers}  {status}")
+        lines.append(escape_controls(f"{cam['name']:28s} {cam['rig']:14s} {what:34s} {numbers}  {status}"))
     return "\n".join(lines)

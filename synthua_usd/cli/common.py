@@ -1,4 +1,5 @@
-"""What every ``synthua`` subcommand module shares: exit statuses and the class-map option's loader."""
+"""What every ``synthua`` subcommand module shares: exit statuses, printing a line of output, and the class-map
+option's loader."""
 
 from __future__ import annotations
 
@@ -7,7 +8,14 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.failures import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK  # noqa: F401 (re-exported)
+from synthua_usd.errors import escape_controls
 from synthua_usd.timecodes import parse_time_code_spec
+
+
+def say(line: str) -> None:
+    """Print ``line`` on stdout as one line, its control characters escaped as in the error messages: a path
+    the user typed with a newline or a terminal escape in it cannot split the line or reach the terminal."""
+    click.echo(escape_controls(line))
 
 
 def load_class_map(path: Path | None):

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, say
 
 
 def worker_time_shares(seconds: dict[str, float]) -> str:
@@ -52,12 +52,16 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
     per condition and per rig type) and splits them train/val/test by camera. Per image: RGB, class ids,
     class colours, instance ids and a coloured preview, panoptic PNG, depth, amodal masks, occlusion and
     truncation, person keypoints and device contact points with visibility flags, QA verdicts. Per dataset:
-    COCO instances (with keypoints) and panoptic JSON, Cityscapes gtFine, YOLO labels and data.yaml,
-    metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
+    COCO instances (with keypoints), person keypoints and panoptic JSON, Cityscapes gtFine, YOLO labels and
+    data.yaml, metadata.csv/.parquet, coverage.json, rejected.csv and manifest.json.
     \b
     With a randomise block (configs/district_random.json) every image is a scene of its own: a new crowd, looks,
     material variants and district per seed, the crowd placed anew and the camera moved per view, the light
     drawn per image, all as USD layers composed over SCENARIO (synthua randomise writes an image's layers).
+    \b
+    With a sequences block (configs/district_sequences.json) it also renders tracking sequences: each camera x
+    condition x seed for duration_s at fps from one loaded scene, in the MOTChallenge layout (img1/, gt/gt.txt,
+    seqinfo.ini) with tracks.csv, per-frame instance maps, a preview video and COCO video annotations.
     \b
     Killed or failed runs resume: run the same command again; finished images are kept.
     The same config, scenario and variant give the same bytes (check one image: synthua replay).
@@ -70,34 +74,45 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
                                            class_map_path=class_map, allow_external_assets=allow_external_assets),
                            show_progress=sys.stderr.isatty())
     s = summary
-    click.echo(f"dataset {s.out_dir}: {s.planned - s.rejected} images ({s.flagged} flagged by QA) and {s.rejected} "
+    say(f"dataset {s.out_dir}: {s.planned - s.rejected} images ({s.flagged} flagged by QA) and {s.rejected} "
                f"rejected by QA, replaced where the pool allowed (rejected.csv); {s.rendered} rendered now, "
                f"{s.resumed} found from an earlier run")
+    if s.splits:
+        asked = "/".join(f"{v['share']:g}" for v in s.splits.values())
+        say("split by camera: " + ", ".join(f"{split} {v['images']} images from {v['cameras']} camera"
+                                            f"{'s' if v['cameras'] != 1 else ''}" for split, v in s.splits.items())
+            + f" (asked {asked})")
     if s.rendered:
         shares = worker_time_shares(s.seconds)
         peak = max(s.peak_rss_mib.values()) if s.peak_rss_mib else 0.0
-        click.echo(f"{s.rendered / s.wall_seconds * 60:.1f} images/min over {s.wall_seconds:.0f} s; worker time: "
+        say(f"{s.rendered / s.wall_seconds * 60:.1f} images/min over {s.wall_seconds:.0f} s; worker time: "
                    f"{shares}; peak memory per worker {peak:.0f} MiB; {s.bytes_per_image / 2**20:.2f} MiB per image")
+    if s.sequences:
+        say(f"{s.sequences} tracking sequences of {s.frames} frames: {s.frames_rendered} rendered now, "
+            f"{s.frames_resumed} found from an earlier run (MOTChallenge layout in {s.out_dir / 'sequences'})")
     for line in s.shortfalls:
-        click.echo(f"quota not met: {line}")
+        say(f"quota not met: {line}")
     return EXIT_OK
 
 
 @click.command()
 @click.argument("dataset", type=click.Path(path_type=Path))
 def verify(dataset: Path) -> int:
-    """Check DATASET against its manifest: every file present with its size and SHA-256, every planned
-    image complete, every COCO annotation equal to its instance's pixels (a visible keypoint within 2
-    pixels of them), every panoptic segment equal to its PNG, Cityscapes and YOLO files consistent. Exit 1 on any problem, listed one per line."""
+    """Check DATASET against its manifest: every file present with its size and SHA-256 and no file it does
+    not list, every planned image complete, every COCO annotation equal to its instance's pixels (a visible
+    keypoint within 2 pixels of them), every panoptic segment equal to its PNG, Cityscapes and YOLO files
+    consistent. Exit 1 on any problem, listed one per line; 2 when the manifest or generate.json is
+    malformed."""
     from synthua_usd.pipeline.verify import MAX_LISTED, verify as run_verify
 
     result = run_verify(dataset, show_progress=sys.stderr.isatty())
     for problem in result.problems[:MAX_LISTED]:
-        click.echo(f"problem: {problem}")
+        say(f"problem: {problem}")
     if len(result.problems) > MAX_LISTED:
-        click.echo(f"... and {len(result.problems) - MAX_LISTED} more problems")
+        say(f"... and {len(result.problems) - MAX_LISTED} more problems")
     verdict = "ok" if result.ok else f"{len(result.problems)} problems"
-    click.echo(f"{dataset}: {result.images} images, {result.files} files checked: {verdict}")
+    sequences = (f", {result.sequences} sequences of {result.frames} frames" if result.sequences else "")
+    say(f"{dataset}: {result.images} images{sequences}, {result.files} files checked: {verdict}")
     return EXIT_OK if result.ok else EXIT_FINDINGS
 
 
@@ -106,13 +121,14 @@ def verify(dataset: Path) -> int:
 @click.argument("image")
 def replay(dataset: Path, image: str) -> int:
     """Render IMAGE (an image id or name) of DATASET again, as its generate.json says, and compare every
-    file with the dataset's byte for byte. Exit 0 when all are identical, 1 otherwise."""
+    file with the dataset's file on disk byte for byte (each one that differs or is missing is listed).
+    Exit 0 when all are identical, 1 otherwise."""
     from synthua_usd.pipeline.verify import replay as run_replay
 
     result = run_replay(dataset, image)
     for path in result.different:
-        click.echo(f"differs: {path}")
+        say(f"differs: {path}")
     verdict = "byte-identical" if result.ok else f"{len(result.different)} of " \
               f"{len(result.different) + len(result.identical)} files differ"
-    click.echo(f"image {result.image_id} ({result.name}): {verdict}")
+    say(f"image {result.image_id} ({result.name}): {verdict}")
     return EXIT_OK if result.ok else EXIT_FINDINGS

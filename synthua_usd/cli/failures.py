@@ -4,7 +4,10 @@
 
 with exit status 2; anything unexpected is one short line with exit status 3 (``--debug`` shows the
 traceback). Warnings from libraries (Python ``warnings``, and the diagnostics OpenUSD's C++ code prints
-straight to the process's stderr) are turned into one-line ``synthua: warning:`` messages.
+straight to the process's stderr) are turned into one-line ``synthua: warning:`` messages, shown when the
+command succeeds; when it fails the error line says what went wrong, and warnings about the same values
+(numpy's "invalid value encountered" on the NaN being refused) would only come before it: they are
+dropped (``--debug`` keeps them).
 """
 
 from __future__ import annotations
@@ -104,9 +107,9 @@ def click_message(exc: click.ClickException) -> str:
 def guarded(fn: Callable[[], int], debug: bool) -> int:
     """Run ``fn`` and turn any failure into one line on stderr and an exit status."""
     try:
-        # On failure the error line says what went wrong; OpenUSD's own warnings about the same problem
-        # would only repeat it (--debug shows them).
-        with native_stderr_as_warnings(keep_on_failure=debug):
+        # On failure the error line says what went wrong; OpenUSD's own warnings and Python's about the same
+        # problem would only repeat it (--debug shows them).
+        with native_stderr_as_warnings(keep_on_failure=debug), python_warnings_held(keep_on_failure=debug):
             return fn()
     except click.exceptions.Exit as exc:
         return exc.exit_code
@@ -127,6 +130,36 @@ def guarded(fn: Callable[[], int], debug: bool) -> int:
         message, status = describe(exc)
         click.echo(f"synthua: error: {one_line(message)}", err=True)
         return status
+
+
+class _Held(logging.Filter):
+    """Holds back every record it sees (they are handled later, or dropped)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.records: list[logging.LogRecord] = []
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        self.records.append(record)
+        return False
+
+
+@contextlib.contextmanager
+def python_warnings_held(keep_on_failure: bool = True) -> Iterator[None]:
+    """Hold back Python warnings (which ``logging.captureWarnings`` routes to the ``py.warnings`` logger) while
+    the block runs; log them afterwards when it succeeded (or ``keep_on_failure``), else drop them."""
+    logger = logging.getLogger("py.warnings")
+    held = _Held()
+    logger.addFilter(held)
+    failed = True
+    try:
+        yield
+        failed = False
+    finally:
+        logger.removeFilter(held)
+        if keep_on_failure or not failed:
+            for record in held.records:
+                logger.handle(record)
 
 
 #: How much of the native diagnostics is read back and how many lines are printed.

@@ -18,7 +18,7 @@ from synthua_usd import __version__
 from synthua_usd.cli.agents_commands import agents
 from synthua_usd.cli.analytics_commands import evaluate, stats
 from synthua_usd.cli.cameras_commands import cameras
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map, say
 from synthua_usd.cli.common import parse_time_codes as _time_codes
 from synthua_usd.cli.dataset_commands import generate, replay, verify
 from synthua_usd.cli.randomise_commands import randomise
@@ -37,7 +37,7 @@ def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
         click.echo(json.dumps([f.to_dict() for f in findings], indent=2))
     else:
         for f in findings:
-            click.echo(f.format())
+            say(f.format())
         counts = {s: sum(1 for f in findings if f.severity is s) for s in Severity}
         click.echo(f"{counts[Severity.ERROR]} errors, {counts[Severity.WARNING]} warnings, {counts[Severity.INFO]} notes",
                    err=True)
@@ -104,8 +104,9 @@ def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: b
     """Validate a USD STAGE: OpenUSD's UsdValidation validators plus synthua's rules.
 
     synthua's rules: every renderable gprim has exactly one class (directly or from one ancestor), every
-    label is in the class map, cameras have valid physical lens values, stage metadata is stated, and
-    render settings name a real camera.
+    label is in the class map, cameras have valid physical lens values, stage metadata is stated, render
+    settings name a real camera, every authored number is finite, Cube/Sphere/Cylinder/Cone/Capsule sizes
+    are > 0; when none finds an error, the stage is read as render reads it.
     """
     from synthua_usd.usd.stage_checks import validate_stage as run_rules
     from synthua_usd.usd.stage_io import open_stage
@@ -119,21 +120,25 @@ def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: b
 @cli.command()
 @click.argument("out", type=click.Path(path_type=Path))
 @click.argument("layers", nargs=-1, required=True, type=click.Path(path_type=Path))
-def compose(out: Path, layers: tuple[Path, ...]) -> int:
+@click.option("--allow-external-assets", is_flag=True,
+              help="Compose layers outside OUT's folder tree (refused by default: validate, render and generate "
+                   "then need the same flag).")
+def compose(out: Path, layers: tuple[Path, ...], allow_external_assets: bool) -> int:
     """Write scenario root OUT that sublayers LAYERS (strongest first).
 
     The root states upAxis, metersPerUnit and timeCodesPerSecond (the layers must agree), the union of
-    their time ranges and the first defaultPrim. Paths are stored relative to OUT.
+    their time ranges and the first defaultPrim. Paths are stored relative to OUT. LAYERS lie in OUT's
+    folder tree (a scenario that reaches outside its folder is refused by the commands that open it).
 
     \b
     Example:
-      synthua compose my.usda stages/render.usda stages/environment.usda stages/cameras.usda \\
+      synthua compose stages/my.usda stages/render.usda stages/environment.usda stages/cameras.usda \\
           stages/agents.usdc stages/semantics.usda stages/twin.usdc
     """
     from synthua_usd.usd.compose import compose_layers
 
-    path = compose_layers(out, list(layers))
-    click.echo(f"wrote {path} ({len(layers)} sublayers)")
+    path = compose_layers(out, list(layers), allow_external_assets=allow_external_assets)
+    say(f"wrote {path} ({len(layers)} sublayers)")
     return EXIT_OK
 
 
@@ -165,7 +170,7 @@ def create_street(out_dir: Path) -> int:
     from synthua_usd.usd.scenario_writer import write_scenario
 
     for path in write_scenario(street_scenario(), out_dir):
-        click.echo(f"wrote {path}")
+        say(f"wrote {path}")
     return EXIT_OK
 
 
@@ -184,7 +189,7 @@ def create_district(out_dir: Path, seed: int) -> int:
     paths, rigs = write_scenario_with_rigs(district.district_scenario(seed), district.district_aimed_rigs(), out_dir)
     click.echo(format_table(rigs.report))
     for path in paths:
-        click.echo(f"wrote {path}")
+        say(f"wrote {path}")
     return EXIT_OK
 
 
@@ -239,8 +244,8 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     \b
     Files per frame (the stage's UsdRender vars choose; all when it names none): rgb.exr
     (scene-linear Rec.709) and rgb.png (display sRGB), class.png (8-bit class ids) and semantic.png
-    (class colours), instance.png (16-bit instance ids, 0 = none), depth.exr (z-depth in metres,
-    0 = no hit), and always frame.json (camera intrinsics/extrinsics, class map, instances with pixel
+    (class colours), instance.png (16-bit instance ids, 0 = none) and instance_preview.png (a colour per
+    id), depth.exr (z-depth in metres, 0 = no hit), and always frame.json (camera intrinsics/extrinsics, class map, instances with pixel
     counts, the condition and the exposure rgb.png was made with). Nothing is written unless every input checks out, and nothing is replaced unless every
     frame rendered.
     """
@@ -256,12 +261,12 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
         doc = frame.document
         visible = sum(1 for i in doc["instances"] if i["pixel_count"])
         condition = f"condition {doc['condition']['name']}, " if doc["condition"] else ""
-        click.echo(f"rendered {doc['camera']['prim_path']} at time code {doc['time_code']:g}: "
+        say(f"rendered {doc['camera']['prim_path']} at time code {doc['time_code']:g}: "
                    f"{doc['image']['width']}x{doc['image']['height']}, {doc['render']['spp']} spp"
                    f"{' denoised' if doc['render'].get('denoise') else ''}, "
                    f"{doc['render']['variant']}, {condition}{visible} visible instances -> {frame.out_dir}")
     files = sum(len(f.files) for f in run.frames)
-    click.echo(f"wrote {files} files for {len(run.frames)} frames to {out_dir} in {time.perf_counter() - t0:.1f} s "
+    say(f"wrote {files} files for {len(run.frames)} frames to {out_dir} in {time.perf_counter() - t0:.1f} s "
                f"({run.loads} scene load{'s' if run.loads != 1 else ''})")
     return EXIT_OK
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_OK
+from synthua_usd.cli.common import EXIT_OK, say
 
 
 @click.command("contact-sheet")
@@ -51,7 +51,7 @@ def contact_sheet(scenario: Path, time_code: float | None, cameras: tuple[str, .
                                           spp=spp, seed=seed, variant=variant, class_map_path=class_map,
                                           allow_external_assets=allow_external_assets),
                              show_progress=sys.stderr.isatty())
-    click.echo(f"wrote {run.path}: {len(run.cameras)} cameras x {len(run.conditions)} conditions "
+    say(f"wrote {run.path}: {len(run.cameras)} cameras x {len(run.conditions)} conditions "
                f"({', '.join(run.conditions)}) in {time.perf_counter() - t0:.1f} s "
                f"({run.loads} scene loads)")
     return EXIT_OK

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, say
 from synthua_usd.cli.options import InRange
 from synthua_usd.errors import echo
 from synthua_usd.survey import LIMITS, THRESHOLD
@@ -58,14 +58,14 @@ def survey_flight_plan(as_json: bool, **kwargs) -> int:
     if as_json:
         click.echo(json.dumps(plan.to_dict(), indent=2))
     else:
-        click.echo(f"footprint W        {plan.footprint_m:.1f} m")
-        click.echo(f"frontal spacing    {plan.frontal_spacing_m:.1f} m")
-        click.echo(f"lateral spacing    {plan.lateral_spacing_m:.1f} m")
-        click.echo(f"flight lines       {plan.flight_lines}")
-        click.echo(f"images per line    {plan.images_per_line}")
-        click.echo(f"images             {plan.images}")
+        say(f"footprint W        {plan.footprint_m:.1f} m")
+        say(f"frontal spacing    {plan.frontal_spacing_m:.1f} m")
+        say(f"lateral spacing    {plan.lateral_spacing_m:.1f} m")
+        say(f"flight lines       {plan.flight_lines}")
+        say(f"images per line    {plan.images_per_line}")
+        say(f"images             {plan.images}")
         if plan.gsd_m is not None:
-            click.echo(f"GSD                {plan.gsd_m * 100:.2f} cm/px")
+            say(f"GSD                {plan.gsd_m * 100:.2f} cm/px")
     return EXIT_OK
 
 
@@ -86,10 +86,10 @@ def survey_gcp(surveyed: Path, model: Path, threshold_m: float, as_json: bool) -
     if as_json:
         click.echo(json.dumps(report.to_dict(), indent=2))
     else:
-        click.echo(f"{'id':>10} {'dX m':>9} {'dY m':>9} {'dZ m':>9} {'error m':>9}")
+        say(f"{'id':>10} {'dX m':>9} {'dY m':>9} {'dZ m':>9} {'error m':>9}")
         for i, d, e in zip(report.ids, report.delta_m, report.errors_m):
-            click.echo(f"{echo(i):>10} {d[0]:9.4f} {d[1]:9.4f} {d[2]:9.4f} {e:9.4f}")
+            say(f"{echo(i):>10} {d[0]:9.4f} {d[1]:9.4f} {d[2]:9.4f} {e:9.4f}")
         x, y, z = report.rmse_xyz_m
-        click.echo(f"RMSE {report.rmse_m:.4f} m (X {x:.4f}, Y {y:.4f}, Z {z:.4f}); threshold {threshold_m:g} m: "
+        say(f"RMSE {report.rmse_m:.4f} m (X {x:.4f}, Y {y:.4f}, Z {z:.4f}); threshold {threshold_m:g} m: "
                    f"{'pass' if report.passed else 'FAIL'}")
     return EXIT_OK if report.passed else EXIT_FINDINGS

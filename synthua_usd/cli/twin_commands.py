@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map, say
 from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
 from synthua_usd.errors import echo
 from synthua_usd.importers import limits as importer_limits
@@ -167,11 +167,11 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
 
         crowd = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=frames, walkable=IMPORT_WALKABLE)
     written, report = write_import(model, out_dir, cmap, report, crowd)
-    click.echo(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
+    say(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
                f"{model.triangle_count()} triangles, classes {model.label_counts()}")
     for seg in model.report.get("segments", []):
         if not seg.get("skipped"):
-            click.echo(f"  {seg['name']}: {seg['points']} points -> {seg['faces']} faces, simplification deviation "
+            say(f"  {seg['name']}: {seg['points']} points -> {seg['faces']} faces, simplification deviation "
                        f"{seg['simplification_deviation_m'] * 1000:.3f} mm, point-to-surface distance p50 "
                        f"{seg['residual_p50_m'] * 1000:.1f} / p95 {seg['residual_p95_m'] * 1000:.1f} / max "
                        f"{seg['residual_max_m'] * 1000:.1f} mm")
@@ -180,14 +180,14 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
         click.echo(f"  building heights: {sources}")
     unmatched = model.report.get("unmatched") or model.report.get("unlabelled_types")
     if unmatched:
-        click.echo(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
+        say(f"  labelled 'unlabelled' (no rule matched): {echo(unmatched)}")
     if "population" in report:
         p = report["population"]
-        click.echo(f"  people: {p['placed']} placed ({p['aid_users']} with mobility aids) on "
+        say(f"  people: {p['placed']} placed ({p['aid_users']} with mobility aids) on "
                    f"{p['walkable_area_m2']:.0f} m² walkable, {frames} time codes")
     for name, cam in report["cameras"].items():
-        click.echo(f"  camera {name}: label pass shows the twin in {cam['labelled_share']:.1%} of its pixels")
-    click.echo(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "
+        say(f"  camera {name}: label pass shows the twin in {cam['labelled_share']:.1%} of its pixels")
+    say(f"wrote {len(written)} files to {out_dir}; render with: synthua render {out_dir / 'scenario.usda'} "
                f"--out OUT")
     findings = report.get("findings", [])
     for f in findings:
@@ -199,17 +199,33 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
 @click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Layout seed.")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder.")
 def twin_demo(seed: int, out_dir: Path) -> int:
-    """Write the procedural Largo da Ordem demo district (twin.usdc, semantics.usda) for SEED.
+    """Write the procedural Largo da Ordem demo district for SEED as a renderable scenario, without people.
 
+    \b
+    Files: twin.usdc (geometry, materials, textures/), semantics.usda (labels), cameras.usda (CCTV_Largo,
+    CCTV_Street, PedestrianEye_Street, WheelchairEye_Largo, UAV_Oblique), environment.usda (the conditions,
+    clear day selected), render.usda (through CCTV_Largo) and scenario.usda, which composes them.
     The same seed writes byte-identical layers; another seed another plausible layout.
-    """
-    from synthua_usd.demo.district import META, build_district
-    from synthua_usd.usd.scenario_writer import write_twin_layers
 
-    model = build_district(seed)
-    files = write_twin_layers(model, out_dir, load_class_map(None), META)
-    click.echo(f"district seed {seed}: {len(model.objects)} objects, {model.triangle_count()} triangles, "
-               f"{len(model.label_counts())} classes")
+    \b
+    From here to a dataset (the README's "Your own scene"):
+      synthua agents populate my_district/scenario.usda --out my_district/agents.usdc
+      synthua cameras author my_district/scenario.usda --layer my_district/agents.usdc \\
+          --rig cctv:aim=aid_user,name=AidCCTV --out my_district/rigs.usda
+      synthua compose my_district/with_people.usda my_district/rigs.usda my_district/agents.usdc \\
+          my_district/scenario.usda
+      synthua render my_district/with_people.usda --camera /World/Cameras/AidCCTV --out out/frame
+    (`synthua create district` writes all of it, people and aimed rigs included, in one step.)
+    """
+    from synthua_usd.demo.district import district_scenario
+    from synthua_usd.usd.scenario_writer import write_scenario
+
+    spec = district_scenario(seed, agents=False)
+    files = write_scenario(spec, out_dir, load_class_map(None))
+    say(f"district seed {seed}: {len(spec.twin.objects)} objects, {spec.twin.triangle_count()} triangles, "
+        f"{len(spec.twin.label_counts())} classes, {len(spec.cameras)} cameras")
     for path in files:
-        click.echo(f"wrote {path}")
+        say(f"wrote {path}")
+    say(f"render with: synthua render {out_dir / 'scenario.usda'} --out OUT; add people with: synthua agents "
+        f"populate {out_dir / 'scenario.usda'} --out {out_dir / 'agents.usdc'}")
     return EXIT_OK

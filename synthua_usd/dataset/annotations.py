@@ -30,6 +30,9 @@ from synthua_usd.taxonomy import ClassMap
 #: Panoptic segment id of stuff class ``c`` is ``STUFF_ID_BASE + c``: above every uint16 instance id, far
 #: below panopticapi's 2**24 limit of an RGB-encoded id.
 STUFF_ID_BASE = 65536
+#: The crowd segment of thing class ``c`` in an image (its instances too small to annotate, merged, as COCO
+#: panoptic has one crowd region per category and image) is ``CROWD_ID_BASE + c``.
+CROWD_ID_BASE = 2 * STUFF_ID_BASE
 
 
 def label_extents(labels: np.ndarray) -> tuple[np.ndarray, list]:
@@ -91,6 +94,45 @@ def rle_from_runs(starts: np.ndarray, lengths: np.ndarray, shape: tuple[int, int
         counts = counts[:-1]
     rle = mask_utils.frPyObjects({"size": [h, w], "counts": counts}, h, w)
     return {"size": [int(rle["size"][0]), int(rle["size"][1])], "counts": rle["counts"].decode("ascii")}
+
+
+def rle_problem(rle, shape: tuple[int, int]) -> str | None:
+    """Why ``rle`` is not a COCO compressed RLE mask of ``shape`` (H, W), or None when it is one.
+
+    pycocotools decodes ``counts`` without checking it: characters outside '0'..'o', a last character that
+    announces more, a negative run or runs that do not add up to H x W pixels make it read past the string or
+    write past the mask. So the string is decoded here first, as pycocotools' ``rleFrString`` does (5 bits a
+    character, 0x20 continues, 0x10 the sign of the last; from the third count on, a delta from the count
+    two before)."""
+    h, w = shape
+    if not isinstance(rle, dict) or rle.get("size") != [h, w]:
+        return f"{str(rle)[:80]} is not {{'size': [{h}, {w}], 'counts': ...}}, an RLE mask of its image's size"
+    text = rle.get("counts")
+    if not isinstance(text, str):
+        return f"counts is {type(text).__name__}; expected pycocotools' compressed counts (a string)"
+    counts: list[int] = []
+    x = k = 0
+    for p, char in enumerate(text):
+        c = ord(char) - 48
+        if not 0 <= c < 64:
+            return f"counts[{p}] is {char!r}; expected characters '0' to 'o' (compressed counts)"
+        x |= (c & 0x1F) << (5 * k)
+        k += 1
+        if c & 0x20:
+            continue
+        if c & 0x10:
+            x -= 1 << (5 * k)
+        if len(counts) > 2:
+            x += counts[-2]
+        if x < 0:
+            return f"counts decode to a negative run ({x}) at character {p}; expected run lengths >= 0"
+        counts.append(x)
+        x = k = 0
+    if k:
+        return "counts end inside a run length (the last character continues); expected complete counts"
+    if sum(counts) != h * w:
+        return f"counts decode to runs of {sum(counts)} pixels in all; expected {h} x {w} = {h * w}"
+    return None
 
 
 def runs_of_indices(column_major: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -199,10 +241,11 @@ def annotate(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
     return out
 
 
-def panoptic_ids(class_ids: np.ndarray, instance_ids: np.ndarray, class_map: ClassMap) -> np.ndarray:
+def panoptic_ids(class_ids: np.ndarray, instance_ids: np.ndarray, class_map: ClassMap,
+                 ignored: set[int] = frozenset()) -> np.ndarray:
     """(H, W) uint32 panoptic segment id per pixel: instance id on thing-class pixels with an instance,
-    ``STUFF_ID_BASE + class`` on stuff-class pixels, 0 (void) on class 0 and on thing pixels without an
-    instance."""
+    ``CROWD_ID_BASE + class`` instead on those of an ``ignored`` instance, ``STUFF_ID_BASE + class`` on
+    stuff-class pixels, 0 (void) on class 0 and on thing pixels without an instance."""
     _check_maps(class_ids, instance_ids)
     thing = np.zeros(256, bool)
     known = np.zeros(256, bool)
@@ -217,8 +260,24 @@ def panoptic_ids(class_ids: np.ndarray, instance_ids: np.ndarray, class_map: Cla
     cls = class_ids.astype(np.uint32)
     is_thing = thing[class_ids]
     stuff = (cls != 0) & ~is_thing
-    return np.where(is_thing & (instance_ids != 0), instance_ids.astype(np.uint32),
-                    np.where(stuff, STUFF_ID_BASE + cls, 0)).astype(np.uint32)
+    ids = np.where(is_thing & (instance_ids != 0), instance_ids.astype(np.uint32),
+                   np.where(stuff, STUFF_ID_BASE + cls, 0)).astype(np.uint32)
+    if ignored:
+        crowd = np.isin(instance_ids, np.fromiter(ignored, np.int64)) & is_thing
+        ids[crowd] = CROWD_ID_BASE + cls[crowd]
+    return ids
+
+
+def mark_ignored(entries: list[dict], min_instance_px: int) -> set[int]:
+    """Set ``ignore`` on every record entry (of :func:`annotate`): True for a thing instance with fewer than
+    ``min_instance_px`` visible pixels, too small to learn from, which every format then writes as an ignore
+    region (``schemas/generate.schema.json``, ``min_instance_px``). Returns the ids of the ignored instances."""
+    ignored = set()
+    for entry in entries:
+        entry["ignore"] = bool(entry["isthing"] and entry["area"] < min_instance_px)
+        if entry["ignore"]:
+            ignored.add(int(entry["id"]))
+    return ignored
 
 
 def ids_to_rgb(ids: np.ndarray) -> np.ndarray:
@@ -228,19 +287,22 @@ def ids_to_rgb(ids: np.ndarray) -> np.ndarray:
 
 
 def panoptic(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequence[Instance],
-             class_map: ClassMap) -> tuple[np.ndarray, list[dict]]:
+             class_map: ClassMap, ignored: set[int] = frozenset()) -> tuple[np.ndarray, list[dict]]:
     """The COCO-panoptic PNG pixels and the record's ``panoptic_segments``.
 
     Thing classes (``isthing`` in ``class_map``) give one segment per instance (segment id = instance id),
-    stuff classes one segment per class (id ``STUFF_ID_BASE + class id``), class 0 is void.
+    stuff classes one segment per class (id ``STUFF_ID_BASE + class id``), class 0 is void. The ``ignored``
+    instances (:func:`mark_ignored`) of a class make one crowd segment (``iscrowd`` 1, id ``CROWD_ID_BASE +
+    class id``): panopticapi keeps one crowd region per category and image, and neither counts a prediction
+    on it nor misses it.
 
     Returns
     -------
     rgb : (H, W, 3) uint8, segment id = R + 256 G + 256² B
-    segments : list of {"id", "category_id", "area", "bbox", "iscrowd": 0} sorted by id; areas and boxes
+    segments : list of {"id", "category_id", "area", "bbox", "iscrowd"} sorted by id; areas and boxes
         exact (pixel-edge ``[x, y, w, h]`` ints)
     """
-    ids = panoptic_ids(class_ids, instance_ids, class_map)
+    ids = panoptic_ids(class_ids, instance_ids, class_map, ignored)
     by_id = {inst.id: inst for inst in instances}
     counts, boxes = label_extents(ids)
     # a thing segment's id is its instance's id: every class under it must be that instance's class
@@ -252,7 +314,9 @@ def panoptic(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
     for seg_id in np.flatnonzero(counts).tolist():
         if seg_id == 0:
             continue
-        if seg_id >= STUFF_ID_BASE:
+        if seg_id >= CROWD_ID_BASE:
+            category = seg_id - CROWD_ID_BASE
+        elif seg_id >= STUFF_ID_BASE:
             category = seg_id - STUFF_ID_BASE
         else:
             inst = by_id.get(seg_id)
@@ -265,7 +329,7 @@ def panoptic(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
                                  f"expected only its class {inst.class_id}")
             category = inst.class_id
         segments.append({"id": int(seg_id), "category_id": int(category), "area": int(counts[seg_id]),
-                         "bbox": box_xywh(boxes[seg_id - 1]), "iscrowd": 0})
+                         "bbox": box_xywh(boxes[seg_id - 1]), "iscrowd": int(seg_id >= CROWD_ID_BASE)})
     return ids_to_rgb(ids), segments
 
 

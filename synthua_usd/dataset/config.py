@@ -180,6 +180,51 @@ class Resample:
 
 
 @dataclass(frozen=True)
+class SequenceCrowd:
+    """The crowd populated for sequences (persons per m² of walkable area, share using mobility aids)."""
+
+    density_per_m2: float = 0.03
+    aid_share: float = 0.3
+
+
+#: Most frames one sequence may have.
+MAX_SEQUENCE_FRAMES = 10_000
+
+
+@dataclass(frozen=True)
+class SequencesConfig:
+    """Tracking sequences: one per camera x condition x seed, ``duration_s`` of scene time at ``fps``; field
+    meanings in the schema's ``$defs.sequences``."""
+
+    cameras: tuple[CameraSelector, ...] = ()
+    conditions: str | tuple[str, ...] = ()
+    seeds: tuple[int, ...] = (0,)
+    duration_s: float = 10.0
+    fps: float = 10.0
+    start_time_code: float | None = None
+    crowd: SequenceCrowd | None = field(default_factory=SequenceCrowd)
+    jpeg_quality: int = 95
+    preview: bool = True
+
+    @property
+    def frames(self) -> int:
+        """Frames per sequence: ``duration_s * fps``, rounded, at least 1."""
+        return max(1, int(round(self.duration_s * self.fps)))
+
+    def time_codes(self, start: float, time_codes_per_second: float) -> tuple[float, ...]:
+        """The frames' time codes from ``start``: one every ``time_codes_per_second / fps``."""
+        return tuple(float(start + k * time_codes_per_second / self.fps) for k in range(self.frames))
+
+    def to_document(self) -> dict:
+        return {"cameras": [c.to_document() for c in self.cameras],
+                "conditions": self.conditions if isinstance(self.conditions, str) else list(self.conditions),
+                "seeds": list(self.seeds), "duration_s": self.duration_s, "fps": self.fps,
+                "start_time_code": self.start_time_code,
+                "crowd": None if self.crowd is None else dict(vars(self.crowd)),
+                "jpeg_quality": self.jpeg_quality, "preview": self.preview}
+
+
+@dataclass(frozen=True)
 class GenerationConfig:
     """One generation run; field meanings in ``schemas/generate.schema.json``.
 
@@ -201,9 +246,13 @@ class GenerationConfig:
     outputs: Outputs = field(default_factory=Outputs)
     resample: Resample | None = None
     amodal_groups: tuple[str, ...] = ("person", "accessibility", "vehicle", "furniture", "animal")
+    #: Thing instances with fewer visible pixels are ignore regions in every format (the schema says how).
+    min_instance_px: int = 32
     workers: int | None = None
     #: Scene randomisation (None: the scenario rendered as composed).
     randomise: RandomisationConfig | None = None
+    #: Tracking sequences (None: none).
+    sequences: SequencesConfig | None = None
 
     @classmethod
     def load(cls, path: str | Path) -> "GenerationConfig":
@@ -240,9 +289,11 @@ class GenerationConfig:
             "outputs": dict(vars(self.outputs)),
             "resample": None if self.resample is None else dict(vars(self.resample)),
             "amodal_groups": list(self.amodal_groups),
+            "min_instance_px": self.min_instance_px,
             "workers": self.workers,
             # absent when off, so that configs without it keep the documents (and job keys) they had
             **({} if self.randomise is None else {"randomise": self.randomise.to_document()}),
+            **({} if self.sequences is None else {"sequences": self.sequences.to_document()}),
         }
 
     def output_size(self, render_width: int, render_height: int) -> tuple[int, int]:
@@ -299,8 +350,7 @@ class _Builder:
         qa_doc = doc.get("qa", {})
         qa = QAThresholds(**{**qa_doc, "reject": tuple(qa_doc.get("reject", ()))})
         outputs = Outputs(**doc.get("outputs", {}))
-        cameras = tuple(CameraSelector(pattern=c) if isinstance(c, str) else CameraSelector(rig_types=tuple(c["rig_types"]))
-                        for c in doc.get("cameras", []))
+        cameras = self.cameras(doc.get("cameras", []))
         return GenerationConfig(
             name=doc["name"], images=images, render=render, cameras=cameras,
             time_codes=self.time_codes(doc.get("time_codes", [])), conditions=conditions,
@@ -308,7 +358,33 @@ class _Builder:
             sampling_seed=doc.get("sampling_seed", GenerationConfig.sampling_seed),
             quotas=quotas, split=split, qa=qa, outputs=outputs, resample=resample,
             amodal_groups=tuple(doc.get("amodal_groups", GenerationConfig.amodal_groups)),
-            workers=doc.get("workers"), randomise=self.randomise(doc.get("randomise")))
+            min_instance_px=doc.get("min_instance_px", GenerationConfig.min_instance_px),
+            workers=doc.get("workers"), randomise=self.randomise(doc.get("randomise")),
+            sequences=self.sequences(doc.get("sequences"), images))
+
+    @staticmethod
+    def cameras(items) -> tuple[CameraSelector, ...]:
+        return tuple(CameraSelector(pattern=c) if isinstance(c, str) else CameraSelector(rig_types=tuple(c["rig_types"]))
+                     for c in items)
+
+    def sequences(self, doc, images: int) -> SequencesConfig | None:
+        if doc is None:
+            if images == 0:
+                self.fail("images", "0 without a sequences block", "expected at least 1 image, or sequences")
+            return None
+        conditions = doc.get("conditions", [])
+        crowd = doc.get("crowd", vars(SequenceCrowd()))
+        config = SequencesConfig(
+            cameras=self.cameras(doc.get("cameras", [])),
+            conditions=conditions if isinstance(conditions, str) else tuple(conditions),
+            seeds=tuple(doc.get("seeds", SequencesConfig.seeds)), duration_s=float(doc.get("duration_s", 10.0)),
+            fps=float(doc.get("fps", 10.0)), start_time_code=doc.get("start_time_code"),
+            crowd=None if crowd is None else SequenceCrowd(**crowd),
+            jpeg_quality=int(doc.get("jpeg_quality", 95)), preview=bool(doc.get("preview", True)))
+        if config.duration_s * config.fps > MAX_SEQUENCE_FRAMES:
+            self.fail("sequences", f"duration_s x fps = {config.duration_s * config.fps:g} frames",
+                      f"expected at most {MAX_SEQUENCE_FRAMES} frames a sequence")
+        return config
 
     def randomise(self, doc) -> RandomisationConfig | None:
         try:

@@ -7,6 +7,7 @@ One layout serves every format at once, so that the RGB image is written once::
       labels/{split}/{name}.txt                  YOLO segmentation labels (Ultralytics convention)
       data.yaml                                  YOLO dataset file
       annotations/instances_{split}.json         COCO instances, RLE masks
+      annotations/person_keypoints_{split}.json  COCO person keypoints (the person category only)
       annotations/panoptic_{split}.json          COCO panoptic
       annotations/panoptic_{split}/{name}.png    COCO panoptic PNGs (id = R + 256 G + 256² B)
       gtFine/{split}/{city}/{city}_{seq}_{frame}_gtFine_{labelIds,instanceIds,color}.png   Cityscapes
@@ -14,6 +15,11 @@ One layout serves every format at once, so that the RGB image is written once::
       frames/{name}/...                          everything else of one image (class, semantic, instance
                                                  ids and preview, depth, optional EXR and one-hot tensor)
       records/{name}.json                        the image's record, written last: the image is complete
+      sequences/{seq}/img1/{frame:06d}.jpg       a tracking sequence in the MOTChallenge layout (seqinfo.ini,
+      sequences/{seq}/gt/gt.txt                  gt/gt.txt), with tracks.csv, instances/{frame:06d}.png (16-bit
+                                                 instance ids), records/{frame:06d}.json (written last) and
+                                                 preview.mp4; sequences/crowds/seed_{s}.usdc its crowd;
+                                                 annotations/sequences.json every sequence as COCO video
       metadata.csv, metadata.parquet, coverage.json, rejected.csv, class_map.json, manifest.json,
       generate.json (the configuration of the run)
 
@@ -108,10 +114,34 @@ class Layout:
     def record(name: str) -> str:
         return f"records/{name}.json"
 
+    # per sequence
+    SEQUENCES = "sequences"
+
+    @staticmethod
+    def sequence_file(sequence: str, file_name: str) -> str:
+        """A file of one sequence: ``seqinfo.ini``, ``tracks.csv``, ``preview.mp4``, ``gt/gt.txt``."""
+        return f"sequences/{sequence}/{file_name}"
+
+    @staticmethod
+    def sequence_frame(sequence: str, frame: int, kind: str = "img1") -> str:
+        """Frame ``frame`` (1-based) of a sequence: ``img1`` (JPEG), ``instances`` (PNG) or ``records`` (JSON)."""
+        suffix = {"img1": "jpg", "instances": "png", "records": "json"}[kind]
+        return f"sequences/{sequence}/{kind}/{frame:06d}.{suffix}"
+
+    @staticmethod
+    def sequence_crowd(seed: int) -> str:
+        return f"sequences/crowds/seed_{int(seed)}.usdc"
+
+    SEQUENCES_COCO = "annotations/sequences.json"
+
     # per dataset
     @staticmethod
     def coco_instances(split: str) -> str:
         return f"annotations/instances_{split}.json"
+
+    @staticmethod
+    def coco_person_keypoints(split: str) -> str:
+        return f"annotations/person_keypoints_{split}.json"
 
     @staticmethod
     def coco_panoptic(split: str) -> str:
@@ -136,3 +166,23 @@ def inside(root: Path, relative: str) -> Path:
         raise OutputError(f"{escape(relative)!r}: a path that leaves the dataset folder or hides in it; expected a "
                           f"plain relative path inside the dataset folder")
     return Path(root).joinpath(*parts)
+
+
+def is_dataset_folder(folder: Path) -> bool:
+    """Whether ``folder`` holds a dataset of ``synthua generate``: its ``records/`` folder beside its
+    ``manifest.json`` or ``generate.json`` (either name alone is common among other tools' files)."""
+    folder = Path(folder)
+    return (folder / "records").is_dir() and ((folder / Layout.MANIFEST).is_file() or
+                                              (folder / Layout.CONFIG).is_file())
+
+
+def check_outside_datasets(out_dir: Path) -> None:
+    """Refuse an output folder that is a dataset folder (:func:`is_dataset_folder`) or lies inside one: a
+    report or a render written there would be files its manifest does not list, and could replace files it
+    does. Only ``synthua generate`` writes into a dataset."""
+    target = Path(out_dir).resolve()
+    for folder in (target, *target.parents):
+        if is_dataset_folder(folder):
+            where = "is the dataset folder" if folder == target else "lies inside the dataset folder"
+            raise OutputError(f"{escape(out_dir)}: the output folder {where} {escape(folder)}; expected a folder "
+                              f"outside every dataset (only `synthua generate` writes into one)")

@@ -43,3 +43,20 @@ def document_digest(document) -> str:
 
     text = json.dumps(document, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def read_manifest(path: str | Path) -> dict:
+    """The manifest at ``path``, read with the limits of every JSON input (:func:`synthua_usd.schemas.read_json`)
+    and checked against ``schemas/manifest.schema.json``: anything else is an :class:`InputError` naming the
+    file and the field (a missing file: "file not found")."""
+    from synthua_usd.errors import InputError
+    from synthua_usd.input_files import shown
+    from synthua_usd.schemas import read_json, validate_document
+
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{shown(path)}: file not found; expected a complete dataset written by `synthua generate` "
+                         f"(the manifest is written last)")
+    document = read_json(path, "a dataset manifest")
+    validate_document(document, "manifest", str(path))
+    return document

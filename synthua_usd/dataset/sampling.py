@@ -113,9 +113,10 @@ class PlannedImage(Candidate):
         return asdict(self)
 
 
-def select_cameras(config: GenerationConfig, cameras: Sequence[CameraInfo]) -> list[CameraInfo]:
-    """The stage's ``cameras`` that the config's ``cameras`` selectors pick, in stage order (all when the
-    config lists none). A selector that picks nothing raises :class:`InputError`."""
+def select_cameras(config, cameras: Sequence[CameraInfo], where: str = "cameras") -> list[CameraInfo]:
+    """The stage's ``cameras`` that the ``cameras`` selectors of ``config`` (a generation config, or its
+    sequences) pick, in stage order (all when it lists none). A selector that picks nothing raises
+    :class:`InputError`."""
     cameras = [(str(p), str(n), r) for p, n, r in cameras]
     if not config.cameras:
         return cameras
@@ -129,9 +130,27 @@ def select_cameras(config: GenerationConfig, cameras: Sequence[CameraInfo]) -> l
             what = f"rig types {', '.join(selector.rig_types)} match no camera"
         if not hits:
             stage = ", ".join(f"{p} ({r or NO_RIG})" for p, _, r in cameras) or "none"
-            raise InputError(f"cameras[{k}]: {what}; expected a camera of the stage: {echo(stage, 600)}")
+            raise InputError(f"{where}[{k}]: {what}; expected a camera of the stage: {echo(stage, 600)}")
         chosen |= hits
     return [c for c in cameras if c[0] in chosen]
+
+
+def select_conditions(asked, offered: Sequence[str], where: str = "conditions") -> list[str | None]:
+    """The conditions a config's ``asked`` (``"all"``, names, or empty: the stage as composed, None) picks among
+    those the stage ``offered``; a name the stage lacks raises :class:`InputError`."""
+    offered = list(offered)
+    if asked == "all":
+        if not offered:
+            raise InputError(f'{where}: "all" but the stage offers no conditions; expected a stage with a condition '
+                             "variant set, or conditions empty")
+        return offered
+    if asked:
+        unknown = [c for c in asked if c not in offered]
+        if unknown:
+            raise InputError(f"{where}: {', '.join(map(echo, unknown))} not offered by the stage; expected among "
+                             f"{', '.join(offered) or 'none (leave conditions empty)'}")
+        return list(asked)
+    return [None]
 
 
 def candidates(config: GenerationConfig, cameras: Sequence[CameraInfo], time_codes: Sequence[float],
@@ -157,20 +176,7 @@ def candidates(config: GenerationConfig, cameras: Sequence[CameraInfo], time_cod
         if outside:
             raise InputError(f"time_codes: {', '.join(f'{t:g}' for t in outside[:5])} outside the stage's time range; "
                              f"expected time codes within {lo:g}..{hi:g}")
-    offered = list(conditions)
-    if config.conditions == "all":
-        if not offered:
-            raise InputError('conditions: "all" but the stage offers no conditions; expected a stage with a condition '
-                             "variant set, or conditions empty")
-        names: list[str | None] = offered
-    elif config.conditions:
-        unknown = [c for c in config.conditions if c not in offered]
-        if unknown:
-            raise InputError(f"conditions: {', '.join(map(echo, unknown))} not offered by the stage; expected among "
-                             f"{', '.join(offered) or 'none (leave conditions empty)'}")
-        names = list(config.conditions)
-    else:
-        names = [None]
+    names = select_conditions(config.conditions, conditions)
     size = len(names) * len(chosen) * len(times) * len(config.seeds)
     if size > MAX_POOL:
         raise InputError(f"the sweep holds {size} candidates; expected at most {MAX_POOL} (fewer time codes, "

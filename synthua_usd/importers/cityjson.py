@@ -88,7 +88,8 @@ def _value(node) -> str:
 
 def check_semantics(geometry: dict, depth: int) -> list[str]:
     """The surface types of a geometry's ``semantics``, after checking that every value is null or an index
-    of ``semantics.surfaces``; raises :class:`_Malformed`."""
+    of ``semantics.surfaces`` and that ``values`` nests like the (checked) boundaries, one entry per shell,
+    solid and surface; raises :class:`_Malformed`."""
     semantics = geometry.get("semantics")
     if semantics is None:
         return []
@@ -102,13 +103,19 @@ def check_semantics(geometry: dict, depth: int) -> list[str]:
         if not isinstance(surface, dict) or not isinstance(surface.get("type"), str):
             raise _Malformed(f"semantics.surfaces[{i}]: {_value(surface)}; expected an object with a \"type\" string")
         types.append(surface["type"])
-    stack = [(semantics.get("values"), 0, ())]
+    levels = _LEVELS[depth]
+    stack = [(semantics.get("values"), geometry.get("boundaries"), 0, ())]
     while stack:
-        node, level, path = stack.pop()
+        node, bounds, level, path = stack.pop()
         if node is None:
             continue
         if isinstance(node, list) and level < depth - 2:
-            stack.extend((child, level + 1, path + (i,)) for i, child in enumerate(node))
+            # values mirror the boundaries: one per shell, solid or surface (a shorter array would leave the
+            # surfaces past its end without the semantics the file means them to have)
+            if len(node) != len(bounds):
+                raise _Malformed(f"semantics.values{_index_path(path)}: {len(node)} values for {len(bounds)} "
+                                 f"{levels[level]}s; expected one value (or null) per {levels[level]}")
+            stack.extend((child, bounds[i], level + 1, path + (i,)) for i, child in enumerate(node))
             continue
         if isinstance(node, bool) or not isinstance(node, int) or not 0 <= node < len(types):
             raise _Malformed(f"semantics.values{_index_path(path)}: {_value(node)}; expected null or an index of "

@@ -65,9 +65,13 @@ def _rings(geometry, where: str) -> list[list[np.ndarray]]:
         for r, ring in enumerate(poly):
             if not isinstance(ring, list):
                 raise InputError(f"{pw}[{r}]: {type_name(ring)}; expected a ring: an array of [x, y] positions")
-            rings.append(np.array([_position(v, f"{pw}[{r}][{i}]") for i, v in enumerate(ring)], float).reshape(-1, 2))
-        if len(rings[0]) < 4:
-            raise InputError(f"{where}: polygon has {len(rings[0])} vertices; a closed ring needs at least 4")
+            xy = np.array([_position(v, f"{pw}[{r}][{i}]") for i, v in enumerate(ring)], float).reshape(-1, 2)
+            if len(xy) < 4:
+                raise InputError(f"{where}: polygon has {len(xy)} vertices; a closed ring needs at least 4")
+            if not np.array_equal(xy[0], xy[-1]):  # RFC 7946 3.1.6: the first and last positions are equivalent
+                raise InputError(f"{pw}[{r}]: the ring is not closed (it ends at {xy[-1].tolist()}, not at its first "
+                                 f"position {xy[0].tolist()}); expected a closed ring, its last position its first")
+            rings.append(xy)
         out.append(rings)
     if not out:
         raise InputError(f"{where}: empty geometry; expected at least one polygon")
@@ -75,7 +79,7 @@ def _rings(geometry, where: str) -> list[list[np.ndarray]]:
 
 
 def footprint_polygon(rings: list[np.ndarray], where: str):
-    """The shapely polygon of projected rings (metres), refused unless valid and of some area."""
+    """The shapely polygon of projected rings (metres), refused unless valid and of some area, each hole too."""
     from shapely.geometry import Polygon
     from shapely.validation import explain_validity
 
@@ -92,6 +96,11 @@ def footprint_polygon(rings: list[np.ndarray], where: str):
     if poly.area < MIN_FOOTPRINT_AREA_M2:
         raise InputError(f"{where}: area {poly.area:.3g} m²; expected a footprint of at least "
                          f"{MIN_FOOTPRINT_AREA_M2:g} m² (a degenerate or zero-area ring)")
+    for k, hole in enumerate(poly.interiors, start=1):
+        area = Polygon(hole).area
+        if area < MIN_FOOTPRINT_AREA_M2:  # a courtyard of no area: a digitising slip that cuts nothing
+            raise InputError(f"{where}: ring {k} (a hole) has area {area:.3g} m²; expected holes of at least "
+                             f"{MIN_FOOTPRINT_AREA_M2:g} m², or none")
     return poly
 
 

@@ -35,6 +35,7 @@ from synthua_usd.errors import InputError, echo
 from synthua_usd.findings import Finding, Severity
 from synthua_usd.importers.crs import (PROJECTED_CRS, USER_DEFINED, LinearUnits, crs_units, geotiff_units,
                                        resolve_units)
+from synthua_usd.importers.las_header import check_las_header, check_las_layout
 from synthua_usd.importers.limits import (MAX_DEVIATION, MAX_EXTENT_M, MAX_HULL_RESIDUAL, MAX_POINTCLOUD_BYTES,
                                           MAX_POINTS, MAX_RESIDUAL, PLANE_THRESHOLD)
 from synthua_usd.importers.segmentation import Region, Segmentation, fit_plane, segment, smoothed_heights
@@ -47,10 +48,6 @@ log = logging.getLogger(__name__)
 
 SUFFIXES = (".las", ".laz", ".ply")
 
-#: Largest point data a LAS/LAZ header may announce (points x record length), decompressed in memory.
-MAX_POINT_DATA_BYTES = 2 * 2**30
-
-
 @contextlib.contextmanager
 def _quiet(logger: str) -> Iterator[None]:
     """Silence a library's own error log while we read (we report the failure ourselves, in one line)."""
@@ -61,28 +58,6 @@ def _quiet(logger: str) -> Iterator[None]:
         yield
     finally:
         log_.setLevel(level)
-
-
-def _check_las_header(header, size: int, where: str) -> None:
-    """Refuse a LAS/LAZ header whose point count, record size, scales or offsets cannot be true of this file
-    (before any point is read, so that a lying header cannot make us allocate what it claims)."""
-    count, record = int(header.point_count), int(header.point_format.size)
-    if count > MAX_POINTS:
-        raise InputError(f"{where}: the header announces {count} points; expected at most {MAX_POINTS} (thin or tile "
-                         f"the cloud)")
-    if count * record > MAX_POINT_DATA_BYTES:
-        raise InputError(f"{where}: the header announces {count} points of {record} bytes ({count * record} bytes); "
-                         f"expected at most {MAX_POINT_DATA_BYTES} bytes of point data")
-    if not header.are_points_compressed and int(header.offset_to_point_data) + count * record > size:
-        held = max(size - int(header.offset_to_point_data), 0) // max(record, 1)
-        raise InputError(f"{where}: the header announces {count} points but the file holds {held}; expected a "
-                         f"complete LAS file")
-    scales, offsets = np.asarray(header.scales, float), np.asarray(header.offsets, float)
-    if not (np.all(np.isfinite(scales)) and np.all(scales > 0) and np.all(scales <= 1e3)):
-        raise InputError(f"{where}: header scale factors {echo(scales.tolist())}; expected numbers in (0, 1000]")
-    if not np.all(np.abs(offsets) <= COORDINATE.high):  # NaN fails too
-        raise InputError(f"{where}: header offsets {echo(offsets.tolist())}; expected numbers within "
-                         f"±{COORDINATE.high:g} m")
 
 
 def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None, LinearUnits | None]:
@@ -106,9 +81,10 @@ def read_points(path: Path) -> tuple[np.ndarray, np.ndarray | None, str | None, 
         return vertices, None, None, None
     import laspy
 
+    check_las_layout(path, size, where)
     try:
         with _quiet("laspy"), laspy.open(str(path)) as reader:
-            _check_las_header(reader.header, size, where)
+            check_las_header(reader.header, where)
             las = reader.read()
     except InputError:
         raise

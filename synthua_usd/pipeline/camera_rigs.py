@@ -42,6 +42,7 @@ from synthua_usd.schemas import validate_document
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd import targets as usd_targets
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
+from synthua_usd.usd.authoring import check_layer_path, export_layer
 from synthua_usd.usd.cameras import camera_paths
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.rig_layer import PlacedRig, build_rig_layer
@@ -73,6 +74,9 @@ class RigRequest:
     variant: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
+    #: Layer files composed over the stage for the placement (strongest first; see ``open_stage``), e.g. the
+    #: agents layer of a twin scenario that does not compose it yet.
+    layers: tuple[Path, ...] = ()
 
     @property
     def report_path(self) -> Path:
@@ -95,7 +99,7 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
     """Place, score, verify and write every rig of ``request`` (see the module docstring)."""
     _check_request(request)
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
-    stage = open_stage(request.stage_path, request.allow_external_assets)
+    stage = open_stage(request.stage_path, request.allow_external_assets, request.layers)
     if UsdGeom.GetStageUpAxis(stage) != UsdGeom.Tokens.z:
         raise StageError(f"{request.stage_path}: upAxis is {UsdGeom.GetStageUpAxis(stage)!r}; camera rigs expect a "
                          f"Z-up stage (heights are along +Z)")
@@ -142,6 +146,8 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
         # Relative to the layer's folder: the pair stays right when the folder moves (or is staged).
         "stage": os.path.relpath(Path(request.stage_path).resolve(), Path(request.out_path).resolve().parent),
         "layer": Path(request.out_path).name,
+        **({"layers": [os.path.relpath(Path(p).resolve(), Path(request.out_path).resolve().parent)
+                       for p in request.layers]} if request.layers else {}),
         "image": {"width": request.width, "height": request.height},
         "time_codes": report_tcs,
         "min_target_px": request.min_target_px,
@@ -163,9 +169,7 @@ def default_time_codes(start: float, end: float, n: int = DEFAULT_REPORT_TIME_CO
 
 
 def _check_request(request: RigRequest) -> None:
-    out = Path(request.out_path)
-    if out.suffix.lower() not in (".usda", ".usdc", ".usd"):
-        raise InputError(f"{echo(out)}: the cameras layer needs a USD file name (.usda, .usdc or .usd)")
+    out = check_layer_path(request.out_path, "the cameras layer")
     if out.exists() and out.resolve() == Path(request.stage_path).resolve():
         raise InputError(f"{echo(out)}: --out is the input stage itself; expected a new layer file")
     if not request.rigs:
@@ -325,6 +329,5 @@ def _write_pair(layer, layer_path: Path, report: dict, report_path: Path) -> Non
     """Both files through temporary files beside them, renamed only when both are complete."""
     layer_path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(report_path) as tmp_report, atomic_path(layer_path) as tmp_layer:
-        if not layer.GetRootLayer().Export(str(tmp_layer)):
-            raise OSError(f"{layer_path}: USD could not write the layer")
+        export_layer(layer.GetRootLayer(), tmp_layer, layer_path)
         tmp_report.write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")

@@ -23,10 +23,10 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.atomic import atomic_path, write_json_atomic, write_text_atomic
-from synthua_usd.backends import images
+from synthua_usd.backends import images, previews
 from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
-from synthua_usd.dataset.formats import cityscapes, onehot, previews, yolo
+from synthua_usd.dataset.formats import cityscapes, onehot, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.outputs import DEPTH_DEFINITION
@@ -136,8 +136,37 @@ class ImageBuffers:
     seconds: dict
 
 
-def render_image(state: WorkerState, planned) -> ImageBuffers:
-    """Render, trace amodal masks, annotate and check one planned image (nothing is written here)."""
+@dataclass(eq=False)
+class AnnotatedFrame:
+    """One rendered frame with its annotations, before any file is made: what an image of a dataset and a frame
+    of a sequence share. ``rgb`` linear, ``class_ids``, ``instance_ids`` and ``depth`` (z, metres) at the written
+    size ``width`` x ``height``; ``instances`` the annotation entries (:func:`annotations.annotate`, with keypoints
+    and the class of what a person uses); ``seconds`` where the time went."""
+
+    snapshot: object
+    camera: object
+    condition: object
+    rendered: object
+    rgb: np.ndarray = field(repr=False)
+    class_ids: np.ndarray = field(repr=False)
+    instance_ids: np.ndarray = field(repr=False)
+    depth: np.ndarray = field(repr=False)
+    instances: list
+    width: int
+    height: int
+    seconds: dict
+    randomised: object = None
+
+    def display(self) -> np.ndarray:
+        """The exposed display-referred sRGB image, (H, W, 3) uint8."""
+        scale = self.rendered.exposure.scale if self.rendered.exposure is not None else 1.0
+        return images.linear_to_display(self.rgb * np.float32(scale))
+
+
+def render_annotated(state: WorkerState, camera_path: str, time_code: float, condition_name: str | None, seed: int,
+                     output_size: tuple[int, int] | None = None) -> AnnotatedFrame:
+    """Render one frame (RGB and exact labels), trace the amodal masks the config asks for, measure truncation and
+    annotate every visible instance; resampled to ``output_size`` when given."""
     from synthua_usd.projection import truncations
     from synthua_usd.usd.cameras import read_camera
 
@@ -147,16 +176,15 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     if state.randomiser is not None:
         from synthua_usd.pipeline.districts import district_of
 
-        district = district_of(job.config.randomise, planned.seed)
+        district = district_of(job.config.randomise, seed)
         if district != state.district:
             _open(state, job.scenes[district] if district is not None else job.scenario, district)
-        randomised = state.randomiser.apply(planned.seed, planned.camera_path, planned.time_code, planned.condition,
-                                            district)
+        randomised = state.randomiser.apply(seed, camera_path, time_code, condition_name, district)
     t_randomise = time.perf_counter() - t0
-    snapshot = state.reader.snapshot(planned.time_code)
-    camera = read_camera(state.stage, planned.camera_path, planned.time_code)
-    condition = state.condition(planned.condition)
-    rendered = state.session.render(snapshot, camera, rgb=True, condition=condition, seed=planned.seed)
+    snapshot = state.reader.snapshot(time_code)
+    camera = read_camera(state.stage, camera_path, time_code)
+    condition = state.condition(condition_name)
+    rendered = state.session.render(snapshot, camera, rgb=True, condition=condition, seed=seed)
     width, height = job.render.width, job.render.height
     visible = [i for i in np.flatnonzero(np.bincount(rendered.instance_ids.reshape(-1))).tolist() if i]
     group_of = {c.id: c.group for c in class_map.classes}
@@ -179,10 +207,10 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     truncated = dict(zip(visible, truncations(parts, camera, width, height)))
     rgb, class_ids, instance_ids, depth = (rendered.rgb, rendered.class_ids, rendered.instance_ids,
                                            rendered.hits.z_m)
-    if job.output_size is not None:
+    if output_size is not None:
         # Images by a filter; labels, depth and amodal sets all copy one source pixel per output pixel (the
         # mode of the joint class and instance label), so they stay consistent and invent no ids.
-        out_w, out_h = job.output_size
+        out_w, out_h = output_size
         rgb = resample.resample_rgb(rgb, out_w, out_h)
         maps, index = resample.resample_label_maps({"instance": instance_ids, "class": class_ids}, out_w, out_h)
         class_ids, instance_ids = maps["class"], maps["instance"]
@@ -190,6 +218,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         amodal = {i: resample.resample_pixel_set(pixels, (height, width), index) for i, pixels in amodal.items()}
         width, height = out_w, out_h
     instances = annotations.annotate(class_ids, instance_ids, snapshot.instances, amodal, truncated)
+    annotations.mark_ignored(instances, job.config.min_instance_px)
     keypoints.annotate_keypoints(instances, snapshot.keypoints, camera, (job.render.width, job.render.height),
                                  instance_ids, depth)
     by_path = {inst.prim_path: inst for inst in snapshot.instances}
@@ -197,9 +226,24 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         used = by_path.get(entry.get("relations", {}).get("uses", ""))
         if used is not None:
             entry["relations"]["uses_class"] = used.class_name
-    panoptic_png, segments = annotations.panoptic(class_ids, instance_ids, snapshot.instances, class_map)
-    scale = rendered.exposure.scale if rendered.exposure is not None else 1.0
-    display = images.linear_to_display(rgb * np.float32(scale))
+    seconds["annotate"] = time.perf_counter() - t0
+    return AnnotatedFrame(snapshot, camera, condition, rendered, rgb, class_ids, instance_ids, depth, instances,
+                          width, height, seconds, randomised)
+
+
+def render_image(state: WorkerState, planned) -> ImageBuffers:
+    """Render, trace amodal masks, annotate and check one planned image (nothing is written here)."""
+    job, class_map = state.job, state.class_map
+    frame = render_annotated(state, planned.camera_path, planned.time_code, planned.condition, planned.seed,
+                             job.output_size)
+    t0 = time.perf_counter()
+    snapshot, camera, condition, rendered = frame.snapshot, frame.camera, frame.condition, frame.rendered
+    rgb, class_ids, instance_ids, depth = frame.rgb, frame.class_ids, frame.instance_ids, frame.depth
+    instances, width, height, seconds, randomised = (frame.instances, frame.width, frame.height, frame.seconds,
+                                                     frame.randomised)
+    ignored = {entry["id"] for entry in instances if entry["ignore"]}
+    panoptic_png, segments = annotations.panoptic(class_ids, instance_ids, snapshot.instances, class_map, ignored)
+    display = frame.display()
     measures = qa.measure(display, instances)
     verdict, reasons = qa.verdict(measures, job.config.qa)
 
@@ -215,7 +259,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
               "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
     if verdict != "rejected":
         labels, instance_cs, colour = cityscapes.cityscapes_arrays(class_ids, instance_ids, snapshot.instances,
-                                                                  class_map)
+                                                                  class_map, ignored)
         files.update({"panoptic": Layout.panoptic_png(split, name),
                       "cs_labelIds": Layout.cityscapes(split, cs, "labelIds"),
                       "cs_instanceIds": Layout.cityscapes(split, cs, "instanceIds"),
@@ -259,7 +303,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     }
     if randomised is not None:
         record["randomisation"] = randomised.to_dict()
-    seconds["annotate"] = time.perf_counter() - t0
+    seconds["annotate"] += time.perf_counter() - t0
     return ImageBuffers(record, arrays, verdict == "rejected", seconds)
 
 

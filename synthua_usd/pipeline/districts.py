@@ -60,9 +60,11 @@ def check_district_scenario(scenario: Path) -> list[str]:
     return sublayers
 
 
-def write_district_scene(scenario: Path, seed: int, out_dir: Path, class_map: ClassMap) -> Path:
+def write_district_scene(scenario: Path, seed: int, out_dir: Path, class_map: ClassMap,
+                         dataset_part: bool = False) -> Path:
     """Write the district of ``seed`` as a scenario in ``out_dir`` (one output set; kept when ``out_dir`` holds
-    it already) and return its ``scenario.usda``."""
+    it already) and return its ``scenario.usda``; ``dataset_part``: ``out_dir`` is the scenes folder of the
+    dataset being generated (the one writer allowed into a dataset)."""
     from synthua_usd.demo.district import META, build_district
     from synthua_usd.texture_images import write_texture_images
     from synthua_usd.usd.authoring import save_layer_atomic
@@ -77,7 +79,7 @@ def write_district_scene(scenario: Path, seed: int, out_dir: Path, class_map: Cl
     model = build_district(seed)
     twin, semantics = author_twin(model, class_map, META)
     own = {LAYER_FILE["twin"]: twin, LAYER_FILE["semantics"]: semantics}
-    with output_set(out_dir) as staging:
+    with output_set(out_dir, dataset_part=dataset_part) as staging:
         order = []
         for path in sublayers:
             name = Path(path).name

@@ -85,6 +85,14 @@ class GenerateSummary:
     shortfalls: list = field(default_factory=list)
     #: (images rendered so far, worker, its peak resident memory in MiB) after each result: memory over a run.
     rss_trace: list = field(default_factory=list)
+    #: Per split (train, val, test): the config's share, the images kept (QA rejections left out) and the cameras
+    #: they come from.
+    splits: dict = field(default_factory=dict)
+    #: Tracking sequences: how many, their frames, frames rendered now and found complete.
+    sequences: int = 0
+    frames: int = 0
+    frames_rendered: int = 0
+    frames_resumed: int = 0
 
 
 def _versions(variant: str) -> dict:
@@ -204,7 +212,8 @@ def write_scenes(request: GenerateRequest, config: GenerationConfig, pool, class
         raise InputError(f"{request.config_path}: {exc}") from None
     clear_partial_scenes(out)
     districts = sorted({district_of(randomise, c.seed) for c in pool})
-    return {d: write_district_scene(request.scenario, d, out / scene_folder(d), class_map) for d in districts}
+    return {d: write_district_scene(request.scenario, d, out / scene_folder(d), class_map, dataset_part=True)
+            for d in districts}
 
 
 def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateSummary:
@@ -243,8 +252,9 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
                           f"resume: pick another --out or remove it")
     scenes = write_scenes(request, config, pool, class_map, out)
     if job_document is None:
-        scores = score_views(stage, pool, render, output_size, class_map, show_progress, config.randomise, scenes)
-        plan = sampling.plan(pool, scores, config)
+        scores = (score_views(stage, pool, render, output_size, class_map, show_progress, config.randomise, scenes)
+                  if config.images else [])
+        plan = sampling.plan(pool, scores, config) if config.images else []
         job_document = {"synthua": __version__, "job_key": job_key, "job_key_digest": document_digest(job_key),
                         "scenario": str(Path(request.scenario).resolve()),
                         "allow_external_assets": request.allow_external_assets, "layer_stack": stack,
@@ -252,6 +262,10 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
                         "quota_targets": sampling.quota_targets(pool, config),
                         "pool": sampling.pool_summary(pool, scores, config), "scores": [s.to_dict() for s in scores],
                         "plan": [p.to_dict() for p in plan]}
+        if config.sequences is not None:
+            from synthua_usd.pipeline.sequences import plan_stage_sequences
+
+            job_document["sequences"] = [q.to_dict() for q in plan_stage_sequences(stage, config)]
         _write_job(out, job_document)
     plan = [sampling.PlannedImage(**p) for p in job_document["plan"]]
     scores = [_score_from_dict(s) for s in job_document["scores"]]
@@ -284,7 +298,7 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     while True:
         _render_all(todo, done, job, request, config_workers, collect, out)
         rejected = {p.id for p in plan if is_rejected(done[p.id])}
-        last_round = max(p.round for p in plan)
+        last_round = max((p.round for p in plan), default=0)
         todo = (sampling.replacements(pool, scores, config, plan, rejected, round=last_round + 1)
                 if rejected and last_round < REPLACEMENT_ROUNDS else [])
         if not todo:
@@ -297,7 +311,13 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     bar.close()
     summary.planned = len(plan)
     records = [done[p.id] for p in plan]
-    assemble(layout, records, class_map, config, job_document)
+    frames = {}
+    if config.sequences is not None:
+        from synthua_usd.pipeline.sequences import render_sequences
+
+        frames = render_sequences(stage, config, class_map, job, job_document, request, config_workers, summary,
+                                  seconds, show_progress)
+    assemble(layout, records, class_map, config, job_document, frames)
     summary.rejected = sum(is_rejected(r) for r in records)
     summary.flagged = sum(r["qa"]["verdict"] == "flagged" for r in records)
     summary.seconds = seconds
@@ -305,7 +325,32 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     summary.wall_seconds = time.perf_counter() - started
     summary.bytes_per_image = _dataset_bytes(out) / max(1, len(records))
     summary.shortfalls = json.loads(layout.path(Layout.COVERAGE).read_text(encoding="utf-8")).get("shortfalls", [])
+    summary.splits = achieved_splits(records, config)
+    _warn_empty_splits(summary.splits)
     return summary
+
+
+def achieved_splits(records: list[dict], config: GenerationConfig) -> dict[str, dict]:
+    """Per split: the config's share, the images kept (not rejected by QA) and the distinct cameras they come
+    from."""
+    out = {}
+    for split in SPLITS:
+        kept = [r for r in records if r["split"] == split and not is_rejected(r)]
+        out[split] = {"share": config.split.ratios[split], "images": len(kept),
+                      "cameras": len({r["camera"]["prim_path"] for r in kept})}
+    return out
+
+
+def _warn_empty_splits(splits: dict[str, dict]) -> None:
+    """A split the config gives a share that ends up with no image: the split is by camera, so fewer cameras
+    than splits (or a camera whose every image was rejected) leave one empty."""
+    cameras = sum(v["cameras"] for v in splits.values())
+    for split, counts in splits.items():
+        share = counts["share"]
+        if share > 0 and counts["images"] == 0:
+            log.warning(f"split {split}: no image, though the config gives it {share:g}; expected a camera of its "
+                        f"own (images are split by camera, and {cameras} camera(s) have kept images): add cameras "
+                        f"or set split.{split} to 0")
 
 
 def _config_document(config: GenerationConfig) -> dict:
@@ -456,13 +501,15 @@ def _complete_records(layout: Layout, plan) -> dict[int, dict]:
 
 
 def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: GenerationConfig,
-             job_document: dict) -> None:
-    """Every dataset-level file, from the records alone; the manifest last."""
+             job_document: dict, frames: dict | None = None) -> None:
+    """Every dataset-level file, from the records alone (the images', and the sequences' ``frames``: (sequence,
+    frame) -> record); the manifest last."""
     root = layout.root
     written = []
     for split in SPLITS:
-        written.append(_write_json(layout.path(Layout.coco_instances(split)),
-                                   coco.coco_instances(records, class_map, split)))
+        instances = coco.coco_instances(records, class_map, split)
+        written.append(_write_json(layout.path(Layout.coco_instances(split)), instances))
+        written.append(_write_json(layout.path(Layout.coco_person_keypoints(split)), coco.person_keypoints(instances)))
         written.append(_write_json(layout.path(Layout.coco_panoptic(split)),
                                    panoptic.coco_panoptic(records, class_map, split)))
     written.append(write_text_atomic(layout.path(Layout.DATA_YAML), yolo.data_yaml(class_map)))
@@ -486,6 +533,16 @@ def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: G
 
     dataset_files += [file_entry(root, p.relative_to(root).as_posix()) for p in sorted((root / SCENES_FOLDER).rglob("*"))
                       if p.is_file()] if (root / SCENES_FOLDER).is_dir() else []
+    if config.sequences is not None:
+        from synthua_usd.dataset.sequences import PlannedSequence
+        from synthua_usd.pipeline.sequences import assemble_sequences, sequence_files
+
+        sequences = [PlannedSequence.from_dict(q) for q in job_document["sequences"]]
+        for path in assemble_sequences(layout, sequences, frames or {}, class_map, config):
+            dataset_files.append(file_entry(root, path.relative_to(root).as_posix()))
+        dataset_files += sequence_files(layout, sequences, frames or {})
+        crowds = root / Layout.SEQUENCES / "crowds"
+        dataset_files += [file_entry(root, p.relative_to(root).as_posix()) for p in sorted(crowds.glob("*.usdc"))]
     _write_json(layout.path(Layout.MANIFEST), manifest_document(provenance=provenance, images=images,
                                                                 dataset_files=sorted(dataset_files,
                                                                                      key=lambda e: e["path"])))

@@ -13,7 +13,7 @@ from synthua_usd.errors import InputError
 from synthua_usd.scenario import StageMetadata
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, build_agents_layer
-from synthua_usd.usd.authoring import save_layer_atomic
+from synthua_usd.usd.authoring import check_layer_path, save_layer_atomic
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.stage_io import open_stage, time_range
 
@@ -34,9 +34,7 @@ def populate(request: PopulateRequest) -> tuple[Crowd, Path, float]:
     them. Everything else, parked devices of the twin included, is terrain or obstacle. Returns the crowd,
     the layer written and the seconds it took."""
     t0 = time.perf_counter()
-    out = Path(request.out_path)
-    if out.suffix.lower() not in (".usda", ".usdc", ".usd"):
-        raise InputError(f"{out}: the agents layer needs a USD file name (.usda, .usdc or .usd)")
+    out = check_layer_path(request.out_path, "the agents layer")
     if out.exists() and out.resolve() == Path(request.stage_path).resolve():
         raise InputError(f"{out}: --out is the input stage itself; expected a new layer file beside it")
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
@@ -53,9 +51,31 @@ def populate(request: PopulateRequest) -> tuple[Crowd, Path, float]:
     meshes = [m for m in snapshot.meshes if not m.prim_path.startswith(AGENTS_ROOT + "/")]
     verts, faces, owner = snapshot.world_triangles(meshes)
     names = np.array([class_map.by_id(m.class_id).name for m in meshes], object)
+    _check_walkable_classes(request.stage_path, set(names), walkable)
     crowd = populate_crowd(verts, faces, names[owner] if len(owner) else np.zeros(0, object), params)
     meta = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=fps, start_time_code=start,
                          end_time_code=start + params.time_codes - 1, default_prim="World")
     layer = build_agents_layer(crowd, meta, class_map.taxonomy)
     save_layer_atomic(layer.GetRootLayer(), out)  # one file: atomic by itself
     return crowd, out, time.perf_counter() - t0
+
+
+def _check_walkable_classes(stage_path: Path, classes: set[str], walkable: tuple[str, ...]) -> None:
+    """Name the real cause when nothing of the stage is walkable: its gprims carry no labels at all (a twin layer
+    opened without its semantics layer), or none of the walkable classes."""
+    if classes & set(walkable):
+        return
+    labelled = sorted(classes - {"unlabelled"})
+    path = Path(stage_path)
+    if not labelled:
+        scenario = path.parent / "scenario.usda"
+        fix = (f"pass the scenario ({scenario}) or compose its semantics layer over it" if scenario.exists()
+               and scenario.resolve() != path.resolve() else
+               "compose the twin's semantics layer (semantics.usda, written beside twin.usdc by `synthua twin`) "
+               "over it with `synthua compose`, or pass the scenario that does")
+        raise InputError(f"{path}: none of its gprims has a 'synthua' label (all are class 0, unlabelled), so "
+                         f"nothing is walkable; expected labelled surfaces: {fix}")
+    fix = ("add --walk-on road when its roads include their sidewalks (CityJSON often does), or name the classes "
+           "people walk on with --walk-on" if "road" in labelled else "name the classes people walk on with --walk-on")
+    raise InputError(f"{path}: has none of the walkable classes ({', '.join(walkable)}); its classes are "
+                     f"{', '.join(labelled)}; expected one to walk on: {fix}")

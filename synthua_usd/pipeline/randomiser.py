@@ -27,6 +27,7 @@ from pxr import Sdf, Usd, UsdGeom
 
 from synthua_usd.assets.postures import BodyParts
 from synthua_usd.errors import StageError
+from synthua_usd.pipeline.districts import district_of
 from synthua_usd.randomisation.config import RandomisationConfig
 from synthua_usd.randomisation.light import LightDraw, draw_light
 from synthua_usd.randomisation.scene import SceneDraw, draw_scene
@@ -198,8 +199,10 @@ class Randomiser:
 @dataclass(frozen=True)
 class RandomiseRequest:
     """One image's randomisation to write: of ``config_path``'s ``randomise`` block with ``seed``, ``camera``,
-    ``time_code`` and ``condition`` (None: the stage's own lights), at ``size`` (None: the config's render size,
-    else the stage's); or, with ``record_path``, of that record of a dataset (its generate.json gives the config)."""
+    ``time_code`` and ``condition`` (None: the stage's own lights), at the config's render size (else the
+    stage's); or, with ``record_path``, of that record of a dataset (its generate.json gives the config). When
+    the seed's scene is another district, the layers go over that district's scenario: the dataset's copy, or
+    one written beside ``out`` (``<stem>.district_<d>/``); the render command printed names it."""
 
     scenario: Path
     out: Path
@@ -272,7 +275,19 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
         raise InputError(f"{source}: has no randomise block; expected a config that randomises scenes (see "
                          f"schemas/generate.schema.json, randomise)")
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
-    stage = open_stage(request.scenario, request.allow_external_assets)
+    scenario, district = Path(request.scenario), district_of(config.randomise, seed)
+    if district is not None:
+        # the seed's scene lies in another district: the dataset's copy of it, or one written beside --out
+        from synthua_usd.pipeline.districts import check_district_scenario, scene_folder, write_district_scene
+
+        check_district_scenario(scenario)
+        dataset = Path(request.record_path).resolve().parent.parent if request.record_path is not None else None
+        if dataset is not None and (dataset / scene_folder(district) / "scenario.usda").is_file():
+            scenario = dataset / scene_folder(district) / "scenario.usda"
+        else:
+            scenario = write_district_scene(scenario, district, out.parent / f"{out.stem}.district_{district}",
+                                            class_map)
+    stage = open_stage(scenario, request.allow_external_assets or district is not None)
     defaults = render_defaults(stage)
     if camera is None:
         camera = defaults.camera_path
@@ -287,14 +302,14 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     else:
         width, height = config.render.size(*(defaults.resolution or (RenderConfig.width, RenderConfig.height)))
     randomiser = Randomiser(stage, config.randomise, class_map, (width, height))
-    drawn = randomiser.apply(seed, camera, time_code, condition)
+    drawn = randomiser.apply(seed, camera, time_code, condition, district)
     with output_set(out.parent) as staging:
         randomiser.export(staging / out.name, anchor=out.parent)
         files = tuple(out.parent / p.name for p in sorted(staging.iterdir()))
     spp = render.get("spp", config.render.spp)
     max_depth = render.get("max_depth", config.render.max_depth)
     denoise = render["denoise"] is not None if "denoise" in render else config.render.denoise
-    args = ("synthua", "render", str(request.scenario), "--layer", str(out), "--camera", camera,
+    args = ("synthua", "render", str(scenario), "--layer", str(out), "--camera", camera,
             "--time-code", f"{time_code:g}", *(("--condition", condition) if condition else ()), "--seed", str(seed),
             "--width", str(width), "--height", str(height), "--spp", str(spp), "--max-depth", str(max_depth),
             "--denoise" if denoise else "--no-denoise", "--out", "OUT")

@@ -1,18 +1,21 @@
 """``synthua verify`` and ``synthua replay``: is a dataset complete, intact and what its manifest says?
 
-:func:`verify` checks, without trusting any file more than another: the manifest and the plan (every
-planned image has a record), every file's size and SHA-256 against the manifest, and cross-file
-consistency: every COCO annotation's mask is its instance's pixels in ``instance.png`` (area and box
-included) and every visible thing instance has one; every panoptic segment matches its PNG exactly; the
-Cityscapes label ids are the class map's ids of ``class.png``; YOLO has one line per annotated instance.
+:func:`verify` checks, without trusting any file more than another: the manifest (against its schema)
+and the plan (every planned image has a record), every file's size and SHA-256 against the manifest, that
+the folder holds no file the manifest does not list, and cross-file consistency: every COCO annotation's
+mask is its instance's pixels in ``instance.png`` (area and box included) and every visible thing instance
+has one; the person keypoints file is the person part of the instances file; every panoptic segment matches its PNG exactly; the Cityscapes label ids are the class map's ids of
+``class.png``; YOLO has one line per annotated instance. A record or an annotation document that is not
+what generate writes is a problem of the dataset, never a crash.
 
 :func:`replay` renders one image again in a fresh worker, into a temporary folder, and compares every file
-with the dataset's, byte for byte.
+with the file of the same name in the dataset, byte for byte (not with the checksums the dataset records:
+a file overwritten after generation must show).
 """
 
 from __future__ import annotations
 
-import json
+import os
 import shutil
 import tempfile
 from dataclasses import dataclass, field
@@ -20,9 +23,13 @@ from pathlib import Path
 
 import numpy as np
 
+from synthua_usd.atomic import named_as
+from synthua_usd.dataset.annotations import rle_problem
 from synthua_usd.dataset.layout import SPLITS, Layout
-from synthua_usd.dataset.manifest import sha256_file
+from synthua_usd.dataset.manifest import read_manifest, sha256_file
 from synthua_usd.errors import InputError, OutputError, echo
+from synthua_usd.input_files import shown
+from synthua_usd.schemas import read_json, type_name
 
 #: Problems listed in full; beyond this many, verify counts the rest.
 MAX_LISTED = 50
@@ -33,6 +40,9 @@ class Verification:
     images: int = 0
     files: int = 0
     problems: list[str] = field(default_factory=list)
+    #: Tracking sequences checked and their frames.
+    sequences: int = 0
+    frames: int = 0
 
     def add(self, problem: str) -> None:
         self.problems.append(problem)
@@ -42,32 +52,81 @@ class Verification:
         return not self.problems
 
 
-def _load_json(path: Path, what: str) -> dict:
+def _job(root: Path) -> dict:
+    """The run's ``generate.json`` with its plan (a list of planned images, each with an integer id)."""
+    path = root / Layout.CONFIG
+    if not path.exists():
+        raise InputError(f"{shown(path)}: file not found; expected the generate.json of a dataset written by "
+                         f"`synthua generate`")
+    job = read_json(path, "the generate.json of a dataset")
+    plan = job.get("plan") if isinstance(job, dict) else None
+    if not isinstance(plan, list) or not all(isinstance(p, dict) and isinstance(p.get("id"), int)
+                                             and not isinstance(p.get("id"), bool) for p in plan):
+        raise InputError(f"{shown(path)}: plan: {type_name(plan)}; expected a list of planned images with integer "
+                         f"ids (the generate.json of a dataset written by `synthua generate`)")
+    return job
+
+
+def _document(layout: Layout, relative: str, what: str, result: Verification):
+    """The JSON file ``relative`` of the dataset, or None when it is absent (the checksums report that) or
+    unreadable (a problem is added)."""
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{path}: missing; expected the {what} of a dataset written by synthua generate") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{path}: unreadable ({echo(exc)}); expected the {what} JSON") from None
+        path = layout.path(relative)
+        return read_json(path, what) if path.exists() else None
+    except (InputError, OutputError) as exc:
+        result.add(f"{relative}: {echo(exc, 240)}")
+        return None
+
+
+def _entries(document, key: str, fields: tuple[str, ...]) -> list[dict] | None:
+    """``document[key]`` when it is a list of objects holding ``fields``, else None."""
+    items = document.get(key) if isinstance(document, dict) else None
+    if isinstance(items, list) and all(isinstance(i, dict) and all(f in i for f in fields) for i in items):
+        return items
+    return None
+
+
+def _is_record(record) -> bool:
+    """Whether ``record`` has the fields verify reads, of the types generate writes."""
+    return (isinstance(record, dict) and isinstance(record.get("id"), int) and isinstance(record.get("name"), str)
+            and isinstance(record.get("files"), dict) and all(isinstance(v, str) for v in record["files"].values())
+            and isinstance(record.get("instances"), list) and all(isinstance(i, dict) for i in record["instances"]))
+
+
+def unlisted_files(root: Path, listed: set[str]) -> list[str]:
+    """Relative POSIX paths of every file, link or other non-folder entry below ``root`` that is not in
+    ``listed`` (links are not followed)."""
+    out = []
+    for dirpath, dirnames, filenames in os.walk(root):
+        folder = Path(dirpath)
+        for name in filenames + [d for d in dirnames if (folder / d).is_symlink()]:
+            rel = (folder / name).relative_to(root).as_posix()
+            if rel not in listed:
+                out.append(rel)
+    return sorted(out)
 
 
 def verify(root: Path, show_progress: bool = False) -> Verification:
-    """Check the dataset at ``root``; problems are collected, not raised (a missing manifest is an error)."""
+    """Check the dataset at ``root``; problems are collected, not raised (a missing or malformed manifest or
+    generate.json is an :class:`InputError` naming the file)."""
     from tqdm import tqdm
 
     root = Path(root)
     if not root.is_dir():
-        raise InputError(f"{root}: not a folder; expected a dataset folder written by synthua generate")
+        raise InputError(f"{shown(root)}: not a folder; expected a dataset folder written by `synthua generate`")
     result = Verification()
-    manifest = _load_json(root / Layout.MANIFEST, "manifest")
-    job = _load_json(root / Layout.CONFIG, "generate.json")
+    manifest = read_manifest(root / Layout.MANIFEST)
+    job = _job(root)
     layout = Layout(root)
-    planned = {p["id"] for p in job.get("plan", [])}
-    listed = {img["id"] for img in manifest.get("images", [])}
+    planned = {p["id"] for p in job["plan"]}
+    listed = {img["id"] for img in manifest["images"]}
     for missing in sorted(planned - listed):
         result.add(f"image {missing}: planned in generate.json but not in the manifest (run generate again to "
                    f"finish it)")
-    entries = [e for img in manifest.get("images", []) for e in img["files"]] + manifest.get("dataset_files", [])
+    entries = [e for img in manifest["images"] for e in img["files"]] + manifest["dataset_files"]
+    for rel in unlisted_files(root, {e["path"] for e in entries} | {Layout.MANIFEST}):
+        result.add(f"{rel}: in the dataset folder but not listed in the manifest (written there since, or left "
+                   f"by another tool)")
     damaged = set()
     for entry in tqdm(entries, desc="checksums", unit="file", disable=not show_progress):
         result.files += 1
@@ -83,50 +142,135 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         result.add(f"{Layout.CLASS_MAP}: {exc}")
         yolo_classes = {}
     records = []
-    for img in manifest.get("images", []):
-        try:
-            records.append(json.loads(layout.path(Layout.record(img["name"])).read_text(encoding="utf-8")))
-        except (OSError, ValueError):
-            continue  # already reported by the checksums
+    for img in manifest["images"]:
+        relative = Layout.record(img["name"])
+        record = _document(layout, relative, "an image record", result)
+        if record is None:
+            continue
+        if _is_record(record):
+            records.append(record)
+        else:
+            result.add(f"{relative}: not an image record (id, name, files and instances); expected the record "
+                       f"generate writes")
     result.images = len(records)
     coco_by_image, coco_images = {}, {}
     for split in SPLITS:
-        path = layout.path(Layout.coco_instances(split))
-        if path.exists():
-            try:
-                document = json.loads(path.read_text(encoding="utf-8"))
-            except (UnicodeDecodeError, json.JSONDecodeError):
-                continue  # reported by the checksums
-            coco_images.update({img["id"]: split for img in document.get("images", [])})
-            for ann in document.get("annotations", []):
-                coco_by_image.setdefault(ann["image_id"], []).append(ann)
+        relative = Layout.coco_instances(split)
+        document = _document(layout, relative, "COCO instances", result)
+        if document is None:
+            continue
+        images, annotations = _entries(document, "images", ("id",)), _entries(document, "annotations", ("image_id",))
+        if images is None or annotations is None:
+            result.add(f"{relative}: not a COCO instances document (images with ids, annotations with image ids)")
+            continue
+        coco_images.update({img["id"]: split for img in images})
+        for ann in annotations:
+            coco_by_image.setdefault(ann["image_id"], []).append(ann)
+        _check_person_keypoints(layout, split, document, result)
     kept = {r["id"]: r for r in records if not is_rejected(r)}
-    for image_id in sorted(set(coco_by_image) - set(kept)):
-        result.add(f"COCO annotations of image {image_id}: no such image kept in the dataset (unknown or rejected)")
+    for image_id in sorted(set(coco_by_image) - set(kept), key=str):
+        result.add(f"COCO annotations of image {echo(image_id)}: no such image kept in the dataset (unknown or "
+                   f"rejected)")
     for image_id, record in kept.items():
-        if coco_images.get(image_id) != record["split"]:
+        if coco_images.get(image_id) != record.get("split"):
             result.add(f"image {image_id} ({record['name']}): not among the COCO images of its split "
-                       f"{record['split']}")
+                       f"{echo(record.get('split'))}")
     panoptic_by_image = {}
     for split in SPLITS:
-        path = layout.path(Layout.coco_panoptic(split))
-        if path.exists():
-            try:
-                document = json.loads(path.read_text(encoding="utf-8"))
-            except (UnicodeDecodeError, json.JSONDecodeError):
-                continue
-            for ann in document.get("annotations", []):
-                panoptic_by_image[ann["image_id"]] = ann
+        relative = Layout.coco_panoptic(split)
+        document = _document(layout, relative, "COCO panoptic", result)
+        if document is None:
+            continue
+        annotations = _entries(document, "annotations", ("image_id", "segments_info"))
+        if annotations is None:
+            result.add(f"{relative}: not a COCO panoptic document (annotations with image ids and segments_info)")
+            continue
+        for ann in annotations:
+            panoptic_by_image[ann["image_id"]] = ann
+    config = (job.get("job_key") or {}).get("config") or {}
+    min_px = config.get("min_instance_px", 0) if isinstance(config, dict) else 0
     for record in tqdm(records, desc="consistency", unit="image", disable=not show_progress):
         if is_rejected(record) or damaged & set(record["files"].values()):
             continue  # a damaged file is reported already; its image is not read
         try:
             _check_image(layout, record, coco_by_image.get(record["id"], []), panoptic_by_image.get(record["id"]),
-                         yolo_classes, result)
+                         yolo_classes, result, min_px)
         except Exception as exc:  # noqa: BLE001 - whatever a broken file raises, it is a problem of the dataset
             result.add(f"image {record['id']} ({record['name']}): cannot be checked: {type(exc).__name__}: "
                        f"{echo(exc)}")
+    if isinstance(job.get("sequences"), list):
+        try:
+            _check_sequences(layout, job["sequences"], ClassMap.load(root / Layout.CLASS_MAP), damaged, result)
+        except InputError as exc:
+            result.add(f"{Layout.CLASS_MAP}: {exc}")
     return result
+
+
+def _check_sequences(layout: Layout, planned: list, class_map, damaged: set, result: Verification) -> None:
+    """Every planned frame of every sequence is there; its record's tracked instances have, in its instance map,
+    the pixels the record says; a track keeps one prim, class and link over the sequence; ``gt/gt.txt`` and
+    ``tracks.csv`` are what the records make, and ``seqinfo.ini`` counts the frames."""
+    from synthua_usd.dataset.formats import mot
+    from synthua_usd.dataset.sequences import PlannedSequence
+
+    for document in planned:
+        try:
+            seq = PlannedSequence.from_dict(document)
+        except (TypeError, KeyError, ValueError) as exc:
+            result.add(f"{Layout.CONFIG}: sequences: {echo(exc)}; expected the sequences generate plans")
+            continue
+        result.sequences += 1
+        pairs, tracks = [], {}
+        for k in range(1, seq.frames + 1):
+            relative = Layout.sequence_frame(seq.name, k, "records")
+            record = _document(layout, relative, "a sequence frame's record", result)
+            if record is None:
+                continue
+            result.frames += 1
+            try:
+                instances = record["instances"]
+                pairs.append((k, instances))
+                ids_path = record["files"]["instances"]
+                ids = None if ids_path in damaged else _read(layout, ids_path)
+                for entry in instances:
+                    tid = int(entry["id"])
+                    seen = (entry["prim_path"], entry["class_name"], (entry.get("relations") or {}).get("uses"))
+                    if tracks.setdefault(tid, seen) != seen:
+                        result.add(f"sequence {seq.name} frame {k}: track {tid} is {echo(seen)}, earlier "
+                                   f"{echo(tracks[tid])}; expected a track to keep its prim, class and link")
+                    if ids is not None and int((ids == tid).sum()) != int(entry["area"]):
+                        result.add(f"sequence {seq.name} frame {k}: track {tid} has {int((ids == tid).sum())} "
+                                   f"pixels in {ids_path}, the record says {entry['area']}")
+            except (KeyError, TypeError, ValueError) as exc:
+                result.add(f"{relative}: {type(exc).__name__} {echo(exc)}; expected the record generate writes")
+        if len(pairs) != seq.frames:
+            result.add(f"sequence {seq.name}: {len(pairs)} of {seq.frames} frames have a record (run generate "
+                       f"again to finish it)")
+            continue
+        expected = {"gt/gt.txt": mot.gt_text(mot.gt_rows(pairs, class_map)),
+                    "tracks.csv": mot.tracks_text(pairs, class_map)}
+        for name, text in expected.items():
+            path = layout.path(Layout.sequence_file(seq.name, name))
+            if not path.is_file() or path.read_text(encoding="utf-8") != text:
+                result.add(f"{Layout.sequence_file(seq.name, name)}: missing or not what the frames' records make")
+        info = layout.path(Layout.sequence_file(seq.name, "seqinfo.ini"))
+        if not info.is_file() or f"seqLength={seq.frames}\n" not in info.read_text(encoding="utf-8"):
+            result.add(f"{Layout.sequence_file(seq.name, 'seqinfo.ini')}: missing or not seqLength={seq.frames}")
+
+
+def _check_person_keypoints(layout: Layout, split: str, instances: dict, result: Verification) -> None:
+    """``person_keypoints_{split}.json`` is the person part of the split's (checked) instances document."""
+    from synthua_usd.dataset.formats.coco import person_keypoints
+
+    relative = Layout.coco_person_keypoints(split)
+    document = _document(layout, relative, "COCO person keypoints", result)
+    try:
+        expected = person_keypoints(instances)
+    except (KeyError, TypeError):
+        expected = None
+    if document is not None and document != expected:
+        result.add(f"{relative}: differs from the person category and annotations of "
+                   f"{Layout.coco_instances(split)}")
 
 
 def _check_file(layout: Layout, entry: dict, result: Verification) -> bool:
@@ -156,7 +300,9 @@ def _read(layout: Layout, relative: str) -> np.ndarray:
 
 
 def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], panoptic_annotation: dict | None,
-                 yolo_classes: dict[int, int], result: Verification) -> None:
+                 yolo_classes: dict[int, int], result: Verification, min_px: int = 0) -> None:
+    """The image's annotations against its label maps; an instance with fewer than ``min_px`` pixels in
+    ``instance.png`` must be an ignore region (COCO iscrowd 1, no YOLO line) and every other one must not."""
     from pycocotools import mask as mask_utils
 
     where = f"image {record['id']} ({record['name']})"
@@ -167,6 +313,11 @@ def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], pan
     seen = set()
     for ann in coco_annotations:
         inst = ann.get("instance_id")
+        problem = rle_problem(ann.get("segmentation"), instance_ids.shape)
+        if problem:  # pycocotools would read past the string or write past the mask
+            result.add(f"{where}: COCO annotation {echo(ann.get('id'))} (instance {echo(inst)}): segmentation: "
+                       f"{problem}")
+            continue
         mask = mask_utils.decode(ann["segmentation"]).astype(bool)
         truth = instance_ids == inst
         if mask.shape != truth.shape or not np.array_equal(mask, truth):
@@ -181,6 +332,9 @@ def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], pan
             result.add(f"{where}: COCO annotation {ann['id']}: bbox {ann['bbox']}; the mask's box is {box}")
         if "keypoints" in ann:
             _check_keypoints(where, ann, truth, result)
+        if int(ann.get("iscrowd", 0)) != int(truth.sum() < min_px):
+            result.add(f"{where}: COCO annotation {ann['id']}: iscrowd {ann.get('iscrowd')} for {int(truth.sum())} "
+                       f"pixels; expected iscrowd 1 below min_instance_px = {min_px}, else 0")
         seen.add(inst)
     for missing in sorted(set(things) - seen):
         result.add(f"{where}: instance {missing} ({things[missing]['class_name']}) is visible but has no COCO "
@@ -201,10 +355,12 @@ def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], pan
         result.add(f"{where}: {files['cs_labelIds']} differs from {files['class']}")
     if "yolo_label" in files:
         lines = [ln for ln in layout.path(files["yolo_label"]).read_text(encoding="utf-8").splitlines() if ln.strip()]
-        expected = sum(1 for i in record["instances"] if i["category_id"] in yolo_classes)
+        pixels = np.bincount(instance_ids.reshape(-1).astype(np.int64))
+        expected = sum(1 for i in record["instances"] if i["category_id"] in yolo_classes
+                       and (pixels[i["id"]] if i["id"] < len(pixels) else 0) >= min_px)
         if len(lines) != expected:
             result.add(f"{where}: {files['yolo_label']} has {len(lines)} lines; the image has {expected} instances "
-                       f"of YOLO classes")
+                       f"of YOLO classes with at least min_instance_px = {min_px} pixels")
 
 
 def _check_keypoints(where: str, ann: dict, truth: np.ndarray, result: Verification) -> None:
@@ -235,6 +391,9 @@ def _check_keypoints(where: str, ann: dict, truth: np.ndarray, result: Verificat
 
 @dataclass
 class Replay:
+    """What a replay found: each file of the image, identical to the dataset's file on disk or different (a
+    file of the dataset's record that the re-render did not make, or one missing on disk, is different)."""
+
     image_id: int
     name: str
     identical: list[str] = field(default_factory=list)
@@ -245,15 +404,26 @@ class Replay:
         return not self.different
 
 
+def _sha256_or_none(path: Path) -> str | None:
+    return sha256_file(path) if path.is_file() else None
+
+
 def replay(root: Path, image: str) -> Replay:
-    """Render the image ``image`` (its id or name) of the dataset at ``root`` again and compare its files."""
+    """Render the image ``image`` (its id or name) of the dataset at ``root`` again and compare each of its
+    files with the dataset's file on disk."""
     from synthua_usd.pipeline.dataset_worker import FLUSH, init_worker, work
     from synthua_usd.pipeline.generate import worker_job_from_document
     from synthua_usd.dataset.sampling import PlannedImage
 
     root = Path(root)
-    job_doc = _load_json(root / Layout.CONFIG, "generate.json")
-    plan = [PlannedImage(**p) for p in job_doc["plan"]]
+    if not root.is_dir():
+        raise InputError(f"{shown(root)}: not a folder; expected a dataset folder written by `synthua generate`")
+    job_doc = _job(root)
+    try:
+        plan = [PlannedImage(**p) for p in job_doc["plan"]]
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{shown(root / Layout.CONFIG)}: plan: {echo(exc)}; expected the planned images "
+                         f"`synthua generate` writes") from None
     chosen = [p for p in plan if str(p.id) == str(image).lstrip("0") or str(p.id) == str(image)]
     if not chosen:
         from synthua_usd.dataset.layout import image_name
@@ -264,21 +434,29 @@ def replay(root: Path, image: str) -> Replay:
                          f"1..{len(plan)}")
     planned = chosen[0]
     layout = Layout(root)
-    scratch = Path(tempfile.mkdtemp(prefix=".replay-", dir=root.parent))
     try:
-        job = worker_job_from_document(job_doc, scratch, dataset=root)
-        state = init_worker(job)
-        results = work(state, planned) + work(state, FLUSH)
+        scratch = Path(tempfile.mkdtemp(prefix=".replay-", dir=root.parent))
+    except OSError as exc:
+        raise OutputError(f"{shown(root.parent)}: cannot make the replay's scratch folder beside the dataset "
+                          f"({exc.strerror}); expected a writable folder") from None
+    try:
+        with named_as(scratch, root):  # a failure names the dataset, never the scratch folder
+            try:
+                job = worker_job_from_document(job_doc, scratch, dataset=root)
+            except (KeyError, TypeError, ValueError) as exc:
+                raise InputError(f"{shown(root / Layout.CONFIG)}: {type(exc).__name__} {echo(exc)}; expected the "
+                                 f"generate.json `synthua generate` writes") from None
+            state = init_worker(job)
+            results = work(state, planned) + work(state, FLUSH)
         record = results[-1]["record"]
         out = Replay(planned.id, record["name"])
-        original = json.loads(layout.path(Layout.record(record["name"])).read_text(encoding="utf-8"))
-        for key, rel in sorted(record["files"].items()):
-            theirs = original.get("checksums", {}).get(key, {}).get("sha256")
-            ours = sha256_file(scratch / rel)
-            (out.identical if ours == theirs else out.different).append(rel)
-        ours_record = sha256_file(scratch / Layout.record(record["name"]))
-        theirs_record = sha256_file(layout.path(Layout.record(record["name"])))
-        (out.identical if ours_record == theirs_record else out.different).append(Layout.record(record["name"]))
+        record_path = Layout.record(record["name"])
+        original = _document(layout, record_path, "an image record", Verification())
+        theirs = set(original["files"].values()) if _is_record(original) else set()
+        for rel in sorted(set(record["files"].values()) | theirs | {record_path}):
+            ours = _sha256_or_none(scratch / rel)
+            same = ours is not None and ours == _sha256_or_none(layout.path(rel))
+            (out.identical if same else out.different).append(rel)
         return out
     finally:
         shutil.rmtree(scratch, ignore_errors=True)

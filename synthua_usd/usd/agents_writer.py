@@ -165,21 +165,25 @@ def author_keypoints(prim: Usd.Prim, names, points: np.ndarray, times) -> None:
         attr.Set(Vt.Vec3fArray.FromNumpy(p), t)
 
 
-def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.Stage:
-    """The agents layer of ``crowd``: time samples from ``meta.start_time_code``, labels of ``taxonomy``."""
+def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str, root_path: str = AGENTS_ROOT,
+                       time_step: float = 1.0) -> Usd.Stage:
+    """The agents layer of ``crowd``: under ``root_path``, one time sample every ``time_step`` time codes from
+    ``meta.start_time_code`` (the crowd is simulated at ``crowd.params.time_codes_per_second`` samples a second:
+    a sequence's crowd at its frame rate), labels of ``taxonomy``."""
     trajectories, looks = crowd.trajectories, crowd.looks
     stage = new_layer(meta, crowd.doc)
     stage.SetDefaultPrim(stage.OverridePrim("/World"))
-    define_xform(stage, AGENTS_ROOT, kind=Kind.Tokens.group)
+    define_xform(stage, root_path, kind=Kind.Tokens.group)
     used = set().union(*(look.materials() for look in looks)) if looks else set()
     used |= {p.material for t in trajectories if t.plan.profile.device for p in devices.DEVICES[t.plan.profile.device]()}
-    mats = {key: define_preview_material(stage, f"{AGENTS_ROOT}/Looks/{key}", PALETTE[key]) for key in sorted(used)}
-    library = PrototypeLibrary(stage, mats)
+    mats = {key: define_preview_material(stage, f"{root_path}/Looks/{key}", PALETTE[key]) for key in sorted(used)}
+    library = PrototypeLibrary(stage, mats, root=f"{root_path}/Prototypes")
     bodies = BodyParts()
-    times = [Usd.TimeCode(meta.start_time_code + f) for f in range(len(trajectories[0].positions))] if trajectories else []
+    times = [Usd.TimeCode(meta.start_time_code + f * time_step) for f in range(len(trajectories[0].positions))] \
+        if trajectories else []
     for i, (traj, look) in enumerate(zip(trajectories, looks)):
         profile = traj.plan.profile
-        root = define_xform(stage, f"{AGENTS_ROOT}/Agent_{i:04d}", kind=Kind.Tokens.group)
+        root = define_xform(stage, f"{root_path}/Agent_{i:04d}", kind=Kind.Tokens.group)
         translate, heading = root.AddTranslateOp(), root.AddRotateZOp()
         for t, p, h in zip(times, traj.positions, traj.headings_deg):
             translate.Set(Gf.Vec3d(*map(float, p)), t)
@@ -198,7 +202,8 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str) -> Usd.
         device = profile.device
         posture = BENCH if traj.plan.seat is not None else device
         fit, base, parts = bodies.get(look.body, posture, bench_fit(traj.plan.seat.seat_height_m) if posture == BENCH else None)
-        phase, amplitude, cycle = _phases(traj, float(bodies.bank.height_m[look.body]), meta.time_codes_per_second)
+        phase, amplitude, cycle = _phases(traj, float(bodies.bank.height_m[look.body]),
+                                          crowd.params.time_codes_per_second)
         if device == "electric_wheelchair":
             amplitude = np.zeros_like(amplitude)
         shifts = [aid_shift_m(device, p, a, cycle) for p, a in zip(phase, amplitude)]

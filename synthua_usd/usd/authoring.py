@@ -10,11 +10,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdSemantics, UsdShade, Vt
+from pxr import Gf, Kind, Sdf, Tf, Usd, UsdGeom, UsdSemantics, UsdShade, Vt
 
-from synthua_usd.atomic import atomic_path
+from synthua_usd.atomic import atomic_path, write_failure
+from synthua_usd.errors import InputError, echo
 from synthua_usd.scenario import StageMetadata
 from synthua_usd.scene import Material
+from synthua_usd.usd.stage_io import tf_message
 
 
 def new_layer(meta: StageMetadata, doc: str) -> Usd.Stage:
@@ -35,15 +37,42 @@ def apply_metadata(stage: Usd.Stage, meta: StageMetadata) -> None:
     stage.GetRootLayer().defaultPrim = meta.default_prim
 
 
+#: The extensions a layer is written under: OpenUSD picks the format by them (``.usd`` is a crate) and
+#: writes text under any other name, a USDA that no USD tool opens as ``out.txt``. (``.usdz`` is a package.)
+LAYER_SUFFIXES = (".usda", ".usdc", ".usd")
+
+
+def check_layer_path(path: str | Path, what: str = "the layer") -> Path:
+    """``path`` when its extension is one of :data:`LAYER_SUFFIXES`, else an :class:`InputError` naming it."""
+    path = Path(path)
+    if path.suffix.lower() not in LAYER_SUFFIXES:
+        raise InputError(f"{echo(path)}: {what} needs a USD file name (.usda text, .usdc binary or .usd); found the "
+                         f"extension '{echo(path.suffix)}'")
+    return path
+
+
 def save_layer_atomic(layer: Sdf.Layer, path: str | Path) -> Path:
     """Export ``layer`` to ``path`` through a temporary file and a rename; the suffix picks the format
     (``.usda`` text, ``.usdc`` binary crate)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp:
-        if not layer.Export(str(tmp)):
-            raise OSError(f"{path}: USD could not write the layer")
+        export_layer(layer, tmp, path)
     return path
+
+
+def export_layer(layer: Sdf.Layer, tmp: Path, path: Path) -> None:
+    """Write ``layer`` to the temporary file ``tmp`` of the output ``path``. OpenUSD reports a failed write
+    (a full disk, a file-size limit) as a Tf error or a False without an errno: either becomes the
+    ``OSError`` naming ``path`` that :func:`synthua_usd.atomic.write_failure` finds (ENOSPC on a full disk)."""
+    check_layer_path(path)
+    try:
+        written = layer.Export(str(tmp))
+        reason = "OpenUSD could not write the layer"
+    except Tf.ErrorException as exc:
+        written, reason = False, f"OpenUSD could not write the layer ({tf_message(exc)})"
+    if not written:
+        raise write_failure(path, tmp, reason)
 
 
 def define_xform(stage: Usd.Stage, path: str, kind: str | None = None,

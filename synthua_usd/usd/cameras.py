@@ -18,6 +18,7 @@ from synthua_usd.cameras import PinholeCamera
 from synthua_usd.distortion import COEFFICIENTS, MODEL, BrownConrady
 from synthua_usd.errors import StageError
 from synthua_usd.usd.prim_checks import DISTORTION_PREFIX, camera_findings, lens_unit_mm, raise_first_error, read_distortion
+from synthua_usd.usd.stage_io import prim_path
 
 
 def author_camera(stage: Usd.Stage, path: str, camera_to_world: np.ndarray, *, focal_length_mm: float,
@@ -74,11 +75,12 @@ def camera_paths(stage: Usd.Stage) -> list[str]:
 def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
     """The camera at ``path`` at ``time_code`` in mm and world metres.
 
-    Raises :class:`StageError` for a missing prim, a prim that is not a camera, or any error of
+    Raises :class:`StageError` for a path that is not exactly a prim path (:func:`stage_io.prim_path`), a
+    missing prim, a prim that is not a camera, or any error of
     :func:`synthua_usd.usd.prim_checks.camera_findings` (the check ``synthua validate stage`` runs too).
     """
-    prim = stage.GetPrimAtPath(path) if path.startswith("/") else Usd.Prim()
-    if not prim or not prim.IsActive():
+    prim = stage.GetPrimAtPath(prim_path(path, stage.GetRootLayer().identifier, "camera"))
+    if not prim or not prim.IsActive() or str(prim.GetPath()) != path:
         known = ", ".join(camera_paths(stage)) or "none"
         raise StageError(f"{stage.GetRootLayer().identifier}: no camera at '{path}'; cameras in the stage: {known}")
     if not prim.IsA(UsdGeom.Camera):

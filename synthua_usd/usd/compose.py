@@ -8,8 +8,8 @@ from pathlib import Path
 
 from pxr import Sdf, UsdGeom
 
-from synthua_usd.errors import StageError, echo
-from synthua_usd.usd.authoring import save_layer_atomic
+from synthua_usd.errors import InputError, StageError, echo
+from synthua_usd.usd.authoring import check_layer_path, save_layer_atomic
 from synthua_usd.usd.stage_io import open_layer
 
 # Metadata that only the root layer of a stage decides: sublayers' values are ignored on composition,
@@ -17,17 +17,28 @@ from synthua_usd.usd.stage_io import open_layer
 _AGREE = ("upAxis", "metersPerUnit", "timeCodesPerSecond")
 
 
-def compose_layers(out_path: str | Path, layer_paths: list[str | Path], doc: str = "") -> Path:
+def compose_layers(out_path: str | Path, layer_paths: list[str | Path], doc: str = "",
+                   allow_external_assets: bool = True) -> Path:
     """Write a root layer at ``out_path`` that sublayers ``layer_paths`` (strongest first).
 
     Sublayer paths are written relative to the root's folder. The root takes upAxis, metersPerUnit and
     timeCodesPerSecond from the layers (which must agree), the union of their time ranges, and the
-    first defaultPrim stated. Raises :class:`StageError` for a missing layer or disagreeing metadata.
+    first defaultPrim stated. Raises :class:`StageError` for a missing layer or disagreeing metadata, and
+    :class:`InputError` for an ``out_path`` without a USD layer's extension, and, unless
+    ``allow_external_assets``, for a layer outside the root's folder tree (which opening the scenario would
+    refuse: :func:`synthua_usd.usd.stage_io.check_layers_inside`).
     """
-    out_path = Path(out_path)
+    out_path = check_layer_path(out_path, "the scenario root")
     if not layer_paths:
         raise StageError(f"{out_path}: no layers to compose; give at least one layer file")
     layers = [(Path(p), open_layer(p)) for p in layer_paths]
+    if not allow_external_assets:
+        folder = out_path.resolve().parent
+        for p in layer_paths:
+            if not Path(p).resolve().is_relative_to(folder):
+                raise InputError(f"{echo(p)}: outside the scenario's folder {echo(folder)}, so validate, render and "
+                                 f"generate would refuse {echo(out_path)}; expected layers in that folder tree (write "
+                                 f"the scenario beside them, or pass --allow-external-assets to compose it anyway)")
     if any(p.resolve() == out_path.resolve() for p, _ in layers):
         raise StageError(f"{out_path}: the scenario cannot sublayer itself")
     root = Sdf.Layer.CreateAnonymous(".usda")

@@ -60,6 +60,25 @@ def mesh_topology(prim: Usd.Prim, t: Usd.TimeCode, rule: str = "mesh-topology") 
     return out, (points, counts, indices)
 
 
+#: The size parameters of the implicit gprims and whether 0 is allowed (a Capsule's height, its cylinder
+#: part, may be 0: a sphere); every other must be > 0.
+SHAPE_PARAMETERS = {"Cube": (("size", False),), "Sphere": (("radius", False),),
+                    "Cylinder": (("radius", False), ("height", False)), "Cone": (("radius", False), ("height", False)),
+                    "Capsule": (("radius", False), ("height", True))}
+
+
+def shape_findings(prim: Usd.Prim, t: Usd.TimeCode, rule: str = "gprim-shape") -> list[Finding]:
+    """An implicit gprim's (Cube, Sphere, Cylinder, Cone, Capsule) size, radius and height at ``t``: finite
+    and > 0 (scene units; see :data:`SHAPE_PARAMETERS`). Other prims have none."""
+    out = []
+    for name, zero_allowed in SHAPE_PARAMETERS.get(prim.GetTypeName(), ()):
+        value = prim.GetAttribute(name).Get(t)
+        if value is None or not math.isfinite(value) or value < 0 or (value == 0 and not zero_allowed):
+            out.append(Finding(rule, str(prim.GetPath()), f"{name} is {value}; expected a finite value "
+                                                          f"{'>=' if zero_allowed else '>'} 0"))
+    return out
+
+
 def label_findings(path: str, labels: tuple[str, ...], class_map: ClassMap, rule: str = "label-in-class-map") -> list[Finding]:
     """A labelled prim holds exactly one label, and it names a class (or alias) of the class map."""
     if len(labels) != 1:
@@ -89,9 +108,17 @@ def camera_findings(prim: Usd.Prim, t: Usd.TimeCode, meters_per_unit: float, rul
             continue
         mm = value * unit
         if not lo <= mm <= hi:
-            out.append(Finding(rule, path, f"{attr} = {value:g} is {mm:g} mm, outside the plausible {lo:g}-{hi:g} mm; "
-                                           f"USD lens values are in tenths of a scene unit ({unit:g} mm here)",
-                               Severity.WARNING))
+            # Only the ratios reach the image, so such a lens renders: but every intrinsic in millimetres
+            # (frame.json, the metadata table) would be off by the same factor. Authored, that is an error (a
+            # lens in the wrong unit); USD's fallback lens (50, 20.955 x 15.2908) on a metre stage is a warning.
+            if prim.GetAttribute(attr).HasAuthoredValue():
+                out.append(Finding(rule, path, f"{attr} = {value:g} is {mm:g} mm, outside the plausible {lo:g}-{hi:g} "
+                                               f"mm; USD lens values are in tenths of a scene unit ({unit:g} mm here): "
+                                               f"{value:g} mm is authored as {value / unit:g}"))
+            else:
+                out.append(Finding(rule, path, f"{attr} is not authored: USD's fallback {value:g} is {mm:g} mm here, "
+                                               f"outside the plausible {lo:g}-{hi:g} mm; author the lens in tenths of a "
+                                               f"scene unit ({unit:g} mm here)", Severity.WARNING))
     for attr in ("horizontalApertureOffset", "verticalApertureOffset"):
         offset = prim.GetAttribute(attr).Get(t)
         if offset:

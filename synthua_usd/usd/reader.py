@@ -23,7 +23,7 @@ from synthua_usd.photometry import CD_PER_M2_PER_UNIT, MAX_RENDERER_UNITS, dista
 from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, keypoint_prims, read_keypoints
-from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error
+from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error, shape_findings
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
 from synthua_usd.usd.shading import Materials
 from synthua_usd.usd.stage_io import check_time_code, meters_per_unit
@@ -471,6 +471,7 @@ class StageReader:
         message = unsupported_gprim_message(prim)
         if message:
             raise UnsupportedPrimError(f"{prim.GetPath()}: {message}")
+        raise_first_error(shape_findings(prim, t))
         material = self._materials.of(prim, t)
         points, tris, uvs = self._geometry(prim, t, material)
         if len(tris) == 0:

@@ -2,7 +2,9 @@
 
 Each rule is a small object with a name and ``check(context) -> list[Finding]``; rules collect findings
 and never raise on a bad stage. The CLI decides what is fatal. Rules about what render refuses run the
-very checks the reader runs (:mod:`synthua_usd.usd.prim_checks`), so validation and render agree.
+very checks the reader runs (:mod:`synthua_usd.usd.prim_checks`), so validation and render agree; and when
+the rules find no error, the reader itself reads the stage at its start time code (:class:`RenderReadsRule`),
+so that nothing render refuses there passes validation.
 """
 
 from __future__ import annotations
@@ -10,12 +12,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pxr import Usd, UsdGeom, UsdLux, UsdRender, UsdValidation
+import numpy as np
+from pxr import Gf, Usd, UsdGeom, UsdLux, UsdRender, UsdValidation
 
+from synthua_usd.errors import SynthuaError
 from synthua_usd.findings import Finding, Severity
 from synthua_usd.taxonomy import ClassMap
-from synthua_usd.usd.prim_checks import camera_findings, label_findings, mesh_topology
-from synthua_usd.usd.reader import unsupported_gprim_message, unsupported_light_message
+from synthua_usd.usd.prim_checks import (SHAPE_PARAMETERS, camera_findings, label_findings, mesh_topology,
+                                        shape_findings)
+from synthua_usd.usd.reader import read_snapshot, unsupported_gprim_message, unsupported_light_message
 from synthua_usd.usd.render_settings import settings_findings
 from synthua_usd.usd.semantics import direct_labels, label_sites, renderable_gprims
 
@@ -28,6 +33,16 @@ class RuleContext:
     @property
     def root(self) -> str:
         return self.stage.GetRootLayer().identifier
+
+    @property
+    def start(self) -> Usd.TimeCode:
+        """The time code render reads by default: the stage's start, or the default time of a static stage."""
+        return Usd.TimeCode(self.stage.GetStartTimeCode()) if self.stage.HasAuthoredTimeCodeRange() \
+            else Usd.TimeCode.Default()
+
+    def prims(self) -> list[Usd.Prim]:
+        """Every prim of the stage, those of instance prototypes included (once each)."""
+        return list(self.stage.Traverse()) + [p for proto in self.stage.GetPrototypes() for p in Usd.PrimRange(proto)]
 
 
 class UsdValidationRule:
@@ -113,12 +128,68 @@ class MeshTopologyRule:
     name = "mesh-topology"
 
     def check(self, ctx: RuleContext) -> list[Finding]:
-        t = Usd.TimeCode(ctx.stage.GetStartTimeCode()) if ctx.stage.HasAuthoredTimeCodeRange() else Usd.TimeCode.Default()
         out = []
         for prim in renderable_gprims(ctx.stage):
             if prim.IsA(UsdGeom.Mesh):
-                out += mesh_topology(prim, t, self.name)[0]
+                out += mesh_topology(prim, ctx.start, self.name)[0]
         return out
+
+
+class GprimShapeRule:
+    """Implicit gprims (Cube, Sphere, Cylinder, Cone, Capsule) have finite, positive sizes (what the reader
+    refuses): a negative radius turns the sphere inside out, a NaN size has no surface."""
+
+    name = "gprim-shape"
+
+    def check(self, ctx: RuleContext) -> list[Finding]:
+        return [f for prim in renderable_gprims(ctx.stage) for f in shape_findings(prim, ctx.start, self.name)]
+
+
+def _numbers(value) -> np.ndarray | None:
+    """The numbers of a scalar, vector, matrix or quaternion value as a float array; None for anything else
+    (tokens, strings, asset paths, booleans)."""
+    if value is None or isinstance(value, (bool, str)):
+        return None
+    if isinstance(value, (Gf.Quatd, Gf.Quatf, Gf.Quath)):
+        return np.array([value.GetReal(), *value.GetImaginary()], float)
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return None
+
+
+class FiniteValuesRule:
+    """Every authored number that is not an array (transform operations, sizes, lens values, light and
+    material inputs), by default and at every time sample, is finite (a custom attribute's may be infinite,
+    never NaN): a NaN translate or light intensity renders nothing, or NaN pixels, at some time code.
+    (Arrays: :class:`MeshTopologyRule`.)"""
+
+    name = "finite-values"
+
+    def check(self, ctx: RuleContext) -> list[Finding]:
+        out = []
+        for prim in ctx.prims():
+            shape = {name for name, _ in SHAPE_PARAMETERS.get(prim.GetTypeName(), ())}  # GprimShapeRule's
+            for attr in prim.GetAttributes():
+                if attr.GetTypeName().isArray or not attr.HasAuthoredValue() or attr.GetName() in shape:
+                    continue
+                finding = self._first_bad_value(attr)
+                if finding:
+                    out.append(Finding(self.name, str(prim.GetPath()), finding))
+        return out
+
+    @staticmethod
+    def _first_bad_value(attr: Usd.Attribute) -> str | None:
+        # A custom attribute may say "unbounded" with infinity (synthua:condition:fogVisibilityM = inf: no fog);
+        # a schema attribute, and NaN anywhere, may not.
+        custom = attr.IsCustom()
+        for t in [Usd.TimeCode.Default()] + [Usd.TimeCode(t) for t in attr.GetTimeSamples()]:
+            value = attr.Get(t)
+            numbers = _numbers(value)
+            if numbers is not None and (np.isnan(numbers).any() if custom else not np.isfinite(numbers).all()):
+                when = "by default" if t.IsDefault() else f"at time code {t.GetValue():g}"
+                return f"{attr.GetName()} is {value} {when}; expected {'numbers' if custom else 'finite numbers'}"
+        return None
 
 
 class SupportedPrimRule:
@@ -141,9 +212,8 @@ class CameraLensRule:
 
     def check(self, ctx: RuleContext) -> list[Finding]:
         mpu = UsdGeom.GetStageMetersPerUnit(ctx.stage)
-        t = Usd.TimeCode(ctx.stage.GetStartTimeCode()) if ctx.stage.HasAuthoredTimeCodeRange() else Usd.TimeCode.Default()
         return [f for prim in ctx.stage.Traverse() if prim.IsA(UsdGeom.Camera)
-                for f in camera_findings(prim, t, mpu, self.name)]
+                for f in camera_findings(prim, ctx.start, mpu, self.name)]
 
 
 class RenderSettingsRule:
@@ -172,10 +242,33 @@ class RenderableRule:
         return out
 
 
+class RenderReadsRule:
+    """The reader render runs reads the stage at its start time code: whatever it refuses that no rule above
+    names (a lamp role, keypoints, more instances than the instance map holds, ...) is a finding in its words."""
+
+    name = "render-reads"
+
+    def check(self, ctx: RuleContext) -> list[Finding]:
+        try:
+            read_snapshot(ctx.stage, ctx.stage.GetStartTimeCode(), ctx.class_map)
+        except SynthuaError as exc:
+            text = str(exc)
+            where, _, message = text.partition(": ") if text.startswith("/") else (ctx.root, "", text)
+            return [Finding(self.name, where, message or text)]
+        return []
+
+
 DEFAULT_RULES = (UsdValidationRule(), StageMetadataRule(), GprimClassRule(), LabelInClassMapRule(),
-                 MeshTopologyRule(), SupportedPrimRule(), CameraLensRule(), RenderSettingsRule(), RenderableRule())
+                 MeshTopologyRule(), GprimShapeRule(), FiniteValuesRule(), SupportedPrimRule(), CameraLensRule(),
+                 RenderSettingsRule(), RenderableRule())
 
 
-def validate_stage(stage: Usd.Stage, class_map: ClassMap, rules=DEFAULT_RULES) -> list[Finding]:
+def validate_stage(stage: Usd.Stage, class_map: ClassMap, rules=DEFAULT_RULES,
+                   last=RenderReadsRule()) -> list[Finding]:
+    """The findings of ``rules``, then, when none is an error, of ``last`` (the reader's own read, which stops
+    at its first refusal: it would only repeat an error the rules already name)."""
     ctx = RuleContext(stage, class_map)
-    return [f for rule in rules for f in rule.check(ctx)]
+    findings = [f for rule in rules for f in rule.check(ctx)]
+    if last is not None and not any(f.severity is Severity.ERROR for f in findings):
+        findings += last.check(ctx)
+    return findings

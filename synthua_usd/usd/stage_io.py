@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdGeom
@@ -11,6 +12,13 @@ from pxr import Sdf, Tf, Usd, UsdGeom
 from synthua_usd.errors import StageError, echo
 
 USD_SUFFIXES = (".usda", ".usdc", ".usd", ".usdz")
+
+
+def tf_message(exc: Exception) -> str:
+    """The message of a Tf error (``Error in '...' at line N in file ... : 'message'``) on one line."""
+    text = _first_line(exc)
+    m = re.search(r" : '(.*)'$", text)
+    return m.group(1) if m else text
 
 
 def _first_line(exc: Exception) -> str:
@@ -113,7 +121,8 @@ def check_textures_inside(stage: Usd.Stage, path: Path, extra=()) -> None:
 
 
 def check_stage_metadata(stage: Usd.Stage, path: Path) -> None:
-    """metersPerUnit finite and > 0, upAxis Y or Z: every length and direction depends on them."""
+    """metersPerUnit finite and > 0, upAxis Y or Z, timeCodesPerSecond finite and > 0, a finite time range with
+    start <= end: every length, direction and time code depends on them."""
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
     if not (math.isfinite(mpu) and mpu > 0):
         raise StageError(f"{path}: metersPerUnit is {mpu!r}; expected a finite number > 0 (1 for metres)")
@@ -123,6 +132,12 @@ def check_stage_metadata(stage: Usd.Stage, path: Path) -> None:
     fps = stage.GetTimeCodesPerSecond()
     if not (math.isfinite(fps) and fps > 0):
         raise StageError(f"{path}: timeCodesPerSecond is {fps!r}; expected a finite number > 0")
+    start, end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
+    if not (math.isfinite(start) and math.isfinite(end)):
+        raise StageError(f"{path}: the time range is [{start!r}, {end!r}] (startTimeCode, endTimeCode); expected "
+                         f"finite time codes")
+    if stage.HasAuthoredTimeCodeRange() and start > end:
+        raise StageError(f"{path}: startTimeCode {start:g} is after endTimeCode {end:g}; expected start <= end")
 
 
 def _check_file(path: Path) -> None:
@@ -137,6 +152,25 @@ def _check_file(path: Path) -> None:
             pass
     except OSError as exc:
         raise StageError(f"{path}: cannot read ({exc.strerror})") from None
+
+
+_CONTROL_OR_SPACE = re.compile(r"[\x00-\x20\x7f]")
+
+
+def prim_path(text: str, where: str, what: str) -> Sdf.Path:
+    """``text`` as an absolute prim path, exactly as written: refused (a :class:`StageError` naming ``where`` and
+    ``what``, e.g. ``--camera``) when it holds control characters or spaces, is not an absolute prim path
+    (a relative path, a property or a variant selection), or is not the path SdfPath reads from it (SdfPath
+    stops reading at a newline: ``/World/Cam\\nX`` would name ``/World/Cam``)."""
+    refused = StageError(f"{where}: {what} '{echo(text)}' is not a prim path; expected an absolute prim path such "
+                         f"as /World/Cameras/CCTV")
+    if _CONTROL_OR_SPACE.search(text) or not text.startswith("/") or not Sdf.Path.IsValidPathString(text):
+        raise refused
+    path = Sdf.Path(text)
+    if not (path.IsPrimPath() and path.IsAbsolutePath()) or path.ContainsPrimVariantSelection() \
+            or str(path) != text:
+        raise refused
+    return path
 
 
 def time_range(stage: Usd.Stage) -> tuple[float, float] | None:

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from pxr import Usd, UsdGeom, UsdLux
 
 from synthua_usd.conditions import display_order
+from synthua_usd.errors import escape_controls
 from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.conditions import condition_names, selected_condition
 from synthua_usd.usd.prim_checks import lens_unit_mm
@@ -37,23 +38,26 @@ class StageSummary:
     condition: str | None = None  # the one the stage selects
 
     def format(self) -> str:
-        lines = [f"stage      {self.root}",
-                 "layers     " + ("\n           ".join(self.layers)),
-                 f"upAxis     {self.up_axis}    metersPerUnit {self.meters_per_unit:g}    defaultPrim {self.default_prim or '(none)'}",
+        # Layer files and names come from the user's files: control characters escaped, one line each.
+        lines = [f"stage      {escape_controls(self.root)}",
+                 "layers     " + ("\n           ".join(map(escape_controls, self.layers))),
+                 f"upAxis     {self.up_axis}    metersPerUnit {self.meters_per_unit:g}    "
+                 f"defaultPrim {escape_controls(self.default_prim or '(none)')}",
                  f"time       {'static' if not self.time_range else f'{self.time_range[0]:g}..{self.time_range[1]:g}'}"
                  f" at {self.time_codes_per_second:g} time codes/s",
                  f"prims      {self.prim_count} ({self.gprim_count} renderable gprims, ~{self.triangle_estimate} triangles)",
                  "classes    " + ("\n           ".join(textwrap.wrap(
-                     "  ".join(f"{k}:{v}" for k, v in sorted(self.classes.items())), 88, break_on_hyphens=False))
+                     "  ".join(escape_controls(f"{k}:{v}") for k, v in sorted(self.classes.items())), 88, break_on_hyphens=False))
                      or "(none)")]
         if self.unlabelled_gprims:
             lines.append(f"           {self.unlabelled_gprims} gprims without a class")
         lines.append("cameras    " + ("\n           ".join(
-            f"{c['path']}  f={c['focal_length_mm']:g} mm  aperture {c['horizontal_aperture_mm']:g}x"
+            f"{escape_controls(c['path'])}  f={c['focal_length_mm']:g} mm  aperture {c['horizontal_aperture_mm']:g}x"
             f"{c['vertical_aperture_mm']:g} mm  hfov {c['hfov_deg']:.1f} deg" for c in self.cameras) or "(none)"))
         lines.append("lights     " + ("\n           ".join(
-            f"{l['path']}  {l['type']}  intensity {l['intensity']:g}" for l in self.lights) or "(none)"))
-        lines.append("conditions " + ("  ".join(f"{c}*" if c == self.condition else c for c in self.conditions)
+            f"{escape_controls(l['path'])}  {l['type']}  intensity {l['intensity']:g}" for l in self.lights) or "(none)"))
+        lines.append("conditions " + ("  ".join(escape_controls(f"{c}*" if c == self.condition else c)
+                                                for c in self.conditions)
                                       + "   (* selected; render --condition NAME picks another)"
                                       if self.conditions else "(none)"))
         return "\n".join(lines)

@@ -166,3 +166,21 @@ def test_malformed_detections_are_refused(run_cli, dataset, tmp_path, field, val
     code, _, err = run_cli("eval", "--gt", dataset, "--pred", path, "--out", tmp_path / "e")
     line = one_error(err)
     assert code == 2 and expected in line, line
+
+
+@pytest.mark.parametrize("counts, expected", [
+    ("!!not rle!!", "counts[0] is '!'"),
+    ("o", "the last character continues"),
+    ("5", "runs of 5 pixels in all"),
+    ("PPYo0", "runs of 1025024 pixels in all"),  # pycocotools would write past the mask
+    ("0@", "a negative run"),
+])
+def test_garbage_rle_counts_are_refused_before_pycocotools_reads_them(run_cli, dataset, tmp_path, counts, expected):
+    detection = coco_results(dataset)[0]
+    detection["segmentation"] = {"size": detection["segmentation"]["size"], "counts": counts}
+    path = tmp_path / "results.json"
+    path.write_text(json.dumps([detection]))
+    code, _, err = run_cli("eval", "--gt", dataset, "--pred", path, "--out", tmp_path / "e")
+    line = one_error(err)
+    assert code == 2 and "[0].segmentation: " in line and expected in line, line
+    assert not (tmp_path / "e").exists()

@@ -115,6 +115,21 @@ def test_stats_errors_are_one_line(run_cli, tmp_path):
     assert code == 2 and "not a folder; expected a dataset folder written by `synthua generate`" in err
 
 
+@pytest.mark.parametrize("where", [".", "report", "frames/report"])
+def test_a_report_inside_a_dataset_is_refused(run_cli, tmp_path, where):
+    """`stats DIR --out DIR` wrote its report into the dataset: files its manifest does not list."""
+    from hostile import tree_state
+
+    root = tiny_dataset.write(tmp_path / "ds")
+    before = tree_state(root)
+    code, _, err = run_cli("stats", root, "--out", root / where)
+    assert code == 2 and err.count("synthua: error:") == 1 and "dataset folder" in err, err
+    assert tree_state(root) == before
+    code, _, err = run_cli("eval", "--gt", root, "--pred", root / "images", "--out", root / where)
+    assert code == 2 and "dataset folder" in err, err
+    assert tree_state(root) == before
+
+
 def test_stats_of_a_generated_dataset_agree_with_its_pngs_and_coco(generated, run_cli, tmp_path, class_map):
     """Pixel counts from class.png, objects from instance.png (things) and class.png (stuff regions), aid
     classes, per-condition counts from the manifest and records: counted here without analytics code."""

@@ -26,7 +26,7 @@ def write(out_dir, frame, outputs, document, palette):
 def test_writes_the_files_of_the_outputs_and_frame_json_last(tmp_path, frame, class_map):
     written = write(tmp_path / "out", frame, select_outputs(["instance_id", "depth"]), frame.document,
                     class_map.palette())
-    assert [p.name for p in written] == ["instance.png", "depth.exr", FRAME_DOCUMENT]
+    assert [p.name for p in written] == ["instance.png", "instance_preview.png", "depth.exr", FRAME_DOCUMENT]
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(p.name for p in written)
 
 

@@ -42,6 +42,19 @@ def test_frame_json_is_schema_valid_and_describes_the_images(rendered, class_map
         assert entry["pixel_count"] == int((inst == entry["id"]).sum())
 
 
+def test_instance_preview_gives_each_instance_its_own_colour(rendered):
+    """The raw 16-bit id map looks black in a viewer; the preview beside it is one colour per id, black only
+    where there is none, and as many colours as instances."""
+    inst, _ = read_image(rendered / "instance.png")
+    preview, _ = read_image(rendered / "instance_preview.png")
+    ids = inst[..., 0].astype(np.int64)
+    assert preview.shape == ids.shape + (3,) and preview.dtype == np.uint8
+    assert not preview[ids == 0].any() and (preview[ids > 0].max(axis=1) > 0).all()
+    colours = {i: np.unique(preview[ids == i], axis=0) for i in np.unique(ids[ids > 0])}
+    assert all(len(c) == 1 for c in colours.values())  # one colour per id
+    assert len({tuple(c[0]) for c in colours.values()}) == len(colours) >= 3  # and ids do not share one
+
+
 def test_semantic_png_is_the_class_palette(rendered, class_map):
     classes, _ = read_image(rendered / "class.png")
     semantic, _ = read_image(rendered / "semantic.png")

@@ -11,7 +11,6 @@ variation of a stage that renders.
 from __future__ import annotations
 
 import os
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import DATA, SCENARIO
-from hostile import assert_refused, run_synthua, tree_state
+from hostile import assert_refused, run_synthua, small_disk, tree_state
 
 TINY = (DATA / "valid" / "tiny_scene.usda").read_text()
 CAM = "/World/Cam"
@@ -77,6 +76,15 @@ BROKEN_STAGES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "upAxis X": (_variant('upAxis = "Z"', 'upAxis = "X"'), ("upAxis",)),
     "label not in the class map": (_variant('["road"]', '["spaceship"]'), ("/World/Ground", "spaceship")),
     "two labels": (_variant('["road"]', '["road", "sidewalk"]'), ("/World/Ground", "2 labels")),
+    "NaN translate": (_variant("(0, 0, 0.5)", "(nan, 0, 0.5)"), ("/World/Box", "finite")),
+    "NaN cube size": (_variant("double size = 1", "double size = nan"), ("/World/Box", "size")),
+    "negative sphere radius": (_variant('def Cube "Box"', 'def Sphere "Box"').replace("double size = 1",
+                                                                                    "double radius = -1"),
+                               ("/World/Box", "radius")),
+    "NaN startTimeCode": (_variant("startTimeCode = 1", "startTimeCode = nan"), ("time range",)),
+    "lens in millimetres on a metre stage": (_variant("focalLength = 0.2", "focalLength = 24").replace(
+        "horizontalAperture = 0.36", "horizontalAperture = 36").replace("verticalAperture = 0.24", "verticalAperture = 24"),
+        (CAM, "tenths of a scene unit")),
 }
 
 #: Cases `validate stage` reports as findings (exit 1) rather than refusing to read (exit 2).
@@ -86,7 +94,8 @@ FINDINGS = {"NaN points": "mesh-topology", "face counts do not match": "mesh-top
             "unsupported light": "supported-prim", "camera with a zero transform": "camera-lens",
             "camera focal length 0": "camera-lens", "orthographic camera": "camera-lens",
             "label not in the class map": "label-in-class-map", "two labels": "gprim-has-one-class",
-            "no geometry": "renderable"}
+            "no geometry": "renderable", "NaN translate": "finite-values", "NaN cube size": "gprim-shape",
+            "negative sphere radius": "gprim-shape", "lens in millimetres on a metre stage": "camera-lens"}
 
 
 @pytest.fixture(scope="module")
@@ -166,6 +175,12 @@ def test_external_layers_are_accepted_when_allowed(corpus, run_cli):
 BAD_PARAMETERS = {
     "unknown camera": (["--camera", "/World/Nope"], ("/World/Nope",)),
     "camera path with a newline": (["--camera", "/World/Ca\nm"], ("\\n",)),
+    "a camera's path, a newline and more": (["--camera", "/World/Cam\nX"], ("/World/Cam\\nX", "not a prim path")),
+    "camera path with a trailing slash": (["--camera", "/World/Cam/"], ("/World/Cam/", "not a prim path")),
+    "camera path with a space": (["--camera", "/World/Cam "], ("not a prim path",)),
+    "relative camera path": (["--camera", "World/Cam"], ("World/Cam", "not a prim path")),
+    "camera path of a property": (["--camera", "/World/Cam.focalLength"], ("not a prim path",)),
+    "camera path with a variant selection": (["--camera", "/World{v=a}Cam"], ("not a prim path",)),
     "time code out of range": (["--time-code", "500"], ("time code 500",)),
     "time code NaN": (["--time-code", "nan"], ("--time-code",)),
     "time code infinite": (["--time-code", "inf"], ("--time-code",)),
@@ -178,6 +193,23 @@ BAD_PARAMETERS = {
     "unknown variant": (["--variant", "teapot_rgb"], ("teapot_rgb",)),
     "class map is not JSON": (["--class-map", str(DATA / "invalid" / "not_json.json")], ("not_json.json",)),
 }
+
+
+def test_paths_echoed_on_stdout_are_escaped(corpus, tmp_path, run_cli):
+    """What stdout echoes of the user's input is escaped as the error messages are: one line each, no control
+    characters (a newline in --out cannot forge a line, an escape sequence cannot reach the terminal)."""
+    stage = tmp_path / "ti\x1b[2Jny.usda"
+    stage.write_text(TINY)
+    runs = [run_cli("render", corpus / "tiny.usda", "--camera", CAM, "--width", "8", "--height", "6", "--spp", "1",
+                    "--out", tmp_path / "o\nut"),
+            run_cli("compose", tmp_path / "ro\not.usda", corpus / "tiny.usda", "--allow-external-assets"),
+            run_cli("inspect", stage)]
+    for code, out, err in runs:
+        assert code == 0, err
+        assert not any(c in out.replace("\n", "") for c in "\x1b\r\x00"), out
+        assert "o\\nut" in out or "ro\\not.usda" in out or "ti\\x1b[2Jny.usda" in out, out
+    assert all(line.startswith(("rendered ", "wrote ")) for line in runs[0][1].splitlines()), runs[0][1]
+    assert runs[1][1].count("\n") == 1, runs[1][1]
 
 
 @pytest.mark.parametrize("name", sorted(BAD_PARAMETERS))
@@ -248,22 +280,8 @@ def test_a_file_that_became_a_folder_fails_before_anything_is_replaced(corpus, t
     assert sorted(os.listdir(tmp_path)) == ["out"]
 
 
-def _mount(tmp: Path, options: str) -> Path:
-    where = tmp / "mnt"
-    where.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(where)], capture_output=True)
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a small tmpfs here ({done.stderr.decode().strip()}); CI runs as root and can")
-    return where
-
-
-def _unmount(where: Path) -> None:
-    subprocess.run(["umount", str(where)], check=False)
-
-
 def test_a_full_disk_leaves_the_earlier_results(corpus, tmp_path):
-    disk = _mount(tmp_path, "size=160k")
-    try:
+    with small_disk(tmp_path, "size=160k") as disk:
         out = disk / "out"
         first = run_synthua("render", corpus / "tiny.usda", "--camera", CAM, "--width", "16", "--height", "12",
                             "--spp", "1", "--out", out)
@@ -274,18 +292,13 @@ def test_a_full_disk_leaves_the_earlier_results(corpus, tmp_path):
         assert_refused(result, "no space left on device")
         assert tree_state(out) == before
         assert sorted(os.listdir(disk)) == ["out"]  # the staging folder is gone too
-    finally:
-        _unmount(disk)
 
 
 def test_a_read_only_disk_is_one_line(corpus, tmp_path):
-    disk = _mount(tmp_path, "size=64k,ro")
-    try:
+    with small_disk(tmp_path, "size=64k,ro") as disk:
         result = run_synthua("render", corpus / "tiny.usda", "--camera", CAM, "--width", "8", "--height", "6",
                              "--spp", "1", "--out", disk / "out")
         assert_refused(result, "read-only")
-    finally:
-        _unmount(disk)
 
 
 def test_native_usd_diagnostics_become_one_line_warnings(tmp_path):
@@ -304,6 +317,10 @@ def test_compose_refuses_nonsense(corpus, tmp_path, run_cli):
     assert code == 2 and "itself" in err, err
     code, _, err = run_cli("compose", tmp_path / "y.usda", tmp_path / "nope.usda")
     assert code == 2 and "nope.usda" in err and not (tmp_path / "y.usda").exists()
+    for name in ("out.txt", "out", "out.usdz", "out.usda.bak"):  # OpenUSD wrote USDA text under any of them
+        code, _, err = run_cli("compose", tmp_path / name, corpus / "tiny.usda")
+        assert code == 2 and name in err and "USD file name" in err, err
+        assert not (tmp_path / name).exists()
 
 
 def test_populate_refuses_nonsense(corpus, tmp_path, run_cli):
@@ -320,3 +337,14 @@ def test_populate_refuses_nonsense(corpus, tmp_path, run_cli):
 def test_populate_on_a_surface_nobody_walks_on_ends(tmp_path):
     result = run_synthua("agents", "populate", SCENARIO, "--walk-on", "door", "--out", tmp_path / "a.usdc", timeout=60)
     assert_refused(result, "walkable surface")
+
+
+@pytest.mark.parametrize("args", [
+    ["render", "{corpus}/NaN_translate.usda", "--camera", CAM, "--width", "8", "--height", "6", "--spp", "1"],
+    ["cameras", "author", str(SCENARIO), "--rig", "cctv:k1=1e308", "--width", "16", "--height", "16"],
+], ids=["NaN translate", "k1=1e308"])
+def test_numpy_warnings_about_the_refused_value_do_not_come_before_the_error(args, corpus, tmp_path):
+    """numpy's "invalid value encountered" about the NaN being refused would only repeat the error line."""
+    result = run_synthua(*[a.format(corpus=corpus) for a in args], "--out", tmp_path / "out.usda")
+    assert_refused(result)
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr

@@ -133,3 +133,34 @@ def test_plane_threshold_nan(space):
 
 def test_demo_seed_2_64(space):
     _refused(space, "twin", "demo", "--seed", str(2**64), "--out", space / "out", mentions=("--seed",))
+
+
+def test_the_laz_of_the_issue_is_refused_at_once(space):
+    """'LASF' and random bytes: laspy believed the header's 4e9 VLRs and looped past 60 s."""
+    import numpy as np
+
+    laz = write(space / "garbage.laz", b"LASF" + np.random.default_rng(24).integers(0, 256, 4000, np.uint8).tobytes())
+    result = run_limited("twin", "import", "pointcloud", laz, "--units", "m", "--out", space / "out", cwd=space,
+                         timeout=10)
+    assert_refused(result, "garbage.laz")
+
+
+@pytest.mark.parametrize("where,value", [("chunks", 2**32 - 1), ("table", 2**40), ("version", 7)])
+def test_a_lying_laz_chunk_table_is_refused_before_lazrs_allocates(space, where, value):
+    """A LAZ whose chunk table announces 4e9 chunks made lazrs abort the process (a 46 GB allocation)."""
+    import struct
+
+    import numpy as np
+    from las_files import write_las
+
+    path = write_las(space / "scan.laz", np.random.default_rng(0).uniform(0, 50, (500, 3)))
+    data = bytearray(path.read_bytes())
+    to_points = struct.unpack_from("<I", data, 96)[0]
+    table = struct.unpack_from("<q", data, to_points)[0]
+    if where == "table":
+        struct.pack_into("<q", data, to_points, value)
+    else:
+        struct.pack_into("<I", data, table + (4 if where == "chunks" else 0), value)
+    path.write_bytes(bytes(data))
+    assert_refused(run_limited("twin", "import", "pointcloud", path, "--out", space / "new", cwd=space,
+                               timeout=HANG_S), "scan.laz", "chunk")

@@ -126,3 +126,19 @@ def test_a_mixed_class_instance_is_named_in_instance_order(class_map):
     low = min(first, later, key=lambda i: i.id)
     with pytest.raises(InputError, match=f"instance {low.id} .*expected only its class {low.class_id}"):
         panoptic(cls, ins, instances, class_map)
+
+
+def test_rle_problem_accepts_every_mask_pycocotools_encodes_and_refuses_garbage():
+    from pycocotools import mask as mask_utils
+
+    from synthua_usd.dataset.annotations import rle_problem
+
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        h, w = (int(v) for v in rng.integers(1, 40, 2))
+        mask = (rng.random((h, w)) < rng.random()).astype(np.uint8)
+        rle = mask_utils.encode(np.asfortranarray(mask))
+        assert rle_problem({"size": [h, w], "counts": rle["counts"].decode("ascii")}, (h, w)) is None
+    assert "size" in rle_problem({"size": [3, 3], "counts": "9"}, (4, 5))
+    assert "string" in rle_problem({"size": [4, 5], "counts": [20]}, (4, 5))
+    assert "20" in rle_problem({"size": [4, 5], "counts": "6"}, (4, 5))

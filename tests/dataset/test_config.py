@@ -22,7 +22,7 @@ def load(tmp_path, **changes):
 
 
 @pytest.mark.parametrize("name", ["demo.json", "district.json", "demo_random.json", "district_random.json",
-                                  "sim2real.json", "sim2real_street.json"])
+                                  "district_sequences.json", "sim2real.json", "sim2real_street.json"])
 def test_shipped_configs_load_and_round_trip(name):
     config = GenerationConfig.load(REPO / "configs" / name)
     assert GenerationConfig.from_document(config.to_document()) == config
@@ -60,7 +60,7 @@ def test_minimal_document_takes_the_defaults():
 
 
 @pytest.mark.parametrize("changes, message", [
-    ({"images": 0}, "gen.json: images: 0 is less than the minimum of 1; expected a document matching generate.schema.json"),
+    ({"images": 0}, "gen.json: images: 0 without a sequences block; expected at least 1 image, or sequences"),
     ({"colour": 1}, "gen.json: (document): Additional properties are not allowed ('colour' was unexpected)"),
     ({"render": {"pixel_filter": "gaussian"}}, "gen.json: render.pixel_filter: 'box' was expected"),
     ({"cameras": ["World/Cam"]}, "gen.json: cameras[0]: "),

@@ -127,12 +127,16 @@ def test_district_labels_agree_with_embree(views):
 
 
 def test_twin_demo_cli(run_cli, tmp_path, monkeypatch, seed1):
-    # The command's wiring: the seed reaches the builder (tested above) and two layers come out.
+    # The command's wiring: the seed reaches the builder (tested above) and a renderable scenario without people
+    # comes out (the README's quickstart renders and generates from it).
     seeds = []
     monkeypatch.setattr(district, "build_district", lambda seed: seeds.append(seed) or seed1)
     code, out, _ = run_cli("twin", "demo", "--seed", "1", "--out", tmp_path)
     assert code == 0 and seeds == [1] and f"district seed 1: {len(seed1.objects)} objects" in out
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["semantics.usda", "textures", "twin.usdc"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cameras.usda", "environment.usda", "render.usda",
+                                                          "scenario.usda", "semantics.usda", "textures", "twin.usdc"]
+    assert run_cli("validate", "stage", tmp_path / "scenario.usda")[0] == 0
+    assert not Usd.Stage.Open(str(tmp_path / "scenario.usda")).GetPrimAtPath("/World/Agents")
     twin = Usd.Stage.Open(str(tmp_path / "twin.usdc"))
     assert sum(1 for p in twin.Traverse() if p.IsA(UsdGeom.Mesh)) == sum(len(o.parts) for o in seed1.objects)
 

@@ -70,7 +70,15 @@ CASES = {
                                   ("house-1", "semantics")),
     "semantics-surface-number": (lambda d: _set(d, HOUSE + ("semantics", "surfaces", 0), 3),
                                  ("house-1", "semantics")),
-    "metadata-list": (lambda d: _set(d, ("metadata",), ["EPSG:7415"]), ("metadata",)),
+    "semantics-values-shorter-than-the-shell": (lambda d: _set(d, HOUSE + ("semantics", "values", 0),
+                                                               d["CityObjects"]["house-1"]["geometry"][0]["semantics"]
+                                                               ["values"][0][:2]), ("house-1", "semantics.values[0]")),
+    "semantics-values-shorter-than-the-shells": (lambda d: _set(d, HOUSE + ("semantics", "values"), []),
+                                                 ("house-1", "semantics.values")),
+    "semantics-values-longer-than-the-shell": (lambda d: _set(d, HOUSE + ("semantics", "values", 0),
+                                                              d["CityObjects"]["house-1"]["geometry"][0]["semantics"]
+                                                              ["values"][0] + [0]), ("house-1", "semantics.values[0]")),
+        "metadata-list": (lambda d: _set(d, ("metadata",), ["EPSG:7415"]), ("metadata",)),
     "crs-number": (lambda d: _set(d, ("metadata", "referenceSystem"), 7415), ("referenceSystem",)),
     "crs-geographic": (lambda d: _set(d, ("metadata", "referenceSystem"),
                                       "https://www.opengis.net/def/crs/EPSG/0/4326"), ("geographic",)),

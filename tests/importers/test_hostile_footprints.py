@@ -11,6 +11,8 @@ BOWTIE = [[-49.2712, -25.4270], [-49.2710, -25.4268], [-49.2710, -25.4270], [-49
 LINE = [[-49.2712, -25.4270], [-49.2711, -25.4270], [-49.2710, -25.4270], [-49.2712, -25.4270]]
 SLIVER = [[-49.2712, -25.4270], [-49.2710, -25.4270], [-49.2710, -25.42699999999], [-49.2712, -25.4270]]
 POINT_RING = [[-49.2712, -25.4270]] * 4
+#: A hole inside SQUARE whose positions lie on one line: a courtyard of no area.
+FLAT_HOLE = [[-49.27115, -25.4269], [-49.27112, -25.4269], [-49.27108, -25.4269], [-49.27115, -25.4269]]
 
 
 def _feature(d: dict, **changes) -> dict:
@@ -47,6 +49,10 @@ CASES = {
     "zero-area-line": (lambda d: _feature(d, coordinates=[LINE]), ("features[0]", "area")),
     "zero-area-point": (lambda d: _feature(d, coordinates=[POINT_RING]), ("features[0]", "area")),
     "sliver": (lambda d: _feature(d, coordinates=[SLIVER]), ("features[0]", "area")),
+    "hole-of-zero-area": (lambda d: _feature(d, coordinates=[SQUARE, FLAT_HOLE]), ("features[0]", "hole", "area")),
+    "shell-not-closed": (lambda d: _feature(d, coordinates=[SQUARE[:-1]]), ("features[0]", "not closed")),
+    "hole-not-closed": (lambda d: _feature(d, coordinates=[SQUARE, FLAT_HOLE[:-1] + [[-49.27111, -25.42691]]]),
+                        ("features[0]", "coordinates[1]", "not closed")),
     "hole-outside": (lambda d: _feature(d, coordinates=[SQUARE, [[x + 0.01, y] for x, y in SQUARE]]),
                      ("features[0]",)),
     "height-1e308": (lambda d: _feature(d, height=1e308), ("features[0]", "height", "1000")),

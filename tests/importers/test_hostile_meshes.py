@@ -83,6 +83,38 @@ def _las_header(point_count: int, record_length: int = 20, fmt: int = 0, scale: 
     return h
 
 
+def _las14_header(point_count: int, evlrs: int, evlr_start: int) -> bytearray:
+    """A LAS 1.4 public header block (375 bytes) of point format 6 (30-byte records)."""
+    h = bytearray(375)
+    h[0:4], h[24], h[25] = b"LASF", 1, 4
+    struct.pack_into("<HIIBH", h, 94, 375, 375, 0, 6, 30)
+    struct.pack_into("<3d", h, 131, 0.01, 0.01, 0.01)
+    struct.pack_into("<QIQ", h, 235, evlr_start, evlrs, point_count)
+    return h
+
+
+def _patched(block: bytearray, fmt: str, offset: int, *values) -> bytes:
+    """``block`` with ``values`` packed as ``fmt`` at ``offset``."""
+    block = bytearray(block)
+    struct.pack_into(fmt, block, offset, *values)
+    return bytes(block)
+
+
+def _with_vlrs(h: bytearray, vlrs: int, data: bytes) -> bytes:
+    """``h`` announcing ``vlrs`` VLRs, followed by ``data`` (the VLR bytes), the points starting after it."""
+    h = bytearray(h)
+    struct.pack_into("<II", h, 96, len(h) + len(data), vlrs)
+    return bytes(h) + data
+
+
+def _vlr(length: int, body: bytes = b"") -> bytes:
+    """A VLR header (54 bytes) announcing ``length`` bytes after it, then ``body``."""
+    head = bytearray(54)
+    head[2:18] = b"someone".ljust(16, b"\0")
+    struct.pack_into("<HH", head, 18, 1, length)
+    return bytes(head) + body
+
+
 def _las_points(n: int, rng) -> bytes:
     xyz = rng.integers(0, 1000, size=(n, 3), dtype=np.int32)
     records = np.zeros(n, dtype=[("xyz", "<i4", 3), ("rest", "V8")])
@@ -108,6 +140,24 @@ POINTCLOUD_CASES = {
     "las-zero-points": ("cloud.las", lambda rng: bytes(_las_header(0))),
     "las-signature-only": ("cloud.las", lambda rng: b"LASF"),
     "las-same-point": ("cloud.las", lambda rng: bytes(_las_header(100)) + bytes(20) * 100),
+    # Header fields checked against the file's size before laspy reads (it believes them: hours of looping)
+    "laz-signature-then-random": ("cloud.laz", lambda rng: b"LASF" + rng.integers(0, 256, 4000, np.uint8).tobytes()),
+    "las-version-9": ("cloud.las", lambda rng: bytes(_las_header(10, minor=9)) + _las_points(10, rng)),
+    "las-header-size-past-end": ("cloud.las", lambda rng: _patched(_las_header(10), "<H", 94, 60000)
+                                 + _las_points(10, rng)),
+    "las-point-offset-past-end": ("cloud.las", lambda rng: _patched(_las_header(10), "<I", 96, 2**32 - 1)
+                                  + _las_points(10, rng)),
+    "las-4e9-vlrs": ("cloud.las", lambda rng: _with_vlrs(_las_header(10), 2**32 - 1, _vlr(0)) + _las_points(10, rng)),
+    "las-vlr-past-point-data": ("cloud.las", lambda rng: _with_vlrs(_las_header(10), 1, _vlr(65535, bytes(100)))
+                                + _las_points(10, rng)),
+    "laz-4e9-vlrs": ("cloud.laz", lambda rng: _with_vlrs(_las_header(10, fmt=0x80), 2**32 - 1, b"")
+                     + rng.integers(0, 256, 4000, np.uint8).tobytes()),
+    "las14-4e9-evlrs": ("cloud.las", lambda rng: bytes(_las14_header(10, 2**32 - 1, 375 + 300)) + bytes(300)
+                        + bytes(60)),
+    "las14-evlrs-past-end": ("cloud.las", lambda rng: bytes(_las14_header(10, 1, 2**40)) + bytes(300)),
+    "las14-evlr-longer-than-file": ("cloud.las", lambda rng: bytes(_las14_header(10, 1, 375 + 300)) + bytes(300)
+                                    + _patched(bytearray(60), "<Q", 20, 2**62)),
+    "las14-2e19-points": ("cloud.las", lambda rng: bytes(_las14_header(2**64 - 1, 0, 0)) + bytes(300)),
     "ply-two-points": ("cloud.ply", lambda rng: (b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
                                                  b"property float y\nproperty float z\nend_header\n0 0 0\n1 1 1\n")),
 }

@@ -123,6 +123,44 @@ def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_i
     assert flags[2] > 0
 
 
+def _default_keypoint_cocoeval(gt, dets: list[dict]) -> list[float]:
+    """COCOeval(gt, dt, "keypoints") exactly as its users call it: every category, the default sigmas."""
+    from pycocotools.cocoeval import COCOeval
+
+    with quiet():
+        ev = COCOeval(gt, gt.loadRes(dets), "keypoints")
+        ev.evaluate()
+        ev.accumulate()
+        ev.summarize()
+    return [float(v) for v in ev.stats]
+
+
+def test_cocoevals_default_keypoint_call_reads_instances_and_person_keypoints(dataset):
+    """The default call reads ``num_keypoints`` of every annotation of every category: on instances_{split}.json
+    (person detections) it runs, on COCO's person_keypoints_{split}.json (the person category only, COCO's
+    sigmas) the person keypoints against themselves give AP 1.0."""
+    from pycocotools.coco import COCO
+
+    evaluated = 0
+    for split in splits_with_images(dataset):
+        with quiet():
+            instances = COCO(str(dataset / Layout.coco_instances(split)))
+            people = COCO(str(dataset / Layout.coco_person_keypoints(split)))
+        person = [c["id"] for c in people.dataset["categories"]]
+        assert [c["name"] for c in people.dataset["categories"]] == ["person"]
+        assert all("num_keypoints" in a for a in instances.dataset["annotations"])
+        dets = [{"image_id": a["image_id"], "category_id": a["category_id"], "keypoints": a["keypoints"], "score": 1.0}
+                for a in people.dataset["annotations"] if a["num_keypoints"]]
+        assert people.dataset["annotations"] == [a for a in instances.dataset["annotations"]
+                                                 if a["category_id"] in person]
+        if not dets:
+            continue
+        assert len(_default_keypoint_cocoeval(instances, dets)) == 10
+        assert _default_keypoint_cocoeval(people, dets)[0] == pytest.approx(1.0), split
+        evaluated += 1
+    assert evaluated >= 1, "no split has labelled person keypoints"
+
+
 def test_coco_ids_categories_and_images_agree_with_the_manifest_and_class_map(dataset):
     class_map = dataset_class_map(dataset)
     things = {c.id for c in class_map.classes if c.isthing and c.id >= 1}
@@ -174,6 +212,44 @@ def test_coco_amodal_masks_contain_the_visible_ones_and_occlusion_is_their_ratio
                                for b in doc["annotations"]), (split, a["id"])
     assert occluded >= 1, "no annotation is occluded: the amodal checks above would be vacuous"
     assert relations >= 1, "the demo street has mobility-aid users: some annotation should carry a 'uses' relation"
+
+
+def test_instances_below_min_instance_px_are_ignore_regions_in_every_format(dataset):
+    """The rule, from the written instance maps alone: a thing instance with fewer pixels than the config's
+    min_instance_px is COCO iscrowd 1, one crowd segment per class in panoptic (panopticapi keeps one per
+    category), and no YOLO line; every other one is none of these. COCOeval ignoring the crowd ones is checked by
+    the self-evaluations above, which pass them as detections too."""
+    from panopticapi.utils import rgb2id
+
+    min_px = read_json(dataset, Layout.MANIFEST)["provenance"]["config"]["min_instance_px"]
+    assert min_px > 0
+    ignored_seen = kept_seen = 0
+    for split in splits_with_images(dataset):
+        coco = coco_split(dataset, split)
+        panoptic = {a["image_id"]: a for a in read_json(dataset, Layout.coco_panoptic(split))["annotations"]}
+        names = {m["id"]: m["name"] for m in manifest_images(dataset)}
+        for image in coco["images"]:
+            frame = read_png(dataset / Layout.frame_file(names[image["id"]], "instance.png"))
+            pixels = np.bincount(frame.ravel().astype(np.int64))
+            anns = [a for a in coco["annotations"] if a["image_id"] == image["id"]]
+            crowd_classes = set()
+            for a in anns:
+                small = pixels[a["instance_id"]] < min_px
+                assert a["iscrowd"] == int(small), (split, image["file_name"], a["instance_id"], pixels[a["instance_id"]])
+                ignored_seen += small
+                kept_seen += not small
+                if small:
+                    crowd_classes.add(a["category_id"])
+            segments = panoptic[image["id"]]["segments_info"]
+            ids = rgb2id(read_png(dataset / "annotations" / f"panoptic_{split}" / panoptic[image["id"]]["file_name"]))
+            crowds = [seg for seg in segments if seg["iscrowd"]]
+            assert sorted(seg["category_id"] for seg in crowds) == sorted(crowd_classes)  # one per class
+            for seg in crowds:
+                members = [a["instance_id"] for a in anns if a["iscrowd"] and a["category_id"] == seg["category_id"]]
+                assert np.array_equal(ids == seg["id"], np.isin(frame, members)), (split, image["file_name"], seg)
+            lines = (dataset / "labels" / split / image["file_name"].replace(".png", ".txt")).read_text().splitlines()
+            assert len(lines) == sum(not a["iscrowd"] for a in anns), (split, image["file_name"])
+    assert ignored_seen and kept_seen, (ignored_seen, kept_seen)  # both kinds occur: the checks are not vacuous
 
 
 # ------------------------------------------------------------------------------------------------ panoptic
@@ -266,7 +342,11 @@ def test_cityscapes_scripts_parses_every_name_and_its_evaluation_of_gt_against_i
         assert scored
         for name in scored:
             assert result["classScores"][name] == pytest.approx(1.0), (split, name)
-        for name in scored & {l.name for l in labels if l.hasInstances}:
+        with_instances = set()  # classes with an instance (not only group regions of ignored ones)
+        for gt in gts:
+            ids = read_png(Path(gt.replace("_labelIds.png", "_instanceIds.png")))
+            with_instances |= {class_map.by_id(int(i) // 1000).name for i in np.unique(ids[ids >= 1000])}
+        for name in scored & {l.name for l in labels if l.hasInstances} & with_instances:
             assert result["classInstScores"][name] == pytest.approx(1.0), (split, name)
         assert result["averageScoreClasses"] == pytest.approx(1.0), split
         evaluated += 1
@@ -275,6 +355,7 @@ def test_cityscapes_scripts_parses_every_name_and_its_evaluation_of_gt_against_i
 
 def test_cityscapes_instance_ids_are_class_times_1000_plus_k_and_agree_with_coco(dataset):
     class_map = dataset_class_map(dataset)
+    manifest_names = {m["id"]: m["name"] for m in manifest_images(dataset)}
     things = {c.id for c in class_map.classes if c.isthing}
     checked = 0
     for split in splits_with_images(dataset):
@@ -290,11 +371,15 @@ def test_cityscapes_instance_ids_are_class_times_1000_plus_k_and_agree_with_coco
             big = instance_ids >= 1000
             assert np.array_equal(instance_ids[big] // 1000, label_ids[big]), label_path
             assert np.array_equal(instance_ids[~big], label_ids[~big]), label_path
-            assert np.all(big == np.isin(label_ids, list(things))), label_path  # every thing pixel has its instance
-            # each COCO annotation is one Cityscapes instance of the same class and area
+            # every thing pixel has its instance, but those of an instance too small to annotate (COCO iscrowd 1),
+            # which are a group region: the class id alone
+            anns = [a for a in coco["annotations"] if a["image_id"] == image["id"]]
+            frame = read_png(dataset / Layout.frame_file(manifest_names[image["id"]], "instance.png"))
+            crowd = np.isin(frame, [a["instance_id"] for a in anns if a["iscrowd"]])
+            assert np.all(big == (np.isin(label_ids, list(things)) & ~crowd)), label_path
+            # each other COCO annotation is one Cityscapes instance of the same class and area
             cs = sorted((int(i) // 1000, int(n)) for i, n in zip(*np.unique(instance_ids[big], return_counts=True)))
-            anns = sorted((a["category_id"], a["area"]) for a in coco["annotations"] if a["image_id"] == image["id"])
-            assert cs == anns, label_path
+            assert cs == sorted((a["category_id"], a["area"]) for a in anns if not a["iscrowd"]), label_path
             # leftImg8bit is the very RGB file of images/
             left = label_path.parents[3] / "leftImg8bit" / split / label_path.parent.name / label_path.name.replace(
                 "_gtFine_labelIds.png", "_leftImg8bit.png")
@@ -327,8 +412,8 @@ def test_supervision_loads_every_split_with_the_coco_boxes(dataset):
             found = [(ids[names[k]], box) for k, box in zip(dets.class_id, dets.xyxy)]
             expected = [(a["category_id"], np.array([a["bbox"][0], a["bbox"][1], a["bbox"][0] + a["bbox"][2],
                                                      a["bbox"][1] + a["bbox"][3]], float))
-                        for a in coco["annotations"] if a["image_id"] == image["id"]]
-            assert len(found) == len(expected), (split, image["file_name"])
+                        for a in coco["annotations"] if a["image_id"] == image["id"] and not a["iscrowd"]]
+            assert len(found) == len(expected), (split, image["file_name"])  # no YOLO line for an ignore region
             # supervision scales float32 coordinates by the image size: exact up to float32 rounding
             for cid, box in expected:
                 match = [j for j, (c, b) in enumerate(found) if c == cid and np.abs(b - box).max() < 1e-3]

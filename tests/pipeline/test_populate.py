@@ -35,7 +35,7 @@ def test_populated_layer_composes_renders_and_exports_person_device_pairs(run_cl
     assert code == 0 and "with mobility aids" in out
     layers = [tmp_path / "crowd.usda"] + [STAGES / LAYER_FILE[role] for role in ("render", "environment", "cameras",
                                                                                 "semantics", "twin")]
-    assert run_cli("compose", tmp_path / "scene.usda", *layers)[0] == 0
+    assert run_cli("compose", tmp_path / "scene.usda", *layers, "--allow-external-assets")[0] == 0
     # The scenario lives in tmp_path and composes the repository's layers: external by design here.
     assert run_cli("validate", "stage", tmp_path / "scene.usda", "--allow-external-assets")[0] == 0
     code, _, err = run_cli("render", tmp_path / "scene.usda", "--allow-external-assets", "--camera",
@@ -77,7 +77,7 @@ def test_populate_returns_the_crowd_and_writes_a_binary_layer(tmp_path):
 
 
 @pytest.mark.parametrize("out,text", [
-    ("agents.txt", "the agents layer needs a USD file name (.usda, .usdc or .usd)"),
+    ("agents.txt", "the agents layer needs a USD file name (.usda text, .usdc binary or .usd)"),
     (SCENARIO, "--out is the input stage itself; expected a new layer file beside it"),
 ])
 def test_populate_refuses_bad_output_paths(tmp_path, out, text):
@@ -85,3 +85,19 @@ def test_populate_refuses_bad_output_paths(tmp_path, out, text):
     with pytest.raises(InputError, match=re.escape(text)):
         populate(PopulateRequest(SCENARIO, tmp_path / out))
     assert list(tmp_path.iterdir()) == [] and SCENARIO.read_bytes() == before
+
+
+def test_a_twin_opened_without_its_semantics_is_said_to_be_unlabelled(run_cli, tmp_path):
+    """The demo's twin.usdc alone: every gprim is class 0. The message names that cause and the scenario beside
+    it, not --walk-on."""
+    code, _, err = run_cli("agents", "populate", STAGES / "twin.usdc", "--out", tmp_path / "a.usdc")
+    assert code == 2 and err.count("synthua: error:") == 1, err
+    line = err.strip().splitlines()[-1]
+    assert "none of its gprims has a 'synthua' label" in line and str(STAGES / "scenario.usda") in line and "--walk-on" not in line
+    assert not (tmp_path / "a.usdc").exists()
+
+
+def test_a_stage_without_the_walkable_classes_lists_the_classes_it_has(run_cli, tmp_path):
+    code, _, err = run_cli("agents", "populate", SCENARIO, "--walk-on", "tent", "--out", tmp_path / "a.usdc")
+    line = err.strip().splitlines()[-1]
+    assert code == 2 and "none of the walkable classes (tent)" in line and "sidewalk" in line and "--walk-on" in line

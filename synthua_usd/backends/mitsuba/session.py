@@ -9,11 +9,10 @@ gprim appeared or disappeared, a mesh changed its topology) or other lights is l
 ``reloads`` counts it.
 
 Conditions (:mod:`synthua_usd.conditions`): a session loaded with a condition swaps to another in place
-(sun direction, turbidity, sun and sky scales, night sky, lamps and emitter sampling weights through
-``traverse()``; fog, rain and exposure are image-space steps) unless one has the sun up and the other not
-(the environment emitter changes type: ``sunsky`` or a ``constant`` night dome) or they differ in wetness or
-snow cover (those live in the BSDFs and mesh attributes the scene was built with): then the session
-reloads, and counts it in ``reloads``. Labels come
+(the environment map of sky and ground, the sun's direction and irradiance, lamps and emitter sampling
+weights through ``traverse()``, day or night; fog, rain and exposure are image-space steps) unless they differ
+in wetness or snow cover (those live in the BSDFs and mesh attributes the scene was built with): then the
+session reloads, and counts it in ``reloads``. Labels come
 from the same geometry under every condition.
 
 This is what a dataset worker holds: one session, one scene load, every frame of its share.

@@ -234,6 +234,6 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
         weight = light_sampling_weight(light, up) if condition is None else None
         scene[f"light_{k:03d}"] = emitter_dict(light, weight)
     if condition is not None:
-        scene.update(weather_scene.sky_emitter(mi, snapshot.up_axis, condition.sun_up))
+        scene.update(weather_scene.sky_emitter(mi, snapshot.up_axis))
     return Translation(scene=scene, shape_ids=tuple(shape_ids), lamps=lamps,
                        condition_key=weather_scene.scene_key(condition))

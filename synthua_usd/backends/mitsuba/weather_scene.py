@@ -3,10 +3,16 @@ scene is switched from one condition to another.
 
 Built into the scene when it is loaded with a condition (:mod:`synthua_usd.backends.mitsuba.translate`):
 
-* the sky: Mitsuba's ``sunsky`` emitter (Hosek–Wilkie sky, turbidity, ground albedo) while the sun is up,
-  else a uniform ``constant`` dome for the night sky (Mitsuba allows one environment emitter per scene, and
-  ``sunsky`` is dark with the sun below the horizon);
-* the sun while it is up: a ``directional`` emitter with the irradiance of ``sunsky``'s own sun disk
+* the environment: an ``envmap`` whose upper half is the sky, Mitsuba's ``sunsky`` (Hosek–Wilkie sky,
+  turbidity, ground albedo) evaluated at every texel while the sun is up, else the night sky's uniform
+  radiance; and whose lower half is the ground beyond the twin, to the horizon: a Lambertian plain of the
+  sky model's own ground albedo under the condition's unshadowed sun and sky, radiance albedo · E / π
+  (``sunsky`` alone is black below the horizon, which showed as black bands and voids wherever a camera
+  looks past the modelled ground). Mitsuba allows one environment emitter per scene, hence one map for
+  both; it is importance-sampled, and the ground lights the twin from below as a real plain would. What
+  it leaves out: the plain has no relief, texture or shadows, and it meets the twin's ground at infinity
+  (on the horizon line), not at the twin's edge;
+* the sun: a ``directional`` emitter, dark at night, with the irradiance of ``sunsky``'s own sun disk
   (measured by :class:`LightMeter`), whose disk is switched off (``sun_scale`` 0). A delta light is sampled
   exactly by every shadow ray, where the disk's own sampling also spends samples on the sky and puts
   penumbra noise into every sunlit pixel: measured on the district at 640×480, 16 spp, two seeds, the same
@@ -19,13 +25,12 @@ Built into the scene when it is loaded with a condition (:mod:`synthua_usd.backe
   ``principled`` BSDF and a wet or snowy one, weighted per face by a mesh attribute (``face_wet``,
   ``face_snow``) that holds the wetness or snow cover of upward-facing faces.
 
-:func:`apply_condition` then sets, through ``traverse()`` parameters and without reloading: the sun's
-direction, turbidity, the sun's irradiance and the sky's scale (fog dims both, see
-:mod:`synthua_usd.backends.weather`),
-the night sky's radiance, every lamp's radiance, and the emitters' sampling weights (lumens, so unlit
-lamps are never sampled). Day ↔ night changes the environment emitter's type, and changing wetness or
-snow cover changes the BSDFs and mesh attributes the scene was built with: :func:`scene_key` differs and
-the session reloads.
+:func:`apply_condition` then sets, through ``traverse()`` parameters and without reloading: the environment
+map (the sky of the sun's direction and turbidity, or the night sky, and the ground under them; fog dims the
+sky, see :mod:`synthua_usd.backends.weather`), the sun's direction and irradiance (zero at night), every
+lamp's radiance, and the emitters' sampling weights (lumens, so unlit lamps are never sampled). Changing
+wetness or snow cover changes the BSDFs and mesh attributes the scene was built with: :func:`scene_key`
+differs and the session reloads.
 
 Wet surfaces (Lekner & Dorf 1988, "Why some things are darker when wet", Applied Optics 27(7)): light
 enters the water film (diffuse reflectance of water r_e ≈ 0.066), and of what the ground (albedo a)
@@ -49,10 +54,12 @@ from synthua_usd.photometry import CCT_4000K, CD_PER_M2_PER_UNIT, radiance_rgb
 from synthua_usd.scenario import ENVIRONMENT_PATH
 from synthua_usd.scene import Material, SceneSnapshot
 
-SUNSKY = "sky_sunsky"
+SKY = "sky_environment"
 SUN = "sky_sun"
-NIGHT_SKY = "sky_night"
 GROUND_ALBEDO = 0.2
+#: Texels (width, height) of the environment map: 0.35° at JIT variants; scalar ones evaluate the sky one
+#: direction per call, so they bake a coarser map.
+ENVIRONMENT_TEXELS = {"jit": (1024, 512), "scalar": (256, 128)}
 SNOW_ALBEDO = 0.85
 WATER_N = 1.33
 WATER_DIFFUSE_REFLECTANCE = 0.066
@@ -130,11 +137,12 @@ def lamp_meshes(snapshot: SceneSnapshot) -> tuple[LampMesh, ...]:
 # --- surfaces -------------------------------------------------------------------------------------------
 
 def scene_key(condition: Condition | None) -> tuple | None:
-    """The part of a condition built into the loaded scene, a change of which means a reload: the type of
-    the environment emitter (sun up or not), and wetness and snow cover (BSDFs and mesh attributes)."""
+    """The part of a condition built into the loaded scene, a change of which means a reload: wetness and snow
+    cover (BSDFs and mesh attributes). Day and night share the scene: the environment map and the sun are
+    parameters (the sun is dark at night)."""
     if condition is None:
         return None
-    return (condition.sun_up, condition.ground_wetness, condition.snow_cover)
+    return (condition.ground_wetness, condition.snow_cover)
 
 
 def wet_albedo(albedo: np.ndarray) -> np.ndarray:
@@ -202,17 +210,61 @@ def own_lights(snapshot: SceneSnapshot, condition: Condition | None) -> tuple:
     return tuple(light for light in snapshot.lights if not light.prim_path.startswith(ENVIRONMENT_PATH + "/"))
 
 
-def sky_emitter(mi, up_axis: str, sun_up: bool) -> dict:
-    """The environment emitter, dark until :func:`apply_condition`: ``sunsky`` (its frame is Z up; on Y-up
-    stages it is turned so that its zenith is +Y; its ``sun_direction`` is a world direction) or, with the
-    sun down, a ``constant`` night dome."""
-    if not sun_up:
-        return {NIGHT_SKY: {"type": "constant", "radiance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}}
+def sunsky_dict(mi, up_axis: str) -> dict:
+    """Mitsuba's ``sunsky`` (its frame is Z up; on Y-up stages it is turned so that its zenith is +Y; its
+    ``sun_direction`` is a world direction), dark: what :class:`LightMeter` measures and the environment's
+    sky is evaluated from."""
     to_world = mi.ScalarTransform4f().rotate([1, 0, 0], -90) if up_axis == "Y" else mi.ScalarTransform4f()
-    return {SUNSKY: {"type": "sunsky", "sun_direction": up_vector(up_axis).tolist(), "to_world": to_world,
-                     "sun_scale": 0.0, "sky_scale": 0.0},
+    return {"type": "sunsky", "sun_direction": up_vector(up_axis).tolist(), "to_world": to_world,
+            "sun_scale": 0.0, "sky_scale": 0.0}
+
+
+def environment_to_world(mi, up_axis: str):
+    """The ``envmap`` frame: its latitude-longitude map has +Y as zenith, turned to +Z on Z-up stages."""
+    return mi.ScalarTransform4f() if up_axis == "Y" else mi.ScalarTransform4f().rotate([1, 0, 0], 90)
+
+
+def environment_texels(mi) -> tuple[int, int]:
+    return ENVIRONMENT_TEXELS["scalar" if mi.variant().startswith("scalar") else "jit"]
+
+
+def texel_directions(mi, up_axis: str) -> np.ndarray:
+    """(H, W, 3) unit world directions of the environment map's texel centres (Mitsuba's ``envmap``
+    convention: u = φ / 2π, v = θ / π, local direction (sin φ sin θ, cos θ, −cos φ sin θ))."""
+    w, h = environment_texels(mi)
+    theta = (np.arange(h) + 0.5) / h * math.pi
+    phi = (np.arange(w) + 0.5) / w * 2.0 * math.pi
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    local = np.stack([np.sin(p) * np.sin(t), np.cos(t), -np.cos(p) * np.sin(t)], axis=-1)
+    rotation = np.array(environment_to_world(mi, up_axis).matrix, np.float64)[:3, :3]
+    return local @ rotation.T
+
+
+def sky_emitter(mi, up_axis: str) -> dict:
+    """The environment emitter and the sun (a ``directional`` emitter), dark until :func:`apply_condition` bakes
+    the condition's sky and ground into the one and, while the sun is up, gives the other its irradiance."""
+    w, h = environment_texels(mi)
+    return {SKY: {"type": "envmap", "bitmap": mi.Bitmap(np.zeros((h, w, 3), np.float32)),
+                  "to_world": environment_to_world(mi, up_axis)},
             SUN: {"type": "directional", "direction": (-up_vector(up_axis)).tolist(),
                   "irradiance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}}
+
+
+def environment_radiance(mi, up_axis: str, sky: np.ndarray, ground: np.ndarray) -> np.ndarray:
+    """(H, W, 3) float32 texels: ``sky`` (H, W, 3) or (3,) above the horizon, ``ground`` (3,) below. The map's
+    zenith is the stage's up axis (:func:`environment_to_world`), so its upper half of rows is the sky."""
+    w, h = environment_texels(mi)
+    out = np.empty((h, w, 3), np.float32)
+    out[:h // 2] = np.broadcast_to(np.asarray(sky, np.float64), (h, w, 3))[:h // 2]
+    out[h // 2:] = np.asarray(ground, np.float64)
+    return out
+
+
+def _set_environment(mi, params, texels: np.ndarray) -> None:
+    """Replace the environment map's texels: the data of a map loaded from them (so that its layout, with
+    the columns Mitsuba pads for periodicity, is Mitsuba's own); the scene rebuilds its sampling on update."""
+    fresh = mi.traverse(mi.load_dict({"type": "envmap", "bitmap": mi.Bitmap(texels)}))
+    params[f"{SKY}.data"] = fresh["data"]
 
 
 def _perpendicular(direction) -> np.ndarray:
@@ -230,16 +282,12 @@ def apply_condition(mi, params, shape_ids: tuple[str, ...], lamps: tuple[LampMes
                     up_axis: str, meter: "LightMeter") -> Lighting:
     """Set the sky and lamp parameters of a scene loaded by ``translate(..., condition=...)`` to ``condition``
     (``params.update()`` is left to the caller)."""
+    albedo = GROUND_ALBEDO + (SNOW_ALBEDO - GROUND_ALBEDO) * condition.snow_cover
     if condition.sun_up:
         direction = condition.sun_direction(up_axis)
-        albedo = GROUND_ALBEDO + (SNOW_ALBEDO - GROUND_ALBEDO) * condition.snow_cover
         e_sun, e_sky = meter.measure(direction, condition.turbidity, albedo, up_axis)
         sun_scale, sky_scale, airlight = fog_lighting(condition, e_sun, e_sky)
-        params[f"{SUNSKY}.sun_direction"] = type(params[f"{SUNSKY}.sun_direction"])(*map(float, direction))
-        params[f"{SUNSKY}.turbidity"] = type(params[f"{SUNSKY}.turbidity"])(float(condition.turbidity))
-        params[f"{SUNSKY}.albedo.value"] = type(params[f"{SUNSKY}.albedo.value"])(float(albedo))
-        params[f"{SUNSKY}.sky_scale"] = float(sky_scale)
-        params[f"{SUNSKY}.sun_scale"] = 0.0  # the sun is the directional emitter
+        sky = sky_scale * meter.sky_texels(direction, condition.turbidity, albedo, up_axis)
         # The directional sun gives, on a surface facing it, what sunsky's sun disk gives: E_horizontal / cos(zenith).
         cos_zenith = float(np.dot(direction, up_vector(up_axis)))
         normal = sun_scale * np.asarray(e_sun, np.float64) / max(cos_zenith, 1e-6)
@@ -250,13 +298,18 @@ def apply_condition(mi, params, shape_ids: tuple[str, ...], lamps: tuple[LampMes
         sun_lux = float(np.mean(sun_scale * e_sun)) * CD_PER_M2_PER_UNIT
         sky_lux = float(np.mean(sky_scale * e_sky)) * CD_PER_M2_PER_UNIT
         params[f"{SUN}.sampling_weight"] = max(sun_lux, MIN_SKY_WEIGHT)
-        params[f"{SUNSKY}.sampling_weight"] = max(sky_lux, MIN_SKY_WEIGHT)
+        params[f"{SKY}.sampling_weight"] = max(sky_lux, MIN_SKY_WEIGHT)
     else:
         sun_scale = sky_scale = 0.0
         direction = normal = None
         airlight = np.asarray(radiance_rgb(condition.night_sky_luminance_cd_m2, CCT_4000K))
-        params[f"{NIGHT_SKY}.radiance.value"] = type(params[f"{NIGHT_SKY}.radiance.value"])(*map(float, airlight))
-        params[f"{NIGHT_SKY}.sampling_weight"] = max(math.pi * condition.night_sky_luminance_cd_m2, MIN_SKY_WEIGHT)
+        sky = airlight
+        params[f"{SUN}.irradiance.value"] = type(params[f"{SUN}.irradiance.value"])(0.0, 0.0, 0.0)
+        params[f"{SUN}.sampling_weight"] = MIN_SKY_WEIGHT
+        params[f"{SKY}.sampling_weight"] = max(math.pi * condition.night_sky_luminance_cd_m2, MIN_SKY_WEIGHT)
+    # The ground below the horizon: a Lambertian plain of the sky model's albedo under the light that makes the
+    # airlight (E / π of the sun and sky after fog; at night the sky's own radiance, E = π L).
+    _set_environment(mi, params, environment_radiance(mi, up_axis, sky, albedo * np.asarray(airlight, np.float64)))
     flux_lm: dict[int, float] = {}
     for lamp in lamps:
         kind = KINDS[lamp.role]
@@ -288,16 +341,38 @@ def focus_lamps(params, shape_ids: tuple[str, ...], lamps: tuple[LampMesh, ...],
         params[f"{shape_ids[lamp.index]}.emitter.sampling_weight"] = flux / (4.0 * math.pi) * float(focus)
 
 
+def radiance_towards(mi, emitter, directions: np.ndarray) -> np.ndarray:
+    """(n, 3) float64 radiance an environment ``emitter`` sends from unit world ``directions`` (n, 3) (towards
+    the sky), by its own ``eval``: one kernel on JIT variants, one call per direction on scalar ones."""
+    d = np.asarray(directions, np.float64)
+    if mi.variant().startswith("scalar"):
+        out = np.zeros((len(d), 3))
+        for k, w in enumerate(d):
+            si = mi.SurfaceInteraction3f()
+            si.wi = mi.Vector3f(*map(float, -w))
+            value = emitter.eval(si)
+            out[k] = (value[0], value[1], value[2])
+        return out
+    import drjit as dr
+
+    si = dr.zeros(mi.SurfaceInteraction3f, len(d))
+    si.wi = mi.Vector3f(*(np.ascontiguousarray(-d[:, i], np.float32) for i in range(3)))
+    value = emitter.eval(si)
+    return np.column_stack([np.asarray(value[i], np.float64) for i in range(3)])
+
+
 class LightMeter:
     """Horizontal irradiance (3,) of a ``sunsky``'s sun and of its sky alone, renderer units:
     E = ∫ L cosθ dω, estimated by sampling directions from the emitter itself (2^16 of them, seeded), so
-    the sun disk is sampled as well as the dome. Results are cached per sky."""
+    the sun disk is sampled as well as the dome; and the sky's radiance at the environment map's texels.
+    Results are cached per sky."""
 
     SAMPLES = 1 << 16
 
     def __init__(self, mi) -> None:
         self.mi = mi
         self._cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+        self._textures: dict[tuple, np.ndarray] = {}
 
     def _irradiance(self, emitter: dict, up: np.ndarray) -> np.ndarray:
         mi = self.mi
@@ -321,9 +396,28 @@ class LightMeter:
                 up_axis: str) -> tuple[np.ndarray, np.ndarray]:
         key = (tuple(np.round(direction, 9)), turbidity, albedo, up_axis)
         if key not in self._cache:
-            base = sky_emitter(self.mi, up_axis, sun_up=True)[SUNSKY]
-            base.update(sun_direction=[float(x) for x in direction], turbidity=float(turbidity), albedo=float(albedo))
+            base = self._sunsky(direction, turbidity, albedo, up_axis)
             up = up_vector(up_axis)
             self._cache[key] = (self._irradiance(dict(base, sun_scale=1.0, sky_scale=0.0), up),
                                 self._irradiance(dict(base, sun_scale=0.0, sky_scale=1.0), up))
         return self._cache[key]
+
+    def sky_texels(self, direction: np.ndarray, turbidity: float, albedo: float, up_axis: str) -> np.ndarray:
+        """(H, W, 3) float64: the clear sky alone (no sun disk) at the environment map's texel centres
+        (:func:`texel_directions`), by the emitter's own ``eval``; zero below the horizon. Cached per sky."""
+        key = ("texels", tuple(np.round(direction, 9)), turbidity, albedo, up_axis)
+        if key not in self._textures:
+            mi = self.mi
+            sky = mi.load_dict({"type": "scene", "sky": dict(self._sunsky(direction, turbidity, albedo, up_axis),
+                                                              sky_scale=1.0)}).emitters()[0]
+            dirs = texel_directions(mi, up_axis)
+            flat = dirs.reshape(-1, 3)
+            values = radiance_towards(mi, sky, flat)
+            values[flat @ up_vector(up_axis) <= 0.0] = 0.0
+            self._textures.clear()  # one sky at a time: 12 MB each
+            self._textures[key] = values.reshape(dirs.shape)
+        return self._textures[key]
+
+    def _sunsky(self, direction: np.ndarray, turbidity: float, albedo: float, up_axis: str) -> dict:
+        return dict(sunsky_dict(self.mi, up_axis), sun_direction=[float(x) for x in direction], turbidity=float(turbidity),
+                    albedo=float(albedo))

@@ -30,7 +30,7 @@ MAX_INSTANCES_PER_CLASS = 1000
 
 
 def cityscapes_arrays(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequence[Instance],
-                      class_map: ClassMap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                      class_map: ClassMap, ignored: set[int] = frozenset()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The three gtFine images of one frame.
 
     Parameters
@@ -39,11 +39,15 @@ def cityscapes_arrays(class_ids: np.ndarray, instance_ids: np.ndarray, instances
     instance_ids : (H, W) uint16 instance ids (0 none)
     instances : the scene's instances (their ``class_id`` is their class)
     class_map : thing/stuff and colours of the classes
+    ignored : instance ids too small to annotate (:func:`synthua_usd.dataset.annotations.mark_ignored`): their
+        pixels keep the class id without an instance number, Cityscapes' group region, which its instance
+        evaluation ignores
 
     Returns
     -------
     label_ids : (H, W) uint8, the class ids as they are
-    cs_instance_ids : (H, W) uint16, ``class * 1000 + k`` on thing instances, the class id elsewhere
+    cs_instance_ids : (H, W) uint16, ``class * 1000 + k`` on thing instances (k counting the instances not
+        ignored), the class id elsewhere
     color : (H, W, 3) uint8 sRGB class colours
     """
     if class_ids.ndim != 2 or class_ids.dtype != np.uint8 or instance_ids.shape != class_ids.shape:
@@ -63,7 +67,7 @@ def cityscapes_arrays(class_ids: np.ndarray, instance_ids: np.ndarray, instances
         if inst is None:
             raise InputError(f"instance map: id {inst_id} has no instance; expected one of the scene's "
                              f"{len(by_id)} instances")
-        if inst.class_id not in thing:
+        if inst.class_id not in thing or inst_id in ignored:
             continue
         k = counters.get(inst.class_id, 0)
         counters[inst.class_id] = k + 1

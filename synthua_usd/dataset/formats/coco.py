@@ -1,7 +1,9 @@
 """COCO instances (``annotations/instances_{split}.json``) from the per-image records.
 
 pycocotools reads it as it is: RLE masks, ``bbox`` as floats ``[x, y, w, h]`` (pixel-edge box), ``area`` in
-pixels, ``iscrowd`` 0. Only thing classes are annotated (COCO's instances task has no stuff); stuff is in
+pixels, ``iscrowd`` 0, or 1 for an instance too small to learn from (fewer visible pixels than the config's
+``min_instance_px``): COCOeval then neither rewards nor penalises detections on it, and detectron2 and
+MMDetection leave it out of training. Only thing classes are annotated (COCO's instances task has no stuff); stuff is in
 the panoptic and Cityscapes formats. Extra fields per annotation, which COCO readers ignore:
 ``amodal_segmentation``, ``amodal_bbox``, ``amodal_area``, ``occlusion``, ``truncation``, ``prim_path``,
 ``instance_id`` (the pixel value in the image's instance map) and ``relations`` (``{"uses": prim path,
@@ -12,6 +14,13 @@ the person's 17 COCO body keypoints, a mobility aid's contact points) lists thei
 ``skeleton``; each of its annotations has ``keypoints`` (flat ``[x, y, v, ...]``, pixel coordinates of the
 written image, v 0/1/2 as :mod:`synthua_usd.dataset.keypoints` defines them) and ``num_keypoints`` (how
 many have v > 0). An instance of such a category whose stage authors no keypoints gets all ``0, 0, 0``.
+Every other annotation has ``num_keypoints`` 0: pycocotools' ``COCOeval(gt, dt, "keypoints")`` reads it
+from every annotation of the categories it evaluates (all of them by default), and ignores those at 0.
+
+``person_keypoints_{split}.json`` is COCO's keypoints file: the person category and its annotations only
+(:func:`person_keypoints`), so that COCOeval's default call, with its default (COCO person) OKS sigmas,
+evaluates person keypoints as on COCO. A device's contact points have other counts and sigmas: they are
+evaluated per category on the instances file (``params.catIds``, ``params.kpt_oks_sigmas``).
 """
 
 from __future__ import annotations
@@ -102,13 +111,26 @@ def coco_instances(records: Iterable[dict], class_map: ClassMap, split: str) -> 
             annotations.append({
                 "id": ann_id, "image_id": int(record["id"]), "category_id": int(inst["category_id"]),
                 "segmentation": inst["segmentation"], "area": int(inst["area"]),
-                "bbox": [float(v) for v in inst["bbox"]], "iscrowd": 0,
+                "bbox": [float(v) for v in inst["bbox"]], "iscrowd": int(bool(inst.get("ignore"))),
                 "amodal_segmentation": inst["amodal_segmentation"], "amodal_area": int(inst["amodal_area"]),
                 "amodal_bbox": [float(v) for v in inst["amodal_bbox"]],
                 "occlusion": float(inst["occlusion"]), "truncation": float(inst["truncation"]),
                 "prim_path": inst["prim_path"], "instance_id": int(inst["id"]), "relations": relations,
-                **(_keypoint_fields(record, inst, name) if name in KEYPOINT_CLASSES else {}),
+                **(_keypoint_fields(record, inst, name) if name in KEYPOINT_CLASSES else {"num_keypoints": 0}),
             })
     return {"info": {"description": f"synthua-usd synthetic street scenes, {split} split",
                      "version": "1.0"},
             "licenses": [], "images": images, "annotations": annotations, "categories": categories(class_map)}
+
+
+#: The class of COCO's keypoints task (its file holds this category only).
+PERSON = "person"
+
+
+def person_keypoints(instances: dict) -> dict:
+    """COCO's ``person_keypoints_{split}`` document from the instances document of the same split: its info,
+    licenses and images, the person category and the person annotations (module docstring)."""
+    cats = [c for c in instances["categories"] if c["name"] == PERSON]
+    ids = {c["id"] for c in cats}
+    return {"info": instances["info"], "licenses": instances["licenses"], "images": instances["images"],
+            "annotations": [a for a in instances["annotations"] if a["category_id"] in ids], "categories": cats}

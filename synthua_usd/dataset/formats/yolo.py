@@ -216,7 +216,8 @@ def _merged(parts: list[np.ndarray], offset: np.ndarray | int, size) -> np.ndarr
 
 def yolo_lines(record_instances: Sequence[dict], width: int, height: int, class_index: dict[int, int],
                instance_ids: np.ndarray | None = None) -> str:
-    """The label file's text for one image: one line per instance whose class is in ``class_index``.
+    """The label file's text for one image: one line per instance whose class is in ``class_index`` and that is
+    not an ignore region (``ignore`` True: too small to annotate; YOLO has no ignore flag, so no line).
 
     Parameters
     ----------
@@ -232,7 +233,7 @@ def yolo_lines(record_instances: Sequence[dict], width: int, height: int, class_
     # normalised coordinates are k / width and k / height for pixel corners k: each is formatted once
     columns, rows = ([f"{v:.{DECIMALS}f}".rstrip("0").rstrip(".") for v in (np.arange(n + 1) / np.float64(n)).tolist()]
                      for n in (width, height))
-    chosen = [inst for inst in record_instances if inst["category_id"] in class_index]
+    chosen = [inst for inst in record_instances if inst["category_id"] in class_index and not inst.get("ignore")]
     for inst in chosen:
         if list(inst["segmentation"]["size"]) != [height, width]:
             raise InputError(f"instance {inst.get('id')}: mask size {inst['segmentation']['size']}; "

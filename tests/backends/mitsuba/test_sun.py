@@ -20,7 +20,7 @@ def disk_quadrature(mi, condition, up_axis: str) -> np.ndarray:
     around the sun (the disk is 0.268°) of the emitter's own ``eval``: independent of :class:`LightMeter`,
     which samples the emitter's ``sample_direction``."""
     d = condition.sun_direction(up_axis)
-    base = weather_scene.sky_emitter(mi, up_axis, sun_up=True)[weather_scene.SUNSKY]
+    base = weather_scene.sunsky_dict(mi, up_axis)
     base.update(sun_direction=[float(x) for x in d], turbidity=float(condition.turbidity), albedo=0.2,
                 sun_scale=1.0, sky_scale=0.0)
     emitter = mi.load_dict({"type": "scene", "sky": base}).emitters()[0]
@@ -33,43 +33,33 @@ def disk_quadrature(mi, condition, up_axis: str) -> np.ndarray:
     t1 /= np.linalg.norm(t1)
     t2 = np.cross(d, t1)
     dirs = (s * np.cos(p))[:, None] * t1 + (s * np.sin(p))[:, None] * t2 + c[:, None] * d
-    if mi.variant().startswith("scalar"):  # one direction per call
-        radiance = np.zeros((len(dirs), 3))
-        for k, w in enumerate(dirs):
-            si = mi.SurfaceInteraction3f()
-            si.wi = mi.Vector3f(*map(float, -w))
-            value = emitter.eval(si)
-            radiance[k] = [value[0], value[1], value[2]]
-    else:
-        import drjit as dr
-
-        si = dr.zeros(mi.SurfaceInteraction3f, len(dirs))
-        si.wi = mi.Vector3f(*(np.ascontiguousarray(-dirs[:, i], np.float32) for i in range(3)))
-        value = emitter.eval(si)
-        radiance = np.column_stack([np.asarray(value[i], np.float64) for i in range(3)])
+    radiance = weather_scene.radiance_towards(mi, emitter, dirs)
     up = weather_scene.up_vector(up_axis)
     solid_angle = 2.0 * math.pi * (1.0 - math.cos(half))
     return (radiance * (dirs @ up)[:, None]).mean(axis=0) * solid_angle
 
 
-def plane_radiance(mi, condition, up_axis: str, normal: np.ndarray) -> np.ndarray:
-    """(3,) mean radiance of a white-ish diffuse plane (albedo ``ALBEDO``) facing ``normal``, lit by the
-    condition's sun alone (sky scale 0) as :func:`weather_scene.apply_condition` sets it, seen along its normal."""
+def plane_radiance(mi, condition, up_axis: str, normal: np.ndarray, albedo: float = ALBEDO, sky: bool = False,
+                   spp: int = 4) -> np.ndarray:
+    """(3,) mean radiance of a diffuse plane of ``albedo`` facing ``normal``, lit by the condition's sun alone (sky
+    scale 0) as :func:`weather_scene.apply_condition` sets it, or with ``sky`` by its sun and sky, seen along
+    its normal."""
     side = np.cross(normal, np.eye(3)[int(np.argmin(np.abs(normal)))])
     frame = mi.ScalarTransform4f().look_at(origin=[0, 0, 0], target=normal.tolist(), up=side.tolist())
     camera = mi.ScalarTransform4f().look_at(origin=(2.0 * normal).tolist(), target=[0, 0, 0], up=side.tolist())
     scene = mi.load_dict({
         "type": "scene", "integrator": {"type": "path", "max_depth": 2},
         "plane": {"type": "rectangle", "to_world": frame,
-                  "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [ALBEDO] * 3}}},
+                  "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [albedo] * 3}}},
         "sensor": {"type": "perspective", "fov": 5.0, "to_world": camera,
-                   "sampler": {"type": "independent", "sample_count": 4},
+                   "sampler": {"type": "independent", "sample_count": spp},
                    "film": {"type": "hdrfilm", "width": 4, "height": 4, "rfilter": {"type": "box"}}},
-        **weather_scene.sky_emitter(mi, up_axis, sun_up=True)})
+        **weather_scene.sky_emitter(mi, up_axis)})
     params = mi.traverse(scene)
     weather_scene.apply_condition(mi, params, (), (), condition, up_axis, weather_scene.LightMeter(mi))
-    params[f"{weather_scene.SUNSKY}.sky_scale"] = 0.0
-    params[f"{weather_scene.SUNSKY}.sampling_weight"] = 1e-9  # every shadow ray to the sun: no choice, no noise
+    if not sky:
+        params[f"{weather_scene.SKY}.scale"] = 0.0
+        params[f"{weather_scene.SKY}.sampling_weight"] = 1e-9  # every shadow ray to the sun: no choice, no noise
     params.update()
     return np.asarray(mi.render(scene), np.float64).reshape(-1, 3).mean(axis=0)
 

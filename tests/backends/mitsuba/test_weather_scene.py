@@ -58,14 +58,15 @@ def test_labels_are_byte_identical_under_every_condition(street):
 
 
 def test_conditions_swap_in_the_loaded_scene_and_reload_only_when_they_must(street):
-    # clear_day loads; day_fog swaps in place; day_rain_fog (wet), clear_night (sun down), night_rain_fog
+    # clear_day loads; day_fog swaps in place; day_rain_fog (wet), clear_night (dry again), night_rain_fog
     # (wet), sunset (sun up, dry) and snow (snow) each change what the scene is built with.
     assert street["counts"] == (6, 5)
     assert "update" in street["frames"]["day_fog"].seconds and "load" in street["frames"]["snow"].seconds
     session, c = street["session"], street["conditions"]
     assert "load" in session.render(street["snapshot"], street["camera"], condition=c["sunset"]).seconds  # from snow
     loads = session.loads
-    for name in ("clear_day", "day_fog", "sunset"):  # the sun moves, fog thickens: parameters only
+    for name in ("clear_day", "day_fog", "sunset", "clear_night", "clear_day"):  # the sun moves or sets, fog
+        # thickens: parameters only
         frame = session.render(street["snapshot"], street["camera"], condition=c[name])
         assert "update" in frame.seconds
     assert session.loads == loads
@@ -75,10 +76,11 @@ def test_a_condition_swapped_in_renders_what_a_fresh_load_renders(street):
     c = street["conditions"]
     session = RenderSession(RenderConfig(width=SIZE[0], height=SIZE[1], spp=SPP, variant=street["variant"]))
     session.render(street["snapshot"], street["camera"], condition=c["sunset"])
-    swapped = session.render(street["snapshot"], street["camera"], condition=c["day_fog"])
-    fresh = render(street, c["day_fog"])
-    assert session.loads == 1
-    assert np.allclose(swapped.rgb, fresh.rgb, rtol=1e-4, atol=1e-7)
+    for name in ("day_fog", "clear_night"):
+        swapped = session.render(street["snapshot"], street["camera"], condition=c[name])
+        fresh = render(street, c[name])
+        assert session.loads == 1
+        assert np.allclose(swapped.rgb, fresh.rgb, rtol=1e-4, atol=1e-7), name
 
 
 def test_night_is_lit_by_the_street(street, class_map):

@@ -97,3 +97,21 @@ def test_panopticapi_pq_of_gt_against_itself_is_100(tmp_path, class_map, dataset
         assert result["Things"]["n"] > 0 and result["Stuff"]["n"] == 3
     assert {c["id"]: c["isthing"] for c in doc["categories"]}[1] == 0
     assert [a["image_id"] for a in coco_panoptic(records, class_map, "train")["annotations"]] == [1, 2]
+
+
+def test_every_annotation_has_num_keypoints_and_person_keypoints_is_the_person_part(class_map, dataset):
+    """COCOeval(gt, dt, "keypoints") reads num_keypoints of every annotation of every category (KeyError
+    before); COCO's person_keypoints file holds the person category and its annotations only."""
+    from synthua_usd.dataset.formats.coco import person_keypoints
+    from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
+
+    records, _ = dataset
+    doc = coco_instances(records, class_map, "train")
+    names = {c["id"]: c["name"] for c in doc["categories"]}
+    assert all("num_keypoints" in a for a in doc["annotations"])
+    assert all(a["num_keypoints"] == 0 and "keypoints" not in a for a in doc["annotations"]
+               if names[a["category_id"]] not in KEYPOINT_CLASSES)
+    people = person_keypoints(doc)
+    assert [c["name"] for c in people["categories"]] == ["person"] and people["images"] == doc["images"]
+    assert people["annotations"] == [a for a in doc["annotations"] if names[a["category_id"]] == "person"]
+    assert people["annotations"]

@@ -13,7 +13,7 @@ import pytest
 
 from label_scenes import crowded_scene, record, scene
 from synthua_usd.dataset.formats.onehot import onehot, write_onehot_npz
-from synthua_usd.dataset.formats.previews import instance_colors, instance_preview
+from synthua_usd.backends.previews import instance_colors, instance_preview
 from synthua_usd.dataset.formats.tables import metadata_rows, write_tables
 from synthua_usd.errors import InputError
 
