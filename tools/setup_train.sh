@@ -23,7 +23,7 @@ fi
 # shellcheck source=tools/side_venv.sh
 source tools/side_venv.sh
 side_venv setup_train "$TRAIN_VENV" "$PYTHON" "the detector (Ultralytics)" TRAIN_BASE_PYTHON || exit 1
-echo "setup_train: installing $REQUIREMENTS (about 5.6 GB) into $TRAIN_VENV"
+echo "setup_train: installing $REQUIREMENTS (about 5.9 GB with what they need) into $TRAIN_VENV"
 # opencv-python (Ultralytics' requirement) links the desktop's GUI libraries (libGL, libxcb), which a server may
 # lack: its headless build, the same OpenCV without them, takes its place (both own the cv2 package, so the
 # headless one is reinstalled after the other is removed).
