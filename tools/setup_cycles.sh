@@ -15,16 +15,9 @@ PYTHON=${CYCLES_BASE_PYTHON:-python3.11}
 if [ -x "$CYCLES_VENV/bin/python" ] && "$CYCLES_VENV/bin/python" -c 'import bpy' >/dev/null 2>&1; then
   exit 0
 fi
-if ! command -v "$PYTHON" >/dev/null 2>&1 \
-   || ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))'; then
-  echo "setup_cycles: Blender (bpy $BPY_VERSION) not installed: it needs CPython 3.11" \
-       "($PYTHON not found or another version; set CYCLES_BASE_PYTHON)" >&2
-  exit 1
-fi
-if [ ! -x "$CYCLES_VENV/bin/python" ]; then
-  echo "setup_cycles: creating $CYCLES_VENV with $PYTHON"
-  "$PYTHON" -m venv "$CYCLES_VENV"
-fi
+# shellcheck source=tools/side_venv.sh
+source tools/side_venv.sh
+side_venv setup_cycles "$CYCLES_VENV" "$PYTHON" "Blender (bpy $BPY_VERSION)" CYCLES_BASE_PYTHON || exit 1
 echo "setup_cycles: installing bpy==$BPY_VERSION (about 374 MB) into $CYCLES_VENV"
 if ! "$CYCLES_VENV/bin/python" -m pip install -q "bpy==$BPY_VERSION" numpy; then
   echo "setup_cycles: Blender (bpy $BPY_VERSION) not installed: pip could not install it into $CYCLES_VENV" >&2

@@ -191,3 +191,25 @@ def diversity(figures: dict, path: Path) -> Path:
                  f"{people['count']} people shown")
     fig.tight_layout()
     return _save(fig, path)
+
+
+def missed_boxes(panels: list[tuple[np.ndarray, tuple, tuple | None, str]], path: Path, columns: int = 4) -> Path:
+    """A grid of false negatives: per panel an (h, w, 3) uint8 crop, the missed box (x, y, w, h in crop pixels,
+    drawn red), the best-overlapping detection's box or None (dashed yellow) and a caption."""
+    from matplotlib.patches import Rectangle
+
+    plt = _pyplot()
+    rows = max(1, -(-len(panels) // columns))
+    fig, axes = plt.subplots(rows, columns, figsize=(3.2 * columns, 3.4 * rows), squeeze=False)
+    for ax in axes.ravel():
+        ax.axis("off")
+    for ax, (crop, box, detection, caption) in zip(axes.ravel(), panels):
+        ax.imshow(crop, interpolation="nearest")
+        ax.add_patch(Rectangle(box[:2], box[2], box[3], fill=False, edgecolor="red", linewidth=2))
+        if detection is not None:
+            ax.add_patch(Rectangle(detection[:2], detection[2], detection[3], fill=False, edgecolor="yellow",
+                                   linewidth=1.5, linestyle="--"))
+        ax.set_title(caption, fontsize=7)
+    if not panels:
+        axes[0, 0].text(0.5, 0.5, "no false negatives", ha="center", va="center")
+    return _save(fig, path)

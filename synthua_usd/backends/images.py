@@ -106,3 +106,16 @@ def read_image(path: str | Path) -> tuple[np.ndarray, oiio.ImageSpec]:
     finally:
         inp.close()
     return np.asarray(pixels), spec
+
+
+def image_size(path: str | Path) -> tuple[int, int, int]:
+    """(width, height, orientation) of an image file, from its header (no pixels are read): pixels as stored, and
+    the EXIF orientation (1 = upright as stored; 2-8 a flip or turn a viewer applies, as OpenCV does on reading)."""
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise OSError(f"{path}: OpenImageIO cannot read it: {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        return int(spec.width), int(spec.height), int(spec.get_int_attribute("Orientation", 1))
+    finally:
+        inp.close()

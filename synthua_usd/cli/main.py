@@ -24,6 +24,7 @@ from synthua_usd.cli.dataset_commands import generate, replay, verify
 from synthua_usd.cli.randomise_commands import randomise
 from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
+from synthua_usd.cli.train_commands import evaluate_real, train
 from synthua_usd.cli.twin_commands import twin
 from synthua_usd.cli.failures import configure_logging, guarded
 from synthua_usd.findings import Finding, Severity
@@ -270,7 +271,8 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     return EXIT_OK
 
 
-for _group in (twin, agents, cameras, survey, contact_sheet, generate, verify, replay, randomise, stats, evaluate):
+for _group in (twin, agents, cameras, survey, contact_sheet, generate, verify, replay, randomise, stats, evaluate, train,
+               evaluate_real):
     cli.add_command(_group)
 
 

@@ -1,0 +1,288 @@
+"""Object-detection sets: images with labelled boxes, as a detector is trained and scored on them.
+
+A :class:`DetectionSet` is plain data read from any of the layouts people keep detection data in:
+
+* **Ultralytics YOLO** (``data.yaml`` + ``images/`` + ``labels/``): ``data.yaml`` names the classes (``names``, a
+  list or an index -> name mapping) and each split (``train``, ``val``, ``test``: a folder of images, a ``.txt`` list
+  of image paths, or a list of either, relative to ``path`` or to the file's folder); each image's labels are the
+  ``.txt`` file at the same place under ``labels/`` (Ultralytics' rule: the last ``images`` folder of the path
+  becomes ``labels``), one object a line, ``k cx cy w h`` normalised by the image's size, or ``k x1 y1 x2 y2 ...``, a
+  polygon (boxed by its extreme points). No label file: an image without objects.
+* **COCO JSON** (``images``, ``annotations`` with ``bbox`` = [x, y, width, height] in pixels, ``categories``), the
+  images in the file's folder or ``images_dir``.
+* a dataset ``synthua generate`` wrote, through :mod:`synthua_usd.analytics.detection_targets` (the boxes a
+  detector is trained on are derived from the records there).
+
+Boxes are in pixels of their image, pixel edges: (x, y) the top-left corner, w and h the size. ``ignore`` marks a
+box that evaluation neither requires nor penalises a detection on (COCO's ``iscrowd``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from synthua_usd.errors import InputError
+from synthua_usd.input_files import MAX_DOCUMENT_BYTES, read_input_text, shown
+from synthua_usd.schemas import read_json
+
+#: File suffixes read as images (Ultralytics' own list, lower case, less the formats OpenImageIO cannot read).
+IMAGE_SUFFIXES = (".bmp", ".jpeg", ".jpg", ".png", ".tif", ".tiff", ".webp")
+#: Splits a set may name, in the order a test set is looked for when none is asked for.
+TEST_SPLITS = ("test", "val")
+#: Most images read from one set (a real benchmark holds thousands; this bounds a mistaken folder).
+MAX_IMAGES = 200_000
+#: Normalised coordinates may overshoot [0, 1] by this much (rounding of the tools that wrote them).
+TOLERANCE = 1e-3
+
+
+@dataclass(frozen=True)
+class Box:
+    """A labelled box: ``label`` a class name of its set; x, y (top-left corner), w, h in pixels, pixel edges."""
+
+    label: str
+    x: float
+    y: float
+    w: float
+    h: float
+    ignore: bool = False
+
+    @property
+    def area(self) -> float:
+        """w * h, pixels²."""
+        return self.w * self.h
+
+
+@dataclass(frozen=True)
+class SetImage:
+    """One image of a set: ``id`` from 1, its file, size in pixels and boxes."""
+
+    id: int
+    path: Path
+    width: int
+    height: int
+    boxes: tuple[Box, ...] = field(default=())
+
+
+@dataclass(frozen=True)
+class DetectionSet:
+    """Images and their boxes; ``names`` the set's class names (in its own index order), ``layout`` what it was
+    read from (``yolo``, ``coco`` or ``synthua``), ``source`` the path read, ``split`` the split taken."""
+
+    names: tuple[str, ...]
+    images: tuple[SetImage, ...]
+    layout: str
+    source: str
+    split: str | None = None
+
+    def counts(self) -> dict[str, int]:
+        """Boxes per class name (ignored boxes left out), every class of ``names`` present."""
+        out = dict.fromkeys(self.names, 0)
+        for image in self.images:
+            for box in image.boxes:
+                if not box.ignore:
+                    out[box.label] = out.get(box.label, 0) + 1
+        return out
+
+
+def _image_size(path: Path) -> tuple[int, int]:
+    """(width, height) of an image stored upright. A photo whose EXIF orientation turns it would be read turned by
+    the detector (OpenCV applies it) and as stored here: refused rather than scored on boxes that do not fit."""
+    from synthua_usd.backends.images import image_size
+
+    try:
+        width, height, orientation = image_size(path)
+    except OSError:
+        raise InputError(f"{shown(path)}: not an image OpenImageIO can read; expected an image of the set") from None
+    if orientation != 1:
+        raise InputError(f"{shown(path)}: EXIF orientation {orientation}; expected images stored upright (orientation "
+                         f"1): rotate them as stored first, e.g. with ImageMagick's mogrify -auto-orient")
+    return width, height
+
+
+# --- Ultralytics YOLO ----------------------------------------------------------------------------------------
+
+def _yaml(path: Path) -> dict:
+    text = read_input_text(path, MAX_DOCUMENT_BYTES, "an Ultralytics data.yaml")
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}" if mark is not None else ""
+        raise InputError(f"{shown(path)}: not valid YAML{where}; expected an Ultralytics data.yaml") from None
+    if not isinstance(doc, dict):
+        raise InputError(f"{shown(path)}: {type(doc).__name__}; expected a mapping with names and train/val/test")
+    return doc
+
+
+def yolo_names(doc: dict, where: str) -> tuple[str, ...]:
+    """The class names of a data.yaml document, by index: ``names`` as a list, or a mapping 0..n-1 -> name."""
+    names = doc.get("names")
+    if isinstance(names, dict) and names and all(isinstance(k, int) for k in names) \
+            and sorted(names) == list(range(len(names))):
+        names = [names[k] for k in range(len(names))]
+    if not isinstance(names, list) or not names or not all(isinstance(n, (str, int)) for n in names):
+        raise InputError(f"{where}: names: {str(names)[:80]}; expected a list of class names or a mapping "
+                         f"0..n-1 -> name")
+    out = tuple(str(n) for n in names)
+    if len(set(out)) != len(out):
+        raise InputError(f"{where}: names: {', '.join(out)[:80]}; expected each class name once")
+    return out
+
+
+def _split_images(root: Path, entry, where: str) -> list[Path]:
+    """Image files of a data.yaml split entry: folders (every image below them), .txt lists or image files."""
+    entries = entry if isinstance(entry, list) else [entry]
+    out: list[Path] = []
+    for item in entries:
+        if not isinstance(item, str) or not item:
+            raise InputError(f"{where}: {str(item)[:80]!r}; expected a folder, a .txt list or an image path")
+        path = Path(item) if Path(item).is_absolute() else root / item
+        if path.is_dir():
+            found = []
+            for p in path.rglob("*"):   # counted as found: a split of "/" must not walk the whole disk first
+                if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file():
+                    found.append(p)
+                    if len(out) + len(found) > MAX_IMAGES:
+                        break
+            out += sorted(found)
+        elif path.suffix.lower() == ".txt" and path.is_file():
+            for line in read_input_text(path, MAX_DOCUMENT_BYTES, "a list of image paths").splitlines():
+                line = line.strip()
+                if line:  # relative to the list's folder, as Ultralytics takes "./" lines
+                    p = Path(line)
+                    out.append(p if p.is_absolute() else path.parent / p)
+        elif path.suffix.lower() in IMAGE_SUFFIXES and path.is_file():
+            out.append(path)
+        else:
+            raise InputError(f"{where}: {shown(path)} does not exist; expected a folder of images, a .txt list "
+                             f"of images or an image")
+        if len(out) > MAX_IMAGES:
+            raise InputError(f"{where}: more than {MAX_IMAGES} images; expected a test set of at most that many")
+    return out
+
+
+def label_path(image: Path) -> Path:
+    """Ultralytics' label file of an image: the last ``images`` folder of its path replaced by ``labels``,
+    the suffix by ``.txt``."""
+    parts = list(image.parts)
+    for i in range(len(parts) - 2, -1, -1):
+        if parts[i] == "images":
+            parts[i] = "labels"
+            break
+    return Path(*parts).with_suffix(".txt")
+
+
+def _finite(values: list[float]) -> bool:
+    return all(math.isfinite(v) for v in values)
+
+
+def parse_yolo_labels(text: str, names: tuple[str, ...], width: int, height: int, where: str) -> tuple[Box, ...]:
+    """The boxes of one YOLO label file (pixels of a ``width`` x ``height`` image); bad lines raise
+    :class:`InputError` naming the file and line."""
+    boxes = []
+    for n, line in enumerate(text.splitlines(), 1):
+        fields = line.split()
+        if not fields:
+            continue
+        try:
+            k = int(fields[0])
+            values = [float(v) for v in fields[1:]]
+        except ValueError:
+            raise InputError(f"{where}: line {n}: {line[:80]!r}; expected a class index and normalised "
+                             f"coordinates") from None
+        if not 0 <= k < len(names):
+            raise InputError(f"{where}: line {n}: class index {k}; expected 0..{len(names) - 1} (the names of "
+                             f"data.yaml)")
+        if not _finite(values) or any(v < -TOLERANCE or v > 1 + TOLERANCE for v in values):
+            raise InputError(f"{where}: line {n}: coordinates {' '.join(fields[1:6])}...; expected numbers "
+                             f"in [0, 1] (normalised by the image's size)")
+        if len(values) == 4:
+            cx, cy, w, h = values
+            x0, y0, x1, y1 = cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2
+        elif len(values) >= 6 and len(values) % 2 == 0:
+            xs, ys = values[0::2], values[1::2]
+            x0, y0, x1, y1 = min(xs), min(ys), max(xs), max(ys)
+        else:
+            raise InputError(f"{where}: line {n}: {len(values)} coordinates; expected 4 (cx cy w h) or a polygon "
+                             f"of at least 3 points")
+        x0, y0 = max(0.0, x0) * width, max(0.0, y0) * height
+        x1, y1 = min(1.0, x1) * width, min(1.0, y1) * height
+        boxes.append(Box(names[k], x0, y0, max(0.0, x1 - x0), max(0.0, y1 - y0)))
+    return tuple(boxes)
+
+
+def read_yolo(data_yaml: str | Path, split: str | None = None) -> DetectionSet:
+    """The images and boxes of one split of an Ultralytics YOLO dataset (``split`` default: ``test``, else
+    ``val``)."""
+    data_yaml = Path(data_yaml)
+    if data_yaml.is_dir():
+        data_yaml = data_yaml / "data.yaml"
+    where = shown(data_yaml)
+    doc = _yaml(data_yaml)
+    names = yolo_names(doc, where)
+    base = data_yaml.parent
+    if isinstance(doc.get("path"), str) and doc["path"]:
+        p = Path(doc["path"])
+        base = p if p.is_absolute() else base / p
+    wanted = [split] if split else [s for s in TEST_SPLITS if doc.get(s)]
+    if not wanted or not doc.get(wanted[0]):
+        found = ", ".join(s for s in ("train", "val", "test") if doc.get(s)) or "none"
+        raise InputError(f"{where}: {split or 'test/val'}: not in the file (splits: {found}); expected the split "
+                         f"to score, e.g. --split {next((s for s in ('test', 'val', 'train') if doc.get(s)), 'test')}")
+    split = wanted[0]
+    paths = _split_images(base, doc[split], f"{where}: {split}")
+    if not paths:
+        raise InputError(f"{where}: {split}: no images; expected images in a format OpenImageIO reads "
+                         f"({', '.join(IMAGE_SUFFIXES)})")
+    images = []
+    for i, path in enumerate(paths, 1):
+        width, height = _image_size(path)
+        labels = label_path(path)
+        text = read_input_text(labels, MAX_DOCUMENT_BYTES, "a YOLO label file") if labels.is_file() else ""
+        images.append(SetImage(i, path, width, height, parse_yolo_labels(text, names, width, height, shown(labels))))
+    return DetectionSet(names, tuple(images), "yolo", str(data_yaml), split)
+
+
+# --- COCO JSON ---------------------------------------------------------------------------------------------------
+
+def read_coco(json_path: str | Path, images_dir: str | Path | None = None) -> DetectionSet:
+    """The images and boxes of a COCO instances file; images looked up by ``file_name`` in ``images_dir``
+    (default: the file's folder)."""
+    json_path = Path(json_path)
+    where = shown(json_path)
+    doc = read_json(json_path, "COCO instances (images, annotations, categories)")
+    if not isinstance(doc, dict) or not all(isinstance(doc.get(k), list) for k in ("images", "annotations",
+                                                                                  "categories")):
+        raise InputError(f"{where}: expected a COCO instances document with images, annotations and categories")
+    folder = Path(images_dir) if images_dir is not None else json_path.parent
+    try:
+        categories = {int(c["id"]): str(c["name"]) for c in doc["categories"]}
+        names = tuple(categories[k] for k in sorted(categories))
+        boxes: dict[int, list[Box]] = {}
+        for n, a in enumerate(doc["annotations"]):
+            x, y, w, h = (float(v) for v in a["bbox"])
+            if not _finite([x, y, w, h]) or w < 0 or h < 0:
+                raise InputError(f"{where}: annotations[{n}].bbox: {a['bbox']}; expected [x, y, width, height], "
+                                 f"finite, sizes >= 0")
+            if int(a["category_id"]) not in categories:
+                raise InputError(f"{where}: annotations[{n}].category_id: {a['category_id']}; expected an id of "
+                                 f"categories")
+            boxes.setdefault(int(a["image_id"]), []).append(
+                Box(categories[int(a["category_id"])], x, y, w, h, bool(a.get("iscrowd", 0))))
+        images = []
+        for i, im in enumerate(sorted(doc["images"], key=lambda im: int(im["id"])), 1):
+            path = folder / str(im["file_name"])
+            if not path.is_file():
+                raise InputError(f"{where}: images: {shown(path)}: file not found; expected the image in "
+                                 f"{shown(folder)} (or name its folder with --images)")
+            images.append(SetImage(i, path, int(im["width"]), int(im["height"]), tuple(boxes.get(int(im["id"]), ()))))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"{where}: {type(exc).__name__} {str(exc)[:80]}; expected COCO images (id, file_name, "
+                         f"width, height), annotations (image_id, category_id, bbox) and categories (id, name)") from None
+    if not images:
+        raise InputError(f"{where}: images: empty; expected the images to score")
+    return DetectionSet(names, tuple(images), "coco", str(json_path))

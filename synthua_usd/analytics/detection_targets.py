@@ -1,0 +1,123 @@
+"""The boxes a detector is trained on, derived from a generated dataset's records.
+
+A real photo's ``wheelchair`` box is drawn around what a person sees as "a wheelchair" in the street: the chair
+*with the person sitting in it* (the Mobility Aids dataset of Vasquez et al., 2017, and the public "wheelchair"
+sets label the user and the aid as one object), not the frame alone, which our COCO instances annotate (the device
+is its own instance, linked to its user by ``uses``). So by default (:attr:`DetectionTargets.aid_box` =
+``with_user``) a mobility aid's box is the union of the device's visible box and its user's; ``device`` keeps the
+device's own box. A person is a person whatever they use (COCO's convention, and what a pedestrian detector must
+find): every visible person gets a ``person`` box, a wheelchair user too, unless ``aid_users_as_person`` is off
+(for test sets that label a wheelchair user only as ``wheelchair``).
+
+Boxes are the records' visible, pixel-edge boxes. A box lower than ``min_height_px`` (a person of 3 pixels far
+down the street) is kept as ``ignore``: never a training target, and neither required nor penalised when the
+split is scored (COCO's crowd rule).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from synthua_usd.analytics.dataset_index import load_class_map, manifest_images
+from synthua_usd.analytics.detection_sets import Box, DetectionSet, SetImage
+from synthua_usd.assets.devices import DEVICES
+from synthua_usd.dataset.layout import SPLITS, Layout
+from synthua_usd.errors import InputError
+from synthua_usd.input_files import shown
+from synthua_usd.detection_limits import DEFAULT_MIN_HEIGHT_PX, MIN_HEIGHT_PX
+from synthua_usd.schemas import read_json
+
+PERSON = "person"
+#: The classes trained by default: person and the eight mobility aids.
+DEFAULT_CLASSES = (PERSON,) + tuple(DEVICES)
+AID_BOXES = ("with_user", "device")
+
+
+@dataclass(frozen=True)
+class DetectionTargets:
+    """What a detector is trained to find in a generated dataset.
+
+    ``classes``: class names of the dataset's class map, things; ``aid_box``: ``with_user`` (a mobility aid's box
+    covers its user too) or ``device``; ``aid_users_as_person``: whether an aid user also gets a person box;
+    ``min_height_px``: boxes lower than this, pixels of the written image, are ``ignore``."""
+
+    classes: tuple[str, ...] = DEFAULT_CLASSES
+    aid_box: str = "with_user"
+    aid_users_as_person: bool = True
+    min_height_px: float = DEFAULT_MIN_HEIGHT_PX
+
+    def __post_init__(self):
+        if not self.classes or len(set(self.classes)) != len(self.classes):
+            raise InputError(f"--classes: {','.join(self.classes)}; expected class names, each once")
+        if self.aid_box not in AID_BOXES:
+            raise InputError(f"--aid-box: {self.aid_box!r}; expected one of {', '.join(AID_BOXES)}")
+        MIN_HEIGHT_PX.check(self.min_height_px, "--min-height-px")
+
+    def document(self) -> dict:
+        return {"classes": list(self.classes), "aid_box": self.aid_box,
+                "aid_users_as_person": self.aid_users_as_person, "min_height_px": self.min_height_px}
+
+    @classmethod
+    def from_document(cls, doc: dict) -> "DetectionTargets":
+        return cls(tuple(doc["classes"]), doc["aid_box"], bool(doc["aid_users_as_person"]), float(doc["min_height_px"]))
+
+
+def _union(a: list, b: list) -> list:
+    x0, y0 = min(a[0], b[0]), min(a[1], b[1])
+    return [x0, y0, max(a[0] + a[2], b[0] + b[2]) - x0, max(a[1] + a[3], b[1] + b[3]) - y0]
+
+
+def image_boxes(instances: list[dict], targets: DetectionTargets) -> tuple[Box, ...]:
+    """The target boxes of one record's ``instances`` (dicts with ``class_name``, ``prim_path``, ``area``,
+    ``bbox`` [x, y, w, h] and ``relations``), in instance order."""
+    visible = [i for i in instances if int(i.get("area", 0)) > 0]
+    user_of = {str(i["relations"]["uses"]): i for i in visible
+               if i.get("class_name") == PERSON and (i.get("relations") or {}).get("uses")}
+    wanted = set(targets.classes)
+    out = []
+    for inst in visible:
+        name = str(inst["class_name"])
+        if name not in wanted:
+            continue
+        bbox = [float(v) for v in inst["bbox"]]
+        if name == PERSON:
+            device = (inst.get("relations") or {}).get("uses_class")
+            if not targets.aid_users_as_person and device in wanted:
+                continue
+        elif name in DEVICES and targets.aid_box == "with_user" and str(inst["prim_path"]) in user_of:
+            bbox = _union(bbox, [float(v) for v in user_of[str(inst["prim_path"])]["bbox"]])
+        out.append(Box(name, *bbox, ignore=bbox[3] < targets.min_height_px))
+    return tuple(out)
+
+
+def read_generated(root, split: str | None, targets: DetectionTargets) -> DetectionSet:
+    """The target boxes of the images of ``split`` (every split when None) of a dataset ``synthua generate``
+    wrote; images QA rejected are left out, as every training format leaves them out."""
+    layout = Layout(Path(root))
+    if split is not None and split not in SPLITS:
+        raise InputError(f"--split: {split!r}; expected one of {', '.join(SPLITS)}")
+    class_map = load_class_map(layout.root)
+    things = {c.name for c in class_map.classes if c.isthing}
+    unknown = [c for c in targets.classes if c not in things]
+    if unknown:
+        raise InputError(f"--classes: {', '.join(unknown)}: not thing classes of {shown(layout.path(Layout.CLASS_MAP))}"
+                         f"; expected some of {', '.join(sorted(things))}")
+    entries = sorted((e for e in manifest_images(layout.root) if str(e.get("qa", "accepted")) != "rejected"
+                      and (split is None or e["split"] == split)), key=lambda e: int(e["id"]))
+    if not entries:
+        raise InputError(f"{shown(layout.root)}: no images{f' in split {split}' if split else ''}; expected a "
+                         f"dataset with images in the split (see its manifest.json)")
+    images = []
+    for n, entry in enumerate(entries, 1):
+        name, image_split = str(entry["name"]), str(entry["split"])
+        path = layout.path(Layout.record(name))
+        record = read_json(path, "an image record")
+        try:
+            boxes = image_boxes(record["instances"], targets)
+            width, height = int(record["width"]), int(record["height"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"{shown(path)}: {type(exc).__name__} {exc}; expected an image record written by "
+                             f"`synthua generate`") from None
+        images.append(SetImage(n, layout.path(Layout.rgb_png(image_split, name)), width, height, boxes))
+    return DetectionSet(tuple(targets.classes), tuple(images), "synthua", str(layout.root), split)

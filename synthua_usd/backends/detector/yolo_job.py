@@ -1,0 +1,142 @@
+"""Run one Ultralytics YOLO job inside the detector's interpreter (``.venv-train``): train, or predict.
+
+Started by :mod:`synthua_usd.backends.detector.runner` as ``python yolo_job.py JOB.json``; it imports only the
+standard library, torch and Ultralytics (never synthua, whose dependencies that interpreter does not hold), reads
+the job, writes the result document the job names, and exits 0, or 1 with the reason as its last line of stderr.
+
+Nothing is downloaded: a model is built from an architecture file that ships inside the Ultralytics wheel
+(``yolo26n.yaml``: no weights), or loaded from a ``.pt`` file a previous job wrote; ``YOLO_OFFLINE`` is set by the
+runner, plots (which fetch a font) are off, and on CUDA mixed precision is bfloat16, which skips Ultralytics'
+AMP check (that check downloads pretrained weights). The result lists every file that appeared in Ultralytics'
+weights folder during the job (expected: none).
+
+Job documents (JSON)::
+
+    {"action": "train", "data": "data.yaml", "model": "yolo26n.yaml" | "weights.pt", "imgsz": 320,
+     "epochs": 100, "minutes": 30 | null, "batch": 16, "workers": 2, "device": "cpu" | "cuda" | "auto",
+     "seed": 0, "threads": 2, "project": "DIR", "result": "train_result.json"}
+    {"action": "predict", "weights": "last.pt", "images": ["a.png", ...], "imgsz": 320, "conf": 0.001,
+     "iou": 0.7, "max_det": 300, "device": "cpu", "threads": 2, "batch": 8, "progress": "done.txt" | null,
+     "result": "detections.json"}
+    {"action": "versions", "result": "versions.json"}
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import sys
+import time
+from importlib import metadata
+from pathlib import Path
+
+PACKAGES = ("ultralytics", "torch", "torchvision", "numpy", "opencv-python-headless")
+
+
+def versions() -> dict:
+    """Installed versions of the packages the detector runs on, and what accelerator torch sees."""
+    import torch
+
+    out = {}
+    for name in PACKAGES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = None
+    out["python"] = sys.version.split()[0]
+    out["cuda_available"] = bool(torch.cuda.is_available())
+    out["cuda_device"] = torch.cuda.get_device_name(0) if torch.cuda.is_available() else None
+    return out
+
+
+def _device(asked: str) -> str:
+    import torch
+
+    if asked == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    if asked == "cuda" and not torch.cuda.is_available():
+        raise SystemExit("device cuda asked for, but torch sees no CUDA device")
+    return asked
+
+
+def _weights_files() -> set[str]:
+    from ultralytics.utils import SETTINGS
+
+    folder = Path(SETTINGS["weights_dir"])
+    return {str(p) for p in folder.rglob("*") if p.is_file()} if folder.is_dir() else set()
+
+
+def train(job: dict) -> dict:
+    import torch
+    from ultralytics import YOLO
+
+    torch.set_num_threads(int(job["threads"]))
+    device = _device(job["device"])
+    model = YOLO(job["model"])
+    minutes = job.get("minutes")
+    t0 = time.perf_counter()
+    model.train(data=job["data"], imgsz=int(job["imgsz"]), epochs=int(job["epochs"]),
+                time=None if minutes is None else float(minutes) / 60.0, batch=int(job["batch"]),
+                workers=int(job["workers"]), device=device, seed=int(job["seed"]), deterministic=True,
+                pretrained=False, amp="bf16" if device == "cuda" else False, plots=False, val=False,
+                project=str(Path(job["project"]).resolve()), name="train", exist_ok=True, verbose=False,
+                cache=bool(job.get("cache", False)), patience=0)
+    seconds = time.perf_counter() - t0
+    trainer = model.trainer
+    run_dir = Path(trainer.save_dir)
+    rows = []
+    results_csv = run_dir / "results.csv"
+    if results_csv.exists():
+        with results_csv.open(newline="") as f:
+            rows = [{k.strip(): v.strip() for k, v in row.items()} for row in csv.DictReader(f)]
+    return {"weights": str(Path(trainer.last).resolve()), "device": device, "seconds": seconds,
+            "epochs_done": len(rows), "epochs_planned": int(trainer.epochs), "results": rows,
+            "parameters": sum(p.numel() for p in model.model.parameters())}
+
+
+def predict(job: dict) -> dict:
+    import torch
+    from ultralytics import YOLO
+
+    torch.set_num_threads(int(job["threads"]))
+    device = _device(job["device"])
+    model = YOLO(job["weights"])
+    names = {int(k): str(v) for k, v in model.names.items()}
+    images = list(job["images"])
+    batch = max(1, int(job.get("batch", 8)))
+    detections = []
+    t0 = time.perf_counter()
+    progress = Path(job["progress"]) if job.get("progress") else None
+    if progress is not None:
+        progress.write_text("images done\n", encoding="utf-8")
+    for start in range(0, len(images), batch):
+        chunk = images[start:start + batch]
+        results = model.predict(chunk, imgsz=int(job["imgsz"]), conf=float(job["conf"]), iou=float(job["iou"]),
+                                max_det=int(job["max_det"]), device=device, verbose=False)
+        for offset, result in enumerate(results):
+            boxes = result.boxes
+            xyxy = boxes.xyxy.cpu().numpy().tolist()
+            for (x1, y1, x2, y2), score, cls in zip(xyxy, boxes.conf.cpu().tolist(), boxes.cls.cpu().tolist()):
+                detections.append({"image": start + offset, "class_name": names[int(cls)], "score": float(score),
+                                   "xyxy": [float(x1), float(y1), float(x2), float(y2)]})
+        if progress is not None:  # one line an image: the runner's progress bar counts them
+            with progress.open("a", encoding="utf-8") as f:
+                f.write("".join(f"{start + k}\n" for k in range(len(chunk))))
+    return {"names": names, "device": device, "seconds": time.perf_counter() - t0, "detections": detections}
+
+
+ACTIONS = {"train": train, "predict": predict, "versions": lambda job: {}}
+
+
+def main(argv: list[str]) -> int:
+    job = json.loads(Path(argv[1]).read_text(encoding="utf-8"))
+    before = _weights_files() if job["action"] != "versions" else set()
+    result = ACTIONS[job["action"]](job)
+    result["versions"] = versions()
+    result["downloaded"] = sorted(_weights_files() - before) if job["action"] != "versions" else []
+    Path(job["result"]).write_text(json.dumps(result, indent=1), encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,150 @@
+"""``synthua train`` and ``synthua evaluate-real``: a detector trained on a generated dataset, and scored on real
+photos (or any detection set)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from synthua_usd.cli.common import EXIT_OK
+from synthua_usd import detection_limits as L
+from synthua_usd.cli.options import InRange
+
+_FORMAT = click.Choice(["auto", "yolo", "coco", "synthua"])
+_DEVICE = click.Choice(L.DEVICES)
+
+
+@click.command()
+@click.argument("train_set", type=click.Path(path_type=Path))
+@click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True,
+              help="Run folder (weights.pt, train.json, results.csv, train.log), written when training ends.")
+@click.option("--minutes", type=InRange(L.MINUTES), default=L.DEFAULT_MINUTES, show_default=True,
+              help="Training budget in wall-clock minutes (Ultralytics stops mid-epoch when it is spent and fits its "
+                   "learning-rate schedule to it).")
+@click.option("--epochs", type=InRange(L.EPOCHS),
+              help="Train this many epochs instead of a time budget (--minutes is then ignored).")
+@click.option("--imgsz", type=InRange(L.IMGSZ), default=L.DEFAULT_IMGSZ, show_default=True,
+              help="Training image size in pixels (long side; a multiple of 32).")
+@click.option("--batch", type=InRange(L.BATCH), default=L.DEFAULT_BATCH, show_default=True, help="Images per step.")
+@click.option("--device", type=_DEVICE, default="auto", show_default=True,
+              help="auto: CUDA when torch sees a GPU, else the CPU.")
+@click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True,
+              help="Ultralytics' seed (deterministic mode on).")
+@click.option("--model", default=L.DEFAULT_MODEL, show_default=True,
+              help="Architecture shipped inside the Ultralytics wheel, trained from scratch (e.g. yolo26s.yaml, "
+                   "yolo11n.yaml); no weights are downloaded.")
+@click.option("--init", "init", type=click.Path(path_type=Path),
+              help="Start from the weights of an earlier run folder (fine-tuning), instead of from scratch.")
+@click.option("--classes",
+              help="Classes to train, of a generated dataset's class map, comma-separated [default: person and the eight "
+                   "mobility aids: manual_wheelchair, electric_wheelchair, walker, crutch and the four canes].")
+@click.option("--aid-box", type=click.Choice(["with_user", "device"]), default="with_user", show_default=True,
+              help="A mobility aid's box: with_user covers the aid and its user (what a real 'wheelchair' box "
+                   "covers); device the aid alone (as our COCO instances).")
+@click.option("--aid-users-as-person/--no-aid-users-as-person", default=True, show_default=True,
+              help="Whether a mobility-aid user is also a person box.")
+@click.option("--min-height-px", type=InRange(L.MIN_HEIGHT_PX), default=L.DEFAULT_MIN_HEIGHT_PX, show_default=True,
+              help="Boxes lower than this (pixels of the generated image) are not trained on, nor scored.")
+@click.option("--format", "fmt", type=_FORMAT, default="auto", show_default=True,
+              help="How TRAIN_SET is read: auto picks synthua for a generated dataset, coco for a .json, yolo for a "
+                   "data.yaml folder.")
+@click.option("--images", "images_dir", type=click.Path(path_type=Path),
+              help="Folder of a COCO set's images [default: the .json's folder].")
+@click.option("--python", "python", type=click.Path(path_type=Path),
+              help="Interpreter holding Ultralytics [default: $SYNTHUA_TRAIN_PYTHON, else .venv-train/bin/python].")
+def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, imgsz: int, batch: int, device: str,
+          seed: int, model: str, init: Path | None, classes: str | None, aid_box: str, aid_users_as_person: bool,
+          min_height_px: float, fmt: str, images_dir: Path | None, python: Path | None) -> int:
+    """Train an object detector (Ultralytics YOLO, from scratch) on TRAIN_SET within a bounded budget.
+
+    \b
+    Examples:
+      synthua generate stages/district/scenario.usda --config configs/sim2real.json --out out/sim2real
+      synthua train out/sim2real --minutes 30 --imgsz 320 --out out/runs/synthetic
+      synthua evaluate-real out/runs/synthetic real_photos/ --out out/eval_real
+      synthua train real_photos/ --init out/runs/synthetic --minutes 10 --out out/runs/finetuned
+    \b
+    TRAIN_SET is a dataset `synthua generate` wrote (trained on its train split; boxes from its records: by
+    default a wheelchair's box covers its user, as a real photo's 'wheelchair' box does, and a wheelchair user
+    is a person too), or an Ultralytics YOLO folder or COCO .json of real photos. Ultralytics runs in its own
+    environment, .venv-train (tools/setup_train.sh; AGPL-3.0); on a GPU when one is present. train.json
+    records the set (its SHA-256, a generated dataset's id and config), classes, budget, seed, device and
+    library versions.
+    """
+    from synthua_usd.analytics.detection_targets import DEFAULT_CLASSES, DetectionTargets
+    from synthua_usd.pipeline.train import Budget, TrainRequest
+    from synthua_usd.pipeline.train import train as run
+
+    chosen = tuple(c.strip() for c in classes.split(",") if c.strip()) if classes is not None else DEFAULT_CLASSES
+    targets = DetectionTargets(chosen, aid_box,
+                               aid_users_as_person, min_height_px)
+    budget = Budget(minutes=None if epochs is not None else minutes, epochs=epochs or 300, imgsz=imgsz, batch=batch)
+    doc = run(TrainRequest(train_set, out_dir, budget, targets, model, init, fmt, images_dir, device, seed,
+                           python=python))
+    final = doc["final"] or {}
+    losses = ", ".join(f"{k.split('/')[-1]} {float(v):.3f}" for k, v in final.items() if k.startswith("train/"))
+    images = doc["train_set"]["images"]
+    click.echo(f"trained {', '.join(doc['classes'])} on {images['train']} images (validated on {images['val']}) "
+               f"for {doc['epochs_done']} epochs in {doc['seconds']:.0f} s "
+               f"on {doc['device']} (Ultralytics {doc['versions']['ultralytics']}, torch {doc['versions']['torch']})"
+               f"{': ' + losses if losses else ''}")
+    click.echo(f"-> {out_dir}")
+    return EXIT_OK
+
+
+@click.command("evaluate-real")
+@click.argument("model", type=click.Path(path_type=Path))
+@click.argument("test_set", type=click.Path(path_type=Path))
+@click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True,
+              help="Report folder (metrics.json, per_class.csv, false_negatives.csv/.png, detections.json, "
+                   "report.html).")
+@click.option("--map", "maps", multiple=True,
+              help="TEST_CLASS=MODEL_CLASS[,MODEL_CLASS...]: the model classes that score as a class of the test set; "
+                   "repeat per class [default: same names, and wheelchair=manual_wheelchair,electric_wheelchair].")
+@click.option("--format", "fmt", type=_FORMAT, default="auto", show_default=True,
+              help="How TEST_SET is read: auto picks synthua for a generated dataset, coco for a .json, yolo for a "
+                   "data.yaml folder.")
+@click.option("--split", type=click.Choice(["train", "val", "test"]),
+              help="Split of a YOLO set or generated dataset [default: test, else val; a generated dataset: test].")
+@click.option("--images", "images_dir", type=click.Path(path_type=Path),
+              help="Folder of a COCO set's images [default: the .json's folder].")
+@click.option("--confidence", type=InRange(L.CONFIDENCE), default=L.DEFAULT_CONFIDENCE,
+              show_default=True, help="Confidence of precision, recall and the false negatives (AP uses every score).")
+@click.option("--imgsz", type=InRange(L.IMGSZ), help="Prediction image size [default: the training's].")
+@click.option("--device", type=_DEVICE, default="auto", show_default=True, help="auto: CUDA when present, else CPU.")
+@click.option("--python", "python", type=click.Path(path_type=Path),
+              help="Interpreter holding Ultralytics [default: $SYNTHUA_TRAIN_PYTHON, else .venv-train/bin/python].")
+def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, ...], fmt: str, split: str | None,
+                  images_dir: Path | None, confidence: float, imgsz: int | None, device: str,
+                  python: Path | None) -> int:
+    """Score the detector of run folder MODEL (`synthua train`) on TEST_SET: real photos or a held-out split.
+
+    \b
+    Examples:
+      synthua evaluate-real out/runs/synthetic real_photos/ --out out/eval_real \\
+          --map wheelchair=manual_wheelchair,electric_wheelchair --map person=person
+      synthua evaluate-real out/runs/synthetic photos/instances.json --images photos/ --out out/eval_coco
+      synthua evaluate-real out/runs/synthetic out/sim2real --split test --out out/eval_synthetic
+    \b
+    TEST_SET: an Ultralytics YOLO folder (data.yaml + images/ + labels/; box or polygon labels), a COCO
+    instances .json, or a generated dataset (scored on the boxes the model was trained with). Per mapped
+    class: AP50 and AP50-95 by pycocotools' COCOeval (bbox), precision and recall at --confidence (IoU 0.5),
+    and a page of the worst false negatives (report.html, false_negatives.png). Test classes no --map names
+    are not scored.
+    """
+    from synthua_usd.pipeline.evaluate_real import EvaluateRequest
+    from synthua_usd.pipeline.evaluate_real import evaluate_real as run
+
+    result = run(EvaluateRequest(model, test_set, out_dir, maps, fmt, split, images_dir, confidence,
+                                 imgsz=imgsz, device=device, python=python))
+    ev = result.evaluation
+    click.echo(f"{ev.images} images ({result.document['test_set']['layout']}), mapping "
+               f"{result.document['mapping_options']}: COCO AP {ev.stats['AP']:.4f}, AP50 {ev.stats['AP50']:.4f}")
+    click.echo(f"{'class':20s} {'boxes':>6s} {'AP50':>7s} {'AP50-95':>8s} {'P@' + format(confidence, 'g'):>7s} "
+               f"{'R@' + format(confidence, 'g'):>7s}")
+    for c in ev.classes:
+        f = [("–" if v is None else f"{v:.4f}") for v in (c.ap50, c.ap50_95, c.precision, c.recall)]
+        click.echo(f"{c.name:20s} {c.boxes:6d} {f[0]:>7s} {f[1]:>8s} {f[2]:>7s} {f[3]:>7s}")
+    click.echo(f"{len(ev.misses)} false negatives at confidence {confidence:g}; worst in {out_dir}/report.html")
+    return EXIT_OK

@@ -1,0 +1,182 @@
+"""``synthua train``: an Ultralytics YOLO detector trained on a detection set, within a bounded budget.
+
+The set is a dataset ``synthua generate`` wrote (its boxes derived by
+:class:`~synthua_usd.analytics.detection_targets.DetectionTargets`: a wheelchair's box covers its user by default),
+or any Ultralytics YOLO or COCO set (a few real photos, say). Its ``train`` split is trained on; its ``val`` split is
+what Ultralytics validates the last epoch on (the train split when there is none). The model is built from an
+architecture that ships inside the Ultralytics wheel (``yolo26n.yaml``, from scratch: no weights exist to download),
+or starts from the weights of an earlier run (``init``: fine-tuning; Ultralytics carries over every layer whose
+shape fits, so a head with other classes starts anew).
+
+The run folder, written as a set (nothing of it appears unless training finished)::
+
+    weights.pt     the model at the end of the budget (Ultralytics' last.pt)
+    train.json     what was trained on what: the set (its path, SHA-256 of what it holds, for a generated dataset
+                   the SHA-256 of its manifest, its generation config and name), the classes and box policy, the
+                   model and its initial weights (with their run's train.json), the budget (minutes or epochs,
+                   image size, batch), seed, device, library versions, epochs done, seconds, final losses, and
+                   every file Ultralytics fetched (none)
+    results.csv    Ultralytics' losses per epoch
+    train.log      Ultralytics' output
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import platform
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from synthua_usd import __version__
+from synthua_usd.analytics.detection_sets import DetectionSet
+from synthua_usd.analytics.detection_sources import manifest_sha256, read_detection_set, set_id
+from synthua_usd.analytics.detection_targets import DetectionTargets
+from synthua_usd.atomic import output_set, write_json_atomic
+from synthua_usd import detection_limits as L
+from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
+from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
+from synthua_usd.errors import InputError
+from synthua_usd.input_files import shown
+from synthua_usd.schemas import read_json
+
+log = logging.getLogger(__name__)
+
+
+
+def check_imgsz(imgsz: int) -> int:
+    """``imgsz`` when it is in :data:`IMGSZ` and a multiple of 32 (the model's stride), else :class:`InputError`."""
+    L.IMGSZ.check(imgsz, "--imgsz")
+    if imgsz % 32:
+        raise InputError(f"--imgsz: {imgsz}; expected a multiple of 32 in [32, 4096] (the model's stride)")
+    return imgsz
+
+
+@dataclass(frozen=True)
+class Budget:
+    """How long training may run: ``minutes`` of wall time (Ultralytics' ``time``: it stops mid-epoch when spent
+    and fits its learning-rate schedule to it), or ``epochs`` when ``minutes`` is None; images resized to ``imgsz``
+    pixels (long side), ``batch`` images a step."""
+
+    minutes: float | None = L.DEFAULT_MINUTES
+    epochs: int = 300
+    imgsz: int = L.DEFAULT_IMGSZ
+    batch: int = L.DEFAULT_BATCH
+
+    def __post_init__(self):
+        if self.minutes is not None:
+            L.MINUTES.check(self.minutes, "--minutes")
+        L.EPOCHS.check(self.epochs, "--epochs")
+        check_imgsz(self.imgsz)
+        L.BATCH.check(self.batch, "--batch")
+
+    def document(self) -> dict:
+        return {"minutes": self.minutes, "epochs": None if self.minutes is not None else self.epochs,
+                "imgsz": self.imgsz, "batch": self.batch}
+
+
+@dataclass(frozen=True)
+class TrainRequest:
+    """``train_set``: a generated dataset, a YOLO data.yaml folder or a COCO .json (``fmt``, ``images_dir`` for
+    COCO); ``init``: a run folder (or its weights.pt) to fine-tune from; ``threads``: torch threads (default: the
+    cores this process may use)."""
+
+    train_set: Path
+    out_dir: Path
+    budget: Budget = field(default_factory=Budget)
+    targets: DetectionTargets = field(default_factory=DetectionTargets)
+    model: str = L.DEFAULT_MODEL
+    init: Path | None = None
+    fmt: str = "auto"
+    images_dir: Path | None = None
+    device: str = "auto"
+    seed: int = 0
+    workers: int = 2
+    threads: int | None = None
+    python: Path | None = None
+
+
+def run_weights(path: str | Path) -> tuple[Path, dict]:
+    """The weights and train.json of a run folder of `synthua train` (or of its weights.pt)."""
+    path = Path(path)
+    folder = path.parent if path.suffix == ".pt" else path
+    weights, about = folder / "weights.pt", folder / "train.json"
+    if not weights.is_file() or not about.is_file():
+        raise InputError(f"{shown(path)}: no weights.pt and train.json; expected a run folder written by "
+                         f"`synthua train`")
+    return weights, read_json(about, "a run's train.json")
+
+
+def _splits(request: TrainRequest) -> tuple[dict[str, DetectionSet], DetectionSet]:
+    def read(split):
+        return read_detection_set(request.train_set, request.fmt, split, request.images_dir, request.targets)
+
+    train = read("train")
+    if not any(not b.ignore for im in train.images for b in im.boxes):
+        raise InputError(f"{shown(request.train_set)}: no boxes of {', '.join(train.names)} to train on in its "
+                         f"train split; expected a set whose train split shows them")
+    try:
+        val = read("val")
+    except InputError as exc:  # no val split: Ultralytics validates the last epoch on the train split
+        log.warning("%s; Ultralytics validates on the train split instead", str(exc).split("; expected")[0])
+        val = train
+    return {"train": train, "val": val}, train
+
+
+def _set_document(dataset: DetectionSet, splits: dict[str, DetectionSet]) -> dict:
+    doc = {"source": dataset.source, "layout": dataset.layout, "sha256": set_id(dataset),
+           "images": {s: len(d.images) for s, d in splits.items()}, "boxes": dataset.counts()}
+    manifest = manifest_sha256(dataset)
+    if manifest is not None:
+        provenance = read_json(Path(dataset.source) / "manifest.json", "a dataset manifest").get("provenance", {})
+        doc |= {"dataset_id": manifest, "generation_config": provenance.get("config"),
+                "generation_config_digest": provenance.get("config_digest"),
+                "generated_by": {k: provenance.get(k) for k in ("synthua", "usd-core", "mitsuba", "mitsuba_variant")}}
+    return doc
+
+
+def train(request: TrainRequest) -> dict:
+    """Train, write the run folder (see the module's docstring) and return its train.json document."""
+    if request.device not in L.DEVICES:
+        raise InputError(f"--device: {request.device!r}; expected one of {', '.join(L.DEVICES)}")
+    splits, train_set = _splits(request)
+    init_weights, init_about = run_weights(request.init) if request.init is not None else (None, None)
+    python = find_detector_python(request.python)
+    threads = request.threads or len(os.sched_getaffinity(0))
+    names = train_set.names
+    with output_set(request.out_dir) as stage, tempfile.TemporaryDirectory(prefix="synthua-train-") as scratch:
+        data_yaml = write_yolo_boxes(Path(scratch) / "data", splits, names)
+        b = request.budget
+        job = {"action": "train", "data": str(data_yaml), "model": str(init_weights.resolve()) if init_weights else request.model,
+               "imgsz": b.imgsz, "epochs": b.epochs, "minutes": b.minutes, "batch": b.batch, "workers": request.workers,
+               "device": request.device, "seed": request.seed, "threads": threads,
+               "project": str(Path(scratch) / "runs")}
+        results = Path(scratch) / "runs" / "train" / "results.csv"
+        progress = ({"total": round(b.minutes * 60), "unit": "s", "done": lambda seconds: round(seconds)}
+                    if b.minutes is not None else
+                    {"total": b.epochs, "unit": "epoch", "done": lambda seconds: count_in(results)})
+        result = run_job(python, job, Path(scratch), "train", progress=progress)
+        shutil.copyfile(result["weights"], stage / "weights.pt")
+        results_csv = Path(result["weights"]).parents[1] / "results.csv"
+        if results_csv.exists():
+            shutil.copyfile(results_csv, stage / "results.csv")
+        shutil.copyfile(Path(scratch) / "train.log", stage / "train.log")
+        document = {
+            "synthua": __version__, "python": platform.python_version(),
+            "train_set": _set_document(train_set, splits), "classes": list(names),
+            "targets": request.targets.document() if train_set.layout == "synthua" else None,
+            "model": request.model if init_weights is None else None,
+            "init": None if init_weights is None else {"weights": str(init_weights), "run": init_about},
+            "budget": b.document(), "seed": request.seed, "device": result["device"], "threads": threads,
+            "versions": result["versions"], "epochs_done": result["epochs_done"],
+            "epochs_planned": result["epochs_planned"], "seconds": round(result["seconds"], 1),
+            "parameters": result["parameters"], "final": result["results"][-1] if result["results"] else None,
+            "downloaded": result["downloaded"],
+        }
+        write_json_atomic(stage / "train.json", document)
+    log.info("trained %s in %.0f s (%d epochs) -> %s", ", ".join(names), result["seconds"], result["epochs_done"],
+             request.out_dir)
+    return document
+

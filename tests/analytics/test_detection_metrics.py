@@ -1,0 +1,121 @@
+"""Detection scores from pycocotools checked against values worked out by hand and against an independent greedy
+matcher written here in numpy (precision and recall at a fixed confidence on random boxes)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from synthua_usd.analytics.class_mapping import build_mapping
+from synthua_usd.analytics.detection_metrics import Detection, evaluate_detections, merge_detections
+from synthua_usd.analytics.detection_sets import Box, DetectionSet, SetImage
+
+MODEL = ("person", "manual_wheelchair", "electric_wheelchair")
+
+
+def one_set(boxes_per_image: list[list[Box]], names=("person", "wheelchair"), size=(200, 100)) -> DetectionSet:
+    images = tuple(SetImage(i, Path(f"/nowhere/{i}.png"), size[0], size[1], tuple(b)) for i, b in
+                   enumerate(boxes_per_image, 1))
+    return DetectionSet(tuple(names), images, "yolo", "hand-made", "test")
+
+
+def test_perfect_detections_score_one():
+    gt = [[Box("person", 10, 10, 20, 40), Box("wheelchair", 50, 20, 30, 30)], [Box("person", 100, 5, 10, 30)]]
+    dets = [Detection(i, "person" if b.label == "person" else "manual_wheelchair", 0.9, b.x, b.y, b.w, b.h)
+            for i, boxes in enumerate(gt, 1) for b in boxes]
+    ev = evaluate_detections(one_set(gt), dets, build_mapping([], ("person", "wheelchair"), MODEL))
+    for c in ev.classes:
+        assert (c.ap50, c.ap50_95, c.precision, c.recall) == pytest.approx((1.0, 1.0, 1.0, 1.0))
+    assert ev.misses == () and ev.stats["AP"] == pytest.approx(1.0)
+
+
+def test_ap_worked_out_by_hand():
+    """Two people; a false positive above a true positive, the other person missed. Precision after each
+    detection: 0 (recall 0), 1/2 (recall 1/2). COCO's 101 recall points: the 51 at recall <= 0.5 take the best
+    precision at or beyond them, 1/2; the other 50 nothing: AP = 51 * 0.5 / 101, at every IoU (the hit is exact)."""
+    gt = [[Box("person", 10, 10, 20, 40), Box("person", 120, 10, 20, 40)]]
+    dets = [Detection(1, "person", 0.9, 60, 50, 10, 10), Detection(1, "person", 0.8, 10, 10, 20, 40)]
+    ev = evaluate_detections(one_set(gt, names=("person",)), dets, build_mapping([], ("person",), MODEL), 0.5)
+    (person,) = ev.classes
+    assert person.ap50 == pytest.approx(51 * 0.5 / 101) and person.ap50_95 == pytest.approx(51 * 0.5 / 101)
+    assert (person.tp, person.fp, person.fn) == (1, 1, 1)
+    assert (person.precision, person.recall) == (0.5, 0.5)
+    high = evaluate_detections(one_set(gt, names=("person",)), dets, build_mapping([], ("person",), MODEL), 0.85)
+    assert (high.classes[0].tp, high.classes[0].fp, high.classes[0].fn) == (0, 1, 2)
+    # the misses, largest first (equal sizes: by image, then x); the one at x = 120 has no overlapping detection
+    assert [(m.box.x, m.best_iou) for m in ev.misses] == [(120, 0.0)]
+    assert [m.box.x for m in high.misses] == [10, 120] and high.misses[0].best_iou == pytest.approx(1.0)
+    assert high.misses[0].best_score == pytest.approx(0.8) and high.misses[0].best_box == (10, 10, 20, 40)
+    assert ev.misses[0].best_box is None
+
+
+def test_class_without_boxes_has_no_ap_and_ignored_boxes_cost_nothing():
+    gt = [[Box("person", 10, 10, 20, 40), Box("person", 100, 10, 4, 4, ignore=True)]]
+    dets = [Detection(1, "person", 0.9, 10, 10, 20, 40), Detection(1, "person", 0.8, 100, 10, 4, 4)]
+    ev = evaluate_detections(one_set(gt), dets, build_mapping([], ("person", "wheelchair"), MODEL))
+    person, wheelchair = ev.classes
+    assert (person.tp, person.fp, person.fn, person.boxes) == (1, 0, 0, 1) and person.ap50 == pytest.approx(1.0)
+    assert (wheelchair.ap50, wheelchair.ap50_95, wheelchair.boxes, wheelchair.precision) == (None, None, 0, None)
+
+
+def test_merged_model_classes_count_once():
+    """A chair both wheelchair classes predicted is one detection of 'wheelchair', not a true and a false one."""
+    gt = [[Box("wheelchair", 50, 20, 30, 30)]]
+    dets = [Detection(1, "manual_wheelchair", 0.9, 50, 20, 30, 30), Detection(1, "electric_wheelchair", 0.6, 51, 20, 30, 30),
+            Detection(1, "electric_wheelchair", 0.7, 150, 20, 30, 30)]
+    mapping = build_mapping([], ("wheelchair",), MODEL)
+    merged = merge_detections(dets, mapping, 0.7)
+    assert [(d.label, d.score) for d in merged] == [("wheelchair", 0.9), ("wheelchair", 0.7)]
+    (c,) = evaluate_detections(one_set(gt, names=("wheelchair",)), dets, mapping).classes
+    assert (c.tp, c.fp, c.fn) == (1, 1, 0)
+
+
+def _iou(a, b) -> float:
+    ax1, ay1, bx1, by1 = a[0] + a[2], a[1] + a[3], b[0] + b[2], b[1] + b[3]
+    w, h = max(0.0, min(ax1, bx1) - max(a[0], b[0])), max(0.0, min(ay1, by1) - max(a[1], b[1]))
+    inter = w * h
+    return inter / (a[2] * a[3] + b[2] * b[3] - inter)
+
+
+def greedy_counts(gt_boxes, dets, confidence):
+    """TP, FP, FN at IoU 0.5 of one class over images: detections above ``confidence`` by falling score, each to
+    the unmatched box it overlaps most (COCO's rule)."""
+    tp = fp = fn = 0
+    for image_id, boxes in gt_boxes.items():
+        taken = [False] * len(boxes)
+        for d in sorted((d for d in dets if d.image_id == image_id and d.score >= confidence), key=lambda d: -d.score):
+            ious = [(-1.0 if taken[k] else _iou((d.x, d.y, d.w, d.h), (b.x, b.y, b.w, b.h))) for k, b in enumerate(boxes)]
+            best = int(np.argmax(ious)) if ious else -1
+            if best >= 0 and ious[best] >= 0.5:
+                taken[best] = True
+                tp += 1
+            else:
+                fp += 1
+        fn += taken.count(False)
+    return tp, fp, fn
+
+
+def test_precision_recall_against_an_independent_matcher():
+    rng = np.random.default_rng(3)
+    gt, dets = [], []
+    for image_id in range(1, 9):
+        boxes = []
+        for _ in range(rng.integers(0, 6)):
+            x, y, w, h = rng.uniform(0, 150), rng.uniform(0, 60), rng.uniform(5, 40), rng.uniform(5, 40)
+            boxes.append(Box("person", x, y, w, h))
+            for _ in range(rng.integers(0, 3)):    # jittered detections: some match, some not
+                j = rng.normal(0, 0.25, 4) * [w, h, w, h]
+                dets.append(Detection(image_id, "person", float(rng.uniform()), x + j[0], y + j[1],
+                                      max(1.0, w + j[2]), max(1.0, h + j[3])))
+        for _ in range(rng.integers(0, 3)):        # stray detections
+            dets.append(Detection(image_id, "person", float(rng.uniform()), *rng.uniform(0, 100, 2), 10.0, 10.0))
+        gt.append(boxes)
+    mapping = build_mapping([], ("person",), MODEL)
+    test = one_set(gt, names=("person",))
+    gt_by_image = {im.id: list(im.boxes) for im in test.images}
+    for confidence in (0.1, 0.25, 0.5, 0.8):
+        (c,) = evaluate_detections(test, dets, mapping, confidence).classes
+        assert (c.tp, c.fp, c.fn) == greedy_counts(gt_by_image, dets, confidence)
+        assert len(evaluate_detections(test, dets, mapping, confidence).misses) == c.fn

@@ -1,0 +1,157 @@
+"""The whole sim-to-real path on a tiny randomised dataset: `synthua train` (one epoch of Ultralytics YOLO, from
+scratch, on the CPU) and `synthua evaluate-real` with that dataset as the "real" test set, read as a third party's
+YOLO folder, as COCO JSON and as a generated dataset. No number is asserted of the model (it has barely trained):
+what is checked is that the path runs, records what it trained on, fetched nothing, and that the scores are
+pycocotools' (COCOeval run here on the detections it wrote gives the same AP per class).
+
+Skips with the reason where the detector's environment (.venv-train, tools/setup_train.sh) is absent."""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from synthua_usd.backends.detector.runner import DetectorUnavailable, find_detector_python
+from synthua_usd.cli.main import main
+
+
+@pytest.fixture(scope="module")
+def detector_python() -> Path:
+    try:
+        return find_detector_python()
+    except DetectorUnavailable as exc:
+        pytest.skip(str(exc))
+
+
+@pytest.fixture(scope="module")
+def run(detector_python, generated_random, tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("sim2real") / "run"
+    code = main(["train", str(generated_random), "--epochs", "1", "--imgsz", "64", "--batch", "2", "--seed", "3",
+                 "--min-height-px", "2", "--device", "cpu", "--out", str(out)])
+    assert code == 0
+    return out
+
+
+def test_train_records_what_it_trained_on(run, generated_random):
+    about = json.loads((run / "train.json").read_text())
+    manifest = (generated_random / "manifest.json").read_bytes()
+    assert about["train_set"]["dataset_id"] == hashlib.sha256(manifest).hexdigest()
+    assert about["train_set"]["generation_config"] == json.loads(manifest)["provenance"]["config"]
+    assert about["train_set"]["generation_config"]["randomise"]          # the scene randomisation made it
+    assert about["budget"] == {"minutes": None, "epochs": 1, "imgsz": 64, "batch": 2}
+    assert about["seed"] == 3 and about["device"] == "cpu" and about["epochs_done"] == 1
+    assert about["model"] == "yolo26n.yaml" and about["init"] is None
+    assert about["versions"]["ultralytics"] == "8.4.190" and about["versions"]["torch"]
+    assert about["downloaded"] == []                                      # no weights fetched
+    assert about["targets"]["aid_box"] == "with_user" and about["classes"][0] == "person"
+    assert (run / "weights.pt").stat().st_size > 1_000_000 and (run / "results.csv").is_file()
+
+
+def _cocoeval_ap(gt_doc: dict, detections: list[dict], class_ids: dict[str, int]) -> dict[str, float | None]:
+    """AP (IoU 0.50:0.95, area all, 100 detections) per class by pycocotools, straight from the files."""
+    from pycocotools.coco import COCO
+    from pycocotools.cocoeval import COCOeval
+
+    results = [{"image_id": d["image_id"], "category_id": class_ids[d["class_name"]], "score": d["score"],
+                "bbox": d["bbox"]} for d in detections if d["class_name"] in class_ids]
+    with contextlib.redirect_stdout(io.StringIO()):
+        gt = COCO()
+        gt.dataset = gt_doc
+        gt.createIndex()
+        ev = COCOeval(gt, gt.loadRes(results), "bbox")
+        ev.params.catIds = sorted(class_ids.values())
+        ev.evaluate()
+        ev.accumulate()
+    out = {}
+    for k, cat in enumerate(ev.params.catIds):
+        p = ev.eval["precision"][:, :, k, 0, -1]
+        name = next(n for n, c in class_ids.items() if c == cat)
+        has_boxes = any(a["category_id"] == cat and not a.get("iscrowd") for a in gt_doc["annotations"])
+        out[name] = float(p[p > -1].mean()) if has_boxes and (p > -1).any() else None
+    return out
+
+
+def test_evaluate_real_on_coco_json_is_cocoeval(run, generated_random, tmp_path):
+    out = tmp_path / "eval_coco"
+    coco = generated_random / "annotations" / "instances_val.json"
+    assert main(["evaluate-real", str(run), str(coco), "--images", str(generated_random / "images" / "val"),
+                 "--out", str(out)]) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["evaluator"].startswith("pycocotools") and metrics["downloaded"] == []
+    detections = json.loads((out / "detections.json").read_text())
+    gt_doc = json.loads(coco.read_text())
+    # our image ids number the images by their COCO id order; the detections name their files
+    ids = {im["file_name"]: im["id"] for im in gt_doc["images"]}
+    for d in detections:
+        d["image_id"] = ids[Path(d["file_name"]).name]
+    names = {c["id"]: c["name"] for c in gt_doc["categories"]}
+    scored = {n: c for c, n in names.items() if n in metrics["mapping"]}
+    expected = _cocoeval_ap(gt_doc, detections, scored)
+    got = {c["class"]: c["AP50_95"] for c in metrics["classes"]}
+    assert set(got) == set(expected)
+    for name, value in expected.items():
+        assert got[name] == (None if value is None else pytest.approx(value, abs=1e-12)), name
+    for name in ("per_class.csv", "false_negatives.csv", "false_negatives.png", "report.html"):
+        assert (out / name).stat().st_size > 0
+    assert "false_negatives.png" in (out / "report.html").read_text()
+
+
+def test_evaluate_real_on_a_yolo_folder_with_real_class_names(run, generated_random, tmp_path, capsys):
+    """The generated dataset as a third party's YOLO folder, its two wheelchair classes scored as one."""
+    out = tmp_path / "eval_yolo"
+    assert main(["evaluate-real", str(run), str(generated_random), "--format", "yolo", "--split", "val",
+                 "--map", "person=person", "--map", "manual_wheelchair=manual_wheelchair,electric_wheelchair",
+                 "--confidence", "0.05", "--out", str(out)]) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["test_set"]["layout"] == "yolo" and metrics["confidence"] == 0.05
+    assert [c["class"] for c in metrics["classes"]] == ["person", "manual_wheelchair"]
+    assert metrics["mapping"]["manual_wheelchair"] == ["manual_wheelchair", "electric_wheelchair"]
+    person = metrics["classes"][0]
+    assert person["boxes"] == person["tp"] + person["fn"] and person["boxes"] > 0
+    rows = (out / "false_negatives.csv").read_text().splitlines()
+    assert len(rows) - 1 == sum(c["fn"] for c in metrics["classes"]) == metrics["false_negatives"]
+    assert "person" in capsys.readouterr().out
+
+
+def test_evaluate_real_on_the_held_out_split_uses_the_trained_boxes(run, generated_random, tmp_path):
+    out = tmp_path / "eval_synthetic"
+    assert main(["evaluate-real", str(run), str(generated_random), "--split", "val", "--out", str(out)]) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["test_set"]["layout"] == "synthua" and metrics["test_set"]["targets"]["aid_box"] == "with_user"
+    assert metrics["test_set"]["dataset_id"] == json.loads((run / "train.json").read_text())["train_set"]["dataset_id"]
+    aps = [c["AP50"] for c in metrics["classes"] if c["AP50"] is not None]
+    assert aps and all(0.0 <= v <= 1.0 for v in aps) and np.isfinite(aps).all()
+
+
+def test_fine_tuning_on_a_real_set_starts_from_the_run(run, generated_random, tmp_path):
+    """A YOLO folder as the training set, from the synthetic run's weights: the classes are the set's own."""
+    out = tmp_path / "tuned"
+    assert main(["train", str(generated_random), "--format", "yolo", "--init", str(run), "--epochs", "1",
+                 "--imgsz", "64", "--batch", "2", "--device", "cpu", "--out", str(out)]) == 0
+    about = json.loads((out / "train.json").read_text())
+    assert about["init"]["weights"] == str(run / "weights.pt") and about["model"] is None
+    assert about["train_set"]["layout"] == "yolo" and about["targets"] is None
+    assert about["classes"][:2] == ["curb_ramp", "crosswalk"]          # the generated data.yaml's names
+    assert not list((generated_random / "labels").glob("*.cache"))      # Ultralytics' cache went to its own copy
+
+
+def test_refusals_are_one_line(run, generated_random, tmp_path, capsys):
+    cases = [
+        (["evaluate-real", str(run), str(generated_random), "--format", "yolo", "--split", "val",
+          "--map", "wheelchair=manual_wheelchair"], "'wheelchair' is not a class of the test set"),
+        (["evaluate-real", str(tmp_path), str(generated_random)], "no weights.pt and train.json"),
+        (["evaluate-real", str(run), str(tmp_path / "nothing")], "not found; expected an Ultralytics YOLO folder"),
+        (["train", str(generated_random), "--classes", "person,road"], "not thing classes"),
+        (["train", str(generated_random), "--imgsz", "100"], "multiple of 32"),
+    ]
+    for args, found in cases:
+        assert main(args + ["--out", str(tmp_path / "out")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("synthua: error:") and found in err[0], err
+        assert not (tmp_path / "out").exists()
