@@ -4,7 +4,7 @@ BIN := $(VENV)/bin
 DEMO_OUT ?= out/demo
 SCENARIO := stages/scenario.usda
 
-.PHONY: setup demo test refs stages bench cycles train-env clean
+.PHONY: setup demo test docs refs stages bench cycles train-env clean
 
 setup:
 	@bash tools/setup.sh
@@ -40,11 +40,18 @@ demo: setup
 	$(BIN)/synthua stats $(DEMO_OUT)/dataset_random --out $(DEMO_OUT)/dataset_random_report
 	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}; a dataset (COCO, panoptic, Cityscapes, YOLO) in $(DEMO_OUT)/dataset, its statistics in $(DEMO_OUT)/dataset_report/report.html; a randomised one (every image a new scene) in $(DEMO_OUT)/dataset_random, its statistics and diversity in $(DEMO_OUT)/dataset_random_report/report.html"
 
-## The whole test suite (slow tests included). The detector's environment first: where it cannot be made, its
-## tests skip with the reason.
+## The whole test suite (slow tests included), then the package's import layers (import-linter's contracts in
+## pyproject.toml) and the documentation site built with --strict (a broken link or reference fails). The
+## detector's environment first: where it cannot be made, its tests skip with the reason.
 test: setup
 	-@TRAIN_VENV=$(TRAIN_VENV) bash tools/setup_train.sh
 	SYNTHUA_TRAIN_PYTHON=$(TRAIN_VENV)/bin/python $(BIN)/python -m pytest -q
+	$(BIN)/lint-imports
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet --site-dir build/site
+
+## The documentation site from docs/ into site/ (offline: open site/index.html).
+docs: setup
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 ## Regenerate the RGB reference images of the tests (tests/data/refs): only when a change of the renders is
 ## intended (tools/make_refs.py; the tests compare renders with them statistically).

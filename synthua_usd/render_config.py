@@ -38,7 +38,7 @@ class RenderConfig:
 
     width: int = 1280
     height: int = 960
-    # The default quality, chosen by measurement (tools/bench_denoise.py, README "Denoising"): 32 multi-jittered
+    # The default quality, chosen by measurement (tools/bench_denoise.py, docs/rendering.md, "Denoising"): 32 multi-jittered
     # box-filtered samples, denoised: 38.0-42.8 dB on the district's four views at 1280x960 against 256-spp
     # references whose own noise caps the score at 39.9-46.2 dB (8 spp: 34.5-40.9 dB in 36 % of the time).
     # Dataset configs choose their own (configs/*.json: 8).

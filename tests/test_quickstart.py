@@ -1,6 +1,6 @@
 """The README's "Your own scene, end to end": its command block, run as written, into a temporary folder outside
 the repository: twin, people, an aimed camera, composition, a frame with no black pixel past the twin, a dataset
-that verifies."""
+that verifies, and its statistics report."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from pathlib import Path
 from conftest import MOBILITY_AIDS, REPO
 from frame_checks import black_shares
 
-MARKER = "<!-- quickstart -->"
+MARKER = "<!-- --8<-- [start:quickstart] -->"
 
 
 def quickstart_block() -> str:
@@ -45,4 +45,7 @@ def test_the_readme_quickstart_runs_from_twin_to_dataset(tmp_path):
         if camera == "PedestrianEye_Street":  # looks along the street at the horizon
             overall, past_the_twin = black_shares(frame)
             assert past_the_twin == 0.0 and overall < 0.001, (overall, past_the_twin)
-    assert result.stdout.rstrip().endswith(": ok"), result.stdout[-500:]  # synthua verify, last
+    verified = [line for line in result.stdout.splitlines() if line.startswith(f"{folder / 'dataset'}: ")]
+    assert verified and verified[-1].endswith("files checked: ok"), result.stdout[-500:]  # synthua verify
+    report = folder / "report"
+    assert (report / "report.html").stat().st_size > 0, sorted(p.name for p in report.iterdir())  # synthua stats

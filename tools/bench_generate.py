@@ -74,6 +74,7 @@ class Probe:
     def install(self) -> None:
         from synthua_usd.pipeline import executors
         from synthua_usd.pipeline import generate as gen
+        from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 
         probe = self
 
@@ -89,7 +90,7 @@ class Probe:
         run_shards = executors.run_shards
         host = socket.gethostname()
 
-        def run_shards_probed(shards, init, work, on_result, config=executors.ExecutorConfig()):
+        def run_shards_probed(shards, init, work, on_result, config=ExecutorConfig()):
             probe.rounds += 1
             t0, seen = time.perf_counter(), set()
 

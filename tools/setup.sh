@@ -3,7 +3,7 @@
 #   1. system libraries, when apt is available and we may use it: libllvm19 (Mitsuba's llvm_ad_rgb
 #      variant needs LLVM >= 19; with only 14/15 it aborts) and python3-venv;
 #   2. chromium, when apt may be used (the HTML report tests; they skip without it);
-#   3. a virtual environment in .venv with the package and its test and torch extras, pinned by constraints.txt.
+#   3. a virtual environment in .venv with the package and its test, torch and docs extras, pinned by constraints.txt.
 # Safe to run again: it only does what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -66,7 +66,7 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ constraints.txt -nt
   echo "setup: installing synthua-usd and its dependencies into $VENV"
   "$VENV/bin/python" -m pip install -q --upgrade pip
   # The torch extra: torch==2.13.0 from PyPI (constraints.txt) is the CPU build on Linux x86-64.
-  "$VENV/bin/python" -m pip install -q -c constraints.txt -e '.[test,torch]'
+  "$VENV/bin/python" -m pip install -q -c constraints.txt -e '.[test,torch,docs]'
   # panopticapi (the COCO panoptic reader of the tests): its PyPI wheel, panopticapi-lite, is the
   # cocodataset/panopticapi code but declares numpy<2, which the rest of the stack cannot meet; its code runs
   # on NumPy 2, and what it needs (numpy, pillow) comes with the test extra.

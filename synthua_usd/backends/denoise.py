@@ -12,7 +12,7 @@ Why this order and these inputs:
   per pixel their edges are anti-aliased from those few samples only, so the filter runs **without**
   ``cleanAux`` (OIDN then treats the guides as possibly noisy): measured on the district at 4 spp, +0.85,
   +0.24, +1.06 and 0.00 dB PSNR on four views against ``cleanAux`` on, and equal at 8 spp
-  (``tools/bench_denoise.py``, README).
+  (``tools/bench_denoise.py``, docs/rendering.md).
 * The colour is HDR scene-linear radiance (``hdr``): exposure is chosen afterwards, from the denoised image.
 * **Fireflies.** Mitsuba's ``path`` integrator gives no access to single samples, so samples are not clamped;
   instead :func:`suppress_fireflies` runs before OIDN: a pixel whose luminance exceeds ``FIREFLY_RATIO`` times

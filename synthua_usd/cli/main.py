@@ -212,7 +212,7 @@ def create_district(out_dir: Path, seed: int) -> int:
 @click.option("--denoise/--no-denoise", default=None,
               help="Denoise RGB: a firefly filter, then Intel Open Image Denoise guided by albedo and normal from the "
                    "same samples, before fog, rain and exposure (box pixel filter either way) [default: on; see the "
-                   "README's Denoising for what each sample count reaches].")
+                   "docs/rendering.md's Denoising for what each sample count reaches].")
 @click.option("--max-depth", type=click.IntRange(1, 1024),
               help=f"Path length of the RGB pass [default: {RenderConfig.max_depth}; 4 matches Cycles' max_bounces 2].")
 @click.option("--layer", "layers", multiple=True, type=click.Path(path_type=Path),

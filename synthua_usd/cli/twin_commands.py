@@ -208,7 +208,7 @@ def twin_demo(seed: int, out_dir: Path) -> int:
     The same seed writes byte-identical layers; another seed another plausible layout.
 
     \b
-    From here to a dataset (the README's "Your own scene"):
+    From here to a dataset (the README's quickstart):
       synthua agents populate my_district/scenario.usda --out my_district/agents.usdc
       synthua cameras author my_district/scenario.usda --layer my_district/agents.usdc \\
           --rig cctv:aim=aid_user,name=AidCCTV --out my_district/rigs.usda

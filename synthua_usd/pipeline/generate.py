@@ -13,7 +13,7 @@
    the metadata table, the coverage report, the rejected list, the class map and, last, the manifest.
 
 An image's bytes depend only on the scenario, the config and the image (box pixel filter; see the
-README's Reproducibility), never on which worker rendered it or what it rendered before: a resumed run,
+docs/datasets.md, Reproducibility), never on which worker rendered it or what it rendered before: a resumed run,
 a run on more workers and a run on Ray give the same dataset, byte for byte.
 """
 
@@ -222,7 +222,7 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     from tqdm import tqdm
 
     from synthua_usd.backends.mitsuba import variants
-    from synthua_usd.pipeline.executors import ExecutorConfig
+    from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 
     started = time.perf_counter()
     # the executor's options are checked before anything is planned or written
@@ -405,7 +405,8 @@ def worker_job_from_document(document: dict, out_dir: Path, scenario: Path | Non
 def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, workers: int, collect, out: Path) -> None:
     """Render every planned image of ``todo`` on the executor, in shards; rounds repeat for images a lost
     worker took with it."""
-    from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
+    from synthua_usd.pipeline.executors import run_shards
+    from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 
     # a shard's images follow one another in the order that changes least in its loaded scene: the condition
     # first (wetness and a sun below the horizon mean a reload), then camera and time code; with randomisation

@@ -4,7 +4,7 @@ Each actor builds its state once (``init``) and runs ``work`` for the items sent
 caller's calls on one actor in the order they were sent, so a shard's items run in order. Two items per
 actor are in flight at a time: the actor starts the next while the parent fetches the last, and results
 do not pile up in Ray's object store when the parent is slower than the workers. Actor methods return the
-same plain envelopes as the local pool's workers (:func:`~synthua_usd.pipeline.executors.call_work`), so
+same plain envelopes as the local pool's workers (:func:`~synthua_usd.pipeline.worker_protocol.call_work`), so
 errors reach the parent the same way; a Ray error on a call means the actor (its process or its node) is
 gone, and the shard continues on another actor (an idle one, else a new one).
 
@@ -21,8 +21,9 @@ from typing import Any, Callable
 
 from synthua_usd import __version__
 from synthua_usd.errors import InputError, echo
-from synthua_usd.pipeline.executors import (ExecutorConfig, ItemResult, RunSummary, WorkerError, WorkerLostError,
-                                            call_work, failure, lost_message, peak_rss_mib, raise_failure, worker_name)
+from synthua_usd.pipeline.worker_protocol import (ExecutorConfig, ItemResult, RunSummary, WorkerError, WorkerLostError,
+                                                 call_work, failure, lost_message, peak_rss_mib, raise_failure,
+                                                 worker_name)
 
 log = logging.getLogger(__name__)
 

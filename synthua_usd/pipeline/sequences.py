@@ -277,7 +277,8 @@ def render_sequences(stage, config: GenerationConfig, class_map: ClassMap, job: 
     from tqdm import tqdm
 
     from synthua_usd.errors import OutputError
-    from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
+    from synthua_usd.pipeline.executors import run_shards
+    from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 
     out = Path(job.out_dir)
     layout = Layout(out)

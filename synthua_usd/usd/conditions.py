@@ -4,7 +4,7 @@ Each variant sets ``synthua:condition:*`` attributes (the fields of
 :class:`synthua_usd.conditions.Condition`, camelCase, with their units in the name, e.g.
 ``double synthua:condition:fogVisibilityM = inf``) on ``/World/Environment``, and poses the prim's
 ``UsdLux`` ``Sun`` and ``Sky`` as a viewer's approximation of that condition (direction, a rough
-intensity). synthua's renderer uses the attributes, not the approximation (see the README, Conditions).
+intensity). synthua's renderer uses the attributes, not the approximation (see docs/rigs-and-conditions.md).
 
 A render chooses a condition without editing any layer: :func:`condition_selected` sets the variant
 selection in the stage's session layer, which is never saved, and restores it afterwards.

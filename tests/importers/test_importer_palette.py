@@ -1,6 +1,6 @@
 """The importers take their materials from the one palette (synthua_usd/materials.py): every material key a
 CityJSON, footprint or point-cloud import uses is a palette key with the palette's values, and each class
-gets the palette's material for it. Real third-party files import as before (counts from README)."""
+gets the palette's material for it. Real third-party files import as before (counts from docs/twins.md)."""
 
 from __future__ import annotations
 

@@ -23,8 +23,9 @@ import numpy as np
 import pytest
 
 from synthua_usd.errors import InputError, OutputError, StageError
-from synthua_usd.pipeline.executors import (STOP_GRACE_S, ExecutorConfig, RemoteTraceback, WorkerError,
-                                            WorkerLostError, peak_rss_mib, run_shards)
+from synthua_usd.pipeline.executors import run_shards
+from synthua_usd.pipeline.worker_protocol import (STOP_GRACE_S, ExecutorConfig, RemoteTraceback, WorkerError,
+                                                 WorkerLostError, peak_rss_mib)
 
 HERE = Path(__file__).resolve().parent
 SEED = 1234
@@ -266,7 +267,8 @@ PARENT = """
 import sys
 sys.path.insert(0, {here!r})
 from test_executors import INIT, toy_work
-from synthua_usd.pipeline.executors import ExecutorConfig, run_shards
+from synthua_usd.pipeline.executors import run_shards
+from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 shards = [[("sleep", {folder!r})], [("sleep", {folder!r})]]
 run_shards(shards, INIT, toy_work, print, ExecutorConfig("local", workers=2))
 """

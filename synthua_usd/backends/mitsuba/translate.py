@@ -57,7 +57,7 @@ def light_sampling_weight(light: Light, up: np.ndarray) -> float:
 
     Why: a distant light is a delta light that only emitter sampling can reach, while BSDF sampling finds the
     dome as well (Mitsuba weighs the two by MIS), so sampling the sun more often removes most of the noise of
-    sunlit surfaces. Measured on the district (320x240, two views, 256-spp reference; README "Rendering
+    sunlit surfaces. Measured on the district (320x240, two views, 256-spp reference; docs/rendering.md "Rendering
     backend"): picking by these weights instead of evenly gained 3.9 dB at 16 spp and 1.2-1.4 dB at 8 spp + OIDN.
     A light that brings nothing to an up-facing surface (a sun below the horizon) keeps a small weight."""
     tone = float(np.mean(light.color))
@@ -112,7 +112,7 @@ def film_dict(config: RenderConfig, width: int | None = None, height: int | None
 #: The sampler of every RGB pass: Mitsuba's correlated multi-jittered sampler (Kensler 2013). Its samples are
 #: stratified in each pair of dimensions, so where a pixel holds detail smaller than itself (edges of cobbles,
 #: awnings, people, fine texture) its coverage is estimated far better than by independent samples, and the
-#: denoiser starts from less noise (measured in README "Denoising").
+#: denoiser starts from less noise (measured in docs/rendering.md, "Denoising").
 SAMPLER = "multijitter"
 #: Mitsuba's multi-jittered sampler draws an r x c grid with r = isqrt(n), c = ceil(n / r) and rounds other
 #: counts up (5 -> 6); every pass asks for a count it takes as it is (:func:`pass_sample_counts`).

@@ -1,5 +1,5 @@
 """Same seed, same bytes: RGB with the box pixel filter is bit-identical between sessions, whatever a
-session rendered before; with the Gaussian filter, the LLVM variant's splats race (see the README)."""
+session rendered before; with the Gaussian filter, the LLVM variant's splats race (see docs/rendering.md)."""
 
 from __future__ import annotations
 
