@@ -48,15 +48,18 @@ from dataclasses import dataclass
 from multiprocessing.connection import wait
 from typing import Any, Callable, Sequence, TypeVar
 
-
-log = logging.getLogger(__name__)
-
-from synthua_usd.pipeline.worker_protocol import (STOP_GRACE_S, ExecutorConfig, ItemResult, R, RunSummary,
+from synthua_usd.pipeline.worker_protocol import (ExecutorConfig, ItemResult, R, RunSummary,
                                                  WorkerLostError, call_work, failure, lost_message, peak_rss_mib,
                                                  raise_failure, worker_name)
 
+log = logging.getLogger(__name__)
+
 T = TypeVar("T")
 S = TypeVar("S")
+
+#: Seconds a stopped worker gets to exit before it is terminated, then killed.
+STOP_GRACE_S = 5.0
+
 
 def run_shards(shards: Sequence[Sequence[T]], init: Callable[[], S], work: Callable[[S, T], R],
                on_result: Callable[[ItemResult[R]], None], config: ExecutorConfig = ExecutorConfig()) -> RunSummary:

@@ -1,7 +1,7 @@
 """What a worker and its parent exchange under either executor (:mod:`synthua_usd.pipeline.executors`' local
 pool, :mod:`synthua_usd.pipeline.ray_executor`'s actors): the run's settings, an item's result, the run's summary,
-the envelopes a worker sends back and how the parent raises a worker's failure. Both executors import it; neither
-imports the other's module from here, so the two stay out of each other's way."""
+the envelopes a worker sends back and how the parent raises a worker's failure. Both executors import it, so
+neither needs the other."""
 
 from __future__ import annotations
 
@@ -25,9 +25,6 @@ R = TypeVar("R")
 
 #: The executors :func:`run_shards` knows.
 EXECUTORS = ("local", "ray")
-
-#: Seconds a stopped worker gets to exit before it is terminated, then killed.
-STOP_GRACE_S = 5.0
 
 #: The install line given when Ray is asked for and missing.
 RAY_INSTALL = "pip install 'synthua-usd[ray]'"

@@ -23,9 +23,9 @@ import numpy as np
 import pytest
 
 from synthua_usd.errors import InputError, OutputError, StageError
-from synthua_usd.pipeline.executors import run_shards
-from synthua_usd.pipeline.worker_protocol import (STOP_GRACE_S, ExecutorConfig, RemoteTraceback, WorkerError,
-                                                 WorkerLostError, peak_rss_mib)
+from synthua_usd.pipeline.executors import STOP_GRACE_S, run_shards
+from synthua_usd.pipeline.worker_protocol import (ExecutorConfig, RemoteTraceback, WorkerError, WorkerLostError,
+                                                 peak_rss_mib)
 
 HERE = Path(__file__).resolve().parent
 SEED = 1234
