@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from synthua_usd.cli.main import main
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parent / "data"
@@ -69,7 +69,7 @@ def lamps_scenario(tmp_path_factory) -> Path:
     person; camera /World/Cam) for condition tests."""
     import shutil
 
-    from synthua_usd.scenario import SHIPPED_ENVIRONMENT, StageMetadata
+    from synthua_usd.composition.scenario import SHIPPED_ENVIRONMENT, StageMetadata
     from synthua_usd.usd.authoring import save_layer_atomic
     from synthua_usd.usd.compose import compose_layers
     from synthua_usd.usd.scenario_layers import build_environment
@@ -84,7 +84,7 @@ def lamps_scenario(tmp_path_factory) -> Path:
 def activate_variant(name: str):
     """The ``mitsuba`` module with ``name`` active, or skip the test when this machine cannot run it."""
     from synthua_usd.backends.mitsuba import variants
-    from synthua_usd.errors import InputError
+    from synthua_usd.core.errors import InputError
 
     try:
         return variants.activate(name)

@@ -13,7 +13,7 @@ import io
 import numpy as np
 
 from synthua_usd.dataset.formats.cityscapes import cityscapes_labels
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 
 def cityscapes_evaluation(monkeypatch, class_map: ClassMap):
@@ -65,11 +65,11 @@ def coco_keypoint_self_evaluation(gt) -> dict[str, float]:
     """COCOeval's keypoint AP (OKS) of ``gt`` (a pycocotools COCO) against its own keypoints as detections
     with score 1, per category that has labelled keypoints on an annotation that is not a crowd (an ignore
     region, iscrowd 1: the detections on those are passed too, and COCOeval must neither reward nor penalise
-    them), each with its own OKS sigmas (:func:`synthua_usd.keypoint_classes.sigmas`: COCOeval takes one
+    them), each with its own OKS sigmas (:func:`synthua_usd.model.keypoint_classes.sigmas`: COCOeval takes one
     sigma array for all the categories it evaluates); 1.0 for each when the format is right."""
     from pycocotools.cocoeval import COCOeval
 
-    from synthua_usd.keypoint_classes import sigmas
+    from synthua_usd.model.keypoint_classes import sigmas
 
     dets = [{"image_id": a["image_id"], "category_id": a["category_id"], "keypoints": a["keypoints"], "score": 1.0}
             for a in gt.dataset["annotations"] if a.get("num_keypoints")]

@@ -11,7 +11,7 @@ import numpy as np
 from scipy import ndimage
 
 from synthua_usd.dataset.annotations import annotate, panoptic
-from synthua_usd.scene import Instance
+from synthua_usd.model.scene import Instance
 
 H, W = 40, 48
 

@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import read_snapshot
 from synthua_usd.usd.stage_io import open_stage

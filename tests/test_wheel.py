@@ -14,6 +14,7 @@ import os
 import site
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 from conftest import REPO
@@ -30,6 +31,11 @@ def test_the_wheel_installed_alone_creates_the_district_and_generates_from_it(tm
     wheels = tmp_path / "wheels"
     run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", wheels, REPO], REPO)
     (wheel,) = wheels.glob("synthua_usd-*.whl")
+    with zipfile.ZipFile(wheel) as archive:
+        carried = set(archive.namelist())
+    sources = {p.relative_to(REPO).as_posix() for p in (REPO / "synthua_usd").rglob("*.py")}
+    schemas = {f"synthua_usd/schema_files/{p.name}" for p in (REPO / "schemas").glob("*.json")}
+    assert sources | schemas | {"synthua_usd/assets/data/bodies.npz"} <= carried, sorted(sources | schemas - carried)
     venv = tmp_path / "venv"
     run([sys._base_executable, "-m", "venv", venv], tmp_path)
     python = venv / "bin" / "python"

@@ -19,7 +19,7 @@ from conftest import DATA
 from pxr import Sdf, UsdGeom, UsdLux, UsdShade
 
 from synthua_usd.backends.mitsuba.translate import translate
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig
 
 
 #: 8 wide, 6 tall, every texel different: a transposed, mirrored or flipped lookup cannot pass.

@@ -25,8 +25,8 @@ GROUPS = ("person", "vehicle", "accessibility", "furniture")
 
 def main() -> None:
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.reader import read_snapshot
     from synthua_usd.usd.stage_io import open_stage

@@ -39,9 +39,9 @@ def capture(args) -> None:
     from synthua_usd.dataset.config import GenerationConfig
     from synthua_usd.dataset.formats import yolo
     from synthua_usd.dataset.sampling import PlannedImage
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.pipeline import dataset_worker
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
 
     class_map = ClassMap.default()
     document = json.loads((REPO / "configs" / "district.json").read_text())
@@ -89,7 +89,7 @@ class _Replay:
     """The parts of a worker's state ``render_image`` uses, answering with the captured frame."""
 
     def __init__(self, frame: dict) -> None:
-        from synthua_usd.taxonomy import ClassMap
+        from synthua_usd.model.taxonomy import ClassMap
 
         self.job = frame["job"]
         self.class_map = ClassMap.from_document(self.job.class_map_document, source="class_map.json")

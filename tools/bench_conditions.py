@@ -35,9 +35,9 @@ def main() -> int:
     args = parser.parse_args()
 
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.conditions import display_order
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.conditions import display_order
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.conditions import condition_names, read_condition
     from synthua_usd.usd.reader import StageReader

@@ -20,10 +20,10 @@ a denoiser):
   N spp box + OIDN, no ff    (ablation, the default N only) the same without the firefly filter
   N spp gaussian + OIDN      (ablation, the default N only) OIDN on correlated noise
 
-and is scored with synthua_usd.image_quality (PSNR and SSIM on display values at the reference's exposure,
+and is scored with synthua_usd.backends.image_quality (PSNR and SSIM on display values at the reference's exposure,
 metered as rgb.png is: over the pixels whose label-pass ray sees a surface, not the sky or the void).
 The reference's own noise caps every score: the ceiling printed per view is what a noise-free image would score,
-from the difference of the two halves (synthua_usd.image_quality.reference_ceiling_db).
+from the difference of the two halves (synthua_usd.backends.image_quality.reference_ceiling_db).
 Time is the RGB pass plus denoising (labels and scene loads left out; each setting renders one warm-up
 frame first so kernel compilation is not counted). Other seeds than the reference's. Printed: one row per
 view and setting, then per setting the mean PSNR, the minimum PSNR, the mean SSIM, the mean time and the
@@ -87,13 +87,13 @@ def main() -> int:
 
     import numpy as np
 
+    from synthua_usd.backends import denoise as denoise_module
     from synthua_usd.backends import images
     from synthua_usd.backends.denoise import FireflyReport
-    from synthua_usd.backends import denoise as denoise_module
+    from synthua_usd.backends.image_quality import psnr_db, reference_ceiling_db, reference_scale, ssim
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.image_quality import psnr_db, reference_ceiling_db, reference_scale, ssim
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.conditions import read_condition
     from synthua_usd.usd.reader import StageReader

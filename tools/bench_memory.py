@@ -40,8 +40,8 @@ def main() -> int:
     args = parser.parse_args()
 
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.cameras import camera_paths, read_camera
     from synthua_usd.usd.reader import StageReader
     from synthua_usd.usd.stage_io import open_stage, time_range

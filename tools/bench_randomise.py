@@ -47,10 +47,10 @@ def main() -> int:
     args = parser.parse_args()
 
     from synthua_usd.backends.mitsuba.session import RenderSession
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.pipeline.randomiser import Randomiser
     from synthua_usd.randomisation.config import RandomisationConfig
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
     from synthua_usd.usd.cameras import camera_paths, read_camera
     from synthua_usd.usd.conditions import read_condition
     from synthua_usd.usd.reader import StageReader

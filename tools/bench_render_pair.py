@@ -31,8 +31,8 @@ AGENTS = "/World/Agents"
 def child(args: argparse.Namespace) -> dict:
     """Measure one scenario in this process (see the module's docstring)."""
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.reader import StageReader
     from synthua_usd.usd.stage_io import open_stage

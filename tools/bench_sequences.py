@@ -44,10 +44,10 @@ def main() -> int:
     from synthua_usd.dataset.config import GenerationConfig
     from synthua_usd.dataset.layout import cityscapes_city
     from synthua_usd.dataset.sequences import PlannedFrame
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.pipeline import sequences as seqs
     from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
     from synthua_usd.usd.stage_io import open_stage
 
     class_map = ClassMap.default()

@@ -14,7 +14,7 @@ Prints one markdown table with ratios, then where each target stands:
 * RGB at 16 spp (box filter) and, where the denoiser is built (``RenderConfig.denoise``), the denoised mode at
   the fewest spp that reaches 16 spp's PSNR; PSNR against a ``--reference-spp`` reference of the same view, the
   mean of two halves with other seeds, whose difference measures the reference's own noise (the PSNR a
-  noise-free image would score: :func:`synthua_usd.image_quality.reference_ceiling_db`);
+  noise-free image would score: :func:`synthua_usd.backends.image_quality.reference_ceiling_db`);
 * the whole annotated image through the dataset pipeline (``synthua generate`` on ``--views`` x seeds: RGB,
   labels, amodal masks, annotations, QA, every file written): images/min and seconds per image by part, once in
   the fast denoised mode and once at the default quality — target 15 images/min on 2 cores (300 on cuda_ad_rgb)
@@ -101,18 +101,18 @@ def verdict(met: bool | None, detail: str = "") -> str:
 
 def quality_metric():
     """(psnr(test, reference, scale) -> dB, a line saying which), both (H, W, 3) float32 scene-linear, ``scale``
-    the view's exposure (:func:`view_scale`): :func:`synthua_usd.image_quality.psnr_db` on display values."""
-    from synthua_usd.image_quality import psnr_db
+    the view's exposure (:func:`view_scale`): :func:`synthua_usd.backends.image_quality.psnr_db` on display values."""
+    from synthua_usd.backends.image_quality import psnr_db
 
     return (lambda test, reference, scale: float(psnr_db(test, reference, scale)),
-            "PSNR: synthua_usd.image_quality.psnr_db, display-referred at the reference's exposure, metered as "
+            "PSNR: synthua_usd.backends.image_quality.psnr_db, display-referred at the reference's exposure, metered as "
             "rgb.png is (over the pixels that see a surface)")
 
 
 def view_scale(reference: np.ndarray, frame) -> float:
     """The exposure scores are taken at: ``reference``'s, metered over the pixels whose label-pass ray (of
     ``frame``, any render of the view) sees a surface, the rule ``rgb.png`` is exposed by."""
-    from synthua_usd.image_quality import reference_scale
+    from synthua_usd.backends.image_quality import reference_scale
 
     return reference_scale(reference, frame.hits.mesh_index >= 0)
 
@@ -133,10 +133,10 @@ def timed(fn):
 def measure_session(args, stage, reader, views, psnr, ssim) -> dict:
     """Label pass and raw bound, RGB (reference, 16 spp, denoised), first load and per-frame updates, through one
     render session; also hands on the snapshot, cameras and references for the Cycles comparison."""
+    from synthua_usd.backends.image_quality import reference_ceiling_db
     from synthua_usd.backends.mitsuba.render import intersect_pixel_centres, render_rgb
-    from synthua_usd.image_quality import reference_ceiling_db
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.render_config import RenderConfig
+    from synthua_usd.model.render_config import RenderConfig
     from synthua_usd.usd.cameras import camera_paths, read_camera
 
     w, h, tc = args.width, args.height, args.time_code
@@ -277,7 +277,7 @@ def measure_pipeline(args, views, spp: int, denoise: bool) -> dict:
 def measure_cycles(args, session_out: dict, targets_db: dict, psnr, views) -> dict:
     from synthua_usd.backends.cycles.interchange import write_interchange
     from synthua_usd.backends.cycles.runner import CyclesJob, find_cycles_python, render_jobs
-    from synthua_usd.image_quality import reference_scale
+    from synthua_usd.backends.image_quality import reference_scale
 
     python = find_cycles_python(args.cycles_python)
     view = views[0]
@@ -493,13 +493,13 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     from synthua_usd.backends.cycles.runner import CyclesUnavailable
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.reader import StageReader
     from synthua_usd.usd.stage_io import open_stage
 
     load_before = os.getloadavg()
     psnr, psnr_note = quality_metric()
-    from synthua_usd.image_quality import ssim as ssim_of
+    from synthua_usd.backends.image_quality import ssim as ssim_of
 
     def ssim(test, reference, scale):
         return float(ssim_of(test, reference, scale))

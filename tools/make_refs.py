@@ -20,7 +20,7 @@ from conftest import MITSUBA_VARIANTS  # noqa: E402  (tests/ is put on the path 
 from reference_images import REF_SEED, REF_SPP, reference_path, render_reference, tiny_scene  # noqa: E402
 from synthua_usd.backends import images  # noqa: E402
 from synthua_usd.backends.mitsuba import variants  # noqa: E402
-from synthua_usd.errors import InputError  # noqa: E402
+from synthua_usd.core.errors import InputError  # noqa: E402
 
 
 def main() -> int:

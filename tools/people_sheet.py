@@ -45,7 +45,6 @@ ROW_GAP_M = 40.0
 
 def people_scenario():
     """The scenario spec of the sheet (see the module's docstring)."""
-    from synthua_usd import geometry as geo
     from synthua_usd.agents.crowd import CrowdParams, scripted_crowd
     from synthua_usd.agents.motion import simulate
     from synthua_usd.agents.population import Plan
@@ -53,10 +52,11 @@ def people_scenario():
     from synthua_usd.agents.seats import ORIGIN_FROM_BACK_M, SeatPlace
     from synthua_usd.assets import street
     from synthua_usd.assets.people import PersonLook
-    from synthua_usd.cameras import CameraSpec
-    from synthua_usd.materials import subset
-    from synthua_usd.scenario import ScenarioSpec, StageMetadata
-    from synthua_usd.twin import TwinModel, TwinObject, TwinPart
+    from synthua_usd.composition.scenario import ScenarioSpec, StageMetadata
+    from synthua_usd.model import meshes as geo
+    from synthua_usd.model.cameras import CameraSpec
+    from synthua_usd.model.materials import subset
+    from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart
 
     meta = StageMetadata(time_codes_per_second=24.0, start_time_code=1.0, end_time_code=24.0)
     grounds, benches, plans, looks, cameras = [], [], [], [], []

@@ -42,10 +42,10 @@ def main() -> int:
     from synthua_usd.backends import images
     from synthua_usd.backends.mitsuba.session import RenderSession
     from synthua_usd.dataset.config import GenerationConfig
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.pipeline.randomiser import Randomiser
     from synthua_usd.randomisation.config import DistrictRandomisation
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.conditions import read_condition
     from synthua_usd.usd.reader import StageReader

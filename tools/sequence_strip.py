@@ -32,8 +32,8 @@ def main() -> int:
     from PIL import Image
 
     from synthua_usd.dataset.layout import Layout
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.pipeline.sequences import boxed_frame
-    from synthua_usd.taxonomy import ClassMap
 
     layout = Layout(args.dataset)
     class_map = ClassMap.load(args.dataset / Layout.CLASS_MAP)

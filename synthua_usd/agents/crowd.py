@@ -17,7 +17,7 @@ from synthua_usd.agents.population import DEFAULT_AID_SHARE, check_density, plan
 from synthua_usd.agents.seats import find_seat_places
 from synthua_usd.agents.walkable import WALKABLE, build_grid, walkable_graph
 from synthua_usd.assets.people import PersonLook
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 
 #: Most time codes a crowd is animated over (the motion planner's work grows with agents² x time codes).

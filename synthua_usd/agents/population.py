@@ -16,7 +16,7 @@ import numpy as np
 from synthua_usd.agents.profiles import AID_PROFILES, PROFILES, AgentProfile
 from synthua_usd.agents.seats import SeatPlace
 from synthua_usd.agents.walkable import WalkableGrid, shortest_path
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 log = logging.getLogger(__name__)
 

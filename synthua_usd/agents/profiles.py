@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 
 @dataclass(frozen=True)

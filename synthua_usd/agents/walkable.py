@@ -17,7 +17,7 @@ import numpy as np
 import trimesh
 
 from synthua_usd.agents.profiles import AgentProfile
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 WALKABLE = ("sidewalk", "crosswalk", "curb_ramp", "street_road")
 CROSSING_ONLY = "road"

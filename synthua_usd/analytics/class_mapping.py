@@ -16,7 +16,7 @@ import re
 from dataclasses import dataclass
 from typing import Iterable, Sequence
 
-from synthua_usd.errors import InputError, echo
+from synthua_usd.core.errors import InputError, echo
 
 #: Test-set class names that take several of our classes when no --map is given.
 DEFAULT_ALIASES = {"wheelchair": ("manual_wheelchair", "electric_wheelchair")}

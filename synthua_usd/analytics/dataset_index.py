@@ -10,14 +10,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import shown
+from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.annotations import CROWD_ID_BASE, STUFF_ID_BASE
 from synthua_usd.dataset.layout import Layout
-from synthua_usd.dataset.qa import AidUser, aid_users
-from synthua_usd.errors import InputError
-from synthua_usd.input_files import shown
 from synthua_usd.dataset.manifest import read_manifest
-from synthua_usd.schemas import read_json
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.dataset.qa import AidUser, aid_users
+from synthua_usd.model.taxonomy import ClassMap
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ from synthua_usd.analytics import plots
 from synthua_usd.analytics.csv_text import csv_text
 from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluation, Miss
 from synthua_usd.analytics.detection_sets import DetectionSet
-from synthua_usd.atomic import output_set, write_json_atomic, write_text_atomic
+from synthua_usd.core.atomic import output_set, write_json_atomic, write_text_atomic
 
 #: False negatives shown in the figure.
 SHOWN_MISSES = 12

@@ -25,9 +25,9 @@ from pathlib import Path
 
 import yaml
 
-from synthua_usd.errors import InputError
-from synthua_usd.input_files import MAX_DOCUMENT_BYTES, read_input_text, shown
-from synthua_usd.schemas import read_json
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import MAX_DOCUMENT_BYTES, read_input_text, shown
+from synthua_usd.core.schemas import read_json
 
 #: File suffixes read as images (Ultralytics' own list, lower case, less the formats OpenImageIO cannot read).
 IMAGE_SUFFIXES = (".bmp", ".jpeg", ".jpg", ".png", ".tif", ".tiff", ".webp")

@@ -13,8 +13,8 @@ from pathlib import Path
 
 from synthua_usd.analytics.detection_sets import DetectionSet, read_coco, read_yolo
 from synthua_usd.analytics.detection_targets import DetectionTargets, read_generated
-from synthua_usd.errors import InputError
-from synthua_usd.input_files import shown
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import shown
 
 FORMATS = {
     "yolo": lambda path, split, images_dir, targets: read_yolo(path, split),

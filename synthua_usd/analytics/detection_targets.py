@@ -22,11 +22,11 @@ from pathlib import Path
 from synthua_usd.analytics.dataset_index import load_class_map, manifest_images
 from synthua_usd.analytics.detection_sets import Box, DetectionSet, SetImage
 from synthua_usd.assets.devices import DEVICES
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import shown
+from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.layout import SPLITS, Layout
-from synthua_usd.errors import InputError
-from synthua_usd.input_files import shown
-from synthua_usd.detection_limits import DEFAULT_MIN_HEIGHT_PX, MIN_HEIGHT_PX
-from synthua_usd.schemas import read_json
+from synthua_usd.model.detection_limits import DEFAULT_MIN_HEIGHT_PX, MIN_HEIGHT_PX
 
 PERSON = "person"
 #: The classes trained by default: person and the eight mobility aids.

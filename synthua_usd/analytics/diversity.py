@@ -25,9 +25,9 @@ from itertools import combinations
 import numpy as np
 
 from synthua_usd.analytics.dataset_index import DatasetIndex, ImageSummary
-from synthua_usd.materials import MONK_SKIN_TONES
-from synthua_usd.scenario import CROWD_ROOT
-from synthua_usd.srgb import from_linear
+from synthua_usd.composition.scenario import CROWD_ROOT
+from synthua_usd.model.materials import MONK_SKIN_TONES
+from synthua_usd.model.srgb import from_linear
 
 #: Most image pairs the class-map disagreement reads.
 MAX_PAIRS = 200

@@ -20,12 +20,12 @@ import numpy as np
 
 from synthua_usd.analytics import segmentation_metrics as sm
 from synthua_usd.analytics.dataset_index import load_class_map, manifest_images
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.input_files import check_input_file, shown
+from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.annotations import rle_problem
 from synthua_usd.dataset.layout import SPLITS, Layout, inside
-from synthua_usd.errors import InputError, echo
-from synthua_usd.input_files import check_input_file, shown
-from synthua_usd.schemas import read_json
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 #: Largest prediction image read (bytes): far above any label map of a 16384-pixel-wide image in PNG.
 MAX_PNG_BYTES = 512 * 2**20

@@ -15,7 +15,7 @@ from pathlib import Path
 from synthua_usd.analytics import plots
 from synthua_usd.analytics.csv_text import csv_text
 from synthua_usd.analytics.evaluation import SemanticEvaluation
-from synthua_usd.atomic import output_set, write_json_atomic, write_text_atomic
+from synthua_usd.core.atomic import output_set, write_json_atomic, write_text_atomic
 
 
 def class_rows(ev: SemanticEvaluation) -> list[dict]:

@@ -10,7 +10,7 @@ elsewhere; it refers only to files inside the folder, by relative paths::
                       aid_area,aid_users}.png
     REPORT_DIR/gallery/{name}.png        RGB with the class colours laid over at 50 % (unlabelled left clear)
 
-Everything is written into a staging folder and moved into place as a set (:func:`synthua_usd.atomic.output_set`).
+Everything is written into a staging folder and moved into place as a set (:func:`synthua_usd.core.atomic.output_set`).
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ from synthua_usd.analytics import plots
 from synthua_usd.analytics.csv_text import csv_text
 from synthua_usd.analytics.dataset_index import DatasetIndex, ImageSummary
 from synthua_usd.analytics.statistics import DatasetStatistics, mobility_aid_classes
-from synthua_usd.atomic import output_set, write_json_atomic, write_text_atomic
-from synthua_usd.errors import InputError
-from synthua_usd.input_files import shown
+from synthua_usd.core.atomic import output_set, write_json_atomic, write_text_atomic
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import shown
 
 OVERLAY_ALPHA = 0.5
 PLOTS = ("class_distribution", "area_boxplot", "cooccurrence", "coverage_cdf", "instances_per_image", "aid_area",

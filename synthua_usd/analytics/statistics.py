@@ -28,9 +28,9 @@ from synthua_usd.analytics import measures as m
 from synthua_usd.analytics.dataset_index import DatasetIndex
 from synthua_usd.analytics.diversity import diversity
 from synthua_usd.assets.devices import DEVICES
-from synthua_usd.errors import InputError
-from synthua_usd.input_files import shown
-from synthua_usd.taxonomy import SemanticClass
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import shown
+from synthua_usd.model.taxonomy import SemanticClass
 
 #: Occlusion buckets of aid users (the same edges as coverage.json's).
 OCCLUSION_EDGES = (0.0, 0.25, 0.5, 0.75, 1.0)

@@ -22,9 +22,9 @@ import numpy as np
 import torch
 
 from synthua_usd.analytics.dataset_index import manifest_images
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.layout import SPLITS, Layout
-from synthua_usd.errors import InputError
-from synthua_usd.schemas import read_json
 
 
 def collate(batch):

@@ -1,7 +1,7 @@
 """Parametric low-poly assets as plain geometry: each builder returns named parts in local metres.
 
 A builder returns ``list[TwinPart]`` (part name, points, triangles, material key of
-:mod:`synthua_usd.materials`). Local frames put the asset's footprint centre at the origin on z = 0 with
+:mod:`synthua_usd.model.materials`). Local frames put the asset's footprint centre at the origin on z = 0 with
 its front facing +X, unless a docstring says otherwise. Placement (translation, rotation about Z) is done
 by :func:`place`.
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthua_usd.twin import TwinPart
+from synthua_usd.model.twin import TwinPart
 
 
 def place(parts: list[TwinPart], at, heading_deg: float = 0.0) -> list[TwinPart]:

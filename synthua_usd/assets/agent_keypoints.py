@@ -1,5 +1,5 @@
 """Keypoints of a posed agent, consistent with the geometry that renders: the 17 COCO body keypoints and
-the contact points of its mobility aid (names: :mod:`synthua_usd.keypoint_classes`).
+the contact points of its mobility aid (names: :mod:`synthua_usd.model.keypoint_classes`).
 
 The rendered body is its base posture's skinned mesh moved rigidly per segment
 (:func:`synthua_usd.assets.postures.segment_motion`), so a keypoint is computed the same way: the bank's
@@ -25,7 +25,7 @@ import numpy as np
 from synthua_usd.assets import devices
 from synthua_usd.assets.bodies import BONES, SEGMENTS, Bank, Pose, skin, skin_keypoints
 from synthua_usd.assets.postures import AID_OFFSETS, DeviceFit
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
 
 #: How far above its lowest point a device point still counts as its tip, metres.
 TIP_BAND_M = 0.005

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.keypoint_classes import PERSON_KEYPOINTS
+from synthua_usd.model.keypoint_classes import PERSON_KEYPOINTS
 
 log = logging.getLogger(__name__)
 

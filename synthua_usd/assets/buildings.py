@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from synthua_usd import geometry as geo
-from synthua_usd.twin import TwinPart
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.twin import TwinPart
 
 STOREY_M = 3.2
 

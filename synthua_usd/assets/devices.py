@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthua_usd import geometry as geo
 from synthua_usd.assets.postures import DeviceFit
-from synthua_usd.twin import TwinPart
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.twin import TwinPart
 
 
 def manual_wheelchair(fit: DeviceFit = DeviceFit()) -> list[TwinPart]:

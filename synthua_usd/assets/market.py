@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from synthua_usd import geometry as geo
-from synthua_usd.twin import TwinPart
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.twin import TwinPart
 
 
 def tent(size: float = 3.0, height: float = 2.4, canvas: str = "CanvasWhite") -> list[TwinPart]:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthua_usd import geometry as geo
-from synthua_usd.twin import TwinPart
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.twin import TwinPart
 
 
 def tree(rng: np.random.Generator, height: float = 7.0) -> list[TwinPart]:

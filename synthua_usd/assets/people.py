@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from synthua_usd.assets.bodies import load_bank
-from synthua_usd.materials import SHIRTS, SHOES, SKINS, TROUSERS
+from synthua_usd.model.materials import SHIRTS, SHOES, SKINS, TROUSERS
 
 
 @dataclass(frozen=True)

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthua_usd import geometry as geo
-from synthua_usd.twin import TwinPart
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.twin import TwinPart
 
 
 def light_pole(height: float = 4.5, arm: float = 0.0) -> tuple[list[TwinPart], list[TwinPart]]:

@@ -1,13 +1,13 @@
 """Vehicles: car, bus, motorcycle, bicycle. Front faces +X; footprint centre at the origin on z = 0.
 
 Head and tail lamps are parts of their own, tagged ``lamp=headlamp|taillamp`` (authored as ``synthua:lamp``),
-that stand 1 cm proud of the body: a night condition makes them emitters (:mod:`synthua_usd.lamps`).
+that stand 1 cm proud of the body: a night condition makes them emitters (:mod:`synthua_usd.model.lamps`).
 """
 
 from __future__ import annotations
 
-from synthua_usd import geometry as geo
-from synthua_usd.twin import TwinPart
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.twin import TwinPart
 
 
 def _wheels(xs, half_track, radius, width, sections=16):

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synthua_usd.photometry import luminance
+from synthua_usd.model.photometry import luminance
 
 log = logging.getLogger(__name__)
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synthua_usd.photometry import CD_PER_M2_PER_UNIT, luminance
+from synthua_usd.model.photometry import CD_PER_M2_PER_UNIT, luminance
 
 KEY = 0.18
 METER_K = 12.5
@@ -56,7 +56,7 @@ class Exposure:
 
 def choose_exposure(rgb: np.ndarray, metered: np.ndarray | None = None, compensation_ev: float = 0.0) -> Exposure:
     """The exposure of (H, W, 3) scene-linear Rec.709 ``rgb`` in renderer units (see
-    :mod:`synthua_usd.photometry`), metered over the (H, W) bool mask ``metered`` (pixels that see a
+    :mod:`synthua_usd.model.photometry`), metered over the (H, W) bool mask ``metered`` (pixels that see a
     surface; None or an empty mask: every pixel), then brightened by ``compensation_ev`` stops (the camera's
     USD ``exposure``)."""
     lum = np.maximum(luminance(rgb), 0.0) * CD_PER_M2_PER_UNIT

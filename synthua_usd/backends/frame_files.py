@@ -1,10 +1,10 @@
-"""Writing one rendered frame: the files of its outputs (:mod:`synthua_usd.outputs`) and ``frame.json``.
+"""Writing one rendered frame: the files of its outputs (:mod:`synthua_usd.core.outputs`) and ``frame.json``.
 
 Image files are encoded in parallel on a small thread pool (OpenImageIO releases the GIL while it
 encodes): the caller's (a :class:`synthua_usd.pipeline.background.BackgroundWriter`'s encoders, when frames are
 written while the next one renders) or one made for the call; :func:`write_frame` returns when every file is
 written. Each file is written atomically; the caller writes a whole command's frames into a staging folder
-(:func:`synthua_usd.atomic.output_set`).
+(:func:`synthua_usd.core.atomic.output_set`).
 """
 
 from __future__ import annotations
@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.atomic import write_json_atomic
 from synthua_usd.backends import images, previews
-from synthua_usd.outputs import DEPTH_DEFINITION, FRAME_DOCUMENT, RenderOutput
-from synthua_usd.schemas import validate_document
+from synthua_usd.core.atomic import write_json_atomic
+from synthua_usd.core.outputs import DEPTH_DEFINITION, FRAME_DOCUMENT, RenderOutput
+from synthua_usd.core.schemas import validate_document
 
 
 def _jobs(output: RenderOutput, out_dir: Path, *, rgb, class_ids, instance_ids, z_depth, palette, display_scale):

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import OpenImageIO as oiio
 
-from synthua_usd.atomic import atomic_path, write_failure
+from synthua_usd.core.atomic import atomic_path, write_failure
 
 LINEAR_SPACE = "lin_rec709_scene"
 DISPLAY_SPACE = "srgb_rec709_scene"

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.atomic import atomic_path
+from synthua_usd.core.atomic import atomic_path
 
 CODEC = "libx264"
 

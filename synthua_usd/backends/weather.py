@@ -39,7 +39,7 @@ import math
 
 import numpy as np
 
-from synthua_usd.cameras import PinholeCamera
+from synthua_usd.model.cameras import PinholeCamera
 
 FOG_ASYMMETRY_G = 0.85
 SHUTTER_S = 1.0 / 50.0

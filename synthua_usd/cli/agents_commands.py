@@ -8,7 +8,7 @@ import click
 
 from synthua_usd.cli.common import EXIT_OK, say
 from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
-from synthua_usd.ranges import Range
+from synthua_usd.model.ranges import Range
 
 # --- agents -----------------------------------------------------------------------------------------------
 

@@ -9,8 +9,8 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK, say
-from synthua_usd.dataset.layout import check_outside_datasets
-from synthua_usd.errors import InputError
+from synthua_usd.core.dataset_folders import check_outside_datasets
+from synthua_usd.core.errors import InputError
 
 
 @click.command()
@@ -83,7 +83,7 @@ def evaluate(gt_dir: Path, pred: Path, out_dir: Path, split: str | None) -> int:
     """
     from synthua_usd.analytics.evaluation import evaluate_coco, evaluate_semantic
     from synthua_usd.analytics.evaluation_report import write_evaluation
-    from synthua_usd.input_files import shown
+    from synthua_usd.core.input_files import shown
 
     check_outside_datasets(out_dir)  # before the work: write_evaluation would refuse it at the end
     if pred.suffix.lower() == ".json":

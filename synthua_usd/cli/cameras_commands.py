@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, parse_time_codes, say
-from synthua_usd.errors import escape_controls
+from synthua_usd.core.errors import escape_controls
 
 
 @click.group()
@@ -25,7 +25,7 @@ def cameras() -> None:
 @cameras.command("types")
 def cameras_types() -> int:
     """List the rig types with their height ranges, lenses, default aim and options."""
-    from synthua_usd.rigs import describe_types
+    from synthua_usd.composition.rigs import describe_types
 
     click.echo(describe_types())
     return EXIT_OK
@@ -89,8 +89,8 @@ def cameras_author(scenario: Path, rigs: tuple[str, ...], out_path: Path, min_ta
     Distortion (k1, k2, k3, p1, p2; OpenCV's convention) is stored on the camera as synthua:distortion:*
     attributes and applied to RGB and labels alike by `synthua render`.
     """
+    from synthua_usd.composition.rigs import RigSpec
     from synthua_usd.pipeline.camera_rigs import RigRequest, author_rigs
-    from synthua_usd.rigs import RigSpec
 
     specs = tuple(RigSpec.parse(text) for text in rigs)
     result = author_rigs(RigRequest(stage_path=scenario, out_path=out_path, rigs=specs, width=width, height=height,

@@ -8,8 +8,8 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.failures import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK  # noqa: F401 (re-exported)
-from synthua_usd.errors import escape_controls
-from synthua_usd.timecodes import parse_time_code_spec
+from synthua_usd.core.errors import escape_controls
+from synthua_usd.model.timecodes import parse_time_code_spec
 
 
 def say(line: str) -> None:
@@ -20,14 +20,14 @@ def say(line: str) -> None:
 
 def load_class_map(path: Path | None):
     """The class map at ``path``, or the bundled one."""
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.taxonomy import ClassMap
 
     return ClassMap.load(path) if path else ClassMap.default()
 
 
 def parse_time_codes(ctx, param, values: tuple[str, ...]) -> tuple[float, ...]:
     """``--time-code 24 --time-code 1:48:8 --frame 1,12``: single time codes, comma lists, and START:END[:STEP]
-    ranges with END included when the steps reach it (:func:`synthua_usd.timecodes.parse_time_code_spec`)."""
+    ranges with END included when the steps reach it (:func:`synthua_usd.model.timecodes.parse_time_code_spec`)."""
     out: list[float] = []
     for value in values:
         try:

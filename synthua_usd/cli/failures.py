@@ -25,7 +25,7 @@ from typing import Callable, Iterator
 
 import click
 
-from synthua_usd.errors import SynthuaError, echo, escape_controls
+from synthua_usd.core.errors import SynthuaError, echo, escape_controls
 
 EXIT_OK, EXIT_FINDINGS, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
 

@@ -21,14 +21,14 @@ from synthua_usd.cli.cameras_commands import cameras
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map, say
 from synthua_usd.cli.common import parse_time_codes as _time_codes
 from synthua_usd.cli.dataset_commands import generate, replay, verify
+from synthua_usd.cli.failures import configure_logging, guarded
 from synthua_usd.cli.randomise_commands import randomise
 from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.train_commands import evaluate_real, train
 from synthua_usd.cli.twin_commands import twin
-from synthua_usd.cli.failures import configure_logging, guarded
-from synthua_usd.findings import Finding, Severity
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.core.findings import Finding, Severity
+from synthua_usd.model.render_config import RenderConfig
 
 
 def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
@@ -86,8 +86,8 @@ def validate_classes(file: Path | None, as_json: bool, strict: bool) -> int:
     Runs the JSON Schema first, then rules it cannot express: unique ids, names, aliases and colours,
     id 0 = black 'unlabelled', and a minimum CIEDE2000 distance between class colours.
     """
-    from synthua_usd.classmap_checks import check_classmap
-    from synthua_usd.schemas import bundled_path, read_json
+    from synthua_usd.core.schemas import bundled_path, read_json
+    from synthua_usd.model.classmap_checks import check_classmap
 
     path = file or bundled_path("classmap.json")
     return _report(check_classmap(read_json(path)), as_json, strict)
@@ -149,8 +149,8 @@ def compose(out: Path, layers: tuple[Path, ...], allow_external_assets: bool) ->
               help="Accept layers outside the stage's folder tree (refused by default).")
 def inspect(stage: Path, class_map: Path | None, allow_external_assets: bool) -> int:
     """Print what STAGE holds: layer stack, prims per class, cameras, lights, conditions and time range."""
-    from synthua_usd.usd.summary import summarize
     from synthua_usd.usd.stage_io import open_stage
+    from synthua_usd.usd.summary import summarize
 
     click.echo(summarize(open_stage(stage, allow_external_assets), load_class_map(class_map)).format())
     return EXIT_OK

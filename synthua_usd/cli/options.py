@@ -1,4 +1,4 @@
-"""Numeric option types built from the library's stated ranges (:class:`synthua_usd.ranges.Range`).
+"""Numeric option types built from the library's stated ranges (:class:`synthua_usd.model.ranges.Range`).
 
 click's ``FloatRange`` lets NaN through (every comparison with NaN is false) and accepts infinities when a
 bound is open; :class:`InRange` refuses both, and its message names the option as typed and states the
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import click
 
-from synthua_usd.errors import echo
-from synthua_usd.ranges import Range
+from synthua_usd.core.errors import echo
+from synthua_usd.model.ranges import Range
 
 
 class InRange(click.ParamType):

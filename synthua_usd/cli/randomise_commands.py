@@ -9,7 +9,7 @@ import click
 
 from synthua_usd.cli.common import EXIT_OK
 from synthua_usd.cli.options import InRange
-from synthua_usd.ranges import Range
+from synthua_usd.model.ranges import Range
 
 
 @click.command()

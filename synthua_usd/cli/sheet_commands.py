@@ -40,7 +40,7 @@ def contact_sheet(scenario: Path, time_code: float | None, cameras: tuple[str, .
     """
     import math
 
-    from synthua_usd.errors import InputError
+    from synthua_usd.core.errors import InputError
     from synthua_usd.pipeline.contact_sheet import SheetRequest, make_contact_sheet
 
     if time_code is not None and not math.isfinite(time_code):

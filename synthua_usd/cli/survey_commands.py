@@ -9,8 +9,8 @@ import click
 
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, say
 from synthua_usd.cli.options import InRange
-from synthua_usd.errors import echo
-from synthua_usd.survey import LIMITS, THRESHOLD
+from synthua_usd.core.errors import echo
+from synthua_usd.model.survey import LIMITS, THRESHOLD
 
 # --- survey -----------------------------------------------------------------------------------------------
 
@@ -51,7 +51,7 @@ def survey_flight_plan(as_json: bool, **kwargs) -> int:
         --area-width-m 1225 --area-length-m 1225 --sensor-width-mm 13.2 --focal-length-mm 10.26 \\
         --image-width-px 5472
     """
-    from synthua_usd.survey import FlightPlanInput, check_flight_input, plan_flight
+    from synthua_usd.model.survey import FlightPlanInput, check_flight_input, plan_flight
 
     check_flight_input(kwargs, option_name)  # the GSD options go together: named as typed
     plan = plan_flight(FlightPlanInput(**kwargs), option_name)
@@ -79,7 +79,7 @@ def survey_gcp(surveyed: Path, model: Path, threshold_m: float, as_json: bool) -
 
     Both are CSV files with a header id,x,y,z (metres). Exit 1 when the RMSE exceeds --threshold-m.
     """
-    from synthua_usd.survey import gcp_report, read_points_csv
+    from synthua_usd.model.survey import gcp_report, read_points_csv
 
     report = gcp_report(read_points_csv(surveyed), read_points_csv(model), threshold_m,
                         names=(str(surveyed), str(model)))

@@ -8,8 +8,8 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK
-from synthua_usd import detection_limits as L
 from synthua_usd.cli.options import InRange
+from synthua_usd.model import detection_limits as L
 
 _FORMAT = click.Choice(["auto", "yolo", "coco", "synthua"])
 _DEVICE = click.Choice(L.DEVICES)
@@ -133,8 +133,8 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
     and a page of the worst false negatives (report.html, false_negatives.png). Test classes no --map names
     are not scored.
     """
-    from synthua_usd.pipeline.evaluate_real import EvaluateRequest
     from synthua_usd.pipeline.evaluate_real import evaluate_real as run
+    from synthua_usd.pipeline.evaluate_real import EvaluateRequest
 
     result = run(EvaluateRequest(model, test_set, out_dir, maps, fmt, split, images_dir, confidence,
                                  imgsz=imgsz, device=device, python=python))

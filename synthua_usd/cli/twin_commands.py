@@ -10,7 +10,7 @@ import click
 
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map, say
 from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
-from synthua_usd.errors import echo
+from synthua_usd.core.errors import echo
 from synthua_usd.importers import limits as importer_limits
 
 # --- twin -------------------------------------------------------------------------------------------------
@@ -138,8 +138,8 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     Options of one kind (--lod, --scale, ...) are refused for the others. Nothing in --out changes
     unless the whole import is written.
     """
-    from synthua_usd.class_assignment import AssignmentRules
     from synthua_usd.importers import importers
+    from synthua_usd.model.class_assignment import AssignmentRules
 
     _refuse_foreign_options(ctx, kind)
     _refuse_population_options(ctx, populate)

@@ -23,9 +23,9 @@ import numpy as np
 from pycocotools import mask as mask_utils
 from scipy import ndimage
 
-from synthua_usd.errors import InputError
-from synthua_usd.scene import Instance
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.core.errors import InputError
+from synthua_usd.model.scene import Instance
+from synthua_usd.model.taxonomy import ClassMap
 
 #: Panoptic segment id of stuff class ``c`` is ``STUFF_ID_BASE + c``: above every uint16 instance id, far
 #: below panopticapi's 2**24 limit of an RGB-encoded id.

@@ -17,13 +17,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from synthua_usd.errors import InputError, echo
-from synthua_usd.input_files import shown
+from synthua_usd.composition.rigs import RIG_TYPES
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.input_files import shown
+from synthua_usd.core.schemas import load_schema, read_json, validate_document
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.timecodes import parse_time_code_spec
 from synthua_usd.randomisation.config import RandomisationConfig
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.rigs import RIG_TYPES
-from synthua_usd.schemas import load_schema, read_json, validate_document
-from synthua_usd.timecodes import parse_time_code_spec
 
 SCHEMA = "generate"
 #: Rig-type key of cameras that carry no ``synthua:rig:type``.

@@ -2,7 +2,7 @@
 flags from the exact label pass.
 
 For each keypoint (world point ``p`` of instance ``i``), with the camera's projection
-(:meth:`synthua_usd.cameras.PinholeCamera.project`: lens distortion applied, pixel centres at +0.5) at the
+(:meth:`synthua_usd.model.cameras.PinholeCamera.project`: lens distortion applied, pixel centres at +0.5) at the
 render size, scaled to the written size when the images are resampled:
 
 * ``v = 0`` (not labelled; written as ``x = y = 0``): ``p`` is not in front of the near clipping plane, or
@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.scene import Keypoints
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.scene import Keypoints
 
 #: Half-size of the pixel neighbourhood searched for the instance around a keypoint, written pixels.
 WINDOW_PX = 2

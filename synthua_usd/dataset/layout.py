@@ -34,8 +34,9 @@ import re
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from synthua_usd.errors import OutputError
-from synthua_usd.errors import echo as escape
+from synthua_usd.core import dataset_folders
+from synthua_usd.core.errors import echo as escape
+from synthua_usd.core.errors import OutputError
 
 SPLITS = ("train", "val", "test")
 
@@ -112,7 +113,7 @@ class Layout:
 
     @staticmethod
     def record(name: str) -> str:
-        return f"records/{name}.json"
+        return f"{dataset_folders.RECORDS}/{name}.json"
 
     # per sequence
     SEQUENCES = "sequences"
@@ -153,8 +154,8 @@ class Layout:
     COVERAGE = "coverage.json"
     REJECTED = "rejected.csv"
     CLASS_MAP = "class_map.json"
-    MANIFEST = "manifest.json"
-    CONFIG = "generate.json"
+    MANIFEST = dataset_folders.MANIFEST
+    CONFIG = dataset_folders.CONFIG
 
 
 def inside(root: Path, relative: str) -> Path:
@@ -166,23 +167,3 @@ def inside(root: Path, relative: str) -> Path:
         raise OutputError(f"{escape(relative)!r}: a path that leaves the dataset folder or hides in it; expected a "
                           f"plain relative path inside the dataset folder")
     return Path(root).joinpath(*parts)
-
-
-def is_dataset_folder(folder: Path) -> bool:
-    """Whether ``folder`` holds a dataset of ``synthua generate``: its ``records/`` folder beside its
-    ``manifest.json`` or ``generate.json`` (either name alone is common among other tools' files)."""
-    folder = Path(folder)
-    return (folder / "records").is_dir() and ((folder / Layout.MANIFEST).is_file() or
-                                              (folder / Layout.CONFIG).is_file())
-
-
-def check_outside_datasets(out_dir: Path) -> None:
-    """Refuse an output folder that is a dataset folder (:func:`is_dataset_folder`) or lies inside one: a
-    report or a render written there would be files its manifest does not list, and could replace files it
-    does. Only ``synthua generate`` writes into a dataset."""
-    target = Path(out_dir).resolve()
-    for folder in (target, *target.parents):
-        if is_dataset_folder(folder):
-            where = "is the dataset folder" if folder == target else "lies inside the dataset folder"
-            raise OutputError(f"{escape(out_dir)}: the output folder {where} {escape(folder)}; expected a folder "
-                              f"outside every dataset (only `synthua generate` writes into one)")

@@ -46,12 +46,12 @@ def document_digest(document) -> str:
 
 
 def read_manifest(path: str | Path) -> dict:
-    """The manifest at ``path``, read with the limits of every JSON input (:func:`synthua_usd.schemas.read_json`)
+    """The manifest at ``path``, read with the limits of every JSON input (:func:`synthua_usd.core.schemas.read_json`)
     and checked against ``schemas/manifest.schema.json``: anything else is an :class:`InputError` naming the
     file and the field (a missing file: "file not found")."""
-    from synthua_usd.errors import InputError
-    from synthua_usd.input_files import shown
-    from synthua_usd.schemas import read_json, validate_document
+    from synthua_usd.core.errors import InputError
+    from synthua_usd.core.input_files import shown
+    from synthua_usd.core.schemas import read_json, validate_document
 
     path = Path(path)
     if not path.exists():

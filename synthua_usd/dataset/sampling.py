@@ -23,9 +23,9 @@ from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
+from synthua_usd.core.errors import InputError, echo
 from synthua_usd.dataset.config import NO_RIG, GenerationConfig, SplitRatios
 from synthua_usd.dataset.layout import SPLITS
-from synthua_usd.errors import InputError, echo
 
 #: Condition key of images rendered with the stage's own condition (config ``conditions`` empty).
 STAGE_CONDITION = "(stage)"

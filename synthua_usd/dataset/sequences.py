@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.config import SequencesConfig
 from synthua_usd.dataset.layout import safe_component
 from synthua_usd.dataset.sampling import CameraInfo, select_cameras, select_conditions
-from synthua_usd.errors import InputError
 
 
 @dataclass(frozen=True)

@@ -17,16 +17,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
 from synthua_usd.assets import buildings, devices, market, nature, place, street, vehicles
-from synthua_usd.cameras import CameraSpec
+from synthua_usd.composition.rigs import AimedRigs, RigSpec
+from synthua_usd.composition.scenario import ScenarioSpec, StageMetadata
 from synthua_usd.demo.district_textures import add_textures
-from synthua_usd.materials import WALL_COLOURS, subset
-from synthua_usd.rigs import AimedRigs, RigSpec
-from synthua_usd.scenario import ScenarioSpec, StageMetadata
-from synthua_usd.taxonomy import ClassMap
-from synthua_usd.twin import TwinModel, TwinObject, TwinPart
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.cameras import CameraSpec
+from synthua_usd.model.materials import WALL_COLOURS, subset
+from synthua_usd.model.taxonomy import ClassMap
+from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart
 
 ROAD_Y = (-45.0, -37.0)
 ROAD_SIDEWALK_S = (-49.5, -45.0)

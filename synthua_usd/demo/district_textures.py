@@ -10,7 +10,7 @@ The cobbled street's setts and the largo's pavers are images too (:data:`PAVED`,
 a flat surface whose colour image holds stones of the palette's shades in running bond with joints, and
 whose normal map rounds their edges.
 
-Projections (:mod:`synthua_usd.uv`): ``ground`` maps x, y straight down and keeps every point as it is; the
+Projections (:mod:`synthua_usd.geometry.uv`): ``ground`` maps x, y straight down and keeps every point as it is; the
 paving uses it (the sides of its slabs are a few centimetres tall). ``box`` aligns the image to each face (walls upright at any heading), splitting points at the box's
 edges. Neither moves a triangle, so the label maps are those of the untextured district.
 """
@@ -21,12 +21,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from synthua_usd.core.texture_images import texture_path
 from synthua_usd.demo.textures import SIZE, decode_srgb8, district_images, encode_normals8, encode_srgb8, paving
-from synthua_usd.materials import PALETTE
-from synthua_usd.scene import Texture
-from synthua_usd.texture_images import texture_path
-from synthua_usd.twin import TwinModel, TwinObject, TwinPart
-from synthua_usd.uv import box_uvs, planar_uvs
+from synthua_usd.geometry.uv import box_uvs, planar_uvs
+from synthua_usd.model.materials import PALETTE
+from synthua_usd.model.scene import Texture
+from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart
 
 #: Palette key → (image, metres per repeat of the image, projection).
 TEXTURED: dict[str, tuple[str, float, str]] = {

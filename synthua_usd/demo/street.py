@@ -13,16 +13,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd, CrowdParams, scripted_crowd
 from synthua_usd.agents.motion import simulate
 from synthua_usd.agents.population import Plan
 from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.assets.people import PersonLook
-from synthua_usd.cameras import CameraSpec
-from synthua_usd.materials import subset
-from synthua_usd.scenario import ScenarioSpec, StageMetadata
-from synthua_usd.twin import TwinModel, TwinObject, TwinPart
+from synthua_usd.composition.scenario import ScenarioSpec, StageMetadata
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.cameras import CameraSpec
+from synthua_usd.model.materials import subset
+from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart
 
 META = StageMetadata(up_axis="Z", meters_per_unit=1.0, time_codes_per_second=24.0,
                      start_time_code=1.0, end_time_code=48.0, default_prim="World")

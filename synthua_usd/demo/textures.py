@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from synthua_usd import srgb
+from synthua_usd.model import srgb
 
 SIZE = 512
 #: Image name → function of (rng, size) → (size, size, 3) linear values around 1.
@@ -114,7 +114,7 @@ def paving(rng: np.random.Generator, size: int, tile_m: float, stones: int, rows
 
     Returns (size, size, 3) linear colour (variation around the shades) and (size, size, 3) tangent-space
     normals in [-1, 1] (x along s, y along t, z out of the surface; the image's row 0 is at t = 1, as
-    :mod:`synthua_usd.uv` has it), both tileable."""
+    :mod:`synthua_usd.geometry.uv` has it), both tileable."""
     if rows % 2:
         raise ValueError(f"paving: rows should be even so that the running bond tiles, but was {rows}")
     texel = tile_m / size

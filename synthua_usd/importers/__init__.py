@@ -1,4 +1,4 @@
-"""Importers: real city data → :class:`synthua_usd.twin.TwinModel` (plain data; no USD, no renderer).
+"""Importers: real city data → :class:`synthua_usd.model.twin.TwinModel` (plain data; no USD, no renderer).
 
 Each importer module parses and validates one kind of input and returns a TwinModel; it never writes
 files. :func:`importers` maps the kind names of ``synthua twin import KIND`` to them.
@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Callable
 
 if TYPE_CHECKING:  # the twin module pulls in trimesh; the CLI imports this package at start-up
-    from synthua_usd.twin import TwinModel
+    from synthua_usd.model.twin import TwinModel
 
 Importer = Callable[..., "TwinModel"]
 

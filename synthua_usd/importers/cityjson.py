@@ -16,15 +16,15 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from synthua_usd.class_assignment import AssignmentRules
-from synthua_usd.errors import InputError, echo
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.input_files import shown
+from synthua_usd.core.schemas import read_json, type_name
 from synthua_usd.importers.crs import crs_units, parse_crs, resolve_units
 from synthua_usd.importers.limits import MAX_EXTENT_M, TRANSFORM_SCALE
-from synthua_usd.input_files import shown
-from synthua_usd.materials import class_material, subset
-from synthua_usd.ranges import COORDINATE, number_field
-from synthua_usd.schemas import read_json, type_name
-from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
+from synthua_usd.model.class_assignment import AssignmentRules
+from synthua_usd.model.materials import class_material, subset
+from synthua_usd.model.ranges import COORDINATE, number_field
+from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 
 log = logging.getLogger(__name__)
 

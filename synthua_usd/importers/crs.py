@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synthua_usd.errors import InputError, echo
+from synthua_usd.core.errors import InputError, echo
 
 
 def require_projected_metres(crs_text: str, source: str):

@@ -19,16 +19,16 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from synthua_usd.errors import InputError, echo
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.input_files import shown
+from synthua_usd.core.schemas import read_json, type_name
 from synthua_usd.importers.crs import local_tmerc, lonlat_to, require_projected_metres
 from synthua_usd.importers.heights import BuildingHeight, building_height, heights_report
 from synthua_usd.importers.limits import (DEFAULT_HEIGHT, DEFAULT_HEIGHT_M, DEFAULT_STOREY_HEIGHT_M, MAX_EXTENT_M,
                                           MIN_FOOTPRINT_AREA_M2, STOREY_HEIGHT)
-from synthua_usd.input_files import shown
-from synthua_usd.materials import class_material, subset
-from synthua_usd.ranges import COORDINATE, number_field
-from synthua_usd.schemas import read_json, type_name
-from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
+from synthua_usd.model.materials import class_material, subset
+from synthua_usd.model.ranges import COORDINATE, number_field
+from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 
 #: Palette keys of the two parts of every block.
 WALL_MATERIAL = class_material("building").key

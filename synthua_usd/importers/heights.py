@@ -26,9 +26,9 @@ import numbers
 import re
 from dataclasses import dataclass
 
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.importers.limits import HEIGHT, LEVELS, MIN_BLOCK_HEIGHT_M, MIN_HEIGHT, ROOF_LEVELS
-from synthua_usd.ranges import Range, _show
+from synthua_usd.model.ranges import Range, _show
 
 #: The sources of a building's top, in the order they are tried.
 SOURCES = ("height", "building:levels", "roof:height", "default")
@@ -181,7 +181,7 @@ def heights_report(heights: dict[str, BuildingHeight], where: str, storey_height
     """The import report's ``heights`` (the storey and default heights, how many buildings took each source,
     and every building's height and source, keyed by its object path) and its findings: one for the
     buildings that took the default height, one for those with skipped values."""
-    from synthua_usd.findings import Finding, Severity
+    from synthua_usd.core.findings import Finding, Severity
 
     counts = {s: sum(h.source == s for h in heights.values()) for s in SOURCES}
     report = {"storey_height_m": storey_height_m, "default_height_m": default_height_m, "sources": counts,

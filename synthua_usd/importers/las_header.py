@@ -16,9 +16,9 @@ import struct
 
 import numpy as np
 
-from synthua_usd.errors import InputError, echo
+from synthua_usd.core.errors import InputError, echo
 from synthua_usd.importers.limits import MAX_POINTS
-from synthua_usd.ranges import COORDINATE
+from synthua_usd.model.ranges import COORDINATE
 
 #: Largest point data a LAS/LAZ header may announce (points x record length), decompressed in memory.
 MAX_POINT_DATA_BYTES = 2 * 2**30

@@ -6,8 +6,8 @@ loading trimesh, laspy or pymeshlab. Each limit says why it is where it is.
 
 from __future__ import annotations
 
-from synthua_usd.input_files import MiB
-from synthua_usd.ranges import Range
+from synthua_usd.core.input_files import MiB
+from synthua_usd.model.ranges import Range
 
 # --- parameters --------------------------------------------------------------------------------------------
 

@@ -16,14 +16,14 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from synthua_usd.class_assignment import AssignmentRules
-from synthua_usd.errors import InputError, echo
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.input_files import check_input_file, shown
 from synthua_usd.importers.limits import MAX_MESH_BYTES, MAX_TRIANGLES, SCALE
-from synthua_usd.input_files import check_input_file, shown
 from synthua_usd.importers.mesh_materials import ImageFailures, geometry_material, obj_texture_problems
-from synthua_usd.scene import Material
-from synthua_usd.ranges import COORDINATE
-from synthua_usd.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
+from synthua_usd.model.class_assignment import AssignmentRules
+from synthua_usd.model.ranges import COORDINATE
+from synthua_usd.model.scene import Material
+from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart, prim_name, unique_paths
 
 log = logging.getLogger(__name__)
 

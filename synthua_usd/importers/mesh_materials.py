@@ -3,7 +3,7 @@
 OBJ/MTL arrive as trimesh's ``SimpleMaterial`` (``Kd``; ``map_Kd`` as ``image``), glTF/GLB as ``PBRMaterial``
 (``baseColorFactor``/``baseColorTexture``, ``metallicRoughnessTexture`` with roughness in G and metallic in B,
 ``normalTexture``, ``alphaMode``/``alphaCutoff``). Images are kept as 8-bit pixels under
-``textures/<material>_<role>.png`` (written beside the twin layer, :mod:`synthua_usd.texture_images`), and
+``textures/<material>_<role>.png`` (written beside the twin layer, :mod:`synthua_usd.core.texture_images`), and
 glTF's factors become UsdUVTexture scales: the factor multiplies the texture, as glTF says. trimesh gives
 texture coordinates per vertex with v up (OBJ's convention; it flips glTF's on load): USD's ``st`` as is.
 """
@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from synthua_usd import srgb
-from synthua_usd.scene import Material, Texture
-from synthua_usd.texture_images import texture_path
-from synthua_usd.twin import prim_name
+from synthua_usd.core.texture_images import texture_path
+from synthua_usd.model import srgb
+from synthua_usd.model.scene import Material, Texture
+from synthua_usd.model.twin import prim_name
 
 #: glTF normal textures hold n * 0.5 + 0.5; UsdPreviewSurface's normal input wants n.
 NORMAL_SCALE, NORMAL_BIAS = (2.0, 2.0, 2.0, 1.0), (-1.0, -1.0, -1.0, 0.0)
@@ -142,7 +142,7 @@ class ImageFailures(logging.Handler):
 def obj_texture_problems(path: Path) -> list[tuple[str, str, str]]:
     """(material, texture file as the MTL writes it, why it cannot be read) for every ``map_Kd`` of the MTL files
     an OBJ names (``mtllib``, beside the OBJ) whose image is missing or not one OpenImageIO opens."""
-    from synthua_usd.texture_files import unreadable
+    from synthua_usd.core.texture_files import unreadable
 
     problems = []
     with open(path, "rb") as fh:

@@ -20,14 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.errors import InputError, echo
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.input_files import check_input_file, shown
 from synthua_usd.importers.crs import local_tmerc, lonlat_to
 from synthua_usd.importers.footprints import Footprint, check_projected, extruded_model, footprint_polygon
 from synthua_usd.importers.heights import building_height
 from synthua_usd.importers.limits import (DEFAULT_HEIGHT, DEFAULT_HEIGHT_M, DEFAULT_STOREY_HEIGHT_M, MAX_OSM_BYTES,
                                           MIN_FOOTPRINT_AREA_M2, STOREY_HEIGHT)
-from synthua_usd.input_files import check_input_file, shown
-from synthua_usd.twin import TwinModel, prim_name
+from synthua_usd.model.twin import TwinModel, prim_name
 
 WHAT = "an OpenStreetMap extract (.osm or .osm.pbf)"
 #: File names pyosmium reads by their suffix.
@@ -116,7 +116,7 @@ def import_osm(path: str | Path, storey_height_m: float = DEFAULT_STOREY_HEIGHT_
     """Extrude the buildings of an OpenStreetMap extract; heights from their tags (metres), every building's
     source in the report. With ``strict``, a building without a usable height or with an invalid outline is
     refused instead of taking the next source (or ``default_height_m``) or being repaired."""
-    from synthua_usd.findings import Finding, Severity
+    from synthua_usd.core.findings import Finding, Severity
 
     path = Path(path)
     where = shown(path)

@@ -30,19 +30,19 @@ from typing import Iterator
 import numpy as np
 from tqdm import tqdm
 
-from synthua_usd.class_assignment import AssignmentRules
-from synthua_usd.errors import InputError, echo
-from synthua_usd.findings import Finding, Severity
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.findings import Finding, Severity
+from synthua_usd.core.input_files import check_input_file, shown
 from synthua_usd.importers.crs import (PROJECTED_CRS, USER_DEFINED, LinearUnits, crs_units, geotiff_units,
                                        resolve_units)
 from synthua_usd.importers.las_header import check_las_header, check_las_layout
 from synthua_usd.importers.limits import (MAX_DEVIATION, MAX_EXTENT_M, MAX_HULL_RESIDUAL, MAX_POINTCLOUD_BYTES,
                                           MAX_POINTS, MAX_RESIDUAL, PLANE_THRESHOLD)
 from synthua_usd.importers.segmentation import Region, Segmentation, fit_plane, segment, smoothed_heights
-from synthua_usd.input_files import check_input_file, shown
-from synthua_usd.materials import class_material, subset
-from synthua_usd.ranges import COORDINATE
-from synthua_usd.twin import TwinModel, TwinObject, TwinPart
+from synthua_usd.model.class_assignment import AssignmentRules
+from synthua_usd.model.materials import class_material, subset
+from synthua_usd.model.ranges import COORDINATE
+from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart
 
 log = logging.getLogger(__name__)
 

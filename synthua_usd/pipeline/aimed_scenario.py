@@ -3,7 +3,7 @@
 The scenario's layers are written into a staging folder, the rigs are placed in that staged scenario (they
 aim at its own crowd, so they can only be placed once it exists), then ``rigs.usda`` and its report join
 the layers, the render settings point at the chosen rig camera, and ``scenario.usda`` is composed again.
-Everything moves into place together (:func:`synthua_usd.atomic.output_set`).
+Everything moves into place together (:func:`synthua_usd.core.atomic.output_set`).
 """
 
 from __future__ import annotations
@@ -11,11 +11,11 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from synthua_usd.atomic import output_set
+from synthua_usd.composition.rigs import AimedRigs
+from synthua_usd.composition.scenario import CAMERAS_ROOT, LAYER_FILE, ROOT_FILE, ScenarioSpec
+from synthua_usd.core.atomic import output_set
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.camera_rigs import RigRequest, RigsResult, author_rigs
-from synthua_usd.rigs import AimedRigs
-from synthua_usd.scenario import CAMERAS_ROOT, LAYER_FILE, ROOT_FILE, ScenarioSpec
-from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.authoring import save_layer_atomic
 from synthua_usd.usd.compose import compose_layers
 from synthua_usd.usd.scenario_layers import build_render_settings

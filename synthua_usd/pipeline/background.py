@@ -9,7 +9,7 @@ files of one job (OpenImageIO releases the GIL while it encodes). The queue is b
 while ``max_pending`` jobs are still unfinished, so at most ``max_pending`` frames' buffers wait in memory
 beside the one being rendered, however long the run. Results come back in submission order; a job that
 failed raises its exception from the :meth:`submit` or :meth:`drain` that collects it — the caller's loop
-stops there, and a caller writing into an :func:`synthua_usd.atomic.output_set` leaves earlier outputs as
+stops there, and a caller writing into an :func:`synthua_usd.core.atomic.output_set` leaves earlier outputs as
 they were.
 """
 

@@ -1,7 +1,7 @@
 """Place camera rigs in a scenario, aim them at targets, and report what each camera sees: the job behind
 ``synthua cameras author``.
 
-1. Targets (:mod:`synthua_usd.usd.targets`) and candidate placements (:mod:`synthua_usd.placement`) come from
+1. Targets (:mod:`synthua_usd.usd.targets`) and candidate placements (:mod:`synthua_usd.geometry.placement`) come from
    the stage. 2. Every candidate is scored by its target's visible pixels in the label pass, at a quarter of
    the image size, at three of the report's time codes (the first, middle and last); the smallest count
    decides, and each rig keeps its ``count`` best targets. 3. The chosen cameras are rendered (labels only,
@@ -27,19 +27,19 @@ from pxr import UsdGeom
 
 from synthua_usd import __version__
 from synthua_usd.agents.walkable import WALKABLE
-from synthua_usd.atomic import atomic_path
-from synthua_usd.errors import InputError, StageError, echo
-from synthua_usd.pipeline.target_pixels import CandidateGroup, evaluate, prefilter, score
-from synthua_usd.placement import (DEFAULT_DISTANCE_M, Placement, Terrain, dashcam_candidates, fixed_candidates,
+from synthua_usd.composition.rigs import RigSpec
+from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.core.atomic import atomic_path
+from synthua_usd.core.errors import InputError, StageError, echo
+from synthua_usd.core.resources import check_frame_memory
+from synthua_usd.core.schemas import validate_document
+from synthua_usd.geometry.placement import (DEFAULT_DISTANCE_M, Placement, Terrain, dashcam_candidates, fixed_candidates,
                                    riding_placement)
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.resources import check_frame_memory
-from synthua_usd.rigs import RigSpec
-from synthua_usd.roads import ROAD_CLASSES
-from synthua_usd.scenario import StageMetadata
-from synthua_usd.scene import SceneSnapshot
-from synthua_usd.schemas import validate_document
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.geometry.roads import ROAD_CLASSES
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import SceneSnapshot
+from synthua_usd.model.taxonomy import ClassMap
+from synthua_usd.pipeline.target_pixels import CandidateGroup, evaluate, prefilter, score
 from synthua_usd.usd import targets as usd_targets
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
 from synthua_usd.usd.authoring import check_layer_path, export_layer

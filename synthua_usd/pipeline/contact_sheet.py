@@ -21,11 +21,11 @@ from synthua_usd.backends.contact_sheet import class_overlay, compose, write_she
 from synthua_usd.backends.images import linear_to_display
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.backends.mitsuba.weather_scene import scene_key
-from synthua_usd.conditions import display_order
-from synthua_usd.errors import InputError, StageError
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.resources import check_frame_memory
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.core.errors import InputError, StageError
+from synthua_usd.core.resources import check_frame_memory
+from synthua_usd.model.conditions import display_order
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.cameras import camera_paths, read_camera
 from synthua_usd.usd.conditions import check_condition_name, condition_names, read_condition
 from synthua_usd.usd.reader import StageReader

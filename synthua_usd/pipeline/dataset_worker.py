@@ -22,17 +22,17 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.atomic import atomic_path, write_json_atomic, write_text_atomic
 from synthua_usd.backends import images, previews
+from synthua_usd.core.atomic import atomic_path, write_json_atomic, write_text_atomic
+from synthua_usd.core.outputs import DEPTH_DEFINITION
 from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, onehot, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
 from synthua_usd.dataset.manifest import file_entry
-from synthua_usd.outputs import DEPTH_DEFINITION
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.background import BackgroundWriter
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.taxonomy import ClassMap
 
 #: The item that ends a shard: the worker finishes its pending write and returns that record.
 FLUSH = "flush"
@@ -167,7 +167,7 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
                      output_size: tuple[int, int] | None = None) -> AnnotatedFrame:
     """Render one frame (RGB and exact labels), trace the amodal masks the config asks for, measure truncation and
     annotate every visible instance; resampled to ``output_size`` when given."""
-    from synthua_usd.projection import truncations
+    from synthua_usd.geometry.projection import truncations
     from synthua_usd.usd.cameras import read_camera
 
     job, class_map = state.job, state.class_map

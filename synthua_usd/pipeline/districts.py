@@ -14,12 +14,12 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from synthua_usd.atomic import output_set
-from synthua_usd.errors import InputError
+from synthua_usd.composition.scenario import LAYER_FILE, ROOT_FILE
+from synthua_usd.core.atomic import output_set
+from synthua_usd.core.errors import InputError
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.randomisation.config import RandomisationConfig
 from synthua_usd.randomisation.streams import stream
-from synthua_usd.scenario import LAYER_FILE, ROOT_FILE
-from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.stage_io import open_layer
 
 #: What the demo district's twin layer says it is (``customLayerData`` ``synthua:source``).
@@ -65,8 +65,8 @@ def write_district_scene(scenario: Path, seed: int, out_dir: Path, class_map: Cl
     """Write the district of ``seed`` as a scenario in ``out_dir`` (one output set; kept when ``out_dir`` holds
     it already) and return its ``scenario.usda``; ``dataset_part``: ``out_dir`` is the scenes folder of the
     dataset being generated (the one writer allowed into a dataset)."""
+    from synthua_usd.core.texture_images import write_texture_images
     from synthua_usd.demo.district import META, build_district
-    from synthua_usd.texture_images import write_texture_images
     from synthua_usd.usd.authoring import save_layer_atomic
     from synthua_usd.usd.compose import compose_layers
     from synthua_usd.usd.twin_writer import author_twin

@@ -22,9 +22,9 @@ from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluati
 from synthua_usd.analytics.detection_report import write_detection_report
 from synthua_usd.analytics.detection_sources import detect_format, manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
-from synthua_usd import detection_limits as L
 from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
+from synthua_usd.model import detection_limits as L
 from synthua_usd.pipeline.train import check_imgsz, run_weights
 
 #: Confidence below which predictions are dropped before scoring (COCO's AP ranks every detection).

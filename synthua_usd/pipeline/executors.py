@@ -18,7 +18,7 @@ Guarantees:
   side by side, so results of different shards interleave: each :class:`ItemResult` names its shard
   and index, and the caller orders by them);
 - an error raised by ``init`` or ``work`` stops the run (the other workers are ended) and is raised in the
-  parent: :class:`~synthua_usd.errors.SynthuaError` subclasses (``InputError``, ``StageError``,
+  parent: :class:`~synthua_usd.core.errors.SynthuaError` subclasses (``InputError``, ``StageError``,
   ``OutputError``...), ``OSError`` and ``MemoryError`` as the same type with the same message; anything
   else as :class:`WorkerError`, whose ``__cause__`` carries the worker's traceback;
 - a worker that dies (native crash, out-of-memory kill, a lost Ray node) takes its state with it: its

@@ -19,18 +19,18 @@ import numpy as np
 from tqdm import tqdm
 
 from synthua_usd import __version__
-from synthua_usd.atomic import output_set
 from synthua_usd.backends.frame_files import write_frame
 from synthua_usd.backends.mitsuba.render import RenderedFrame
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.cameras import CONFORM_EXPAND, PinholeCamera
-from synthua_usd.errors import InputError, StageError, echo
-from synthua_usd.outputs import OUTPUT_NAMES, RenderOutput, select_outputs
+from synthua_usd.core.atomic import output_set
+from synthua_usd.core.errors import InputError, StageError, echo
+from synthua_usd.core.outputs import OUTPUT_NAMES, RenderOutput, select_outputs
+from synthua_usd.core.resources import check_frame_memory
+from synthua_usd.model.cameras import CONFORM_EXPAND, PinholeCamera
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import SceneSnapshot
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.background import BackgroundWriter
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.resources import check_frame_memory
-from synthua_usd.scene import SceneSnapshot
-from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.cameras import author_auto_camera, read_camera
 from synthua_usd.usd.conditions import read_condition
 from synthua_usd.usd.reader import StageReader

@@ -30,19 +30,19 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd import __version__
-from synthua_usd.atomic import write_json_atomic, write_text_atomic
+from synthua_usd.composition.scenario import ROOT_FILE
+from synthua_usd.core.atomic import write_json_atomic, write_text_atomic
+from synthua_usd.core.errors import InputError, OutputError, StageError, echo
+from synthua_usd.core.resources import check_frame_memory
 from synthua_usd.dataset import coverage, qa, sampling
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, coco, panoptic, tables, yolo
 from synthua_usd.dataset.formats.records import is_rejected
 from synthua_usd.dataset.layout import SPLITS, Layout, cityscapes_city
 from synthua_usd.dataset.manifest import document_digest, file_entry, manifest_document
-from synthua_usd.errors import InputError, OutputError, StageError, echo
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, work
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.resources import check_frame_memory
-from synthua_usd.scenario import ROOT_FILE
-from synthua_usd.taxonomy import ClassMap
 
 log = logging.getLogger(__name__)
 

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
-from synthua_usd.errors import InputError
-from synthua_usd.scenario import StageMetadata
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.core.errors import InputError
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, build_agents_layer
 from synthua_usd.usd.authoring import check_layer_path, save_layer_atomic
 from synthua_usd.usd.reader import StageReader

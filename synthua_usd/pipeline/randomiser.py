@@ -26,15 +26,15 @@ import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
 from synthua_usd.assets.postures import BodyParts
-from synthua_usd.errors import StageError
+from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.core.errors import StageError
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.districts import district_of
 from synthua_usd.randomisation.config import RandomisationConfig
 from synthua_usd.randomisation.light import LightDraw, draw_light
 from synthua_usd.randomisation.scene import SceneDraw, draw_scene
 from synthua_usd.randomisation.streams import stream
 from synthua_usd.randomisation.view import CameraJitter, ViewDraw, WalkArea, draw_camera, place_cast
-from synthua_usd.scenario import StageMetadata
-from synthua_usd.taxonomy import ClassMap
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
 from synthua_usd.usd.cameras import camera_rig_type, read_camera
 from synthua_usd.usd.conditions import read_condition
@@ -229,9 +229,9 @@ def _from_record(path: Path) -> tuple:
     """(config document, seed, camera path, time code, condition name, render dict) of a dataset record."""
     import json
 
+    from synthua_usd.core.errors import InputError
+    from synthua_usd.core.schemas import read_json
     from synthua_usd.dataset.layout import Layout
-    from synthua_usd.errors import InputError
-    from synthua_usd.schemas import read_json
 
     record = read_json(path, "an image record of a dataset (records/NAME.json)")
     job_path = Path(path).resolve().parent.parent / Layout.CONFIG
@@ -250,10 +250,10 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     """Draw one image's randomisation over ``request.scenario`` and write its three layers as one output set."""
     import shlex
 
-    from synthua_usd.atomic import output_set
+    from synthua_usd.core.atomic import output_set
+    from synthua_usd.core.errors import InputError
     from synthua_usd.dataset.config import GenerationConfig
-    from synthua_usd.errors import InputError
-    from synthua_usd.render_config import RenderConfig
+    from synthua_usd.model.render_config import RenderConfig
     from synthua_usd.usd.render_settings import render_defaults
     from synthua_usd.usd.stage_io import USD_SUFFIXES, check_time_code, open_stage
 

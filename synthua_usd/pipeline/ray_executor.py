@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from synthua_usd import __version__
-from synthua_usd.errors import InputError, echo
+from synthua_usd.core.errors import InputError, echo
 from synthua_usd.pipeline.worker_protocol import (ExecutorConfig, ItemResult, RunSummary, WorkerError, WorkerLostError,
                                                  call_work, failure, lost_message, peak_rss_mib, raise_failure,
                                                  worker_name)

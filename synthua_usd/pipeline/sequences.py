@@ -26,14 +26,14 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.atomic import write_json_atomic, write_text_atomic
+from synthua_usd.core.atomic import write_json_atomic, write_text_atomic
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import mot
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.dataset.sequences import PlannedFrame, PlannedSequence
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, camera_document, init_worker, render_annotated
-from synthua_usd.taxonomy import ClassMap
 
 #: Where a sequence crowd's agents live (the scenario's stay under /World/Agents, deactivated).
 SEQUENCE_AGENTS = "/World/SequenceAgents"
@@ -49,7 +49,7 @@ def write_crowds(stage, config: GenerationConfig, class_map: ClassMap, out: Path
     from pxr import UsdGeom
 
     from synthua_usd.agents.crowd import CrowdParams, populate_crowd
-    from synthua_usd.scenario import StageMetadata
+    from synthua_usd.composition.scenario import StageMetadata
     from synthua_usd.usd.agents_writer import AGENTS_ROOT, build_agents_layer
     from synthua_usd.usd.authoring import save_layer_atomic
     from synthua_usd.usd.reader import StageReader
@@ -276,7 +276,7 @@ def render_sequences(stage, config: GenerationConfig, class_map: ClassMap, job: 
     (sequence, frame)."""
     from tqdm import tqdm
 
-    from synthua_usd.errors import OutputError
+    from synthua_usd.core.errors import OutputError
     from synthua_usd.pipeline.executors import run_shards
     from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 

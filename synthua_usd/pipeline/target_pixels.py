@@ -13,10 +13,10 @@ import numpy as np
 from tqdm import tqdm
 
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.placement import Placement, Terrain
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.rigs import RigSpec
-from synthua_usd.scene import SceneSnapshot
+from synthua_usd.composition.rigs import RigSpec
+from synthua_usd.geometry.placement import Placement, Terrain
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import SceneSnapshot
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.targets import Target
 

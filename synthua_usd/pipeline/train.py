@@ -34,13 +34,13 @@ from synthua_usd import __version__
 from synthua_usd.analytics.detection_sets import DetectionSet
 from synthua_usd.analytics.detection_sources import manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
-from synthua_usd.atomic import output_set, write_json_atomic
-from synthua_usd import detection_limits as L
 from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
-from synthua_usd.errors import InputError
-from synthua_usd.input_files import shown
-from synthua_usd.schemas import read_json
+from synthua_usd.core.atomic import output_set, write_json_atomic
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import shown
+from synthua_usd.core.schemas import read_json
+from synthua_usd.model import detection_limits as L
 
 log = logging.getLogger(__name__)
 

@@ -4,7 +4,7 @@
 Each automatic camera's label pass is rendered (exact pixel-centre labels, :data:`CHECK_SIZE`) on the written
 scenario; a camera whose pixels show less than :data:`MIN_LABELLED_SHARE` of the twin's labelled geometry (the
 generated ground is unlabelled and does not count) is a finding in the report; so is a camera that could not be
-placed in free space outdoors (:mod:`synthua_usd.free_space`), with the reason.
+placed in free space outdoors (:mod:`synthua_usd.geometry.free_space`), with the reason.
 """
 
 from __future__ import annotations
@@ -15,14 +15,14 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
-from synthua_usd.atomic import output_set, write_json_atomic
-from synthua_usd.findings import Finding, Severity
-from synthua_usd.framing import Framing, automatic_cameras
-from synthua_usd.ground import ground_object
-from synthua_usd.materials import subset
-from synthua_usd.scenario import CAMERAS_ROOT, ROOT_FILE, ScenarioSpec, StageMetadata
-from synthua_usd.taxonomy import ClassMap
-from synthua_usd.twin import TwinModel
+from synthua_usd.composition.scenario import CAMERAS_ROOT, ROOT_FILE, ScenarioSpec, StageMetadata
+from synthua_usd.core.atomic import output_set, write_json_atomic
+from synthua_usd.core.findings import Finding, Severity
+from synthua_usd.geometry.framing import Framing, automatic_cameras
+from synthua_usd.geometry.ground import ground_object
+from synthua_usd.model.materials import subset
+from synthua_usd.model.taxonomy import ClassMap
+from synthua_usd.model.twin import TwinModel
 from synthua_usd.usd.scenario_writer import write_scenario
 
 REPORT_FILE = "import_report.json"
@@ -35,7 +35,7 @@ CHECK_SIZE = (160, 120)
 
 
 def with_ground(model: TwinModel) -> TwinModel:
-    """``model`` with its generated ground (:func:`synthua_usd.ground.ground_object`) as its last object."""
+    """``model`` with its generated ground (:func:`synthua_usd.geometry.ground.ground_object`) as its last object."""
     ground = ground_object(model)
     objects = (*model.objects, ground)
     materials = {**model.materials, **subset(p.material for p in ground.parts)}
@@ -77,7 +77,7 @@ def import_scenario(model: TwinModel, crowd: CrowdParams | None = None) -> tuple
 def labelled_shares(scenario: Path, class_map: ClassMap, cameras: list[str]) -> dict[str, float]:
     """Camera name → share of its pixel-centre label pass (:data:`CHECK_SIZE`) that hits labelled geometry."""
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.render_config import RenderConfig
+    from synthua_usd.model.render_config import RenderConfig
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.reader import StageReader
     from synthua_usd.usd.stage_io import open_stage

@@ -23,13 +23,13 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.atomic import named_as
+from synthua_usd.core.atomic import named_as
+from synthua_usd.core.errors import InputError, OutputError, echo
+from synthua_usd.core.input_files import shown
+from synthua_usd.core.schemas import read_json, type_name
 from synthua_usd.dataset.annotations import rle_problem
 from synthua_usd.dataset.layout import SPLITS, Layout
 from synthua_usd.dataset.manifest import read_manifest, sha256_file
-from synthua_usd.errors import InputError, OutputError, echo
-from synthua_usd.input_files import shown
-from synthua_usd.schemas import read_json, type_name
 
 #: Problems listed in full; beyond this many, verify counts the rest.
 MAX_LISTED = 50
@@ -134,7 +134,7 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
             damaged.add(entry["path"])
     from synthua_usd.dataset.formats.records import is_rejected
     from synthua_usd.dataset.formats.yolo import class_index
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.taxonomy import ClassMap
 
     try:
         yolo_classes = class_index(ClassMap.load(root / Layout.CLASS_MAP))
@@ -411,9 +411,9 @@ def _sha256_or_none(path: Path) -> str | None:
 def replay(root: Path, image: str) -> Replay:
     """Render the image ``image`` (its id or name) of the dataset at ``root`` again and compare each of its
     files with the dataset's file on disk."""
+    from synthua_usd.dataset.sampling import PlannedImage
     from synthua_usd.pipeline.dataset_worker import FLUSH, init_worker, work
     from synthua_usd.pipeline.generate import worker_job_from_document
-    from synthua_usd.dataset.sampling import PlannedImage
 
     root = Path(root)
     if not root.is_dir():

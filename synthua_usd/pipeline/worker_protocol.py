@@ -17,7 +17,7 @@ import traceback
 from dataclasses import dataclass, field
 from typing import Any, Callable, Generic, TypeVar
 
-from synthua_usd.errors import InputError, SynthuaError, echo
+from synthua_usd.core.errors import InputError, SynthuaError, echo
 
 log = logging.getLogger(__name__)
 

@@ -14,8 +14,8 @@ import math
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
-from synthua_usd.errors import InputError, echo
-from synthua_usd.materials import DEVICE_FINISHES, RECOLOUR_PALETTES
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.model.materials import DEVICE_FINISHES, RECOLOUR_PALETTES
 
 #: The mobility-aid classes a randomised crowd can use (the device classes of the agent profiles).
 AID_CLASSES = ("manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from synthua_usd.conditions import Condition
+from synthua_usd.model.conditions import Condition
 from synthua_usd.randomisation.config import LightRandomisation
 
 #: Conditions whose sun stands lower than this are low-sun conditions (sunset, sunrise): band LOW_SUN_BAND_DEG.

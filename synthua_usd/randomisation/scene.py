@@ -17,7 +17,7 @@ from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.agents.seats import SeatPlace
 from synthua_usd.assets.devices import DEVICE_MODELS
 from synthua_usd.assets.people import PersonLook
-from synthua_usd.materials import (DEVICE_FINISHES, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
+from synthua_usd.model.materials import (DEVICE_FINISHES, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
                                    WOOD_COLOURS)
 from synthua_usd.randomisation.config import RandomisationConfig
 

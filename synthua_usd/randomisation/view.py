@@ -18,10 +18,10 @@ from synthua_usd.agents.motion import MARGIN_M
 from synthua_usd.agents.profiles import PROFILES, AgentProfile
 from synthua_usd.agents.seats import SeatPlace, find_seat_places
 from synthua_usd.agents.walkable import WALKABLE, WalkableGrid, build_grid, edge_cost, walkable_graph
-from synthua_usd.cameras import PinholeCamera
+from synthua_usd.composition.rigs import RIG_TYPES
+from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.randomisation.config import CameraRandomisation, CrowdRandomisation
 from synthua_usd.randomisation.scene import CastMember
-from synthua_usd.rigs import RIG_TYPES
 
 #: A person is "seen" when this point above its feet projects inside the image (a margin of 5 % of each side
 #: left free) with nothing of the twin in front of it, and a person of PERSON_HEIGHT_M standing there would

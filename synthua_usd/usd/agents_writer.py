@@ -20,7 +20,7 @@ agents reference prototypes from ``instanceable`` prims. Per agent, and therefor
 - keypoints (:mod:`synthua_usd.assets.agent_keypoints`): on the ``Person`` prim the 17 COCO body keypoints,
   on the device prim its contact points, each as ``synthua:keypoints`` (point3f[], the prim's frame,
   time-sampled when they move) with their names in ``synthua:keypointNames`` (token[], uniform; the order
-  of :data:`synthua_usd.keypoint_classes.KEYPOINT_CLASSES`).
+  of :data:`synthua_usd.model.keypoint_classes.KEYPOINT_CLASSES`).
 
 Layout of one agent (``*`` marks instance roots, ``->`` their prototype)::
 
@@ -41,16 +41,16 @@ from collections import Counter
 import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdShade, Vt
 
-from synthua_usd import geometry as geo
 from synthua_usd.agents.crowd import Crowd
 from synthua_usd.assets import devices
 from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS
 from synthua_usd.assets.postures import (AID_OFFSETS, BENCH, STEPPING_AIDS, BodyParts, DeviceFit, aid_shift_m,
                                        bench_fit, pose, segment_motion, step_length_m)
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
-from synthua_usd.materials import PALETTE
-from synthua_usd.scenario import StageMetadata
+from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
+from synthua_usd.model.materials import PALETTE
 from synthua_usd.usd.authoring import (apply_label, bind_material, bind_material_path, define_mesh,
                                        define_preview_material, define_xform, new_layer, set_kind)
 from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR

@@ -1,6 +1,6 @@
 """Small helpers that author layers the way every synthua layer is authored.
 
-Every layer states (:class:`synthua_usd.scenario.StageMetadata`) ``upAxis``, ``metersPerUnit``, ``defaultPrim`` and ``timeCodesPerSecond``; meshes carry
+Every layer states (:class:`synthua_usd.composition.scenario.StageMetadata`) ``upAxis``, ``metersPerUnit``, ``defaultPrim`` and ``timeCodesPerSecond``; meshes carry
 extents; materials are UsdPreviewSurface; labels use UsdSemantics.LabelsAPI with the taxonomy as
 instance name.
 """
@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 from pxr import Gf, Kind, Sdf, Tf, Usd, UsdGeom, UsdSemantics, UsdShade, Vt
 
-from synthua_usd.atomic import atomic_path, write_failure
-from synthua_usd.errors import InputError, echo
-from synthua_usd.scenario import StageMetadata
-from synthua_usd.scene import Material
+from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.core.atomic import atomic_path, write_failure
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.model.scene import Material
 from synthua_usd.usd.stage_io import tf_message
 
 
@@ -64,7 +64,7 @@ def save_layer_atomic(layer: Sdf.Layer, path: str | Path) -> Path:
 def export_layer(layer: Sdf.Layer, tmp: Path, path: Path) -> None:
     """Write ``layer`` to the temporary file ``tmp`` of the output ``path``. OpenUSD reports a failed write
     (a full disk, a file-size limit) as a Tf error or a False without an errno: either becomes the
-    ``OSError`` naming ``path`` that :func:`synthua_usd.atomic.write_failure` finds (ENOSPC on a full disk)."""
+    ``OSError`` naming ``path`` that :func:`synthua_usd.core.atomic.write_failure` finds (ENOSPC on a full disk)."""
     check_layer_path(path)
     try:
         written = layer.Export(str(tmp))

@@ -6,7 +6,7 @@ stage, and 1/100 of the millimetre value on a metre stage). Everything outside t
 Lens distortion is stored on the camera prim as custom attributes (not an applied schema: a schema would
 need a plugin every reader must load, while custom attributes open anywhere): ``synthua:distortion:model
 = "brown_conrady"`` and the doubles ``synthua:distortion:k1``, ``k2``, ``k3``, ``p1``, ``p2`` (OpenCV's
-convention, see :mod:`synthua_usd.distortion`).
+convention, see :mod:`synthua_usd.model.distortion`).
 """
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom
 
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.distortion import COEFFICIENTS, MODEL, BrownConrady
-from synthua_usd.errors import StageError
+from synthua_usd.core.errors import StageError
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.distortion import COEFFICIENTS, MODEL, BrownConrady
 from synthua_usd.usd.prim_checks import DISTORTION_PREFIX, camera_findings, lens_unit_mm, raise_first_error, read_distortion
 from synthua_usd.usd.stage_io import prim_path
 
@@ -101,7 +101,7 @@ def read_camera(stage: Usd.Stage, path: str, time_code: float) -> PinholeCamera:
                          distortion=distortion, exposure_ev=float(cam.GetExposureAttr().Get(t) or 0.0))
 
 
-#: The rig type a camera stands for (cctv, dashcam, uav_nadir, ...: :data:`synthua_usd.rigs.RIG_TYPES`).
+#: The rig type a camera stands for (cctv, dashcam, uav_nadir, ...: :data:`synthua_usd.composition.rigs.RIG_TYPES`).
 RIG_TYPE_ATTRIBUTE = "synthua:rig:type"
 
 
@@ -139,11 +139,11 @@ def rendered_bound(stage: Usd.Stage, time_code: float) -> Gf.Range3d:
 
 def author_auto_camera(stage: Usd.Stage, time_code: float) -> str:
     """Author a camera framing what the stage renders at ``time_code`` (:func:`rendered_bound`; the overview rule of
-    :func:`synthua_usd.framing.overview_view`: every corner inside a full-frame 24 mm view, from the tightest
+    :func:`synthua_usd.geometry.framing.overview_view`: every corner inside a full-frame 24 mm view, from the tightest
     of 16 directions) into the stage's session layer at :data:`AUTO_CAMERA_PATH`; returns the path. Y-up and
     any ``metersPerUnit`` are honoured. Raises :class:`StageError` when the stage has no bounded geometry."""
-    from synthua_usd.framing import LENS_MM, overview_view
-    from synthua_usd.geometry import look_at
+    from synthua_usd.geometry.framing import LENS_MM, overview_view
+    from synthua_usd.model.meshes import look_at
 
     t = Usd.TimeCode(time_code)
     bound = rendered_bound(stage, time_code)

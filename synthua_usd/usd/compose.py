@@ -8,7 +8,7 @@ from pathlib import Path
 
 from pxr import Sdf, UsdGeom
 
-from synthua_usd.errors import InputError, StageError, echo
+from synthua_usd.core.errors import InputError, StageError, echo
 from synthua_usd.usd.authoring import check_layer_path, save_layer_atomic
 from synthua_usd.usd.stage_io import open_layer
 

@@ -1,7 +1,7 @@
 """Conditions in USD: a ``condition`` variant set on the environment prim, authored and read back.
 
 Each variant sets ``synthua:condition:*`` attributes (the fields of
-:class:`synthua_usd.conditions.Condition`, camelCase, with their units in the name, e.g.
+:class:`synthua_usd.model.conditions.Condition`, camelCase, with their units in the name, e.g.
 ``double synthua:condition:fogVisibilityM = inf``) on ``/World/Environment``, and poses the prim's
 ``UsdLux`` ``Sun`` and ``Sky`` as a viewer's approximation of that condition (direction, a rough
 intensity). synthua's renderer uses the attributes, not the approximation (see docs/rigs-and-conditions.md).
@@ -18,17 +18,17 @@ from dataclasses import fields
 
 from pxr import Gf, Sdf, Usd, UsdLux
 
-from synthua_usd.conditions import Condition, display_order
-from synthua_usd.errors import InputError, StageError, echo
-from synthua_usd.photometry import CCT_3000K, CD_PER_M2_PER_UNIT
-from synthua_usd.scenario import ENVIRONMENT_PATH
+from synthua_usd.composition.scenario import ENVIRONMENT_PATH
+from synthua_usd.core.errors import InputError, StageError, echo
+from synthua_usd.model.conditions import Condition, display_order
+from synthua_usd.model.photometry import CCT_3000K, CD_PER_M2_PER_UNIT
 
 VARIANT_SET = "condition"
 PREFIX = "synthua:condition:"
 SUN = "Sun"
 SKY = "Sky"
 #: The UsdLux approximation for viewers: about 90 klx of direct sun and a 0.08-unit sky at noon, in the
-#: renderer's units (:mod:`synthua_usd.photometry`).
+#: renderer's units (:mod:`synthua_usd.model.photometry`).
 _VIEWER_SUN = 1.2
 _VIEWER_SKY = 0.08
 

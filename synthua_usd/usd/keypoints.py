@@ -3,13 +3,13 @@
 On an instance prim (the prim carrying the label), two custom attributes:
 
 - ``synthua:keypointNames`` (token[], uniform): the names, which must be those of the instance's class in
-  :data:`synthua_usd.keypoint_classes.KEYPOINT_CLASSES`, in that order (an instance whose class, in the
+  :data:`synthua_usd.model.keypoint_classes.KEYPOINT_CLASSES`, in that order (an instance whose class, in the
   class map in use, has no keypoints there keeps none, with a warning);
 - ``synthua:keypoints`` (point3f[], one point per name): positions in the prim's own frame, stage units,
   time-sampled when they move.
 
 :func:`read_keypoints` gives them in world metres at a time code (the prim's local-to-world transform at
-that time applied), as plain :class:`synthua_usd.scene.Keypoints`.
+that time applied), as plain :class:`synthua_usd.model.scene.Keypoints`.
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ import logging
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from synthua_usd.errors import StageError
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
-from synthua_usd.scene import Instance, Keypoints
+from synthua_usd.core.errors import StageError
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
+from synthua_usd.model.scene import Instance, Keypoints
 
 log = logging.getLogger(__name__)
 

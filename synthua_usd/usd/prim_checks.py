@@ -12,10 +12,10 @@ import math
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from synthua_usd.distortion import COEFFICIENTS, MODEL, BrownConrady
-from synthua_usd.errors import InputError, StageError
-from synthua_usd.findings import Finding, Severity
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.core.errors import InputError, StageError
+from synthua_usd.core.findings import Finding, Severity
+from synthua_usd.model.distortion import COEFFICIENTS, MODEL, BrownConrady
+from synthua_usd.model.taxonomy import ClassMap
 
 #: Plausible physical lens values; outside them the authored numbers are probably in the wrong unit.
 FOCAL_RANGE_MM = (1.0, 2000.0)

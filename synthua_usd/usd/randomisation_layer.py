@@ -35,14 +35,14 @@ from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdShade, Vt
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS
 from synthua_usd.assets.devices import DEVICE_MODELS
 from synthua_usd.assets.postures import STEPPING_AIDS, BodyParts
-from synthua_usd.conditions import Condition
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
-from synthua_usd.materials import PALETTE
+from synthua_usd.composition.scenario import CROWD_ROOT, ENVIRONMENT_PATH, RANDOM_ROOT, StageMetadata
+from synthua_usd.model.conditions import Condition
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
+from synthua_usd.model.materials import PALETTE
+from synthua_usd.model.scene import Material, SceneSnapshot
 from synthua_usd.randomisation.poses import posture_of, pose_member
 from synthua_usd.randomisation.scene import CastMember, Recolour, Recolourable, SceneDraw
 from synthua_usd.randomisation.view import Placement
-from synthua_usd.scenario import CROWD_ROOT, ENVIRONMENT_PATH, RANDOM_ROOT, StageMetadata
-from synthua_usd.scene import Material, SceneSnapshot
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, PrototypeLibrary, posture_name, prim_name, quat
 from synthua_usd.usd.authoring import apply_metadata, bind_material_path, define_preview_material, define_xform
 from synthua_usd.usd.conditions import SUN, VARIANT_SET, attribute_name

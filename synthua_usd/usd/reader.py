@@ -16,12 +16,12 @@ from typing import Callable
 import numpy as np
 from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux
 
-from synthua_usd import geometry as geo
-from synthua_usd.errors import StageError, UnsupportedPrimError, echo
-from synthua_usd.lamps import KINDS as LAMP_KINDS
-from synthua_usd.photometry import CD_PER_M2_PER_UNIT, MAX_RENDERER_UNITS, distant_irradiance, dome_radiance
-from synthua_usd.scene import Instance, Light, Material, MeshItem, SceneSnapshot
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.core.errors import StageError, UnsupportedPrimError, echo
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.lamps import KINDS as LAMP_KINDS
+from synthua_usd.model.photometry import CD_PER_M2_PER_UNIT, MAX_RENDERER_UNITS, distant_irradiance, dome_radiance
+from synthua_usd.model.scene import Instance, Light, Material, MeshItem, SceneSnapshot
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, keypoint_prims, read_keypoints
 from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_first_error, shape_findings
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
@@ -31,7 +31,7 @@ from synthua_usd.usd.texcoords import fan_corners, read_uvs
 
 log = logging.getLogger(__name__)
 
-#: The gprim attribute naming a lamp role (:mod:`synthua_usd.lamps`).
+#: The gprim attribute naming a lamp role (:mod:`synthua_usd.model.lamps`).
 LAMP_ATTRIBUTE = "synthua:lamp"
 
 #: Properties of a prim that its descendant gprims inherit (a change re-reads them).
@@ -118,7 +118,7 @@ def unsupported_light_message(prim: Usd.Prim) -> str | None:
 
 
 def _read_light(prim: Usd.Prim, t: Usd.TimeCode) -> Light:
-    """The light ``prim`` in renderer units (:mod:`synthua_usd.photometry`): UsdLux strength is
+    """The light ``prim`` in renderer units (:mod:`synthua_usd.model.photometry`): UsdLux strength is
     ``inputs:intensity x 2^inputs:exposure``; a strength too great for our convention is read in the
     convention it must follow (:func:`photometry.distant_irradiance`, :func:`photometry.dome_radiance`), with
     a warning naming the light, its value and the rule."""

@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 from pxr import Usd, UsdGeom, UsdRender
 
-from synthua_usd.errors import echo
-from synthua_usd.findings import Finding
-from synthua_usd.render_config import MAX_SIDE, MAX_SPP
+from synthua_usd.core.errors import echo
+from synthua_usd.core.findings import Finding
+from synthua_usd.model.render_config import MAX_SIDE, MAX_SPP
 from synthua_usd.usd.prim_checks import raise_first_error
 
 

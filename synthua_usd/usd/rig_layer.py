@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 from pxr import Kind, Sdf, Usd
 
-from synthua_usd.placement import CLIP_M, Placement
-from synthua_usd.rigs import RigSpec
-from synthua_usd.scenario import CAMERAS_ROOT, StageMetadata
+from synthua_usd.composition.rigs import RigSpec
+from synthua_usd.composition.scenario import CAMERAS_ROOT, StageMetadata
+from synthua_usd.geometry.placement import CLIP_M, Placement
 from synthua_usd.usd.authoring import define_xform, new_layer
 from synthua_usd.usd.cameras import author_camera
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdLux, UsdRender
 
-from synthua_usd import geometry as geo
-from synthua_usd.cameras import CONFORM_EXPAND, CameraSpec
-from synthua_usd.outputs import select_outputs
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scenario import CAMERAS_ROOT, ENVIRONMENT_PATH, Environment, StageMetadata
+from synthua_usd.composition.scenario import CAMERAS_ROOT, ENVIRONMENT_PATH, Environment, StageMetadata
+from synthua_usd.core.outputs import select_outputs
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.cameras import CONFORM_EXPAND, CameraSpec
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.authoring import define_xform, new_layer
 from synthua_usd.usd.cameras import author_camera
 from synthua_usd.usd.conditions import SKY, SUN, author_conditions

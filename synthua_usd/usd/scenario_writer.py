@@ -7,11 +7,11 @@ from pathlib import Path
 
 from pxr import Usd
 
-from synthua_usd.atomic import output_set
-from synthua_usd.scenario import LAYER_FILE, ROOT_FILE, ScenarioSpec, StageMetadata
-from synthua_usd.taxonomy import ClassMap
-from synthua_usd.texture_images import write_texture_images
-from synthua_usd.twin import TwinModel
+from synthua_usd.composition.scenario import LAYER_FILE, ROOT_FILE, ScenarioSpec, StageMetadata
+from synthua_usd.core.atomic import output_set
+from synthua_usd.core.texture_images import write_texture_images
+from synthua_usd.model.taxonomy import ClassMap
+from synthua_usd.model.twin import TwinModel
 from synthua_usd.usd.agents_writer import build_agents_layer
 from synthua_usd.usd.authoring import save_layer_atomic
 from synthua_usd.usd.compose import compose_layers

@@ -1,4 +1,4 @@
-"""UsdPreviewSurface networks → :class:`synthua_usd.scene.Material`: constants and UsdUVTexture images.
+"""UsdPreviewSurface networks → :class:`synthua_usd.model.scene.Material`: constants and UsdUVTexture images.
 
 An input of the surface shader is either a value or a connection. Connections are followed through node
 graphs and interface inputs (``UsdShade.Utils.GetValueProducingAttributes``) to what produces the value:
@@ -14,7 +14,7 @@ graphs and interface inputs (``UsdShade.Utils.GetValueProducingAttributes``) to 
 
 A texture inside a ``.usdz`` package resolves (OpenUSD's Ar) to a package-relative path,
 ``/a/car.usdz[textures/body.png]``, which :class:`Texture` keeps as its ``path``; the image is read from the
-package (:mod:`synthua_usd.texture_files`).
+package (:mod:`synthua_usd.core.texture_files`).
 
 Supported textured inputs: diffuseColor, roughness, metallic, normal, opacity.
 """
@@ -30,9 +30,9 @@ import numpy as np
 
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 
-from synthua_usd.errors import echo
-from synthua_usd.scene import Material, Texture
-from synthua_usd.texture_files import is_packaged, unreadable
+from synthua_usd.core.errors import echo
+from synthua_usd.core.texture_files import is_packaged, unreadable
+from synthua_usd.model.scene import Material, Texture
 
 log = logging.getLogger(__name__)
 

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 from pxr import Gf, Usd, UsdGeom, UsdLux, UsdRender, UsdValidation
 
-from synthua_usd.errors import SynthuaError
-from synthua_usd.findings import Finding, Severity
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.core.errors import SynthuaError
+from synthua_usd.core.findings import Finding, Severity
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.prim_checks import (SHAPE_PARAMETERS, camera_findings, label_findings, mesh_topology,
                                         shape_findings)
 from synthua_usd.usd.reader import read_snapshot, unsupported_gprim_message, unsupported_light_message

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdGeom
 
-from synthua_usd.errors import StageError, echo
+from synthua_usd.core.errors import StageError, echo
 
 USD_SUFFIXES = (".usda", ".usdc", ".usd", ".usdz")
 

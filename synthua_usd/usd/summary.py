@@ -9,9 +9,9 @@ from dataclasses import dataclass, field
 
 from pxr import Usd, UsdGeom, UsdLux
 
-from synthua_usd.conditions import display_order
-from synthua_usd.errors import escape_controls
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.core.errors import escape_controls
+from synthua_usd.model.conditions import display_order
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.conditions import condition_names, selected_condition
 from synthua_usd.usd.prim_checks import lens_unit_mm
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
@@ -34,7 +34,7 @@ class StageSummary:
     unlabelled_gprims: int = 0
     cameras: list[dict] = field(default_factory=list)
     lights: list[dict] = field(default_factory=list)
-    conditions: list[str] = field(default_factory=list)  # shipped order first; see synthua_usd.conditions
+    conditions: list[str] = field(default_factory=list)  # shipped order first; see synthua_usd.model.conditions
     condition: str | None = None  # the one the stage selects
 
     def format(self) -> str:

@@ -15,8 +15,8 @@ import numpy as np
 from pxr import Usd, UsdGeom
 
 from synthua_usd.agents.profiles import PROFILES
-from synthua_usd.errors import InputError, echo
-from synthua_usd.scene import Instance
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.model.scene import Instance
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
 
 WHEELCHAIRS = ("manual_wheelchair", "electric_wheelchair")
@@ -127,7 +127,7 @@ def boxes(stage: Usd.Stage, paths: list[str], time_codes: list[float]) -> dict[f
 
 def find_targets(stage: Usd.Stage, aim: str, instances: dict[str, Instance], tracks: list[AgentTrack],
                  time_codes: list[float], source: str) -> list[Target]:
-    """Every target ``aim`` names (see :class:`synthua_usd.rigs.RigSpec`): aid users in the order of
+    """Every target ``aim`` names (see :class:`synthua_usd.composition.rigs.RigSpec`): aid users in the order of
     :data:`DEVICE_ORDER` (wheelchair users first), crossings and curb ramps largest first, ties in path order.
     Raises :class:`InputError` naming ``source`` when there is none."""
     if aim == "none":

@@ -15,7 +15,7 @@ import logging
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from synthua_usd.uv import split_corners
+from synthua_usd.geometry.uv import split_corners
 
 log = logging.getLogger(__name__)
 

@@ -7,10 +7,10 @@ import logging
 
 from pxr import Gf, Kind, Sdf, Usd
 
-from synthua_usd.errors import InputError
-from synthua_usd.scenario import StageMetadata
-from synthua_usd.taxonomy import ClassMap
-from synthua_usd.twin import TwinModel, prim_name
+from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.core.errors import InputError
+from synthua_usd.model.taxonomy import ClassMap
+from synthua_usd.model.twin import TwinModel, prim_name
 from synthua_usd.usd.authoring import (apply_label, define_mesh, define_preview_material, define_xform, new_layer,
                                        set_kind)
 

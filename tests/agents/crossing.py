@@ -4,10 +4,10 @@ sys.path)."""
 
 import numpy as np
 
-from synthua_usd import geometry as geo
 from synthua_usd.agents.population import plan_agents
 from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.agents.walkable import build_grid, shortest_path, walkable_graph
+from synthua_usd.model import meshes as geo
 
 
 def crossing_scene():

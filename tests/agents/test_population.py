@@ -7,11 +7,11 @@ import pytest
 from scipy import stats
 
 from crossing import corridor_plans, crossing_network, crossing_scene
-from synthua_usd import geometry as geo
 from synthua_usd.agents.motion import simulate
 from synthua_usd.agents.population import check_density, plan_agents, sample_count
 from synthua_usd.agents.walkable import build_grid, walkable_graph
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
+from synthua_usd.model import meshes as geo
 
 
 @pytest.fixture(scope="module")

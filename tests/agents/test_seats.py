@@ -8,7 +8,7 @@ from synthua_usd.agents.population import plan_agents
 from synthua_usd.agents.seats import ORIGIN_FROM_BACK_M, find_seat_places
 from synthua_usd.agents.walkable import build_grid, walkable_graph
 from synthua_usd.demo.street import KERB_HEIGHT, ROAD_HALF_WIDTH, SIDEWALK_WIDTH, street_twin
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 
 @pytest.fixture(scope="module")

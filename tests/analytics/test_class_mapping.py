@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from synthua_usd.analytics.class_mapping import build_mapping, parse_map_options
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 MODEL = ("person", "manual_wheelchair", "electric_wheelchair", "walker")
 

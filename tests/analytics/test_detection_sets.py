@@ -11,7 +11,7 @@ import pytest
 from PIL import Image
 
 from synthua_usd.analytics.detection_sets import Box, label_path, parse_yolo_labels, read_coco, read_yolo
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 
 def _image(path: Path, width: int, height: int) -> Path:

@@ -9,7 +9,7 @@ import pytest
 
 from synthua_usd.analytics.detection_sets import Box
 from synthua_usd.analytics.detection_targets import DEFAULT_CLASSES, DetectionTargets, image_boxes, read_generated
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 CHAIR = "/W/A/ManualWheelchair"
 INSTANCES = [

@@ -10,7 +10,7 @@ import pytest
 
 from synthua_usd.analytics.dataset_index import load_index
 from synthua_usd.analytics.statistics import compute, mobility_aid_classes
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 from analytics import tiny_dataset
 

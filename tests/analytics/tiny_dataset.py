@@ -21,7 +21,7 @@ import numpy as np
 from PIL import Image
 from pycocotools import mask as mask_utils
 
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 H, W = 6, 8
 ROAD, BUILDING, PERSON, WHEELCHAIR, WALKER = 1, 6, 18, 29, 31

@@ -11,7 +11,7 @@ from synthua_usd.assets import devices
 from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points, segment_weights
 from synthua_usd.assets.bodies import SEGMENTS, load_bank, skin, skin_keypoints
 from synthua_usd.assets.postures import AID_OFFSETS, fit_device, pose, segment_motion
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
 
 PHASES = np.linspace(0.0, 2 * np.pi, 6, endpoint=False)
 #: Rendered rigid segments vs the fully skinned rig (measured: 4.2 mm at most).

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from synthua_usd.backends.denoise import FIREFLY_RATIO, Denoiser, suppress_fireflies
-from synthua_usd.photometry import luminance
+from synthua_usd.model.photometry import luminance
 
 
 def noisy_scene(seed: int = 0, size=(48, 64)):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from synthua_usd.backends.exposure import EV100_RANGE, KEY, choose_exposure
-from synthua_usd.photometry import CD_PER_M2_PER_UNIT
+from synthua_usd.model.photometry import CD_PER_M2_PER_UNIT
 
 
 def grey(cd_m2: float) -> np.ndarray:

@@ -4,8 +4,8 @@ import pytest
 
 from conftest import DATA
 from synthua_usd.backends.frame_files import write_frame
-from synthua_usd.errors import SchemaError
-from synthua_usd.outputs import FRAME_DOCUMENT, select_outputs
+from synthua_usd.core.errors import SchemaError
+from synthua_usd.core.outputs import FRAME_DOCUMENT, select_outputs
 from synthua_usd.pipeline.frame import FrameRequest, run_frames
 
 

@@ -8,8 +8,8 @@ import pytest
 
 from synthua_usd.backends.weather import (apply_fog, drop_density_per_m3, fog_lighting, rain_streaks,
                                           terminal_speed_mps)
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.conditions import shipped
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.conditions import shipped
 
 RNG = np.random.default_rng(7)
 RGB = RNG.random((48, 64, 3)).astype(np.float32)

@@ -5,10 +5,10 @@ import filecmp
 from pxr import Sdf
 
 from conftest import STAGES
+from synthua_usd.composition.rigs import RigSpec
+from synthua_usd.composition.scenario import ROOT_FILE
 from synthua_usd.demo import district
 from synthua_usd.demo.street import street_scenario
-from synthua_usd.rigs import RigSpec
-from synthua_usd.scenario import ROOT_FILE
 
 
 def test_create_street_writes_the_committed_stages(run_cli, tmp_path):

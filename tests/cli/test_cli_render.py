@@ -7,8 +7,8 @@ import pytest
 
 from conftest import DATA, SCENARIO
 from synthua_usd.backends.images import read_image
-from synthua_usd.outputs import file_names
-from synthua_usd.schemas import validate_document
+from synthua_usd.core.outputs import file_names
+from synthua_usd.core.schemas import validate_document
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from synthua_usd import detection_limits as L
+from synthua_usd.model import detection_limits as L
 
 BAD = ["nan", "inf", "-inf", "-1", "1e308", "abc"]
 

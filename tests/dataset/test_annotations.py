@@ -8,9 +8,9 @@ import pytest
 from pycocotools import mask as mask_utils
 
 from label_scenes import INSTANCES, H, W, crowded_scene, scene
+from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.annotations import STUFF_ID_BASE, annotate, panoptic
-from synthua_usd.errors import InputError
-from synthua_usd.scene import Instance
+from synthua_usd.model.scene import Instance
 
 
 def box(mask):

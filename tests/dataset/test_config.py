@@ -5,12 +5,12 @@ import json
 import pytest
 
 from conftest import REPO
+from synthua_usd.core.errors import InputError, SchemaError
 from synthua_usd.dataset.config import (
     CountQuota, GenerationConfig, Outputs, QAThresholds, RenderSettings, SplitRatios,
     schema_default,
 )
-from synthua_usd.errors import InputError, SchemaError
-from synthua_usd.timecodes import parse_time_code_spec
+from synthua_usd.model.timecodes import parse_time_code_spec
 
 BASE = {"name": "t", "images": 10}
 

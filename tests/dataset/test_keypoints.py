@@ -14,12 +14,12 @@ from pycocotools.coco import COCO
 
 from format_readers import coco_keypoint_self_evaluation
 from label_scenes import record
-from synthua_usd.cameras import PinholeCamera
+from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.formats.coco import coco_instances
 from synthua_usd.dataset.keypoints import DEPTH_TOLERANCE_M, WINDOW_PX, annotate_keypoints, visibility
-from synthua_usd.errors import InputError
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
-from synthua_usd.scene import Keypoints
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
+from synthua_usd.model.scene import Keypoints
 
 
 def test_visibility_follows_the_stated_rule():

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
+from synthua_usd.core.errors import OutputError
 from synthua_usd.dataset.layout import Layout, cityscapes_city, image_name, inside, safe_component
-from synthua_usd.errors import OutputError
 
 HOSTILE = ["../../etc/passwd", "/abs/path", "a b\nc", "dot.dot..", "\x00nul", "C:\\win", "Câmera_Ω", "", "-", "…"]
 

@@ -4,11 +4,11 @@ from collections import Counter
 
 import pytest
 
+from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.config import GenerationConfig, SplitRatios
 from synthua_usd.dataset.sampling import (
     ViewScore, candidates, plan, pool_summary, quota_targets, replacements, select_cameras, split_counts, split_of,
 )
-from synthua_usd.errors import InputError
 
 CAMERAS = [("/World/Cameras/CCTV_A", "CCTV_A", "cctv"), ("/World/Cameras/CCTV_B", "CCTV_B", "cctv"),
            ("/World/Cameras/Drone", "Drone", "uav_nadir"), ("/World/Cameras/Street", "Street", None)]

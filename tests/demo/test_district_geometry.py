@@ -20,9 +20,9 @@ from scipy.sparse.csgraph import connected_components
 
 from conftest import STAGES
 from reference_raycast import edge_distance, reference_labels
-from synthua_usd import geometry as geo
 from synthua_usd.demo.district import build_district
-from synthua_usd.twin import TwinObject, TwinPart
+from synthua_usd.model import meshes as geo
+from synthua_usd.model.twin import TwinObject, TwinPart
 
 #: Faces whose planes are this close (metres) count as coplanar: far more than float32 rounding of
 #: district coordinates (~1e-5 m), far less than the 5 cm by which doors and windows stand proud.
@@ -228,8 +228,8 @@ def test_cctv_largo_labels_agree_with_embree_on_every_pixel():
     from pxr import Usd
 
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.render_config import RenderConfig
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.cameras import read_camera
     from synthua_usd.usd.reader import StageReader
     from synthua_usd.usd.stage_io import open_stage

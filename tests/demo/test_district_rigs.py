@@ -9,7 +9,7 @@ import pytest
 from conftest import DISTRICT
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.demo import district
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.render_settings import render_defaults

@@ -9,7 +9,7 @@ from conftest import DISTRICT
 from synthua_usd.demo.district import build_district
 from synthua_usd.demo.district_textures import PAVED, TEXTURED, paving_images
 from synthua_usd.demo.textures import SIZE, decode_srgb8, district_images, paving
-from synthua_usd.materials import PALETTE
+from synthua_usd.model.materials import PALETTE
 
 
 @pytest.fixture(scope="module")

@@ -6,8 +6,8 @@ import pytest
 from pxr import Sdf, Usd, UsdGeom, UsdRender, UsdSemantics
 
 from conftest import SCENARIO, STAGES
+from synthua_usd.composition.scenario import LAYERS, ROOT_FILE
 from synthua_usd.demo.street import street_scenario
-from synthua_usd.scenario import LAYERS, ROOT_FILE
 from synthua_usd.usd.scenario_writer import write_scenario
 
 #: The street has every layer: heavy ones binary, thin ones text.

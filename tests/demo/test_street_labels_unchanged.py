@@ -9,8 +9,8 @@ import pytest
 
 from conftest import DATA, SCENARIO
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.errors import InputError
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.core.errors import InputError
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.cameras import camera_paths, read_camera
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.stage_io import open_stage

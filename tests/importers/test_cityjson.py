@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from conftest import DATA, third_party
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.importers.cityjson import import_cityjson
-from synthua_usd.class_assignment import AssignmentRules
+from synthua_usd.model.class_assignment import AssignmentRules
 
 
 def test_lod2_semantic_surfaces_and_holes():

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from conftest import DATA
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.importers.footprints import import_footprints
 
 

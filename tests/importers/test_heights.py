@@ -2,7 +2,7 @@
 
 import pytest
 
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.importers.heights import building_height, parse_length
 
 

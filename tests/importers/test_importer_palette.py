@@ -1,4 +1,4 @@
-"""The importers take their materials from the one palette (synthua_usd/materials.py): every material key a
+"""The importers take their materials from the one palette (synthua_usd/model/materials.py): every material key a
 CityJSON, footprint or point-cloud import uses is a palette key with the palette's values, and each class
 gets the palette's material for it. Real third-party files import as before (counts from docs/twins.md)."""
 
@@ -10,7 +10,7 @@ from conftest import DATA, third_party
 from synthua_usd.importers.cityjson import import_cityjson
 from synthua_usd.importers.footprints import import_footprints
 from synthua_usd.importers.pointcloud import import_pointcloud
-from synthua_usd.materials import PALETTE, class_material
+from synthua_usd.model.materials import PALETTE, class_material
 
 
 def _check_palette(model) -> None:

@@ -8,7 +8,7 @@ import pytest
 
 from conftest import SHARED
 from las_files import write_las
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.importers.las_header import check_las_layout
 
 THIRD_PARTY = SHARED / "data" / "third_party" / "las"

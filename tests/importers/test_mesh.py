@@ -3,9 +3,9 @@ import pytest
 import trimesh
 
 from conftest import DATA
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.importers.mesh import import_mesh
-from synthua_usd.class_assignment import AssignmentRules
+from synthua_usd.model.class_assignment import AssignmentRules
 
 
 @pytest.fixture

@@ -13,8 +13,8 @@ from PIL import Image
 from texture_checks import mitsuba_albedo, reference_albedo, srgb_decoded
 
 from synthua_usd.backends.mitsuba import variants
-from synthua_usd.class_assignment import AssignmentRules
 from synthua_usd.importers.mesh import import_mesh
+from synthua_usd.model.class_assignment import AssignmentRules
 from synthua_usd.pipeline.twin_import import write_import
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import read_snapshot

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.importers.osm import import_osm
 
 LON0, LAT0 = 11.0, 48.0

@@ -5,7 +5,7 @@ import trimesh
 
 from conftest import third_party
 from las_files import write_las
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.importers.pointcloud import import_pointcloud
 from synthua_usd.importers.segmentation import fit_plane
 

@@ -8,11 +8,11 @@ import trimesh
 
 from conftest import SCENARIO
 from synthua_usd.backends.mitsuba.session import RenderSession
+from synthua_usd.composition.rigs import RigSpec
+from synthua_usd.core.schemas import validate_document
+from synthua_usd.geometry.roads import ROAD_CLASSES
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.pipeline.camera_rigs import RigRequest, author_rigs, default_time_codes
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.rigs import RigSpec
-from synthua_usd.roads import ROAD_CLASSES
-from synthua_usd.schemas import validate_document
 from synthua_usd.usd.cameras import camera_paths, read_camera
 from synthua_usd.usd.compose import compose_layers
 from synthua_usd.usd.reader import StageReader
@@ -72,7 +72,7 @@ def test_every_rigs_pose_and_field_of_view_are_the_usd_cameras(placed):
 
 def twin_caster(stage, time_code):
     """An Embree intersector over the twin (agents left out) and the class name of every triangle."""
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.taxonomy import ClassMap
 
     class_map = ClassMap.default()
     snap = StageReader(stage, class_map).snapshot(time_code)

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from conftest import DISTRICT, generate_dataset
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 from synthua_usd.pipeline.districts import check_district_scenario, district_of, write_district_scene
 from synthua_usd.pipeline.verify import verify
 from synthua_usd.randomisation.config import DistrictRandomisation, RandomisationConfig

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from synthua_usd.errors import InputError, OutputError, StageError
+from synthua_usd.core.errors import InputError, OutputError, StageError
 from synthua_usd.pipeline.executors import STOP_GRACE_S, run_shards
 from synthua_usd.pipeline.worker_protocol import (ExecutorConfig, RemoteTraceback, WorkerError, WorkerLostError,
                                                  peak_rss_mib)

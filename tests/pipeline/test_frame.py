@@ -11,10 +11,10 @@ from pxr import Sdf, UsdRender
 
 from conftest import DATA, SCENARIO
 from reference_raycast import reference_labels
-from synthua_usd.outputs import FRAME_DOCUMENT, file_names, select_outputs
+from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.core.outputs import FRAME_DOCUMENT, file_names, select_outputs
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.pipeline.frame import FrameRequest, run_frames
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scenario import StageMetadata
 from synthua_usd.usd.compose import compose_layers
 from synthua_usd.usd.scenario_layers import build_render_settings
 
@@ -123,8 +123,8 @@ def test_a_distorted_camera_renders_with_its_lens_in_frame_json(tmp_path):
     """Distortion authored on the camera prim (synthua:distortion:*) reaches the labels, the RGB and frame.json."""
     from pxr import Usd
 
-    from synthua_usd.distortion import BrownConrady
-    from synthua_usd.schemas import validate_document
+    from synthua_usd.core.schemas import validate_document
+    from synthua_usd.model.distortion import BrownConrady
     from synthua_usd.usd.cameras import author_distortion
 
     stage_path = tmp_path / "tiny.usda"

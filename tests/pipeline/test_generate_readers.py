@@ -24,7 +24,7 @@ from PIL import Image
 
 from format_readers import cityscapes_evaluation, coco_keypoint_self_evaluation, coco_self_evaluation
 from synthua_usd.dataset.layout import SPLITS, Layout
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 
 def read_json(root: Path, relative: str):

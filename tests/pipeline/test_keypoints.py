@@ -33,12 +33,12 @@ from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.assets.bodies import BONES, load_bank, skin_keypoints
 from synthua_usd.assets.people import PersonLook
 from synthua_usd.assets.postures import fit_device, pose
-from synthua_usd.cameras import CameraSpec
 from synthua_usd.dataset.keypoints import DEPTH_TOLERANCE_M, WINDOW_PX
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.demo.street import META, street_scenario
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.cameras import CameraSpec
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.agents_writer import _phases
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import StageReader

@@ -8,9 +8,9 @@ import pytest
 
 from conftest import DATA, MOBILITY_AIDS, SCENARIO, STAGES
 from synthua_usd.agents.crowd import CrowdParams
-from synthua_usd.errors import InputError
+from synthua_usd.composition.scenario import LAYER_FILE
+from synthua_usd.core.errors import InputError
 from synthua_usd.pipeline.populate import PopulateRequest, populate
-from synthua_usd.scenario import LAYER_FILE
 
 
 def test_populate_is_deterministic_per_seed(run_cli, tmp_path):

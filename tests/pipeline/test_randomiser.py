@@ -11,10 +11,10 @@ from conftest import SCENARIO
 from reference_raycast import reference_labels
 from snapshot_checks import assert_same_snapshot
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.conditions import Condition
+from synthua_usd.model.conditions import Condition
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.pipeline.randomiser import Randomiser
 from synthua_usd.randomisation.config import RandomisationConfig
-from synthua_usd.render_config import RenderConfig
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.conditions import read_condition

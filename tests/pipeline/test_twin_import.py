@@ -5,9 +5,9 @@ import pytest
 
 from conftest import third_party
 from reference_raycast import reference_labels
+from synthua_usd.composition.scenario import LAYER_FILE, ROOT_FILE
 from synthua_usd.pipeline.frame import FrameRequest, run_frames
 from synthua_usd.pipeline.twin_import import REPORT_FILE
-from synthua_usd.scenario import LAYER_FILE, ROOT_FILE
 
 
 def import_and_render(run_cli, tmp_path, kind, source, camera="/World/Cameras/Overview", size=(96, 64)):

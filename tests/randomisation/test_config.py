@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import pytest
 
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.schemas import load_schema
 from synthua_usd.dataset.config import GenerationConfig
-from synthua_usd.errors import InputError
 from synthua_usd.randomisation.config import RandomisationConfig
-from synthua_usd.schemas import load_schema
 
 
 def test_defaults_are_the_schemas():
@@ -55,7 +55,7 @@ def test_impossible_ranges_are_refused(block, mentions):
 
 
 def test_unknown_keys_and_values_are_refused_by_the_schema():
-    from synthua_usd.errors import SchemaError
+    from synthua_usd.core.errors import SchemaError
 
     for block in ({"crowd": {"speed": 1}}, {"crowd": {"aids": ["skateboard"]}}, {"materials": {"classes": ["sky"]}},
                   {"what": {}}):

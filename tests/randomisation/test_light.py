@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from synthua_usd.conditions import shipped
+from synthua_usd.model.conditions import shipped
 from synthua_usd.randomisation.config import LightRandomisation
 from synthua_usd.randomisation.light import LOW_SUN_BAND_DEG, draw_light, elevation_band, solar_position
 

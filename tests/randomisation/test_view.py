@@ -11,10 +11,10 @@ import pytest
 from conftest import SCENARIO
 from synthua_usd.agents.motion import MARGIN_M
 from synthua_usd.agents.profiles import PROFILES
+from synthua_usd.composition.rigs import RIG_TYPES
 from synthua_usd.randomisation.config import CameraRandomisation, RandomisationConfig
 from synthua_usd.randomisation.scene import draw_cast
 from synthua_usd.randomisation.view import PERSON_HEIGHT_M, WalkArea, draw_camera, place_cast
-from synthua_usd.rigs import RIG_TYPES
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import read_snapshot

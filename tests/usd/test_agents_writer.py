@@ -17,9 +17,9 @@ from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS, load_bank
 from synthua_usd.assets.people import PersonLook
 from synthua_usd.assets.postures import STEPPING_AIDS, aid_shift_m, step_length_m
+from synthua_usd.core.errors import StageError
 from synthua_usd.demo.street import META, street_scenario
-from synthua_usd.errors import StageError
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES, PERSON_KEYPOINTS
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, PROTOTYPES, build_agents_layer
 from synthua_usd.usd.keypoints import KEYPOINT_NAMES_ATTR, KEYPOINTS_ATTR
 from synthua_usd.usd.reader import StageReader
@@ -170,7 +170,7 @@ def test_flattened_layer_reads_the_same(stage, class_map):
 
 def test_label_maps_are_byte_identical_instanced_and_deinstanced(stage, deinstanced, class_map):
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.render_config import RenderConfig
+    from synthua_usd.model.render_config import RenderConfig
     from synthua_usd.usd.cameras import read_camera
 
     camera = read_camera(stage, "/World/Cameras/CCTV", 24.0)
@@ -216,7 +216,7 @@ def test_same_crowd_gives_byte_identical_crate(crowd, tmp_path, class_map):
 
 def test_random_looks_draw_bodies_of_their_stratum_and_every_skin_tone():
     from synthua_usd.assets.bodies import load_bank
-    from synthua_usd.materials import SKINS
+    from synthua_usd.model.materials import SKINS
     bank = load_bank()
     rng = np.random.default_rng(5)
     walkers = [PersonLook.random(rng) for _ in range(400)]

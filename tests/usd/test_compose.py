@@ -4,7 +4,7 @@ import pytest
 from pxr import Sdf
 
 from conftest import STAGES
-from synthua_usd.errors import StageError
+from synthua_usd.core.errors import StageError
 from synthua_usd.usd.compose import compose_layers
 
 

@@ -6,9 +6,9 @@ import pytest
 from pxr import Usd
 
 from conftest import DATA, DISTRICT, SCENARIO
-from synthua_usd.conditions import SHIPPED, Condition
-from synthua_usd.errors import StageError
-from synthua_usd.scenario import ENVIRONMENT_PATH, Environment, StageMetadata
+from synthua_usd.composition.scenario import ENVIRONMENT_PATH, Environment, StageMetadata
+from synthua_usd.core.errors import StageError
+from synthua_usd.model.conditions import SHIPPED, Condition
 from synthua_usd.usd.conditions import (attribute_name, condition_names, condition_selected, read_condition,
                                         selected_condition)
 from synthua_usd.usd.scenario_layers import build_environment

@@ -6,11 +6,11 @@ from pxr import UsdGeom
 
 from conftest import DATA
 from snapshot_checks import assert_same_snapshot
-from synthua_usd.errors import StageError, UnsupportedPrimError
+from synthua_usd.core.errors import StageError, UnsupportedPrimError
 from synthua_usd.usd.reader import StageReader, read_snapshot
-from synthua_usd.usd.texcoords import fan_corners
 from synthua_usd.usd.semantics import renderable_gprims
 from synthua_usd.usd.stage_io import open_stage
+from synthua_usd.usd.texcoords import fan_corners
 
 
 @pytest.fixture(scope="module")

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 from pxr import Usd, UsdGeom
 
-from synthua_usd.geometry import look_at
-from synthua_usd.placement import Placement
-from synthua_usd.rigs import RigSpec
-from synthua_usd.scenario import StageMetadata
+from synthua_usd.composition.rigs import RigSpec
+from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.geometry.placement import Placement
+from synthua_usd.model.meshes import look_at
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.prim_checks import camera_findings
 from synthua_usd.usd.rig_layer import PlacedRig, build_rig_layer

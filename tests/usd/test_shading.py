@@ -108,9 +108,9 @@ def test_validation_reports_a_missing_texture_file(tmp_path, class_map):
 
 
 def test_written_materials_read_back_with_their_textures(tmp_path, class_map):
-    from synthua_usd.scene import Material, Texture
+    from synthua_usd.composition.scenario import StageMetadata
+    from synthua_usd.model.scene import Material, Texture
     from synthua_usd.usd.authoring import define_mesh, define_preview_material, new_layer
-    from synthua_usd.scenario import StageMetadata
 
     stage = new_layer(StageMetadata(), "a textured material")
     spec = Material("M", (0.2, 0.3, 0.4), 0.6, base_color_texture=Texture("textures/a.png", scale=(0.5, 0.5, 0.5, 1)),
@@ -136,7 +136,7 @@ def test_written_materials_read_back_with_their_textures(tmp_path, class_map):
 
 
 def test_a_texture_outside_the_scenario_folder_is_refused_unless_allowed(tmp_path, class_map):
-    from synthua_usd.errors import StageError
+    from synthua_usd.core.errors import StageError
 
     (tmp_path / "elsewhere").mkdir()
     write_png(tmp_path / "elsewhere" / "quadrants.png", TEXELS)

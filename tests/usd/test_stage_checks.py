@@ -3,8 +3,8 @@
 import pytest
 
 from conftest import DATA
-from synthua_usd.errors import SynthuaError
-from synthua_usd.findings import Severity
+from synthua_usd.core.errors import SynthuaError
+from synthua_usd.core.findings import Severity
 from synthua_usd.pipeline.frame import FrameRequest, run_frames
 from synthua_usd.usd.stage_checks import validate_stage
 from synthua_usd.usd.stage_io import open_stage

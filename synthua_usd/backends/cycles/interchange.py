@@ -13,8 +13,8 @@ with ``usd-core`` in one process), so the scene crosses a process boundary as tw
     ``materials``, one entry per soup (key, index k, ``textured``, base colour linear Rec.709, roughness,
     metallic, emissive colour, ``textures``: per textured input (``base_color``, ``roughness``, ``metallic``,
     ``normal``) the image's absolute ``path``, ``channel``, ``color_space``, ``wrap_s``, ``wrap_t``, ``scale``,
-    ``bias`` of :class:`synthua_usd.scene.Texture`; triangle count, what was not exported), ``lights`` (as
-    :class:`synthua_usd.scene.Light`), ``camera`` (camera_to_world (4, 4) column vectors, looking down local -Z
+    ``bias`` of :class:`synthua_usd.model.scene.Texture`; triangle count, what was not exported), ``lights`` (as
+    :class:`synthua_usd.model.scene.Light`), ``camera`` (camera_to_world (4, 4) column vectors, looking down local -Z
     with +Y up as USD and Blender both do; the conformed horizontal field of view and aperture for the image
     size; clipping range), ``up_axis``, ``width``, ``height``.
 
@@ -34,14 +34,14 @@ import numpy as np
 GEOMETRY = "geometry.npz"
 SCENE = "scene.json"
 FORMAT_VERSION = 2
-#: The textured inputs exported (the ``*_texture`` fields of :class:`synthua_usd.scene.Material`), by their name here.
+#: The textured inputs exported (the ``*_texture`` fields of :class:`synthua_usd.model.scene.Material`), by their name here.
 EXPORTED_TEXTURES = {"base_color_texture": "base_color", "roughness_texture": "roughness",
                      "metallic_texture": "metallic", "normal_texture": "normal"}
 
 
 def write_interchange(snapshot, camera, width: int, height: int, folder: str | Path) -> Path:
-    """Write ``snapshot`` (a :class:`synthua_usd.scene.SceneSnapshot`) seen by ``camera`` (a
-    :class:`synthua_usd.cameras.PinholeCamera`) at ``width`` x ``height`` into ``folder`` (created); returns it.
+    """Write ``snapshot`` (a :class:`synthua_usd.model.scene.SceneSnapshot`) seen by ``camera`` (a
+    :class:`synthua_usd.model.cameras.PinholeCamera`) at ``width`` x ``height`` into ``folder`` (created); returns it.
 
     Lens distortion is not exported (Cycles' perspective camera has none): a distorted camera is refused."""
     if camera.distortion is not None:
@@ -112,7 +112,7 @@ def _not_exported(material) -> list[str]:
 
 
 def _texture(texture) -> dict:
-    """A :class:`synthua_usd.scene.Texture` as plain data, its image path absolute (a snapshot read from a stage
+    """A :class:`synthua_usd.model.scene.Texture` as plain data, its image path absolute (a snapshot read from a stage
     holds absolute paths; a relative one is taken from the working directory, as Mitsuba's translation reads it)."""
     return {"path": os.path.abspath(texture.path), "channel": texture.channel, "color_space": texture.color_space,
             "wrap_s": texture.wrap_s, "wrap_t": texture.wrap_t,

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.backends import images
-from synthua_usd.errors import SynthuaError
+from synthua_usd.core.errors import SynthuaError
 
 REPO = Path(__file__).resolve().parents[3]
 SCRIPT = Path(__file__).resolve().with_name("blender_render.py")

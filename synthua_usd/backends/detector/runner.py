@@ -20,7 +20,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from synthua_usd.errors import SynthuaError
+from synthua_usd.core.errors import SynthuaError
 
 log = logging.getLogger(__name__)
 

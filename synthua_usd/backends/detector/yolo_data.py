@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 
 from synthua_usd.analytics.detection_sets import DetectionSet
-from synthua_usd.atomic import write_text_atomic
+from synthua_usd.core.atomic import write_text_atomic
 
 #: Decimals of normalised coordinates (1e-7 of the image: far below a pixel).
 DECIMALS = 7

@@ -45,10 +45,10 @@ import numpy as np
 
 from synthua_usd.backends.mitsuba.render import pixel_centre_rays
 from synthua_usd.backends.mitsuba.translate import _mesh, sensor_dict, sensor_to_world
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.errors import InputError
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scene import SceneSnapshot
+from synthua_usd.core.errors import InputError
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import SceneSnapshot
 
 log = logging.getLogger(__name__)
 

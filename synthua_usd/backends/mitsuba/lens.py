@@ -20,8 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 from synthua_usd.backends.mitsuba.translate import film_dict, sampler_dict
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.render_config import RenderConfig
 
 #: Newton steps of the in-sensor inverse, from the distorted point. With them the sensor's rays agree with
 #: the float64 label rays to 1e-6 (measured 1.4e-7 for k1 = -0.25; tests/backends/mitsuba/test_lens.py).

@@ -14,10 +14,10 @@ from tqdm import tqdm
 
 from synthua_usd.backends.exposure import Exposure
 from synthua_usd.backends.mitsuba.translate import pass_sample_counts
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.conditions import Condition
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scene import SceneSnapshot
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.conditions import Condition
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import SceneSnapshot
 
 
 

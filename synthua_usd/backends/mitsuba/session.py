@@ -8,7 +8,7 @@ acceleration structure; the scene, its BSDFs and static meshes stay. A snapshot 
 gprim appeared or disappeared, a mesh changed its topology) or other lights is loaded afresh, and
 ``reloads`` counts it.
 
-Conditions (:mod:`synthua_usd.conditions`): a session loaded with a condition swaps to another in place
+Conditions (:mod:`synthua_usd.model.conditions`): a session loaded with a condition swaps to another in place
 (the environment map of sky and ground, the sun's direction and irradiance, lamps and emitter sampling
 weights through ``traverse()``, day or night; fog, rain and exposure are image-space steps) unless they differ
 in wetness or snow cover (those live in the BSDFs and mesh attributes the scene was built with): then the
@@ -34,10 +34,10 @@ from synthua_usd.backends.mitsuba.amodal import AmodalScene, checked_ids
 from synthua_usd.backends.mitsuba.lens import distorted_sensor
 from synthua_usd.backends.mitsuba.render import RenderedFrame, label_maps, render_rgb, trace_pixel_centres
 from synthua_usd.backends.mitsuba.translate import Translation, guide_integrator_dict, sensor_to_world, translate
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.conditions import Condition
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scene import SceneSnapshot
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.conditions import Condition
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import SceneSnapshot
 
 
 class RenderSession:

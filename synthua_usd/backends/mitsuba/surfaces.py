@@ -2,7 +2,7 @@
 ``normalmap`` and a ``mask`` when the material has a normal map or an opacity below one.
 
 Texture files are decoded here, once per file and colour space per translation (:class:`TextureImages`), with
-OpenImageIO (files inside USDZ packages too: :mod:`synthua_usd.texture_files`): 8-bit sRGB images (and ``sRGB`` textures) through the exact sRGB transfer function, alpha never;
+OpenImageIO (files inside USDZ packages too: :mod:`synthua_usd.core.texture_files`): 8-bit sRGB images (and ``sRGB`` textures) through the exact sRGB transfer function, alpha never;
 raw images as stored. Then UsdUVTexture's ``scale`` and ``bias`` and the chosen channel, and the result goes
 to Mitsuba as a float bitmap with ``raw=True``: Mitsuba never converts it again, and a single channel stays
 single (Mitsuba would take an RGB bitmap's luminance for a roughness, not its green). Mitsuba's bitmap puts
@@ -17,10 +17,10 @@ from typing import Callable
 
 import numpy as np
 
-from synthua_usd import srgb
-from synthua_usd.errors import InputError, echo
-from synthua_usd.scene import Material, Texture
-from synthua_usd.texture_files import MAX_TEXELS, TextureFileError, open_image
+from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.texture_files import MAX_TEXELS, TextureFileError, open_image
+from synthua_usd.model import srgb
+from synthua_usd.model.scene import Material, Texture
 
 log = logging.getLogger(__name__)
 

@@ -15,10 +15,10 @@ import numpy as np
 
 from synthua_usd.backends.mitsuba import surfaces, weather_scene
 from synthua_usd.backends.mitsuba.weather_scene import LampMesh
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.conditions import Condition
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scene import Light, Material, SceneSnapshot
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.conditions import Condition
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import Light, Material, SceneSnapshot
 
 
 @dataclass(frozen=True, eq=False)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 log = logging.getLogger(__name__)
 

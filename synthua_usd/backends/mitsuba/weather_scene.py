@@ -1,4 +1,4 @@
-"""What a condition (:class:`synthua_usd.conditions.Condition`) puts into a Mitsuba scene, and how the loaded
+"""What a condition (:class:`synthua_usd.model.conditions.Condition`) puts into a Mitsuba scene, and how the loaded
 scene is switched from one condition to another.
 
 Built into the scene when it is loaded with a condition (:mod:`synthua_usd.backends.mitsuba.translate`):
@@ -20,7 +20,7 @@ Built into the scene when it is loaded with a condition (:mod:`synthua_usd.backe
   UAV_Oblique, and 15–18 % less RGB time on UAV_Oblique at 1280×960. What it leaves out: the sun's 0.27°
   penumbrae and its disk seen in mirror-like reflections; the disk seen straight is drawn in image space
   (:func:`synthua_usd.backends.weather.sun_disk`);
-* an ``area`` emitter on every lamp mesh (:mod:`synthua_usd.lamps`), dark until a condition turns it on;
+* an ``area`` emitter on every lamp mesh (:mod:`synthua_usd.model.lamps`), dark until a condition turns it on;
 * weathered surfaces, only when the condition has them: a ``blendbsdf`` per material between the dry
   ``principled`` BSDF and a wet or snowy one, weighted per face by a mesh attribute (``face_wet``,
   ``face_snow``) that holds the wetness or snow cover of upward-facing faces.
@@ -48,11 +48,11 @@ import numpy as np
 
 from synthua_usd.backends.mitsuba import surfaces
 from synthua_usd.backends.weather import fog_lighting
-from synthua_usd.conditions import SNOW_FREE_CLASSES, SNOW_SLOPE_DEG, WET_GROUND_CLASSES, WET_MAX_SLOPE_DEG, Condition
-from synthua_usd.lamps import KINDS, is_on, lamp_role
-from synthua_usd.photometry import CCT_4000K, CD_PER_M2_PER_UNIT, radiance_rgb
-from synthua_usd.scenario import ENVIRONMENT_PATH
-from synthua_usd.scene import Material, SceneSnapshot
+from synthua_usd.composition.scenario import ENVIRONMENT_PATH
+from synthua_usd.model.conditions import SNOW_FREE_CLASSES, SNOW_SLOPE_DEG, WET_GROUND_CLASSES, WET_MAX_SLOPE_DEG, Condition
+from synthua_usd.model.lamps import KINDS, is_on, lamp_role
+from synthua_usd.model.photometry import CCT_4000K, CD_PER_M2_PER_UNIT, radiance_rgb
+from synthua_usd.model.scene import Material, SceneSnapshot
 
 SKY = "sky_environment"
 SUN = "sky_sun"

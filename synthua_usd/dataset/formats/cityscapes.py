@@ -21,9 +21,9 @@ from typing import Sequence
 
 import numpy as np
 
-from synthua_usd.errors import InputError, OutputError
-from synthua_usd.scene import Instance
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.core.errors import InputError, OutputError
+from synthua_usd.model.scene import Instance
+from synthua_usd.model.taxonomy import ClassMap
 
 #: Instances of one class that ``class * 1000 + k`` can number in one image.
 MAX_INSTANCES_PER_CLASS = 1000

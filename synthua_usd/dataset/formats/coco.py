@@ -9,7 +9,7 @@ the panoptic and Cityscapes formats. Extra fields per annotation, which COCO rea
 ``instance_id`` (the pixel value in the image's instance map) and ``relations`` (``{"uses": prim path,
 "uses_annotation_id": id}``; the id only when the used device or person is annotated in the same image).
 
-Keypoints (COCO's person-keypoints fields): a category with keypoints (:mod:`synthua_usd.keypoint_classes`:
+Keypoints (COCO's person-keypoints fields): a category with keypoints (:mod:`synthua_usd.model.keypoint_classes`:
 the person's 17 COCO body keypoints, a mobility aid's contact points) lists their ``keypoints`` names and
 ``skeleton``; each of its annotations has ``keypoints`` (flat ``[x, y, v, ...]``, pixel coordinates of the
 written image, v 0/1/2 as :mod:`synthua_usd.dataset.keypoints` defines them) and ``num_keypoints`` (how
@@ -27,10 +27,10 @@ from __future__ import annotations
 
 from typing import Iterable
 
+from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.formats.records import image_entry, is_rejected, ordered
-from synthua_usd.errors import InputError
-from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
+from synthua_usd.model.taxonomy import ClassMap
 
 
 def categories(class_map: ClassMap) -> list[dict]:

@@ -26,7 +26,7 @@ from __future__ import annotations
 import csv
 import io
 
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 #: Class-map groups whose instances are tracked.
 TRACKED_GROUPS = ("person", "accessibility", "vehicle")

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.atomic import atomic_path
-from synthua_usd.errors import InputError
+from synthua_usd.core.atomic import atomic_path
+from synthua_usd.core.errors import InputError
 
 #: The zip member holding the tensor: ``np.load(path)["onehot"]``.
 MEMBER = "onehot"

@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import Iterable
 
 from synthua_usd.dataset.formats.records import image_entry, in_split
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 
 def panoptic_categories(class_map: ClassMap) -> list[dict]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Iterable
 
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 
 def is_rejected(record: dict) -> bool:

@@ -25,10 +25,10 @@ from typing import Iterable
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from synthua_usd.atomic import atomic_path
+from synthua_usd.core.atomic import atomic_path
+from synthua_usd.core.errors import OutputError
 from synthua_usd.dataset.formats.records import ordered
-from synthua_usd.errors import OutputError
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 
 def _matrix(prefix: str, matrix) -> dict:

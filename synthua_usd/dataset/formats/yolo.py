@@ -21,9 +21,9 @@ from typing import Iterable, Sequence
 import numpy as np
 from pycocotools import mask as mask_utils
 
+from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.layout import SPLITS
-from synthua_usd.errors import InputError
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.taxonomy import ClassMap
 
 #: Decimals of normalised coordinates: 1e-9 of the image size, far below a pixel at any resolution.
 DECIMALS = 9

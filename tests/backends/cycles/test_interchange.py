@@ -50,7 +50,7 @@ def test_round_trip_keeps_triangles_materials_lights_and_camera(lit, tmp_path):
 
 
 def test_a_distorted_camera_is_refused(lit, tmp_path):
-    from synthua_usd.distortion import BrownConrady
+    from synthua_usd.model.distortion import BrownConrady
 
     snap, cam = lit
     distorted = dataclasses.replace(cam, distortion=BrownConrady(k1=0.1))
@@ -79,7 +79,7 @@ def test_a_missing_cycles_interpreter_says_so_in_one_line(tmp_path):
 def test_cycles_renders_the_exported_scene_like_mitsuba(lit, tmp_path):
     from synthua_usd.backends.cycles.runner import CyclesJob, CyclesUnavailable, find_cycles_python, render_jobs
     from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.render_config import RenderConfig
+    from synthua_usd.model.render_config import RenderConfig
 
     try:
         python = find_cycles_python()

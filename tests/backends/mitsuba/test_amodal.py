@@ -10,11 +10,11 @@ import pytest
 import trimesh
 
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.distortion import BrownConrady
-from synthua_usd.errors import InputError
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scene import Instance, Material, MeshItem, SceneSnapshot
+from synthua_usd.core.errors import InputError
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.distortion import BrownConrady
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import Instance, Material, MeshItem, SceneSnapshot
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import StageReader
 

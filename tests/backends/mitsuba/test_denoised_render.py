@@ -9,11 +9,11 @@ import pytest
 from conftest import activate_variant
 from reference_images import HEIGHT, WIDTH, reference_path, tiny_scene
 from synthua_usd.backends import images
+from synthua_usd.backends.image_quality import psnr_db, ssim
 from synthua_usd.backends.mitsuba.render import render_rgb
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.backends.mitsuba.translate import guide_integrator_dict
-from synthua_usd.image_quality import psnr_db, ssim
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig
 
 GREY = (0.3, 0.3, 0.3)  # the ground's diffuseColor in tests/data/valid/tiny_lit_scene.usda
 

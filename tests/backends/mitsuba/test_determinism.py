@@ -8,8 +8,8 @@ import pytest
 
 from conftest import DISTRICT, activate_variant
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.taxonomy import ClassMap
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.conditions import read_condition
 from synthua_usd.usd.reader import StageReader

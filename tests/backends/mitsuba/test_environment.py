@@ -14,7 +14,7 @@ import pytest
 from conftest import DISTRICT, SCENARIO
 from frame_checks import black_shares
 from synthua_usd.backends.mitsuba import weather_scene
-from synthua_usd.conditions import SHIPPED
+from synthua_usd.model.conditions import SHIPPED
 from test_sun import plane_radiance
 
 CONDITIONS = {c.name: c for c in SHIPPED}

@@ -5,7 +5,7 @@ import pytest
 
 from reference_raycast import reference_labels
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import read_snapshot
 

@@ -13,9 +13,9 @@ from conftest import DATA
 from reference_raycast import labels_of_rays
 from synthua_usd.backends.mitsuba.lens import distorted_sensor, sensor_rays
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.distortion import BrownConrady
-from synthua_usd.geometry import look_at
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.distortion import BrownConrady
+from synthua_usd.model.meshes import look_at
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import read_snapshot
 from synthua_usd.usd.stage_io import open_stage

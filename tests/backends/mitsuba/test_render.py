@@ -6,7 +6,7 @@ from conftest import activate_variant
 from synthua_usd.backends.mitsuba.render import trace_pixel_centres
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.backends.mitsuba.translate import translate
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig
 
 
 def test_scalar_and_jit_labels_are_identical(tiny):

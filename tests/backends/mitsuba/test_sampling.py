@@ -10,7 +10,7 @@ from synthua_usd.backends.mitsuba import variants
 from synthua_usd.backends.mitsuba.render import render_rgb
 from synthua_usd.backends.mitsuba.translate import (MAX_SPP_PER_PASS, film_dict, pass_sample_counts, sampler_dict,
                                                     takes_exactly)
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig
 
 
 def test_pass_counts_add_up_and_are_drawn_exactly(variant):

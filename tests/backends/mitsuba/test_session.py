@@ -4,7 +4,7 @@ import numpy as np
 
 from conftest import SCENARIO
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import StageReader, read_snapshot
 

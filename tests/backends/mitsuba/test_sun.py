@@ -8,8 +8,8 @@ import pytest
 
 from synthua_usd.backends import weather
 from synthua_usd.backends.mitsuba import weather_scene
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.conditions import SHIPPED
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.conditions import SHIPPED
 
 CONDITIONS = {c.name: c for c in SHIPPED}
 ALBEDO = 0.5

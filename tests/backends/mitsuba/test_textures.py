@@ -16,7 +16,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdShade
 
 from synthua_usd.backends.mitsuba import variants
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import StageReader, read_snapshot
 from synthua_usd.usd.stage_io import open_stage
@@ -95,7 +95,7 @@ def test_a_missing_texture_file_renders_the_constant_after_a_warning(tmp_path, c
 
 def test_an_oversized_texture_is_refused_before_it_is_decoded(quads, class_map, monkeypatch):
     from synthua_usd.backends.mitsuba import surfaces
-    from synthua_usd.errors import InputError
+    from synthua_usd.core.errors import InputError
 
     monkeypatch.setattr(surfaces, "MAX_TEXELS", 40)
     snap = read_snapshot(open_stage(quads), 1.0, class_map)

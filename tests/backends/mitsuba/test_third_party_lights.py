@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from synthua_usd.backends.mitsuba.session import RenderSession
-from synthua_usd.photometry import CD_PER_M2_PER_UNIT, distant_irradiance, dome_radiance, luminance
-from synthua_usd.render_config import RenderConfig
+from synthua_usd.model.photometry import CD_PER_M2_PER_UNIT, distant_irradiance, dome_radiance, luminance
+from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.reader import read_snapshot
 from synthua_usd.usd.stage_io import open_stage

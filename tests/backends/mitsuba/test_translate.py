@@ -8,11 +8,11 @@ from pxr import UsdGeom
 
 from synthua_usd.backends.mitsuba import variants
 from synthua_usd.backends.mitsuba.translate import DOME_WEIGHT_SHARE, bsdf_dict, translate
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scene import Material
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import Material
 from synthua_usd.usd.cameras import read_camera
-from synthua_usd.usd.semantics import renderable_gprims
 from synthua_usd.usd.reader import read_snapshot
+from synthua_usd.usd.semantics import renderable_gprims
 
 
 def loaded_shapes(mi, translation) -> dict:

@@ -9,13 +9,13 @@ from pxr import UsdGeom
 
 from synthua_usd.backends.mitsuba import variants
 from synthua_usd.backends.mitsuba.translate import translate
-from synthua_usd.cameras import PinholeCamera
-from synthua_usd.class_assignment import AssignmentRules
-from synthua_usd.geometry import look_at
+from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.importers.mesh import import_mesh
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scenario import StageMetadata
-from synthua_usd.scene import Light
+from synthua_usd.model.cameras import PinholeCamera
+from synthua_usd.model.class_assignment import AssignmentRules
+from synthua_usd.model.meshes import look_at
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import Light
 from synthua_usd.usd.reader import read_snapshot
 from synthua_usd.usd.scenario_writer import write_twin_layers
 from synthua_usd.usd.stage_io import open_stage

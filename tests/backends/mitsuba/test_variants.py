@@ -3,7 +3,7 @@
 import pytest
 
 from synthua_usd.backends.mitsuba import variants
-from synthua_usd.errors import InputError
+from synthua_usd.core.errors import InputError
 
 
 def test_unknown_variant_is_an_input_error():

@@ -9,10 +9,10 @@ import pytest
 
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.backends.mitsuba.weather_scene import LightMeter, face_weights, wet_albedo
-from synthua_usd.conditions import SHIPPED, display_order
-from synthua_usd.photometry import CD_PER_M2_PER_UNIT, luminance
-from synthua_usd.render_config import RenderConfig
-from synthua_usd.scene import MeshItem
+from synthua_usd.model.conditions import SHIPPED, display_order
+from synthua_usd.model.photometry import CD_PER_M2_PER_UNIT, luminance
+from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.scene import MeshItem
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.conditions import condition_names, read_condition
 from synthua_usd.usd.reader import StageReader

@@ -103,7 +103,7 @@ def test_every_annotation_has_num_keypoints_and_person_keypoints_is_the_person_p
     """COCOeval(gt, dt, "keypoints") reads num_keypoints of every annotation of every category (KeyError
     before); COCO's person_keypoints file holds the person category and its annotations only."""
     from synthua_usd.dataset.formats.coco import person_keypoints
-    from synthua_usd.keypoint_classes import KEYPOINT_CLASSES
+    from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
 
     records, _ = dataset
     doc = coco_instances(records, class_map, "train")

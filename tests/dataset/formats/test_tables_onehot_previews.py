@@ -12,10 +12,10 @@ import pyarrow.parquet as pq
 import pytest
 
 from label_scenes import crowded_scene, record, scene
-from synthua_usd.dataset.formats.onehot import onehot, write_onehot_npz
 from synthua_usd.backends.previews import instance_colors, instance_preview
+from synthua_usd.core.errors import InputError
+from synthua_usd.dataset.formats.onehot import onehot, write_onehot_npz
 from synthua_usd.dataset.formats.tables import metadata_rows, write_tables
-from synthua_usd.errors import InputError
 
 
 def test_metadata_table_reads_back_by_pyarrow_and_csv(tmp_path, class_map):

@@ -75,7 +75,7 @@ def test_supervision_loads_the_layout_with_the_same_boxes(tmp_path, class_map):
 
 
 def test_data_yaml_lists_splits_and_names():
-    from synthua_usd.taxonomy import ClassMap
+    from synthua_usd.model.taxonomy import ClassMap
 
     text = data_yaml(ClassMap.default())
     assert "train: images/train\n" in text and "test: images/test\n" in text and "path:" not in text

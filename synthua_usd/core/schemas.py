@@ -1,0 +1,142 @@
+"""The JSON Schemas bundled with the package (the top-level ``schemas/`` folder) and validation against them."""
+
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+
+from synthua_usd.core.errors import InputError, SchemaError, echo
+from synthua_usd.core.input_files import MAX_DOCUMENT_BYTES, read_input_text, shown
+
+SCHEMA_PACKAGE = "synthua_usd.schema_files"
+
+
+def bundled_path(name: str) -> Path:
+    """Filesystem path of a file shipped in ``schemas/`` (e.g. ``classmap.json``)."""
+    path = Path(str(resources.files(SCHEMA_PACKAGE).joinpath(name)))
+    if not path.is_file():
+        raise InputError(f"{name}: no such bundled schema file in {path.parent}")
+    return path
+
+
+@lru_cache(maxsize=None)
+def load_schema(name: str) -> dict:
+    """The JSON Schema ``schemas/<name>.schema.json`` as a dict, checked to be a valid schema."""
+    schema = json.loads(bundled_path(f"{name}.schema.json").read_text(encoding="utf-8"))
+    jsonschema.Draft202012Validator.check_schema(schema)
+    return schema
+
+
+#: Deepest nesting of arrays and objects accepted in a JSON document. CityJSON's MultiSolid boundaries, the
+#: deepest structure we read, sit about 10 levels down; without a limit a deep document would exhaust the
+#: recursion of the parser or of schema validation.
+MAX_JSON_DEPTH = 64
+#: Longest integer accepted in a JSON document (uint64 has 20 digits); Python refuses to convert integers of
+#: more than 4300 digits at all, and no field we read needs more.
+MAX_INTEGER_DIGITS = 20
+
+
+class _Refused(ValueError):
+    """A JSON token the parser hooks refuse (the message is the what-was-found part)."""
+
+
+def _parse_int(text: str) -> int:
+    digits = len(text.lstrip("-"))
+    if digits > MAX_INTEGER_DIGITS:
+        raise _Refused(f"an integer of {digits} digits ({text[:12]}...); expected at most {MAX_INTEGER_DIGITS} digits")
+    return int(text)
+
+
+def _parse_float(text: str) -> float:
+    value = float(text)
+    if value in (float("inf"), float("-inf")):
+        raise _Refused(f"the number {text[:40]} is beyond double precision; expected finite numbers")
+    return value
+
+
+def _parse_constant(name: str):
+    raise _Refused(f"{name} is not JSON; expected finite numbers (NaN and Infinity are not allowed)")
+
+
+def _depth(document: Any) -> int:
+    """Nesting depth of arrays and objects (a scalar document has depth 0), without recursion."""
+    deepest, stack = 0, [(document, 1)]
+    while stack:
+        node, depth = stack.pop()
+        children = node.values() if isinstance(node, dict) else node if isinstance(node, list) else None
+        if children is None:
+            continue
+        deepest = max(deepest, depth)
+        if depth > MAX_JSON_DEPTH:
+            break
+        stack.extend((child, depth + 1) for child in children if isinstance(child, (dict, list)))
+    return deepest
+
+
+def read_json(path: str | Path, what: str = "a JSON document") -> Any:
+    """Parse a JSON file (a regular file of at most :data:`MAX_DOCUMENT_BYTES`, UTF-8, strict RFC 8259
+    numbers, at most :data:`MAX_JSON_DEPTH` levels deep); anything else raises :class:`InputError` naming
+    the file."""
+    path = Path(path)
+    text = read_input_text(path, MAX_DOCUMENT_BYTES, what)
+    try:
+        document = json.loads(text, parse_int=_parse_int, parse_float=_parse_float, parse_constant=_parse_constant)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{shown(path)}: not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}; "
+                         f"expected {what}") from None
+    except _Refused as exc:
+        raise InputError(f"{shown(path)}: {exc}") from None
+    except RecursionError:
+        raise InputError(f"{shown(path)}: nested too deeply to parse; expected at most {MAX_JSON_DEPTH} levels of "
+                         f"arrays and objects") from None
+    depth = _depth(document)
+    if depth > MAX_JSON_DEPTH:
+        raise InputError(f"{shown(path)}: nested more than {MAX_JSON_DEPTH} levels deep; expected at most "
+                         f"{MAX_JSON_DEPTH} levels of arrays and objects")
+    return document
+
+
+def type_name(value: Any) -> str:
+    """The JSON name of a value's type, for messages: object, array, string, number, boolean, null."""
+    if isinstance(value, bool):
+        return "a boolean"
+    return {dict: "an object", list: "an array", str: "a string", int: "a number", float: "a number",
+            type(None): "null"}.get(type(value), type(value).__name__)
+
+
+def schema_errors(document: Any, schema_name: str) -> list[jsonschema.ValidationError]:
+    """All violations of ``schemas/<schema_name>.schema.json``, most specific first."""
+    validator = jsonschema.Draft202012Validator(load_schema(schema_name))
+    return sorted(validator.iter_errors(document), key=lambda e: (list(e.absolute_path), e.message))
+
+
+def json_pointer(error: jsonschema.ValidationError) -> str:
+    """Where in the document an error is, as ``classes[3].color``."""
+    out = ""
+    for part in error.absolute_path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out or "(document)"
+
+
+def schema_message(error: jsonschema.ValidationError) -> str:
+    """A violation's message with a long echoed value cut (jsonschema starts most messages with the
+    value's repr, which can be a whole document)."""
+    message, value = error.message, repr(error.instance)
+    if message.startswith(value) and len(value) > 60:
+        message = echo(value[:57] + "...") + message[len(value):]
+    return message
+
+
+def validate_document(document: Any, schema_name: str, source: str) -> None:
+    """Raise :class:`SchemaError` with the first violation, naming ``source`` and the field."""
+    errors = schema_errors(document, schema_name)
+    if errors:
+        first = errors[0]
+        more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+        raise SchemaError(f"{shown(source)}: {json_pointer(first)}: {schema_message(first)}; "
+                          f"expected a document matching {schema_name}.schema.json{more}")
