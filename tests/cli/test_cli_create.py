@@ -1,10 +1,9 @@
 """`synthua create`: the shipped scenarios written from the library code."""
 
-import filecmp
-
 from pxr import Sdf
 
 from conftest import STAGES
+from layer_match import mismatch
 from synthua_usd.composition.rigs import RigSpec
 from synthua_usd.composition.scenario import ROOT_FILE
 from synthua_usd.demo import district
@@ -16,8 +15,7 @@ def test_create_street_writes_the_committed_stages(run_cli, tmp_path):
     assert code == 0
     names = street_scenario().layer_files() + (ROOT_FILE,)
     assert out.splitlines() == [f"wrote {tmp_path / n}" for n in names]
-    for name in names:
-        assert filecmp.cmp(tmp_path / name, STAGES / name, shallow=False), name
+    assert [m for m in (mismatch(tmp_path / n, STAGES / n) for n in names) if m] == []
 
 
 def test_create_district_passes_the_seed_and_aims_its_rigs(run_cli, tmp_path, monkeypatch):
