@@ -6,9 +6,10 @@ Usage:
 
 For each dataset (folders written by ``synthua generate``): the whole command once as a user runs it (a fresh
 process: imports, class-map check, records, statistics, figures, gallery, HTML), then in one process, best of
-``--repeat``: reading the manifest and the per-image records, computing the statistics, and writing the report.
-Reading and computing grow with the number of images; the figures and the gallery (8 images) do not. The last
-line gives the time per 1,000 images of reading + computing, and the fixed cost. Not a test: note the machine's load.
+``--repeat``: reading the manifest and the per-image records, computing the statistics (which reads every RGB
+once, for contrast and edges), and writing the report. Reading and computing grow with the number of images; the
+figures and the gallery (8 images) do not. The last line gives the time per 1,000 images of reading + computing,
+and the fixed cost. Not a test: note the machine's load.
 """
 
 from __future__ import annotations

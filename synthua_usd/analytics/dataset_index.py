@@ -67,6 +67,16 @@ class DatasetIndex:
     rejected: int
 
 
+def image_file(root: Path, img: ImageSummary, relative: str) -> Path:
+    """``root / relative``: a file of image ``img`` (its :attr:`~ImageSummary.rgb` or
+    :attr:`~ImageSummary.class_png`); a missing one raises :class:`InputError`."""
+    path = Path(root) / relative
+    if not path.is_file():
+        raise InputError(f"{shown(path)}: file not found; expected the image of record {img.name} "
+                         f"(run `synthua verify {shown(root)}`)")
+    return path
+
+
 def load_class_map(root: Path) -> ClassMap:
     """The dataset's own class map (``class_map.json``): the ids its label maps use."""
     return ClassMap.load(Layout(root).path(Layout.CLASS_MAP))

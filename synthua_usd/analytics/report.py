@@ -23,11 +23,11 @@ import numpy as np
 
 from synthua_usd.analytics import plots
 from synthua_usd.analytics.csv_text import csv_text
-from synthua_usd.analytics.dataset_index import DatasetIndex, ImageSummary
+from synthua_usd.analytics.dataset_index import DatasetIndex, ImageSummary, image_file
+from synthua_usd.analytics.image_contrast import EDGE_THRESHOLD, MEASURES, SOBEL_GAIN, SPREAD
 from synthua_usd.analytics.statistics import DatasetStatistics, mobility_aid_classes
 from synthua_usd.core.atomic import output_set, write_json_atomic, write_text_atomic
-from synthua_usd.core.errors import InputError
-from synthua_usd.core.input_files import shown
+from synthua_usd.model.photometry import REC709_LUMA
 
 OVERLAY_ALPHA = 0.5
 PLOTS = ("class_distribution", "area_boxplot", "cooccurrence", "coverage_cdf", "instances_per_image", "aid_area",
@@ -70,11 +70,7 @@ def overlay(rgb: np.ndarray, class_ids: np.ndarray, palette: np.ndarray, alpha: 
 def _read_pair(index: DatasetIndex, img: ImageSummary) -> tuple[np.ndarray, np.ndarray]:
     from synthua_usd.backends.images import read_image
 
-    paths = [index.root / img.rgb, index.root / img.class_png]
-    for p in paths:
-        if not p.is_file():
-            raise InputError(f"{shown(p)}: file not found; expected the image of record {img.name} "
-                             f"(run `synthua verify {shown(index.root)}`)")
+    paths = [image_file(index.root, img, relative) for relative in (img.rgb, img.class_png)]
     rgb, _ = read_image(paths[0])
     ids, _ = read_image(paths[1])
     return rgb, ids[..., 0].astype(np.int64)
@@ -148,6 +144,7 @@ body{font-family:sans-serif;margin:1.5em;max-width:1300px;color:#222}
 table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0 1.5em}
 td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}
 td:first-child,th:first-child{text-align:left}
+th[colspan]{text-align:center}
 .sw{display:inline-block;width:0.9em;height:0.9em;border:1px solid #555;margin-right:4px;vertical-align:middle}
 figure{display:inline-block;margin:4px;vertical-align:top}
 figure img{max-width:100%}
@@ -157,6 +154,24 @@ figure img{max-width:100%}
 figcaption{font-size:0.75em;max-width:320px}
 .legend span.item{display:inline-block;margin:2px 10px 2px 0;font-size:0.85em}
 """
+
+
+def _contrast_section(c: dict) -> list[str]:
+    """The RMS contrast and edge density of the images, over the dataset and per split, as a table."""
+    head = "".join(f"<th>{q}</th>" for q in SPREAD)
+    weights = " + ".join(f"{w:g} {channel}" for w, channel in zip(REC709_LUMA, "RGB"))
+    out = ["<h2>Image contrast and edges</h2><p>Of each image's RGB as stored (display sRGB): RMS contrast is the "
+           f"standard deviation of its Rec. 709 luma ({weights} of the values / 255; 0.5 for half black, half "
+           "white); edge density is the share of its pixels whose Sobel gradient magnitude of "
+           f"that luma, divided by {SOBEL_GAIN:g} (a black-to-white step gives 1), exceeds {EDGE_THRESHOLD:g}, the "
+           "border replicated. Spread over the images.</p>",
+           f'<table><tr><th rowspan="2">images</th><th rowspan="2">count</th><th colspan="{len(SPREAD)}">RMS '
+           f'contrast</th><th colspan="{len(SPREAD)}">edge density</th></tr><tr>{head}{head}</tr>']
+    for label, part in [("all", c)] + [(f"split {k}", v) for k, v in c["per_split"].items()]:
+        cells = "".join(f"<td>{_fmt(part[m][q], 3)}</td>" for m in MEASURES for q in SPREAD)
+        out.append(f"<tr><td>{html.escape(label)}</td><td>{part[MEASURES[0]]['count']:,}</td>{cells}</tr>")
+    out.append("</table>")
+    return out
 
 
 def _html(index: DatasetIndex, stats: DatasetStatistics, chosen: list[ImageSummary], legend_ids: list[int],
@@ -209,7 +224,9 @@ def _html(index: DatasetIndex, stats: DatasetStatistics, chosen: list[ImageSumma
            '<a href="cooccurrence.csv">cooccurrence.csv</a>.</p>',
            "<h2>Summary</h2><table>"]
     out += [f"<tr><td>{e(k)}</td><td>{e(v)}</td></tr>" for k, v in summary_rows]
-    out.append("</table><h2>Gallery</h2><p>RGB with the class colours laid over at 50 %; unlabelled pixels left clear.</p>"
+    out.append("</table>")
+    out += _contrast_section(s["image_contrast"])
+    out.append("<h2>Gallery</h2><p>RGB with the class colours laid over at 50 %; unlabelled pixels left clear.</p>"
                '<div class="legend">')
     for cid in legend_ids:
         c = cmap.by_id(cid)

@@ -15,6 +15,9 @@ What is counted, once for every statistic:
   (:func:`synthua_usd.dataset.qa.aid_users`).
 * ``diversity``: how different the images' scenes are (:mod:`synthua_usd.analytics.diversity`; the one figure
   that reads label maps, the class-map disagreement of images sharing camera and time code).
+* ``image_contrast``: RMS contrast and edge density of each image's RGB, their mean, median, p10 and p90 over the
+  dataset and over each split (:mod:`synthua_usd.analytics.image_contrast`, which defines them; the one figure
+  that reads every RGB, each once).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ import numpy as np
 from synthua_usd.analytics import measures as m
 from synthua_usd.analytics.dataset_index import DatasetIndex
 from synthua_usd.analytics.diversity import diversity
+from synthua_usd.analytics.image_contrast import image_measures, summarise
 from synthua_usd.assets.devices import DEVICES
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
@@ -75,10 +79,11 @@ class DatasetStatistics:
     instances_per_image: list[int]         # by image id
     cooccurrence: np.ndarray               # (N, N) int64 images showing both classes
     summary: dict                          # dataset-level figures (see module docstring)
+    image_contrast: list[dict]             # by image id: id, name, split, rms_contrast, edge_density
 
     def document(self) -> dict:
         return {"summary": self.summary, "classes": [c.csv_row() for c in self.classes],
-                "instances_per_image": self.instances_per_image,
+                "instances_per_image": self.instances_per_image, "image_contrast_per_image": self.image_contrast,
                 "cooccurrence": {"classes": [c.name for c in self.classes], "images": self.cooccurrence.tolist()}}
 
 
@@ -180,5 +185,7 @@ def compute(index: DatasetIndex) -> DatasetStatistics:
                 "histogram": _histogram(sizes, SIZE_EDGES)}},
     }
     summary["diversity"] = diversity(index)
+    contrast = [{"id": img.id, "name": img.name, "split": img.split} | image_measures(index, img) for img in images]
+    summary["image_contrast"] = summarise(contrast)
     return DatasetStatistics(classes=rows, areas=areas, instances_per_image=[int(v) for v in ipi],
-                             cooccurrence=m.cooccurrence(presence), summary=summary)
+                             cooccurrence=m.cooccurrence(presence), summary=summary, image_contrast=contrast)

@@ -31,8 +31,10 @@ def stats(dataset: Path, out_dir: Path, samples: int) -> int:
     Dataset: Shannon entropy (bits) and normalised entropy and Gini coefficient of the pixel area, classes
     covering 80 % of it, objects per image (mean, median, max, histogram, density <=100 / 101-500 / >500),
     images per split, condition and rig type, share of images with a mobility-aid user, class co-occurrence,
-    mobility-aid area, occlusion and size of aid users. Reads the manifest and the per-image records (not the
-    images), and the RGB and class maps of the gallery's sample images only. QA-rejected images are left out.
+    mobility-aid area, occlusion and size of aid users. Images: RMS contrast and edge density of the RGB (mean,
+    median, p10, p90; per dataset and split). Reads the manifest, the per-image records, every RGB once, and
+    the class maps of images sharing camera and time code and of the gallery's samples (their RGB again).
+    QA-rejected images are left out.
     \b
     Writes statistics.json, class_statistics.csv, cooccurrence.csv, plots/*.png, gallery/*.png and
     report.html (self-contained: it refers only to files in the folder).
@@ -53,6 +55,9 @@ def stats(dataset: Path, out_dir: Path, samples: int) -> int:
                f"Gini {s['gini_pixel_area']:.4f}, entropy {s['shannon_entropy_bits']:.4f} bits (normalised "
                f"{s['normalised_entropy']:.4f}), {s['classes_for_coverage']} classes cover 80 % of the area, "
                f"{100 * s['share_images_with_aid_user']:.1f} % of images show a mobility-aid user")
+    c = s["image_contrast"]
+    say("images: " + ", ".join(f"{label} median {c[k]['median']:.3f} (p10-p90 {c[k]['p10']:.3f}-{c[k]['p90']:.3f})"
+                               for label, k in (("RMS contrast", "rms_contrast"), ("edge density", "edge_density"))))
     say(f"statistics in {seconds:.2f} s, report in {time.perf_counter() - t0:.2f} s -> {files.html}")
     return EXIT_OK
 

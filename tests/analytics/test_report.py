@@ -78,6 +78,14 @@ def test_report_files_and_html_in_a_real_browser(run_cli, tmp_path):
     assert code == 0, err
     assert "2 images (1 QA-rejected left out), 8 objects" in stdout and "50.0 % of images show" in stdout
     html = (out / "report.html").read_text()
+    stats = json.loads((out / "statistics.json").read_text())
+    contrast = stats["summary"]["image_contrast"]
+    (c1, e1), (c2, e2) = tiny_dataset.kept_contrast_and_edges(root).values()
+    assert contrast["rms_contrast"]["median"] == pytest.approx((c1 + c2) / 2)
+    assert contrast["per_split"]["val"]["edge_density"]["p90"] == pytest.approx(e2)
+    assert [r["edge_density"] for r in stats["image_contrast_per_image"]] == pytest.approx([e1, e2])
+    assert (f"images: RMS contrast median {(c1 + c2) / 2:.3f} (p10-p90 {min(c1, c2) + 0.1 * abs(c1 - c2):.3f}-"
+            f"{min(c1, c2) + 0.9 * abs(c1 - c2):.3f}), edge density median {(e1 + e2) / 2:.3f}") in stdout
     refs = references(html)
     for src in refs.images + refs.links:
         assert (out / src).is_file(), src
@@ -89,9 +97,12 @@ def test_report_files_and_html_in_a_real_browser(run_cli, tmp_path):
     dom = open_in_chromium(out / "report.html")
     assert 'data-broken=""' in dom, dom[-3000:]
     assert f'data-decoded="{len(refs.images)}"' in dom
+    # the contrast table as the browser has it: a row for the dataset and one per split, 3 decimals
+    cells = [f"<td>{v:.3f}</td>" for v in (c2, c2, c2, c2, e2, e2, e2, e2)]
+    assert "<h2>Image contrast and edges</h2>" in dom and f"<tr><td>split val</td><td>1</td>{''.join(cells)}</tr>" in dom
+    assert f"<tr><td>all</td><td>2</td><td>{(c1 + c2) / 2:.3f}</td>" in dom
     rows = list(csv.DictReader((out / "class_statistics.csv").open()))
     assert len(rows) == 36 and {r["name"]: r["instances"] for r in rows}["building"] == "3"
-    stats = json.loads((out / "statistics.json").read_text())
     assert stats["summary"]["gini_pixel_area"] == pytest.approx(2 * 1866 / (36 * 53) - 37 / 36)
 
 
@@ -167,6 +178,9 @@ def test_stats_of_a_generated_dataset_agree_with_its_pngs_and_coco(generated, ru
     conditions = Counter(json.loads((generated / "records" / f"{e['name']}.json").read_text())["condition"]["name"]
                          for e in kept)
     assert doc["summary"]["images_per_condition"] == dict(conditions)
+    measured = [tiny_dataset.contrast_and_edges(generated / "images" / e["split"] / f"{e['name']}.png") for e in kept]
+    assert [[r["rms_contrast"], r["edge_density"]] for r in doc["image_contrast_per_image"]] == [
+        pytest.approx(list(m), abs=1e-12) for m in measured]
     html = (tmp_path / "report" / "report.html").read_text()
     for src in references(html).images:
         assert (tmp_path / "report" / src).is_file(), src

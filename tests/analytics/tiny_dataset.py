@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 from pycocotools import mask as mask_utils
+from scipy import ndimage
 
 from synthua_usd.model.taxonomy import ClassMap
 
@@ -115,3 +116,18 @@ def write(root: Path) -> Path:
         (root / "annotations" / f"instances_{split}.json").write_text(json.dumps(coco[split]))
     (root / "manifest.json").write_text(json.dumps(manifest))
     return root
+
+
+def contrast_and_edges(png: Path) -> tuple[float, float]:
+    """(RMS contrast, edge density) of an RGB PNG as the statistics define them, computed without analytics
+    code: read with PIL, the luma written out, the edges through scipy."""
+    px = np.asarray(Image.open(png), np.float64)
+    y = (0.2126 * px[..., 0] + 0.7152 * px[..., 1] + 0.0722 * px[..., 2]) / 255
+    g = np.hypot(ndimage.sobel(y, axis=1), ndimage.sobel(y, axis=0)) / 4
+    return float(np.std(y)), float(np.mean(g > 0.1))
+
+
+def kept_contrast_and_edges(root: Path) -> dict[int, tuple[float, float]]:
+    """:func:`contrast_and_edges` by image id of the images kept (1 and 2; 3 is rejected)."""
+    return {k + 1: contrast_and_edges(root / "images" / split / f"{name}.png")
+            for k, (name, split) in enumerate(zip(NAMES[:2], ("train", "val")))}
