@@ -17,7 +17,7 @@ import trimesh
 from synthua_usd.agents.motion import MARGIN_M
 from synthua_usd.agents.profiles import PROFILES, AgentProfile
 from synthua_usd.agents.seats import SeatPlace, find_seat_places
-from synthua_usd.agents.walkable import WALKABLE, WalkableGrid, build_grid, edge_cost, walkable_graph
+from synthua_usd.agents.walkable import WALKABLE, WalkableGrid, build_grid, walkable_graph
 from synthua_usd.composition.rigs import RIG_TYPES
 from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.randomisation.config import CameraRandomisation, CrowdRandomisation
@@ -35,6 +35,10 @@ PLACE_TRIES = 60
 STANDING_SHARE = 0.15
 #: Side-by-side spacing of a group walking together, metres.
 GROUP_SPACING_M = 0.9
+#: The eight neighbours of a walkable cell (di, dj), sorted as the graph's node tuples sort, and the unit heading
+#: (x, y) = (dj, di) / |(dj, di)| towards each.
+NEIGHBOURS = tuple((di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1) if (di, dj) != (0, 0))
+_HEADINGS = np.array([np.array([dj, di], float) / np.linalg.norm([dj, di]) for di, dj in NEIGHBOURS])
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,6 +55,7 @@ class WalkArea:
     occluders: trimesh.Trimesh = field(repr=False)
     ground: trimesh.Trimesh = field(repr=False)
     _by_profile: dict = field(default_factory=dict, repr=False)
+    _edges: dict = field(default_factory=dict, repr=False)
 
     @classmethod
     def build(cls, vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray,
@@ -73,10 +78,9 @@ class WalkArea:
     def choices(self, profile: AgentProfile) -> tuple[np.ndarray, list[np.ndarray]]:
         """For ``profile``: indices into :attr:`nodes` of the cells it may stand on (at least one edge it can
         travel, and for a wide agent all eight neighbours walkable), and per such cell the unit directions
-        (d, 2) of the edges it can travel (its possible headings)."""
+        (d, 2) of the edges it can travel (its possible headings), in the order of the neighbours' cells."""
         key = (profile.can_step_kerb, profile.max_slope, profile.radius_m > 0.5 * self.grid.cell_m)
         if key not in self._by_profile:
-            cost = edge_cost(profile)
             ok = self.grid.walkable
             interior = ok.copy()
             if key[2]:
@@ -84,20 +88,27 @@ class WalkArea:
                 for di in (-1, 0, 1):
                     for dj in (-1, 0, 1):
                         interior &= padded[1 + di:1 + di + ok.shape[0], 1 + dj:1 + dj + ok.shape[1]]
-            keep, headings = [], []
-            for k, (i, j) in enumerate(self.nodes):
-                if not interior[i, j]:
-                    continue
-                dirs = []
-                for nb in sorted(self.graph.neighbors((int(i), int(j)))):
-                    if cost(None, None, self.graph.edges[(int(i), int(j)), nb]) is not None:
-                        d = np.array([nb[1] - j, nb[0] - i], float)
-                        dirs.append(d / np.linalg.norm(d))
-                if dirs:
-                    keep.append(k)
-                    headings.append(np.array(dirs))
-            self._by_profile[key] = (np.array(keep, np.int64), headings)
+            has, kerb, slope = self._neighbour_edges()
+            # What edge_cost(profile) lets pass: a kerb only for those who step kerbs, else a slope within reach.
+            passable = has & np.where(kerb, profile.can_step_kerb, slope <= profile.max_slope)
+            keep = np.flatnonzero(interior[self.nodes[:, 0], self.nodes[:, 1]] & passable.any(axis=1))
+            self._by_profile[key] = (keep.astype(np.int64), [_HEADINGS[passable[k]] for k in keep])
         return self._by_profile[key]
+
+    def _neighbour_edges(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(k, 8) arrays over :attr:`nodes` and :data:`NEIGHBOURS`: whether the graph has that edge, whether it
+        is a kerb, and its slope (0 where there is no edge). Built once; every profile reads them."""
+        if not self._edges:
+            index = {(int(i), int(j)): k for k, (i, j) in enumerate(self.nodes)}
+            offset = {o: n for n, o in enumerate(NEIGHBOURS)}
+            has = np.zeros((len(self.nodes), len(NEIGHBOURS)), bool)
+            kerb, slope = has.copy(), np.zeros(has.shape)
+            for u, v, data in self.graph.edges(data=True):
+                for a, b in ((u, v), (v, u)):
+                    k, n = index[a], offset[(b[0] - a[0], b[1] - a[1])]
+                    has[k, n], kerb[k, n], slope[k, n] = True, bool(data["kerb"]), data["slope"]
+            self._edges.update(has=has, kerb=kerb, slope=slope)
+        return self._edges["has"], self._edges["kerb"], self._edges["slope"]
 
     def ground_z(self, xy: np.ndarray, near_z: np.ndarray) -> np.ndarray:
         """(n,) heights of the walkable surface under points ``xy`` (n, 2), each the hit nearest below

@@ -11,6 +11,7 @@ import pytest
 from conftest import SCENARIO
 from synthua_usd.agents.motion import MARGIN_M
 from synthua_usd.agents.profiles import PROFILES
+from synthua_usd.agents.walkable import edge_cost
 from synthua_usd.composition.rigs import RIG_TYPES
 from synthua_usd.randomisation.config import CameraRandomisation, RandomisationConfig
 from synthua_usd.randomisation.scene import draw_cast
@@ -29,6 +30,29 @@ def street(class_map):
     vertices, faces, owner = snapshot.world_triangles(twin)
     names = np.array([class_map.by_id(m.class_id).name for m in twin], object)
     return stage, WalkArea.build(vertices, faces, names[owner])
+
+
+def test_choices_are_the_cells_and_headings_the_graph_lets_each_profile_travel(street):
+    # Independently: every node's neighbours in the graph's sorted order, each edge asked of edge_cost as A* asks.
+    _, area = street
+    ok = area.grid.walkable
+    for profile in PROFILES.values():
+        wide = profile.radius_m > 0.5 * area.grid.cell_m
+        cost = edge_cost(profile)
+        keep, headings = [], []
+        for k, (i, j) in enumerate(area.nodes):
+            if wide and not all(0 <= i + di < ok.shape[0] and 0 <= j + dj < ok.shape[1] and ok[i + di, j + dj]
+                                for di in (-1, 0, 1) for dj in (-1, 0, 1)):
+                continue
+            dirs = [np.array([b - j, a - i], float) for a, b in sorted(area.graph.neighbors((int(i), int(j))))
+                    if cost(None, None, area.graph.edges[(int(i), int(j)), (a, b)]) is not None]
+            if dirs:
+                keep.append(k)
+                headings.append(np.array([d / math.hypot(*d) for d in dirs]))
+        cells, got = area.choices(profile)
+        assert cells.dtype == np.int64 and cells.tolist() == keep, profile.name
+        assert len(got) == len(headings) and all(np.array_equal(g, h) for g, h in zip(got, headings)), profile.name
+    assert len({len(area.choices(p)[0]) for p in PROFILES.values()}) > 1  # the profiles do differ here
 
 
 def test_people_stand_apart_on_walkable_cells(street):
