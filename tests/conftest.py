@@ -6,6 +6,8 @@ Only this conftest exists: the test folders mirror the package, and every test m
 
 from __future__ import annotations
 
+import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -127,17 +129,53 @@ def generate_dataset(out: Path, config: Path = TINY_CONFIG, scenario: Path = SCE
 RANDOM_CONFIG = DATA / "configs" / "random.json"
 
 
+def built_once(tmp_path_factory, name: str, build) -> Path:
+    """``<temp>/<name>/dataset`` made by ``build(path)`` once for the whole run. With pytest-xdist (``make test``
+    runs the suite on parallel workers) the workers share it: the first to need it builds it under a file lock,
+    the others wait for it and read the same folder."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+        out = tmp_path_factory.mktemp(name) / "dataset"
+        build(out)
+        return out
+    from filelock import FileLock
+
+    root = tmp_path_factory.getbasetemp().parent  # the run's folder, above each worker's own
+    out, built = root / name / "dataset", root / name / "built"
+    with FileLock(str(root / f"{name}.lock")):
+        if not built.exists():
+            shutil.rmtree(out.parent, ignore_errors=True)  # what a worker that failed building left
+            out.parent.mkdir()
+            build(out)
+            built.touch()
+    return out
+
+
 @pytest.fixture(scope="session")
 def generated_random(tmp_path_factory) -> Path:
     """A randomised dataset of the demo street made with tests/data/configs/random.json (do not modify it)."""
-    out = tmp_path_factory.mktemp("random") / "dataset"
-    generate_dataset(out, config=RANDOM_CONFIG)
-    return out
+    return built_once(tmp_path_factory, "random", lambda out: generate_dataset(out, config=RANDOM_CONFIG))
 
 
 @pytest.fixture(scope="session")
 def generated(tmp_path_factory) -> Path:
     """A dataset of the demo street made with tests/data/configs/tiny.json (do not modify it: copy it)."""
-    out = tmp_path_factory.mktemp("generated") / "dataset"
-    generate_dataset(out)
-    return out
+    return built_once(tmp_path_factory, "generated", generate_dataset)
+
+
+#: The test files that take longest (pytest --durations on 2 cores, 2026-12-03), run first: pytest-xdist hands
+#: out files in collection order (``--dist loadfile``), and a long one handed out last keeps one worker busy
+#: while the other idles.
+LONGEST_FIRST = ("pipeline/test_districts.py", "test_wheel.py", "test_quickstart.py", "pipeline/test_generate.py",
+                 "pipeline/test_sim2real.py", "demo/test_district.py", "pipeline/test_generate_randomised.py",
+                 "cli/test_hostile_subprocess.py", "pipeline/test_sequences.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    tests = Path(__file__).resolve().parent
+
+    def rank(item) -> int:
+        path = Path(str(item.path)).resolve()
+        name = path.relative_to(tests).as_posix() if path.is_relative_to(tests) else ""
+        return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
+
+    items.sort(key=rank)
