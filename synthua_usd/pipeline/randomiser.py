@@ -253,7 +253,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     from synthua_usd.core.atomic import output_set
     from synthua_usd.core.errors import InputError
     from synthua_usd.dataset.config import GenerationConfig
-    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.render_config import resolve_render
     from synthua_usd.usd.render_settings import render_defaults
     from synthua_usd.usd.stage_io import USD_SUFFIXES, check_time_code, open_stage
 
@@ -297,21 +297,19 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     time_code = float(stage.GetStartTimeCode()) if time_code is None else float(time_code)
     check_time_code(stage, time_code)
     read_camera(stage, camera, time_code)  # a missing camera is one line, before anything is drawn
-    if render:
-        width, height = int(render["width"]), int(render["height"])
-    else:
-        width, height = config.render.size(*(defaults.resolution or (RenderConfig.width, RenderConfig.height)))
+    # a record's render block is what its image was rendered with: it stands where command-line options do
+    settings = resolve_render(stage=defaults.render_values(), config=config.render.render_values(),
+                              options={key: render.get(key) for key in ("width", "height", "spp", "max_depth")}
+                              | ({"denoise": render["denoise"] is not None} if "denoise" in render else {}))
+    width, height = settings.width, settings.height
     randomiser = Randomiser(stage, config.randomise, class_map, (width, height))
     drawn = randomiser.apply(seed, camera, time_code, condition, district)
     with output_set(out.parent) as staging:
         randomiser.export(staging / out.name, anchor=out.parent)
         files = tuple(out.parent / p.name for p in sorted(staging.iterdir()))
-    spp = render.get("spp", config.render.spp)
-    max_depth = render.get("max_depth", config.render.max_depth)
-    denoise = render["denoise"] is not None if "denoise" in render else config.render.denoise
     args = ("synthua", "render", str(scenario), "--layer", str(out), "--camera", camera,
             "--time-code", f"{time_code:g}", *(("--condition", condition) if condition else ()), "--seed", str(seed),
-            "--width", str(width), "--height", str(height), "--spp", str(spp), "--max-depth", str(max_depth),
-            "--denoise" if denoise else "--no-denoise", "--out", "OUT")
+            "--width", str(width), "--height", str(height), "--spp", str(settings.spp),
+            "--max-depth", str(settings.max_depth), "--denoise" if settings.denoise else "--no-denoise", "--out", "OUT")
     log.info("render with: %s", " ".join(shlex.quote(a) for a in args))
     return RandomiseResult(files, drawn, args)
