@@ -56,7 +56,7 @@ class ImageSummary:
     @property
     def class_png(self) -> str:
         """Relative path of the 8-bit class-id map."""
-        return Layout.frame_file(self.name, "class.png")
+        return Layout.frame_file(self.name, "class")
 
 
 @dataclass(frozen=True)

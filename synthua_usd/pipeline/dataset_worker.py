@@ -250,11 +250,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     name = image_name(planned.id, planned.camera_name, planned.time_code, planned.condition, planned.seed)
     split = planned.split
     cs = CityscapesName(job.city, job.camera_index.get(planned.camera_path, 0), planned.id)
-    files = {"rgb_png": Layout.rgb_png(split, name) if verdict != "rejected" else Layout.frame_file(name, "rgb.png"),
-             "class": Layout.frame_file(name, "class.png"),
-             "semantic": Layout.frame_file(name, "semantic.png"),
-             "instance": Layout.frame_file(name, "instance.png"),
-             "instance_preview": Layout.frame_file(name, "instance_preview.png")}
+    files = {"rgb_png": Layout.rgb_png(split, name) if verdict != "rejected" else Layout.frame_file(name, "rgb_png"),
+             **{key: Layout.frame_file(name, key) for key in ("class", "semantic", "instance", "instance_preview")}}
     arrays = {"rgb_png": display, "class": class_ids, "semantic": class_map.palette()[class_ids],
               "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
     if verdict != "rejected":
@@ -271,13 +268,13 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
                                                                         job.yolo_classes, instance_ids)})
         outputs = job.config.outputs
         if outputs.depth:
-            files["depth"] = Layout.frame_file(name, "depth.exr")
+            files["depth"] = Layout.frame_file(name, "depth")
             arrays["depth"] = depth
         if outputs.rgb_exr:
-            files["rgb_exr"] = Layout.frame_file(name, "rgb.exr")
+            files["rgb_exr"] = Layout.frame_file(name, "rgb_exr")
             arrays["rgb_exr"] = rgb
         if outputs.onehot:
-            files["onehot"] = Layout.frame_file(name, "onehot.npz")
+            files["onehot"] = Layout.frame_file(name, "onehot")
             arrays["onehot"] = class_ids
     record = {
         "id": planned.id,

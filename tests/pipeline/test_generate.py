@@ -291,7 +291,7 @@ def test_verify_checks_visible_keypoints_against_their_instance(damaged):
     coco = json.loads(coco_path.read_text())
     names = {img["id"]: img["file_name"][:-4] for img in coco["images"]}
     ann = next(a for a in coco["annotations"] if 2 in a.get("keypoints", [])[2::3])
-    ids = read_image(damaged / Layout.frame_file(names[ann["image_id"]], "instance.png"))[0][..., 0]
+    ids = read_image(damaged / Layout.frame_file(names[ann["image_id"]], "instance"))[0][..., 0]
     away = np.ones_like(ids, bool)
     for y, x in zip(*np.nonzero(ids == ann["instance_id"])):
         away[max(0, y - WINDOW_PX):y + WINDOW_PX + 1, max(0, x - WINDOW_PX):x + WINDOW_PX + 1] = False
