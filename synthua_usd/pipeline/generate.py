@@ -40,6 +40,7 @@ from synthua_usd.dataset.formats import cityscapes, coco, panoptic, tables, yolo
 from synthua_usd.dataset.formats.records import is_rejected
 from synthua_usd.dataset.layout import SPLITS, Layout, cityscapes_city
 from synthua_usd.dataset.manifest import document_digest, file_entry, manifest_document
+from synthua_usd.dataset.record import ImageRecord
 from synthua_usd.model.render_config import RenderConfig, resolve_render
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, work
@@ -330,7 +331,7 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     return summary
 
 
-def achieved_splits(records: list[dict], config: GenerationConfig) -> dict[str, dict]:
+def achieved_splits(records: list[ImageRecord], config: GenerationConfig) -> dict[str, dict]:
     """Per split: the config's share, the images kept (not rejected by QA) and the distinct cameras they come
     from."""
     out = {}
@@ -480,7 +481,7 @@ def _remove_partial_files(out: Path) -> None:
             path.unlink()
 
 
-def _complete_records(layout: Layout, plan) -> dict[int, dict]:
+def _complete_records(layout: Layout, plan) -> dict[int, ImageRecord]:
     """Records of planned images already complete: a record that parses, names the planned image, and whose
     files all exist with their recorded sizes (checksums are ``synthua verify``'s job)."""
     from synthua_usd.dataset.layout import image_name
@@ -501,7 +502,7 @@ def _complete_records(layout: Layout, plan) -> dict[int, dict]:
     return done
 
 
-def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: GenerationConfig,
+def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, config: GenerationConfig,
              job_document: dict, frames: dict | None = None) -> None:
     """Every dataset-level file, from the records alone (the images', and the sequences' ``frames``: (sequence,
     frame) -> record); the manifest last."""

@@ -232,18 +232,22 @@ def _from_record(path: Path) -> tuple:
     from synthua_usd.core.errors import InputError
     from synthua_usd.core.schemas import read_json
     from synthua_usd.dataset.layout import Layout
+    from synthua_usd.dataset.record import IMAGE, ImageRecord, record_problem
 
-    record = read_json(path, "an image record of a dataset (records/NAME.json)")
+    record: ImageRecord = read_json(path, "an image record of a dataset (records/NAME.json)")
+    problem = record_problem(record, IMAGE)
+    if problem is not None:
+        raise InputError(f"{path}: not a dataset image record: {problem}")
     job_path = Path(path).resolve().parent.parent / Layout.CONFIG
     job = read_json(job_path, "the generate.json of the record's dataset")
     try:
         config = job["job_key"]["config"]
-        condition = record["condition"]["name"] if record.get("condition") else None
-        return (config, int(record["seed"]), str(record["camera"]["prim_path"]), float(record["time_code"]),
-                condition, dict(record["render"]))
-    except (KeyError, TypeError, ValueError) as exc:
-        raise InputError(f"{path}: not a dataset image record ({json.dumps(str(exc))[1:-1]} missing or malformed); "
-                         f"expected records/NAME.json of a dataset synthua generate wrote") from None
+    except (KeyError, TypeError) as exc:
+        raise InputError(f"{job_path}: job_key.config: {json.dumps(str(exc))[1:-1]} missing or malformed; expected "
+                         f"the generate.json of the dataset synthua generate wrote") from None
+    condition = record["condition"]["name"] if record["condition"] else None
+    return (config, record["seed"], record["camera"]["prim_path"], float(record["time_code"]), condition,
+            dict(record["render"]))
 
 
 def randomise_image(request: RandomiseRequest) -> RandomiseResult:
