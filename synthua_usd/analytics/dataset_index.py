@@ -17,6 +17,7 @@ from synthua_usd.dataset.annotations import CROWD_ID_BASE, STUFF_ID_BASE
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.dataset.manifest import read_manifest
 from synthua_usd.dataset.qa import AidUser, aid_users
+from synthua_usd.dataset.record import ImageRecord
 from synthua_usd.model.taxonomy import ClassMap
 
 
@@ -56,7 +57,7 @@ class ImageSummary:
     @property
     def class_png(self) -> str:
         """Relative path of the 8-bit class-id map."""
-        return Layout.frame_file(self.name, "class.png")
+        return Layout.frame_file(self.name, "class")
 
 
 @dataclass(frozen=True)
@@ -91,7 +92,7 @@ def manifest_images(root: Path) -> list[dict]:
     return read_manifest(root / Layout.MANIFEST)["images"]
 
 
-def _objects(record: dict) -> tuple[tuple[int, int], ...]:
+def _objects(record: ImageRecord) -> tuple[tuple[int, int], ...]:
     """(class id, area) of the record's visible thing instances and of its stuff segments (panoptic ids from
     STUFF_ID_BASE up to CROWD_ID_BASE)."""
     things = [(int(i["category_id"]), int(i["area"])) for i in record.get("instances", ())
@@ -101,7 +102,7 @@ def _objects(record: dict) -> tuple[tuple[int, int], ...]:
     return tuple(things + stuff)
 
 
-def _summary(record: dict, verdict: str, where: str) -> ImageSummary:
+def _summary(record: ImageRecord, verdict: str, where: str) -> ImageSummary:
     try:
         camera = record.get("camera") or {}
         condition = (record.get("condition") or {}).get("name") or "stage"

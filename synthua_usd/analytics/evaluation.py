@@ -39,7 +39,7 @@ class GroundTruthImage:
 
     @property
     def class_png(self) -> str:
-        return Layout.frame_file(self.name, "class.png")
+        return Layout.frame_file(self.name, "class")
 
 
 def ground_truth_images(gt_dir: Path, split: str | None) -> list[GroundTruthImage]:

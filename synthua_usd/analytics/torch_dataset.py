@@ -60,7 +60,7 @@ class SynthuaDataset(torch.utils.data.Dataset):
         name, split = str(entry["name"]), str(entry["split"])
         record = read_json(self.layout.path(Layout.record(name)), "an image record")
         rgb = self._png(Layout.rgb_png(split, name))[..., :3]
-        semantic = self._png(Layout.frame_file(name, "class.png"))[..., 0]
+        semantic = self._png(Layout.frame_file(name, "class"))[..., 0]
         h, w = semantic.shape
         things = [inst for inst in record["instances"] if inst.get("isthing", True) and inst["area"] > 0]
         if things:

@@ -22,17 +22,18 @@ from synthua_usd.core.schemas import validate_document
 
 def _jobs(output: RenderOutput, out_dir: Path, *, rgb, class_ids, instance_ids, z_depth, palette, display_scale):
     """(writer, path, data) for every file of ``output``."""
+    path = {f.key: out_dir / f.name for f in output.files}
     if output.var == "rgb":
-        return [(images.write_linear_exr, out_dir / "rgb.exr", rgb),
-                (images.write_display_png, out_dir / "rgb.png", rgb * np.float32(display_scale))]
+        return [(images.write_linear_exr, path["rgb_exr"], rgb),
+                (images.write_display_png, path["rgb_png"], rgb * np.float32(display_scale))]
     if output.var == "class_id":
-        return [(images.write_id_png, out_dir / "class.png", class_ids),
-                (images.write_color_png, out_dir / "semantic.png", palette[class_ids])]
+        return [(images.write_id_png, path["class"], class_ids),
+                (images.write_color_png, path["semantic"], palette[class_ids])]
     if output.var == "instance_id":
-        return [(images.write_id_png, out_dir / "instance.png", instance_ids),
-                (images.write_color_png, out_dir / "instance_preview.png", previews.instance_preview(instance_ids))]
+        return [(images.write_id_png, path["instance"], instance_ids),
+                (images.write_color_png, path["instance_preview"], previews.instance_preview(instance_ids))]
     if output.var == "depth":
-        return [(lambda path, data: images.write_depth_exr(path, data, DEPTH_DEFINITION), out_dir / "depth.exr", z_depth)]
+        return [(lambda path, data: images.write_depth_exr(path, data, DEPTH_DEFINITION), path["depth"], z_depth)]
     raise ValueError(f"output '{output.var}' has no writer")
 
 

@@ -10,6 +10,7 @@ import click
 
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, parse_time_codes, say
 from synthua_usd.core.errors import escape_controls
+from synthua_usd.model.render_config import MAX_SIDE, RenderConfig
 
 
 @click.group()
@@ -46,9 +47,9 @@ def cameras_types() -> int:
 @click.option("--time-code", "--frame", "time_codes", multiple=True, callback=parse_time_codes,
               help="Time codes to report (and to check --min-target-px at): 24, 1,12,24 or 1:48:8 [default: 7 "
                    "evenly spread over the stage's range, first and last included].")
-@click.option("--width", type=click.IntRange(16, 16384), default=1280, show_default=True,
+@click.option("--width", type=click.IntRange(16, MAX_SIDE), default=RenderConfig.width, show_default=True,
               help="Image width the pixel counts are for.")
-@click.option("--height", type=click.IntRange(16, 16384), default=960, show_default=True,
+@click.option("--height", type=click.IntRange(16, MAX_SIDE), default=RenderConfig.height, show_default=True,
               help="Image height the pixel counts are for.")
 @click.option("--variant", help="Mitsuba variant for the label passes [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")

@@ -28,7 +28,7 @@ from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.train_commands import evaluate_real, train
 from synthua_usd.cli.twin_commands import twin
 from synthua_usd.core.findings import Finding, Severity
-from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.render_config import MAX_SIDE, MAX_SPP, RenderConfig
 
 
 def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
@@ -204,9 +204,11 @@ def create_district(out_dir: Path, seed: int) -> int:
 @click.option("--time-code", "--frame", "time_codes", multiple=True, callback=_time_codes,
               help="Time code(s) to render: 24, 1,12,24 or 1:48:8 (START:END:STEP); repeatable; --frame is "
                    "the same option [default: the stage's start time code].")
-@click.option("--width", type=click.IntRange(1, 16384), help="Image width in pixels [default: render settings, else 1280].")
-@click.option("--height", type=click.IntRange(1, 16384), help="Image height in pixels [default: render settings, else 960].")
-@click.option("--spp", type=click.IntRange(1, 65536), help=f"RGB samples per pixel [default: render settings, else "
+@click.option("--width", type=click.IntRange(1, MAX_SIDE),
+              help=f"Image width in pixels [default: render settings, else {RenderConfig.width}].")
+@click.option("--height", type=click.IntRange(1, MAX_SIDE),
+              help=f"Image height in pixels [default: render settings, else {RenderConfig.height}].")
+@click.option("--spp", type=click.IntRange(1, MAX_SPP), help=f"RGB samples per pixel [default: render settings, else "
                                                           f"{RenderConfig.spp}]. Labels always use one ray per pixel centre.")
 @click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed of the RGB pass.")
 @click.option("--denoise/--no-denoise", default=None,

@@ -2,7 +2,8 @@
 
 A scenario's render settings (``render.usda``) author one ``UsdRender.Var`` per entry of :data:`OUTPUTS`
 it wants; ``synthua render`` writes the files of the vars the stage's settings name (every output when a
-stage has no settings or names no vars) and always ``frame.json``, which lists the files it wrote.
+stage has no settings or names no vars) and always ``frame.json``, which lists the files it wrote. A dataset
+image's frame folder holds the same files by the same names (:data:`FILE_NAMES`).
 """
 
 from __future__ import annotations
@@ -59,6 +60,13 @@ OUTPUTS: tuple[RenderOutput, ...] = (
 )
 
 OUTPUT_NAMES: tuple[str, ...] = tuple(o.var for o in OUTPUTS)
+
+#: A dataset image's one-hot class masks (a generation config's ``outputs.onehot``; no render var makes it).
+ONEHOT_FILE = OutputFile("onehot", "onehot.npz")
+
+#: The file name of each file a frame may hold, by its key (``frame.json``'s ``files``, a dataset record's
+#: ``files``): the one place the names are written.
+FILE_NAMES: dict[str, str] = {f.key: f.name for o in OUTPUTS for f in o.files} | {ONEHOT_FILE.key: ONEHOT_FILE.name}
 
 
 def select_outputs(var_names) -> tuple[RenderOutput, ...]:

@@ -32,6 +32,23 @@ def load_schema(name: str) -> dict:
     return schema
 
 
+#: Where the bundled schemas live as URIs: one refers to a part of another by its file name, e.g.
+#: ``frame.schema.json#/properties/condition``, which resolves here, never on the network.
+SCHEMA_BASE = "https://synthua-usd.org/schemas/"
+
+
+@lru_cache(maxsize=None)
+def _registry():
+    """Every bundled schema, by :data:`SCHEMA_BASE` + its file name."""
+    from referencing import Registry
+    from referencing.jsonschema import DRAFT202012
+
+    suffix = ".schema.json"
+    names = sorted(f.name[:-len(suffix)] for f in resources.files(SCHEMA_PACKAGE).iterdir() if f.name.endswith(suffix))
+    return Registry().with_resources((f"{SCHEMA_BASE}{name}{suffix}", DRAFT202012.create_resource(load_schema(name)))
+                                     for name in names)
+
+
 #: Deepest nesting of arrays and objects accepted in a JSON document. CityJSON's MultiSolid boundaries, the
 #: deepest structure we read, sit about 10 levels down; without a limit a deep document would exhaust the
 #: recursion of the parser or of schema validation.
@@ -109,9 +126,12 @@ def type_name(value: Any) -> str:
             type(None): "null"}.get(type(value), type(value).__name__)
 
 
-def schema_errors(document: Any, schema_name: str) -> list[jsonschema.ValidationError]:
-    """All violations of ``schemas/<schema_name>.schema.json``, most specific first."""
-    validator = jsonschema.Draft202012Validator(load_schema(schema_name))
+def schema_errors(document: Any, schema_name: str, definition: str | None = None) -> list[jsonschema.ValidationError]:
+    """All violations of ``schemas/<schema_name>.schema.json`` (of its ``$defs/<definition>`` when given), most
+    specific first."""
+    schema = (load_schema(schema_name) if definition is None
+              else {"$ref": f"{SCHEMA_BASE}{schema_name}.schema.json#/$defs/{definition}"})
+    validator = jsonschema.Draft202012Validator(schema, registry=_registry())
     return sorted(validator.iter_errors(document), key=lambda e: (list(e.absolute_path), e.message))
 
 
@@ -132,11 +152,20 @@ def schema_message(error: jsonschema.ValidationError) -> str:
     return message
 
 
-def validate_document(document: Any, schema_name: str, source: str) -> None:
+def schema_problem(document: Any, schema_name: str, definition: str | None = None) -> str | None:
+    """The first violation as ``<field>: <what was found>; expected ...`` (None when there is none)."""
+    errors = schema_errors(document, schema_name, definition)
+    if not errors:
+        return None
+    first = errors[0]
+    more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+    part = f"$defs/{definition} of " if definition is not None else ""
+    return (f"{json_pointer(first)}: {schema_message(first)}; expected a document matching "
+            f"{part}{schema_name}.schema.json{more}")
+
+
+def validate_document(document: Any, schema_name: str, source: str, definition: str | None = None) -> None:
     """Raise :class:`SchemaError` with the first violation, naming ``source`` and the field."""
-    errors = schema_errors(document, schema_name)
-    if errors:
-        first = errors[0]
-        more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
-        raise SchemaError(f"{shown(source)}: {json_pointer(first)}: {schema_message(first)}; "
-                          f"expected a document matching {schema_name}.schema.json{more}")
+    problem = schema_problem(document, schema_name, definition)
+    if problem is not None:
+        raise SchemaError(f"{shown(source)}: {problem}")

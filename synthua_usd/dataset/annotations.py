@@ -24,6 +24,7 @@ from pycocotools import mask as mask_utils
 from scipy import ndimage
 
 from synthua_usd.core.errors import InputError
+from synthua_usd.dataset.record import InstanceEntry, PanopticSegment
 from synthua_usd.model.scene import Instance
 from synthua_usd.model.taxonomy import ClassMap
 
@@ -162,7 +163,7 @@ def instance_class_table(instances: Sequence[Instance], size: int) -> np.ndarray
 
 def annotate(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequence[Instance],
              amodal: dict[int, np.ndarray] | None = None,
-             truncation: dict[int, float] | None = None) -> list[dict]:
+             truncation: dict[int, float] | None = None) -> list[InstanceEntry]:
     """The record's ``instances`` entries: one per instance with at least one visible pixel, in the order
     of ``instances``.
 
@@ -230,14 +231,14 @@ def annotate(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
         trunc = 0.0 if truncation is None else float(truncation.get(inst.id, 0.0))
         if not 0.0 <= trunc <= 1.0:
             raise InputError(f"truncation of instance {inst.id}: {trunc}; expected a share in 0..1")
-        out.append({
-            "id": inst.id, "category_id": inst.class_id, "class_name": inst.class_name,
-            "isthing": bool(inst.isthing), "prim_path": inst.prim_path,
-            "area": area, "bbox": bbox, "segmentation": segmentation,
-            "amodal_area": amodal_area, "amodal_bbox": amodal_bbox, "amodal_segmentation": amodal_segmentation,
-            "occlusion": 1.0 - area / amodal_area, "truncation": trunc,
-            "relations": {name: target for name, target in inst.relations},
-        })
+        out.append(InstanceEntry(
+            id=inst.id, category_id=inst.class_id, class_name=inst.class_name,
+            isthing=bool(inst.isthing), prim_path=inst.prim_path,
+            area=area, bbox=bbox, segmentation=segmentation,
+            amodal_area=amodal_area, amodal_bbox=amodal_bbox, amodal_segmentation=amodal_segmentation,
+            occlusion=1.0 - area / amodal_area, truncation=trunc,
+            relations={name: target for name, target in inst.relations},
+        ))
     return out
 
 
@@ -268,7 +269,7 @@ def panoptic_ids(class_ids: np.ndarray, instance_ids: np.ndarray, class_map: Cla
     return ids
 
 
-def mark_ignored(entries: list[dict], min_instance_px: int) -> set[int]:
+def mark_ignored(entries: list[InstanceEntry], min_instance_px: int) -> set[int]:
     """Set ``ignore`` on every record entry (of :func:`annotate`): True for a thing instance with fewer than
     ``min_instance_px`` visible pixels, too small to learn from, which every format then writes as an ignore
     region (``schemas/generate.schema.json``, ``min_instance_px``). Returns the ids of the ignored instances."""
@@ -287,7 +288,7 @@ def ids_to_rgb(ids: np.ndarray) -> np.ndarray:
 
 
 def panoptic(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequence[Instance],
-             class_map: ClassMap, ignored: set[int] = frozenset()) -> tuple[np.ndarray, list[dict]]:
+             class_map: ClassMap, ignored: set[int] = frozenset()) -> tuple[np.ndarray, list[PanopticSegment]]:
     """The COCO-panoptic PNG pixels and the record's ``panoptic_segments``.
 
     Thing classes (``isthing`` in ``class_map``) give one segment per instance (segment id = instance id),
@@ -328,8 +329,8 @@ def panoptic(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
                 raise InputError(f"instance {seg_id} ({inst.prim_path}): class ids {found[:5]} under its pixels; "
                                  f"expected only its class {inst.class_id}")
             category = inst.class_id
-        segments.append({"id": int(seg_id), "category_id": int(category), "area": int(counts[seg_id]),
-                         "bbox": box_xywh(boxes[seg_id - 1]), "iscrowd": int(seg_id >= CROWD_ID_BASE)})
+        segments.append(PanopticSegment(id=int(seg_id), category_id=int(category), area=int(counts[seg_id]),
+                                        bbox=box_xywh(boxes[seg_id - 1]), iscrowd=int(seg_id >= CROWD_ID_BASE)))
     return ids_to_rgb(ids), segments
 
 

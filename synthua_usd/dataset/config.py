@@ -7,7 +7,8 @@ schema's as :class:`SchemaError`) with one line ``<file>: <field>: <found>; <exp
 
 The meaning of every field is documented once, in the schema's descriptions; the dataclasses here mirror it.
 Checks that need the stage (camera paths, condition names, the stage's time range and resolution) happen
-where the stage is known: :func:`synthua_usd.dataset.sampling.candidates` and :meth:`RenderSettings.size`.
+where the stage is known: :func:`synthua_usd.dataset.sampling.candidates`, :meth:`GenerationConfig.output_size`
+(the render size is settled by :func:`synthua_usd.model.render_config.resolve_render`).
 """
 
 from __future__ import annotations
@@ -48,25 +49,19 @@ def schema_default(path: str) -> Any:
 
 @dataclass(frozen=True)
 class RenderSettings:
-    """Render settings; ``width``/``height`` None take the stage's resolution. See the schema's ``render``."""
+    """The config's ``render`` block; a field left None is the stage's render settings', else
+    :class:`RenderConfig`'s (:func:`synthua_usd.model.render_config.resolve_render`). See the schema's ``render``."""
 
     width: int | None = None
     height: int | None = None
-    # The render quality of every image: RenderConfig's default (few box-filtered samples, denoised).
-    spp: int = RenderConfig.spp
-    max_depth: int = 8
-    pixel_filter: str = "box"
+    spp: int | None = None
+    max_depth: int = RenderConfig.max_depth
+    pixel_filter: str = RenderConfig.pixel_filter
     denoise: bool = RenderConfig.denoise
 
-    def size(self, stage_width: int, stage_height: int) -> tuple[int, int]:
-        """(width, height) of the render in pixels: the config's, else the stage's."""
-        return (self.width or int(stage_width), self.height or int(stage_height))
-
-    def render_config(self, stage_width: int, stage_height: int, seed: int, variant: str | None = None) -> RenderConfig:
-        """The :class:`RenderConfig` of one image rendered with ``seed``."""
-        width, height = self.size(stage_width, stage_height)
-        return RenderConfig(width=width, height=height, spp=self.spp, max_depth=self.max_depth,
-                            pixel_filter=self.pixel_filter, denoise=self.denoise, seed=int(seed), variant=variant)
+    def render_values(self) -> dict:
+        """The block as :func:`synthua_usd.model.render_config.resolve_render`'s ``config`` source."""
+        return dict(vars(self))
 
 
 @dataclass(frozen=True)

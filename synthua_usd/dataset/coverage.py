@@ -15,6 +15,7 @@ from typing import Sequence
 from synthua_usd.dataset.config import NO_RIG, GenerationConfig
 from synthua_usd.dataset.layout import SPLITS
 from synthua_usd.dataset.qa import aid_users
+from synthua_usd.dataset.record import ImageRecord
 from synthua_usd.dataset.sampling import condition_key
 
 #: Occlusion buckets of the aid-user table: [0, 0.25), [0.25, 0.5), [0.5, 0.75), [0.75, 1].
@@ -32,11 +33,11 @@ def occlusion_bucket(occlusion: float | None) -> str:
     raise AssertionError("unreachable")
 
 
-def _rig_key(record: dict) -> str:
+def _rig_key(record: ImageRecord) -> str:
     return (record.get("camera") or {}).get("rig_type") or NO_RIG
 
 
-def _condition_key(record: dict) -> str:
+def _condition_key(record: ImageRecord) -> str:
     return condition_key((record.get("condition") or {}).get("name"))
 
 
@@ -51,7 +52,7 @@ def _quota(name: str, key: str | None, asked: int, achieved: int, pool: int | No
     return entry, f"{label}: asked {asked}{what}, got {achieved}{why}"
 
 
-def coverage(records: Sequence[dict], config: GenerationConfig, targets: dict | None = None,
+def coverage(records: Sequence[ImageRecord], config: GenerationConfig, targets: dict | None = None,
              pool: dict | None = None) -> dict:
     """The coverage report as a JSON-serialisable dict.
 

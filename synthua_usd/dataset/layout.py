@@ -37,6 +37,7 @@ from pathlib import Path, PurePosixPath
 from synthua_usd.core import dataset_folders
 from synthua_usd.core.errors import echo as escape
 from synthua_usd.core.errors import OutputError
+from synthua_usd.core.outputs import FILE_NAMES
 
 SPLITS = ("train", "val", "test")
 
@@ -108,8 +109,10 @@ class Layout:
         return f"gtFine/{split}/{cs.city}/{cs.stem}_gtFine_{kind}.png"
 
     @staticmethod
-    def frame_file(name: str, file_name: str) -> str:
-        return f"frames/{name}/{file_name}"
+    def frame_file(name: str, key: str) -> str:
+        """The file ``key`` of image ``name``'s frame folder (its name from :data:`FILE_NAMES`: ``class`` is
+        ``class.png``)."""
+        return f"frames/{name}/{FILE_NAMES[key]}"
 
     @staticmethod
     def record(name: str) -> str:

@@ -1,8 +1,11 @@
-"""Render settings as a checked, frozen dataclass (plain data; backends read it)."""
+"""Render settings as a checked, frozen dataclass (plain data; backends read it), and the one rule that settles
+them from their sources (:func:`resolve_render`)."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
+from typing import Any
 
 from synthua_usd.core.errors import InputError
 
@@ -75,3 +78,18 @@ class RenderConfig:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+def resolve_render(stage: Mapping[str, Any] | None = None, config: Mapping[str, Any] | None = None,
+                   options: Mapping[str, Any] | None = None) -> RenderConfig:
+    """The render settings of a frame, each field from the strongest source that sets it, in this order
+    (weakest first): :class:`RenderConfig`'s defaults < ``stage``, the stage's UsdRender settings (resolution
+    and ``synthua:spp``, as :func:`synthua_usd.usd.render_settings.render_defaults` reads them) < ``config``,
+    a dataset config's ``render`` block < ``options``, the command line's. Every source maps field names to
+    values; None (or a key left out) leaves the field to the weaker sources. ``synthua render``, ``synthua
+    generate`` and ``synthua randomise`` all settle their settings here (docs/rendering.md, "Where the render
+    settings come from"). An unknown field or a value out of range raises :class:`InputError`."""
+    values = RenderConfig().to_dict()
+    for source in (stage, config, options):
+        values.update({key: value for key, value in (source or {}).items() if value is not None})
+    return RenderConfig.from_dict(values)

@@ -67,8 +67,8 @@ class RigRequest:
     stage_path: Path
     out_path: Path
     rigs: tuple[RigSpec, ...]
-    width: int = 1280
-    height: int = 960
+    width: int = RenderConfig.width
+    height: int = RenderConfig.height
     time_codes: tuple[float, ...] = ()
     min_target_px: int = 1
     variant: str | None = None

@@ -29,6 +29,8 @@ from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, onehot, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
+from synthua_usd.dataset.record import (IMAGE, ImageRecord, InstanceEntry, QAResult, RecordCamera, RecordRender,
+                                         check_record)
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.taxonomy import ClassMap
@@ -130,7 +132,7 @@ def work(state: WorkerState, item) -> list[dict]:
 class ImageBuffers:
     """One rendered and annotated image, ready to write."""
 
-    record: dict
+    record: ImageRecord
     arrays: dict = field(repr=False)
     rejected: bool
     seconds: dict
@@ -151,7 +153,7 @@ class AnnotatedFrame:
     class_ids: np.ndarray = field(repr=False)
     instance_ids: np.ndarray = field(repr=False)
     depth: np.ndarray = field(repr=False)
-    instances: list
+    instances: list[InstanceEntry]
     width: int
     height: int
     seconds: dict
@@ -250,11 +252,8 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     name = image_name(planned.id, planned.camera_name, planned.time_code, planned.condition, planned.seed)
     split = planned.split
     cs = CityscapesName(job.city, job.camera_index.get(planned.camera_path, 0), planned.id)
-    files = {"rgb_png": Layout.rgb_png(split, name) if verdict != "rejected" else Layout.frame_file(name, "rgb.png"),
-             "class": Layout.frame_file(name, "class.png"),
-             "semantic": Layout.frame_file(name, "semantic.png"),
-             "instance": Layout.frame_file(name, "instance.png"),
-             "instance_preview": Layout.frame_file(name, "instance_preview.png")}
+    files = {"rgb_png": Layout.rgb_png(split, name) if verdict != "rejected" else Layout.frame_file(name, "rgb_png"),
+             **{key: Layout.frame_file(name, key) for key in ("class", "semantic", "instance", "instance_preview")}}
     arrays = {"rgb_png": display, "class": class_ids, "semantic": class_map.palette()[class_ids],
               "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
     if verdict != "rejected":
@@ -271,54 +270,54 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
                                                                         job.yolo_classes, instance_ids)})
         outputs = job.config.outputs
         if outputs.depth:
-            files["depth"] = Layout.frame_file(name, "depth.exr")
+            files["depth"] = Layout.frame_file(name, "depth")
             arrays["depth"] = depth
         if outputs.rgb_exr:
-            files["rgb_exr"] = Layout.frame_file(name, "rgb.exr")
+            files["rgb_exr"] = Layout.frame_file(name, "rgb_exr")
             arrays["rgb_exr"] = rgb
         if outputs.onehot:
-            files["onehot"] = Layout.frame_file(name, "onehot.npz")
+            files["onehot"] = Layout.frame_file(name, "onehot")
             arrays["onehot"] = class_ids
-    record = {
-        "id": planned.id,
-        "name": name,
-        "split": split,
-        "width": width,
-        "height": height,
-        "camera": camera_document(camera, planned, job.render.width, job.render.height, width, height),
-        "time_code": planned.time_code,
-        "seed": planned.seed,
-        "condition": condition.to_dict() if condition is not None else None,
-        "exposure": rendered.exposure.to_dict() if rendered.exposure is not None else None,
-        "render": {"variant": rendered.variant, "spp": job.render.spp, "pixel_filter": job.render.pixel_filter,
-                   "max_depth": job.render.max_depth, "width": job.render.width, "height": job.render.height,
-                   "denoise": rendered.denoised},
-        "layer_stack": job.layer_stack,
-        "files": files,
-        "class_pixel_counts": {class_map.by_id(int(c)).name: int(n)
-                               for c, n in enumerate(np.bincount(class_ids.ravel(), minlength=256)) if n},
-        "instances": instances,
-        "panoptic_segments": segments,
-        "qa": {"verdict": verdict, "reasons": list(reasons), "measures": measures},
-    }
+    record = ImageRecord(
+        id=planned.id,
+        name=name,
+        split=split,
+        width=width,
+        height=height,
+        camera=camera_document(camera, planned, job.render.width, job.render.height, width, height),
+        time_code=planned.time_code,
+        seed=planned.seed,
+        condition=condition.to_dict() if condition is not None else None,
+        exposure=rendered.exposure.to_dict() if rendered.exposure is not None else None,
+        render=RecordRender(variant=rendered.variant, spp=job.render.spp, pixel_filter=job.render.pixel_filter,
+                            max_depth=job.render.max_depth, width=job.render.width, height=job.render.height,
+                            denoise=rendered.denoised),
+        layer_stack=job.layer_stack,
+        files=files,
+        class_pixel_counts={class_map.by_id(int(c)).name: int(n)
+                            for c, n in enumerate(np.bincount(class_ids.ravel(), minlength=256)) if n},
+        instances=instances,
+        panoptic_segments=segments,
+        qa=QAResult(verdict=verdict, reasons=list(reasons), measures=measures),
+    )
     if randomised is not None:
         record["randomisation"] = randomised.to_dict()
     seconds["annotate"] += time.perf_counter() - t0
     return ImageBuffers(record, arrays, verdict == "rejected", seconds)
 
 
-def camera_document(camera, planned, render_w: int, render_h: int, width: int, height: int) -> dict:
+def camera_document(camera, planned, render_w: int, render_h: int, width: int, height: int) -> RecordCamera:
     """Intrinsics at the written size (K scaled from the render size) and extrinsics."""
     K = camera.intrinsics(render_w, render_h).copy()
     K[0] *= width / render_w
     K[1] *= height / render_h
-    return {"prim_path": camera.path, "name": planned.camera_name, "rig_type": planned.rig_type,
-            "K": K.tolist(), "camera_to_world": camera.camera_to_world.tolist(),
-            "world_to_camera_opencv": camera.world_to_camera_opencv().tolist(),
-            "focal_length_mm": camera.focal_length_mm, "horizontal_aperture_mm": camera.horizontal_aperture_mm,
-            "vertical_aperture_mm": camera.vertical_aperture_mm, "clipping_range_m": [camera.clip_near_m,
-                                                                                     camera.clip_far_m],
-            "distortion": camera.distortion.to_dict() if camera.distortion is not None else None}
+    return RecordCamera(prim_path=camera.path, name=planned.camera_name, rig_type=planned.rig_type,
+                        K=K.tolist(), camera_to_world=camera.camera_to_world.tolist(),
+                        world_to_camera_opencv=camera.world_to_camera_opencv().tolist(),
+                        focal_length_mm=camera.focal_length_mm, horizontal_aperture_mm=camera.horizontal_aperture_mm,
+                        vertical_aperture_mm=camera.vertical_aperture_mm,
+                        clipping_range_m=[camera.clip_near_m, camera.clip_far_m],
+                        distortion=camera.distortion.to_dict() if camera.distortion is not None else None)
 
 
 _WRITERS = {
@@ -362,6 +361,7 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
     if "cs_leftImg8bit" in targets:
         _link_or_copy(targets["rgb_png"], targets["cs_leftImg8bit"])
     record["checksums"] = {key: file_entry(layout.root, rel) for key, rel in sorted(record["files"].items())}
+    check_record(record, IMAGE, Layout.record(record["name"]))
     record_path = layout.path(Layout.record(record["name"]))
     record_path.parent.mkdir(parents=True, exist_ok=True)
     write_json_atomic(record_path, record, indent=1)

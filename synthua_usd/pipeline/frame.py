@@ -27,7 +27,7 @@ from synthua_usd.core.errors import InputError, StageError, echo
 from synthua_usd.core.outputs import OUTPUT_NAMES, RenderOutput, select_outputs
 from synthua_usd.core.resources import check_frame_memory
 from synthua_usd.model.cameras import CONFORM_EXPAND, PinholeCamera
-from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig, resolve_render
 from synthua_usd.model.scene import SceneSnapshot
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.background import BackgroundWriter
@@ -51,8 +51,8 @@ AUTO_CAMERA = "auto"
 @dataclass(frozen=True)
 class FrameRequest:
     """What to render: every camera at every time code. Empty ``camera_paths`` take the render settings'
-    camera; empty ``time_codes`` the stage's start time code; unset size and spp come from the stage's
-    UsdRender settings, else from :class:`RenderConfig`'s defaults."""
+    camera; empty ``time_codes`` the stage's start time code; unset render settings (None) come from the
+    stage's UsdRender settings, else from :class:`RenderConfig`'s defaults (:func:`resolve_render`)."""
 
     stage_path: Path
     out_dir: Path
@@ -76,6 +76,11 @@ class FrameRequest:
     max_depth: int | None = None
     #: Layer files composed over the stage through its session layer, strongest first (a randomisation layer).
     layers: tuple[Path, ...] = ()
+
+    def render_values(self) -> dict:
+        """The request's render settings as :func:`resolve_render`'s ``options`` source (None: unset)."""
+        return {"width": self.width, "height": self.height, "spp": self.spp, "seed": self.seed,
+                "variant": self.variant, "denoise": self.denoise, "max_depth": self.max_depth}
 
 
 @dataclass(frozen=True, eq=False)
@@ -137,12 +142,7 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
         if other != cam and len(frames) > 1:
             raise InputError(f"--camera {echo(other)} and {echo(cam)}: both would write frames into "
                              f"'{cam.rsplit('/', 1)[-1]}/'; expected cameras with different prim names")
-    width, height = defaults.resolution or (RenderConfig.width, RenderConfig.height)
-    spp = request.spp if request.spp is not None else defaults.spp if defaults.spp is not None else RenderConfig.spp
-    config = RenderConfig(width=request.width or width, height=request.height or height, spp=spp, seed=request.seed,
-                          variant=request.variant,
-                          denoise=RenderConfig.denoise if request.denoise is None else request.denoise,
-                          max_depth=RenderConfig.max_depth if request.max_depth is None else request.max_depth)
+    config = resolve_render(stage=defaults.render_values(), options=request.render_values())
     condition = read_condition(stage, request.condition)
     reader = StageReader(stage, class_map)
     if not reader.snapshot(time_codes[0]).meshes:

@@ -24,7 +24,7 @@ import json
 import logging
 import os
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -40,7 +40,8 @@ from synthua_usd.dataset.formats import cityscapes, coco, panoptic, tables, yolo
 from synthua_usd.dataset.formats.records import is_rejected
 from synthua_usd.dataset.layout import SPLITS, Layout, cityscapes_city
 from synthua_usd.dataset.manifest import document_digest, file_entry, manifest_document
-from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.dataset.record import ImageRecord
+from synthua_usd.model.render_config import RenderConfig, resolve_render
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, work
 
@@ -104,7 +105,8 @@ def _versions(variant: str) -> dict:
 
 def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: ClassMap):
     """Open the scenario and resolve the sweep against it: the candidate pool (cameras with their rig types ×
-    time codes × conditions × seeds), the render size and the layer stack digest."""
+    time codes × conditions × seeds), the render settings (:func:`resolve_render`: the stage's UsdRender
+    settings under the config's ``render`` block) and the layer stack digest."""
     import math
 
     from synthua_usd.usd.cameras import camera_paths, camera_rig_type, read_camera
@@ -129,9 +131,8 @@ def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: 
     chosen = list(dict.fromkeys((c.camera_path, c.camera_name, c.rig_type) for c in pool))
     for path, _, _ in chosen:  # every camera is checked before anything renders
         read_camera(stage, path, pool[0].time_code)
-    stage_size = defaults.resolution or (RenderConfig.width, RenderConfig.height)
-    width, height = config.render.size(*stage_size)
-    return stage, pool, chosen, (width, height), layer_stack_digest(stage)
+    render = resolve_render(stage=defaults.render_values(), config=config.render.render_values())
+    return stage, pool, chosen, render, layer_stack_digest(stage)
 
 
 def score_views(stage, pool, render: RenderConfig, output_size: tuple[int, int], class_map: ClassMap,
@@ -234,11 +235,11 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
         check_reachable(request.address)
     config = GenerationConfig.load(request.config_path)
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
-    stage, pool, cameras, (width, height), stack = _stage_facts(request, config, class_map)
-    output_size = config.output_size(width, height)  # a resample larger than the render is refused here
-    check_frame_memory(width, height)
+    stage, pool, cameras, render, stack = _stage_facts(request, config, class_map)
+    output_size = config.output_size(render.width, render.height)  # a resample larger than the render is refused here
+    check_frame_memory(render.width, render.height)
     variant = variants.activate(request.variant).variant()
-    render = config.render.render_config(width, height, seed=0, variant=variant)
+    render = replace(render, variant=variant)
     out = Path(request.out_dir)
     layout = Layout(out)
     # What makes a dataset this one: the composed layers (by content, wherever they are), the config (its
@@ -330,7 +331,7 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     return summary
 
 
-def achieved_splits(records: list[dict], config: GenerationConfig) -> dict[str, dict]:
+def achieved_splits(records: list[ImageRecord], config: GenerationConfig) -> dict[str, dict]:
     """Per split: the config's share, the images kept (not rejected by QA) and the distinct cameras they come
     from."""
     out = {}
@@ -480,7 +481,7 @@ def _remove_partial_files(out: Path) -> None:
             path.unlink()
 
 
-def _complete_records(layout: Layout, plan) -> dict[int, dict]:
+def _complete_records(layout: Layout, plan) -> dict[int, ImageRecord]:
     """Records of planned images already complete: a record that parses, names the planned image, and whose
     files all exist with their recorded sizes (checksums are ``synthua verify``'s job)."""
     from synthua_usd.dataset.layout import image_name
@@ -501,7 +502,7 @@ def _complete_records(layout: Layout, plan) -> dict[int, dict]:
     return done
 
 
-def assemble(layout: Layout, records: list[dict], class_map: ClassMap, config: GenerationConfig,
+def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, config: GenerationConfig,
              job_document: dict, frames: dict | None = None) -> None:
     """Every dataset-level file, from the records alone (the images', and the sequences' ``frames``: (sequence,
     frame) -> record); the manifest last."""

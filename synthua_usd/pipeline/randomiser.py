@@ -232,18 +232,22 @@ def _from_record(path: Path) -> tuple:
     from synthua_usd.core.errors import InputError
     from synthua_usd.core.schemas import read_json
     from synthua_usd.dataset.layout import Layout
+    from synthua_usd.dataset.record import IMAGE, ImageRecord, record_problem
 
-    record = read_json(path, "an image record of a dataset (records/NAME.json)")
+    record: ImageRecord = read_json(path, "an image record of a dataset (records/NAME.json)")
+    problem = record_problem(record, IMAGE)
+    if problem is not None:
+        raise InputError(f"{path}: not a dataset image record: {problem}")
     job_path = Path(path).resolve().parent.parent / Layout.CONFIG
     job = read_json(job_path, "the generate.json of the record's dataset")
     try:
         config = job["job_key"]["config"]
-        condition = record["condition"]["name"] if record.get("condition") else None
-        return (config, int(record["seed"]), str(record["camera"]["prim_path"]), float(record["time_code"]),
-                condition, dict(record["render"]))
-    except (KeyError, TypeError, ValueError) as exc:
-        raise InputError(f"{path}: not a dataset image record ({json.dumps(str(exc))[1:-1]} missing or malformed); "
-                         f"expected records/NAME.json of a dataset synthua generate wrote") from None
+    except (KeyError, TypeError) as exc:
+        raise InputError(f"{job_path}: job_key.config: {json.dumps(str(exc))[1:-1]} missing or malformed; expected "
+                         f"the generate.json of the dataset synthua generate wrote") from None
+    condition = record["condition"]["name"] if record["condition"] else None
+    return (config, record["seed"], record["camera"]["prim_path"], float(record["time_code"]), condition,
+            dict(record["render"]))
 
 
 def randomise_image(request: RandomiseRequest) -> RandomiseResult:
@@ -253,7 +257,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     from synthua_usd.core.atomic import output_set
     from synthua_usd.core.errors import InputError
     from synthua_usd.dataset.config import GenerationConfig
-    from synthua_usd.model.render_config import RenderConfig
+    from synthua_usd.model.render_config import resolve_render
     from synthua_usd.usd.render_settings import render_defaults
     from synthua_usd.usd.stage_io import USD_SUFFIXES, check_time_code, open_stage
 
@@ -297,21 +301,19 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     time_code = float(stage.GetStartTimeCode()) if time_code is None else float(time_code)
     check_time_code(stage, time_code)
     read_camera(stage, camera, time_code)  # a missing camera is one line, before anything is drawn
-    if render:
-        width, height = int(render["width"]), int(render["height"])
-    else:
-        width, height = config.render.size(*(defaults.resolution or (RenderConfig.width, RenderConfig.height)))
+    # a record's render block is what its image was rendered with: it stands where command-line options do
+    settings = resolve_render(stage=defaults.render_values(), config=config.render.render_values(),
+                              options={key: render.get(key) for key in ("width", "height", "spp", "max_depth")}
+                              | ({"denoise": render["denoise"] is not None} if "denoise" in render else {}))
+    width, height = settings.width, settings.height
     randomiser = Randomiser(stage, config.randomise, class_map, (width, height))
     drawn = randomiser.apply(seed, camera, time_code, condition, district)
     with output_set(out.parent) as staging:
         randomiser.export(staging / out.name, anchor=out.parent)
         files = tuple(out.parent / p.name for p in sorted(staging.iterdir()))
-    spp = render.get("spp", config.render.spp)
-    max_depth = render.get("max_depth", config.render.max_depth)
-    denoise = render["denoise"] is not None if "denoise" in render else config.render.denoise
     args = ("synthua", "render", str(scenario), "--layer", str(out), "--camera", camera,
             "--time-code", f"{time_code:g}", *(("--condition", condition) if condition else ()), "--seed", str(seed),
-            "--width", str(width), "--height", str(height), "--spp", str(spp), "--max-depth", str(max_depth),
-            "--denoise" if denoise else "--no-denoise", "--out", "OUT")
+            "--width", str(width), "--height", str(height), "--spp", str(settings.spp),
+            "--max-depth", str(settings.max_depth), "--denoise" if settings.denoise else "--no-denoise", "--out", "OUT")
     log.info("render with: %s", " ".join(shlex.quote(a) for a in args))
     return RandomiseResult(files, drawn, args)

@@ -31,6 +31,7 @@ from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import mot
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.dataset.manifest import file_entry
+from synthua_usd.dataset.record import SEQUENCE_FRAME, SequenceFrameRecord, check_record
 from synthua_usd.dataset.sequences import PlannedFrame, PlannedSequence
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, camera_document, init_worker, render_annotated
@@ -147,16 +148,19 @@ def _write_frame(state, frame: PlannedFrame, annotated) -> dict:
     images.write_id_png(layout.path(files["instances"]), annotated.instance_ids)
     tracked = set(mot.tracked(state.class_map))
     rendered = annotated.rendered
-    record = {"sequence": seq.name, "frame": frame.frame, "time_code": frame.time_code, "seed": seq.seed,
-              "width": annotated.width, "height": annotated.height,
-              "camera": camera_document(annotated.camera, seq, job.render.width, job.render.height, annotated.width,
-                                        annotated.height),
-              "condition": annotated.condition.to_dict() if annotated.condition is not None else None,
-              "exposure": rendered.exposure.to_dict() if rendered.exposure is not None else None,
-              "files": files,
-              "instances": [e for e in annotated.instances if e["class_name"] in tracked]}
+    record = SequenceFrameRecord(
+        sequence=seq.name, frame=frame.frame, time_code=frame.time_code, seed=seq.seed,
+        width=annotated.width, height=annotated.height,
+        camera=camera_document(annotated.camera, seq, job.render.width, job.render.height, annotated.width,
+                               annotated.height),
+        condition=annotated.condition.to_dict() if annotated.condition is not None else None,
+        exposure=rendered.exposure.to_dict() if rendered.exposure is not None else None,
+        files=files,
+        instances=[e for e in annotated.instances if e["class_name"] in tracked])
     record["checksums"] = {key: file_entry(layout.root, rel) for key, rel in sorted(files.items())}
-    path = layout.path(Layout.sequence_frame(seq.name, frame.frame, "records"))
+    relative = Layout.sequence_frame(seq.name, frame.frame, "records")
+    check_record(record, SEQUENCE_FRAME, relative)
+    path = layout.path(relative)
     path.parent.mkdir(parents=True, exist_ok=True)
     write_json_atomic(path, record, indent=1)
     seconds = dict(annotated.seconds, write=time.perf_counter() - t0)

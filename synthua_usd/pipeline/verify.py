@@ -6,7 +6,8 @@ the folder holds no file the manifest does not list, and cross-file consistency:
 mask is its instance's pixels in ``instance.png`` (area and box included) and every visible thing instance
 has one; the person keypoints file is the person part of the instances file; every panoptic segment matches its PNG exactly; the Cityscapes label ids are the class map's ids of
 ``class.png``; YOLO has one line per annotated instance. A record or an annotation document that is not
-what generate writes is a problem of the dataset, never a crash.
+what generate writes (a record: one that does not validate against ``schemas/record.schema.json``) is a
+problem of the dataset, never a crash.
 
 :func:`replay` renders one image again in a fresh worker, into a temporary folder, and compares every file
 with the file of the same name in the dataset, byte for byte (not with the checksums the dataset records:
@@ -30,6 +31,7 @@ from synthua_usd.core.schemas import read_json, type_name
 from synthua_usd.dataset.annotations import rle_problem
 from synthua_usd.dataset.layout import SPLITS, Layout
 from synthua_usd.dataset.manifest import read_manifest, sha256_file
+from synthua_usd.dataset.record import IMAGE, SEQUENCE_FRAME, ImageRecord, record_problem
 
 #: Problems listed in full; beyond this many, verify counts the rest.
 MAX_LISTED = 50
@@ -86,13 +88,6 @@ def _entries(document, key: str, fields: tuple[str, ...]) -> list[dict] | None:
     return None
 
 
-def _is_record(record) -> bool:
-    """Whether ``record`` has the fields verify reads, of the types generate writes."""
-    return (isinstance(record, dict) and isinstance(record.get("id"), int) and isinstance(record.get("name"), str)
-            and isinstance(record.get("files"), dict) and all(isinstance(v, str) for v in record["files"].values())
-            and isinstance(record.get("instances"), list) and all(isinstance(i, dict) for i in record["instances"]))
-
-
 def unlisted_files(root: Path, listed: set[str]) -> list[str]:
     """Relative POSIX paths of every file, link or other non-folder entry below ``root`` that is not in
     ``listed`` (links are not followed)."""
@@ -147,11 +142,11 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         record = _document(layout, relative, "an image record", result)
         if record is None:
             continue
-        if _is_record(record):
+        problem = record_problem(record, IMAGE)
+        if problem is None:
             records.append(record)
         else:
-            result.add(f"{relative}: not an image record (id, name, files and instances); expected the record "
-                       f"generate writes")
+            result.add(f"{relative}: not an image record: {problem}")
     result.images = len(records)
     coco_by_image, coco_images = {}, {}
     for split in SPLITS:
@@ -226,6 +221,10 @@ def _check_sequences(layout: Layout, planned: list, class_map, damaged: set, res
             record = _document(layout, relative, "a sequence frame's record", result)
             if record is None:
                 continue
+            problem = record_problem(record, SEQUENCE_FRAME)
+            if problem is not None:
+                result.add(f"{relative}: not a sequence frame's record: {problem}")
+                continue
             result.frames += 1
             try:
                 instances = record["instances"]
@@ -299,7 +298,7 @@ def _read(layout: Layout, relative: str) -> np.ndarray:
     return pixels
 
 
-def _check_image(layout: Layout, record: dict, coco_annotations: list[dict], panoptic_annotation: dict | None,
+def _check_image(layout: Layout, record: ImageRecord, coco_annotations: list[dict], panoptic_annotation: dict | None,
                  yolo_classes: dict[int, int], result: Verification, min_px: int = 0) -> None:
     """The image's annotations against its label maps; an instance with fewer than ``min_px`` pixels in
     ``instance.png`` must be an ignore region (COCO iscrowd 1, no YOLO line) and every other one must not."""
@@ -452,7 +451,7 @@ def replay(root: Path, image: str) -> Replay:
         out = Replay(planned.id, record["name"])
         record_path = Layout.record(record["name"])
         original = _document(layout, record_path, "an image record", Verification())
-        theirs = set(original["files"].values()) if _is_record(original) else set()
+        theirs = set(original["files"].values()) if record_problem(original, IMAGE) is None else set()
         for rel in sorted(set(record["files"].values()) | theirs | {record_path}):
             ours = _sha256_or_none(scratch / rel)
             same = ours is not None and ours == _sha256_or_none(layout.path(rel))

@@ -20,6 +20,12 @@ class StageRenderDefaults:
     spp: int | None = None
     var_names: tuple[str, ...] = ()
 
+    def render_values(self) -> dict:
+        """What the settings say of a render, as :func:`synthua_usd.model.render_config.resolve_render`'s
+        ``stage`` source: width, height and spp, None where the stage authors none."""
+        width, height = self.resolution or (None, None)
+        return {"width": width, "height": height, "spp": self.spp}
+
 
 def settings_findings(settings: UsdRender.Settings, rule: str = "render-settings") -> list[Finding]:
     """Render settings name cameras that exist, a resolution in range and a sample count in range."""

@@ -10,6 +10,7 @@ from synthua_usd.dataset.config import (
     CountQuota, GenerationConfig, Outputs, QAThresholds, RenderSettings, SplitRatios,
     schema_default,
 )
+from synthua_usd.model.render_config import RenderConfig, resolve_render
 from synthua_usd.model.timecodes import parse_time_code_spec
 
 BASE = {"name": "t", "images": 10}
@@ -55,7 +56,8 @@ def test_minimal_document_takes_the_defaults():
     config = GenerationConfig.from_document(BASE)
     assert config.render == RenderSettings() and config.split == SplitRatios() and config.qa == QAThresholds()
     assert config.conditions == () and config.cameras == () and config.time_codes == () and config.seeds == (0,)
-    assert config.render.size(640, 480) == (640, 480)
+    render = resolve_render(stage={"width": 640, "height": 480}, config=config.render.render_values())
+    assert (render.width, render.height, render.spp) == (640, 480, RenderConfig.spp)
     assert config.output_size(640, 480) == (640, 480)
 
 

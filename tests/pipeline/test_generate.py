@@ -291,7 +291,7 @@ def test_verify_checks_visible_keypoints_against_their_instance(damaged):
     coco = json.loads(coco_path.read_text())
     names = {img["id"]: img["file_name"][:-4] for img in coco["images"]}
     ann = next(a for a in coco["annotations"] if 2 in a.get("keypoints", [])[2::3])
-    ids = read_image(damaged / Layout.frame_file(names[ann["image_id"]], "instance.png"))[0][..., 0]
+    ids = read_image(damaged / Layout.frame_file(names[ann["image_id"]], "instance"))[0][..., 0]
     away = np.ones_like(ids, bool)
     for y, x in zip(*np.nonzero(ids == ann["instance_id"])):
         away[max(0, y - WINDOW_PX):y + WINDOW_PX + 1, max(0, x - WINDOW_PX):x + WINDOW_PX + 1] = False
@@ -324,6 +324,27 @@ def test_leftover_temporary_file_does_not_block_a_new_run_and_occlusion_quota_is
     assert job["pool"]["aid_users"] > 0
     quotas = {q["quota"]: q for q in json.loads((out / "coverage.json").read_text())["quotas"]}
     assert quotas["aid_users"]["met"], quotas
+
+
+# --- render settings -----------------------------------------------------------------------------------------
+
+def test_the_stage_spp_is_taken_when_the_config_sets_none(tmp_path):
+    """The order of docs/rendering.md, "Where the render settings come from": a config's render block without
+    spp renders at the stage's synthua:spp (3 here), not at RenderConfig's default."""
+    import re
+
+    stages = tmp_path / "stages"
+    shutil.copytree(SCENARIO.parent, stages, ignore=shutil.ignore_patterns("district"))
+    settings = stages / "render.usda"
+    text, edits = re.subn(r"custom int synthua:spp = \d+", "custom int synthua:spp = 3", settings.read_text())
+    assert edits == 1
+    settings.write_text(text)
+    config = _config(tmp_path, images=2, render={"width": 64, "height": 48, "max_depth": 4, "denoise": False})
+    out = tmp_path / "out"
+    generate_dataset(out, config=config, scenario=stages / SCENARIO.name)
+    assert json.loads((out / "generate.json").read_text())["render"]["spp"] == 3
+    assert records(out) and all(r["render"]["spp"] == 3 for r in records(out))
+    assert verify(out).ok
 
 
 # --- resampling ---------------------------------------------------------------------------------------------

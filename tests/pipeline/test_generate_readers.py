@@ -108,7 +108,7 @@ def test_coco_keypoints_evaluate_to_one_and_their_flags_agree_with_the_written_i
             if "keypoints" not in ann:
                 continue
             image = gt.imgs[ann["image_id"]]
-            ids = read_png(dataset / Layout.frame_file(names[ann["image_id"]], "instance.png"))
+            ids = read_png(dataset / Layout.frame_file(names[ann["image_id"]], "instance"))
             for x, y, v in np.array(ann["keypoints"], float).reshape(-1, 3):
                 flags[int(v)] += 1
                 if v == 0:
@@ -229,7 +229,7 @@ def test_instances_below_min_instance_px_are_ignore_regions_in_every_format(data
         panoptic = {a["image_id"]: a for a in read_json(dataset, Layout.coco_panoptic(split))["annotations"]}
         names = {m["id"]: m["name"] for m in manifest_images(dataset)}
         for image in coco["images"]:
-            frame = read_png(dataset / Layout.frame_file(names[image["id"]], "instance.png"))
+            frame = read_png(dataset / Layout.frame_file(names[image["id"]], "instance"))
             pixels = np.bincount(frame.ravel().astype(np.int64))
             anns = [a for a in coco["annotations"] if a["image_id"] == image["id"]]
             crowd_classes = set()
@@ -374,7 +374,7 @@ def test_cityscapes_instance_ids_are_class_times_1000_plus_k_and_agree_with_coco
             # every thing pixel has its instance, but those of an instance too small to annotate (COCO iscrowd 1),
             # which are a group region: the class id alone
             anns = [a for a in coco["annotations"] if a["image_id"] == image["id"]]
-            frame = read_png(dataset / Layout.frame_file(manifest_names[image["id"]], "instance.png"))
+            frame = read_png(dataset / Layout.frame_file(manifest_names[image["id"]], "instance"))
             crowd = np.isin(frame, [a["instance_id"] for a in anns if a["iscrowd"]])
             assert np.all(big == (np.isin(label_ids, list(things)) & ~crowd)), label_path
             # each other COCO annotation is one Cityscapes instance of the same class and area
@@ -459,7 +459,7 @@ def test_metadata_tables_have_one_row_per_image_with_its_camera_condition_and_co
         if image["qa"] != "accepted":  # rejected and flagged images are listed with their reasons
             assert row["qa_reasons"] and text["qa_reasons"] == row["qa_reasons"], row["image_id"]
         # pixel counts add up to the image and match its class-id PNG
-        classes = read_png(dataset / Layout.frame_file(image["name"], "class.png"))
+        classes = read_png(dataset / Layout.frame_file(image["name"], "class"))
         counts = np.bincount(classes.ravel(), minlength=len(class_map.classes))
         for c in class_map.classes:
             assert row[f"pixels.{c.name}"] == counts[c.id] == int(text[f"pixels.{c.name}"]), (row["image_id"], c.name)

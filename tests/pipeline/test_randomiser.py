@@ -141,3 +141,19 @@ def test_exported_layers_compose_the_same_scene(class_map, tmp_path):
     assert isinstance(read_condition(over, None), Condition)
     randomiser.close()  # the stage as composed before: the scenario's crowd is back
     assert any(i.prim_path.startswith(AGENTS_ROOT + "/") for i in reader.snapshot(24.0).instances)
+
+
+def test_randomise_refuses_a_malformed_record_with_one_line_naming_its_field(tmp_path):
+    """``synthua randomise --record`` validates the record against schemas/record.schema.json first."""
+    import json
+
+    from synthua_usd.core.errors import InputError
+    from synthua_usd.pipeline.randomiser import RandomiseRequest, randomise_image
+
+    record = tmp_path / "dataset" / "records" / "000001_x.json"
+    record.parent.mkdir(parents=True)
+    record.write_text(json.dumps({"id": 1, "seed": "zero"}))
+    with pytest.raises(InputError, match=r"000001_x\.json: not a dataset image record: \(document\): 'camera' is a "
+                                         r"required property; expected a document matching \$defs/image of "
+                                         r"record\.schema\.json"):
+        randomise_image(RandomiseRequest(scenario=SCENARIO, out=tmp_path / "layer.usda", record_path=record))

@@ -199,3 +199,24 @@ def test_verify_catches_a_missing_frame_and_an_altered_gt(sequences, tmp_path):
     gt.write_text(gt.read_text().replace(",1,1,", ",1,3,", 1))
     problems = "\n".join(verify(damaged).problems)
     assert "000004.json" in problems and "gt/gt.txt" in problems
+
+
+def test_every_frame_record_validates_and_verify_names_a_malformed_one(sequences, tmp_path):
+    """Each frame's record is a sequence_frame of schemas/record.schema.json; one edited by hand is a problem
+    verify lists with its field, not a traceback."""
+    from synthua_usd.dataset.record import IMAGE, SEQUENCE_FRAME, record_problem
+
+    paths = sorted(sequences.glob("sequences/*/records/*.json"))
+    assert len(paths) == 12
+    for path in paths:
+        record = json.loads(path.read_text(encoding="utf-8"))
+        assert record_problem(record, SEQUENCE_FRAME) is None, path
+        assert record_problem(record, IMAGE) is not None
+    damaged = tmp_path / "damaged"
+    shutil.copytree(sequences, damaged)
+    relative = f"sequences/{_names(damaged)[0]}/records/000002.json"
+    record = json.loads((damaged / relative).read_text(encoding="utf-8"))
+    record["files"] = {"img1": 7}
+    (damaged / relative).write_text(json.dumps(record), encoding="utf-8")
+    problems = verify(damaged).problems
+    assert any(p.startswith(f"{relative}: not a sequence frame's record: files") for p in problems), problems

@@ -125,3 +125,22 @@ def test_a_record_that_is_not_a_record_is_a_problem(copy):
     _rewrite_with_checksum(copy, f"records/{name}.json", json.dumps({"id": "x"}).encode())
     result = verify(copy)
     assert any(f"records/{name}.json: not an image record" in p for p in result.problems), result.problems
+
+
+@pytest.mark.parametrize("spoil, field", [
+    (lambda r: r["qa"].update(verdict="maybe"), "qa.verdict"),
+    (lambda r: r["instances"][0].update(bbox="everywhere"), "instances[0].bbox"),
+    (lambda r: r["files"].pop("instance"), "files"),
+    (lambda r: r.update(surprise=1), "(document)"),
+])
+def test_a_hand_corrupted_record_is_a_problem_naming_its_field(copy, spoil, field):
+    """Every record verify reads is validated against schemas/record.schema.json: a malformed one is one problem
+    naming the record and the field (its checksum made to agree, so only the validation can notice)."""
+    name = _names(copy)[0]
+    relative = f"records/{name}.json"
+    record = json.loads((copy / relative).read_text())
+    spoil(record)
+    _rewrite_with_checksum(copy, relative, json.dumps(record).encode())
+    result = verify(copy)
+    assert [p for p in result.problems if p.startswith(f"{relative}: not an image record: {field}: ")], result.problems
+    assert result.images == len(_names(copy)) - 1

@@ -29,6 +29,7 @@ from typing import Iterable
 
 from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.formats.records import image_entry, is_rejected, ordered
+from synthua_usd.dataset.record import ImageRecord
 from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.model.taxonomy import ClassMap
 
@@ -46,7 +47,7 @@ def categories(class_map: ClassMap) -> list[dict]:
     return out
 
 
-def _keypoint_fields(record: dict, inst: dict, class_name: str) -> dict:
+def _keypoint_fields(record: ImageRecord, inst: dict, class_name: str) -> dict:
     """``keypoints`` and ``num_keypoints`` of an instance of ``class_name``, a class with keypoints (module
     docstring)."""
     names = KEYPOINT_CLASSES[class_name].names
@@ -59,7 +60,7 @@ def _keypoint_fields(record: dict, inst: dict, class_name: str) -> dict:
     return {"keypoints": list(found["keypoints"]), "num_keypoints": int(found["num_keypoints"])}
 
 
-def annotation_ids(records: Iterable[dict], class_map: ClassMap) -> dict[tuple[int, int], int]:
+def annotation_ids(records: Iterable[ImageRecord], class_map: ClassMap) -> dict[tuple[int, int], int]:
     """(image id, instance id) -> annotation id, unique across the whole dataset (all splits): 1, 2, ... in
     image-id order, then in each record's instance order. Rejected images take no ids."""
     things = {c.id for c in class_map.classes if c.isthing and c.id >= 1}
@@ -73,7 +74,7 @@ def annotation_ids(records: Iterable[dict], class_map: ClassMap) -> dict[tuple[i
     return out
 
 
-def coco_instances(records: Iterable[dict], class_map: ClassMap, split: str) -> dict:
+def coco_instances(records: Iterable[ImageRecord], class_map: ClassMap, split: str) -> dict:
     """The COCO instances document of ``split``.
 
     Parameters

@@ -28,6 +28,7 @@ import pyarrow.parquet as pq
 from synthua_usd.core.atomic import atomic_path
 from synthua_usd.core.errors import OutputError
 from synthua_usd.dataset.formats.records import ordered
+from synthua_usd.dataset.record import ImageRecord
 from synthua_usd.model.taxonomy import ClassMap
 
 
@@ -43,7 +44,7 @@ def _scalar(value):
     return value
 
 
-def metadata_rows(records: Iterable[dict], class_map: ClassMap) -> list[dict]:
+def metadata_rows(records: Iterable[ImageRecord], class_map: ClassMap) -> list[dict]:
     """One dict per record, by image id, every dict with the same keys in the same order (see module)."""
     records = ordered(records)
     condition_keys = sorted({k for r in records for k in (r.get("condition") or {}) if k != "name"})
@@ -113,7 +114,7 @@ def _column(values: list) -> pa.Array:
         return pa.array([None if v is None else _csv_text(v) for v in values], pa.string())
 
 
-def write_rejected(records: Iterable[dict], path: str | Path) -> Path:
+def write_rejected(records: Iterable[ImageRecord], path: str | Path) -> Path:
     """``rejected.csv``: every image QA rejected or flagged, with its verdict and reasons, in image order
     (nothing is dropped silently), atomically."""
     import io
