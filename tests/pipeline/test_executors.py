@@ -346,7 +346,9 @@ def test_ray_replaces_a_killed_actor_or_reports_it(ray_instance, tmp_path):
     # Item 2 is sent once item 0 is in: item 0 comes from the first state and item 2 from another. (Which item
     # the retry starts at depends on what was in flight: Ray may lose item 1's answer with the actor.)
     assert summary.workers_lost == 1 and got[(0, 0)][1] != got[(0, 2)][1]
-    with pytest.raises(WorkerLostError, match=r"item 1 of shard 0: the worker was lost \(.*\) on 2 workers in "
+    # The same race names the first item not delivered: item 1, or item 0 when its answer went down with the actor
+    # (seen with the suite's parallel workers loading the machine).
+    with pytest.raises(WorkerLostError, match=r"item [01] of shard 0: the worker was lost \(.*\) on 2 workers in "
                                               r"turn"):
         run([[0, ("die", None)]], ExecutorConfig("ray", retries=1))
 
