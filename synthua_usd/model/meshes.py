@@ -62,6 +62,54 @@ def ramp(x0: float, x1: float, y_low: float, y_high: float, z_low: float, z_high
     return _arrays(hull)
 
 
+def tube(polyline, radius: float, sections: int = 8) -> Mesh:
+    """Closed tube of ``radius`` along a polyline (k, 3) of k >= 2 points, metres: a ring of ``sections``
+    points at each polyline point, square to the mean direction of its segments (frames carried along by
+    parallel transport, so the tube does not twist), capped flat at both ends."""
+    line = np.asarray(polyline, float)
+    steps = np.diff(line, axis=0)
+    lengths = np.linalg.norm(steps, axis=1)
+    if line.ndim != 2 or line.shape[1] != 3 or len(line) < 2 or np.any(lengths < 1e-9):
+        raise ValueError(f"tube: a polyline of shape {line.shape} with segment lengths {lengths}; expected (k >= 2, 3) "
+                         f"points, no two consecutive ones equal")
+    steps /= lengths[:, None]
+    directions = np.concatenate([steps[:1], steps[:-1] + steps[1:], steps[-1:]])
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    normal = np.cross(directions[0], [0.0, 0.0, 1.0] if abs(directions[0][2]) < 0.9 else [1.0, 0.0, 0.0])
+    rings = []
+    angles = np.linspace(0.0, 2 * np.pi, sections, endpoint=False)
+    for point, direction in zip(line, directions):
+        normal = normal - normal.dot(direction) * direction
+        normal /= np.linalg.norm(normal)
+        binormal = np.cross(direction, normal)
+        rings.append(point + radius * (np.cos(angles)[:, None] * normal + np.sin(angles)[:, None] * binormal))
+    k, j = len(line), np.arange(sections)
+    quads = [(r * sections + j, r * sections + (j + 1) % sections, (r + 1) * sections + (j + 1) % sections,
+              (r + 1) * sections + j) for r in range(k - 1)]
+    sides = np.concatenate([np.stack([a, b, c], 1) for a, b, c, _ in quads] + [np.stack([a, c, d], 1) for a, _, c, d in quads])
+    start, end = k * sections, k * sections + 1
+    caps = np.concatenate([np.stack([np.full(sections, start), (j + 1) % sections, j], 1),
+                           np.stack([np.full(sections, end), (k - 1) * sections + j, (k - 1) * sections + (j + 1) % sections], 1)])
+    return np.concatenate(rings + [line[:1], line[-1:]]), np.concatenate([sides, caps]).astype(np.int64)
+
+
+def torus(center, major_radius: float, minor_radius: float, axis: str = "z", major_sections: int = 32,
+          minor_sections: int = 8) -> Mesh:
+    """Closed torus centred at ``center`` around ``axis`` (a tyre, a rim), metres. With ``major_sections`` a
+    multiple of 4 its points reach exactly ``major_radius + minor_radius`` from the axis along the other two
+    axes (a wheel of that radius touches the ground)."""
+    u = np.linspace(0.0, 2 * np.pi, major_sections, endpoint=False)[:, None]
+    v = np.linspace(0.0, 2 * np.pi, minor_sections, endpoint=False)[None, :]
+    ring = major_radius + minor_radius * np.cos(v)
+    points = np.stack([ring * np.cos(u), ring * np.sin(u), minor_radius * np.sin(v) + 0 * u], -1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(major_sections), np.arange(minor_sections), indexing="ij")
+    a, b = i * minor_sections + j, ((i + 1) % major_sections) * minor_sections + j
+    c, d = ((i + 1) % major_sections) * minor_sections + (j + 1) % minor_sections, i * minor_sections + (j + 1) % minor_sections
+    tris = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    points, tris = _along(trimesh.Trimesh(points, tris, process=False), axis)
+    return points + np.asarray(center, float), tris
+
+
 def merge(*parts: Mesh) -> Mesh:
     """Concatenate meshes into one (no welding)."""
     points, tris, offset = [], [], 0

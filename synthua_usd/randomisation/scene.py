@@ -131,8 +131,10 @@ class SceneDraw:
 
 
 def _device_look(rng: np.random.Generator, aid: str, config: RandomisationConfig) -> DeviceLook:
-    models = sorted(DEVICE_MODELS[aid])
-    model = _pick(rng, models)
+    """The model (uniform over the class's models, drawn from a child stream of ``rng``: ``rng`` itself draws
+    as many numbers whatever the number of models, so adding a model changes no other draw of the scene),
+    then the finishes."""
+    model = _pick(rng.spawn(1)[0], sorted(DEVICE_MODELS[aid]))
     if not config.devices.enabled:
         base = PALETTE["Frame"]
         seat = PALETTE["Seat"]

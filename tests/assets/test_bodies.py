@@ -68,11 +68,11 @@ def test_walking_keeps_a_foot_on_the_ground(bank, body):
         assert abs(pts[:, 2].min()) < 1e-6
 
 
-def _device_solids(device: str, fit) -> list[trimesh.Trimesh]:
-    """The convex pieces (boxes, cylinders) of the device as placed beside its user."""
+def _device_solids(device: str, fit, model: str = "standard") -> list[trimesh.Trimesh]:
+    """The convex pieces (boxes, cylinders, tubes; a torus's is its disc) of the device as placed beside its user."""
     out = []
     for dx, dy in AID_OFFSETS.get(device, [(0.0, 0.0)]):
-        for part in devices.DEVICES[device](fit):
+        for part in devices.DEVICE_MODELS[device][model](fit):
             mesh = trimesh.Trimesh(part.points + [dx, dy, 0.0], part.triangles, process=True)
             out += [piece.convex_hull for piece in mesh.split(only_watertight=False)]
     return out
@@ -89,11 +89,12 @@ def _penetration(points: np.ndarray, solids: list[trimesh.Trimesh]) -> float:
     return deepest
 
 
+@pytest.mark.parametrize("model", ["standard", "detailed"])
 @pytest.mark.parametrize("device", ["manual_wheelchair", "electric_wheelchair"])
 @pytest.mark.parametrize("body", [48, 56, 66])
-def test_seated_pelvis_rests_on_the_seat(bank, body, device):
+def test_seated_pelvis_rests_on_the_seat(bank, body, device, model):
     fit = fit_device(bank, body, device)
-    seat = [p for p in devices.DEVICES[device](fit) if p.name == "Seat"][0]
+    seat = [p for p in devices.DEVICE_MODELS[device][model](fit) if p.name == "Seat"][0]
     pieces = trimesh.Trimesh(seat.points, seat.triangles).split(only_watertight=False)
     cushion = max(pieces, key=lambda m: np.prod(np.ptp(m.vertices[:, :2], axis=0)))  # the seat, not the backrest
     top = cushion.vertices[:, 2].max()
@@ -130,13 +131,15 @@ def _animated(bank, body: int, device: str | None, fit, phase: float, amplitude:
     return np.concatenate(out)
 
 
+@pytest.mark.parametrize("model", ["standard", "detailed"])
 @pytest.mark.parametrize("device", DEVICES)
 @pytest.mark.parametrize("body", [52, 60, 66])
-def test_no_body_part_inside_its_own_device(bank, body, device):
-    """At twelve phases of the cycle, the rendered (rigid-segment) body against its device where it stands then."""
+def test_no_body_part_inside_its_own_device(bank, body, device, model):
+    """At twelve phases of the cycle, the rendered (rigid-segment) body against its device (each model) where
+    it stands then."""
     fit = fit_device(bank, body, device)
     amplitude = 0.0 if device == "electric_wheelchair" else 1.0
-    solids = _device_solids(device, fit)
+    solids = _device_solids(device, fit, model)
     for phase in np.linspace(0, 2 * np.pi, 12, endpoint=False):
         shift = aid_shift_m(device, phase, amplitude, _cycle_m(bank, body, device))
         pts = _animated(bank, body, device, fit, phase, amplitude, shift) - [shift, 0.0, 0.0]
