@@ -20,6 +20,7 @@ import numpy as np
 
 from synthua_usd.assets.bodies import (BONES, REGIONS, SEGMENTS, Bank, Pose, forward_kinematics, load_bank, rot_y,
                                        rotation_between, skin, two_bone_aims)
+from synthua_usd.assets.hair import hair_mesh
 
 #: Walk ratio (step length / cadence) of adults, m per (steps/min), for a 1.7 m person (Sekiya & Nagasaki 1998).
 WALK_RATIO = 0.0064
@@ -262,6 +263,8 @@ class BodyParts:
     def __init__(self) -> None:
         self.bank = load_bank()
         self._cache: dict[tuple, tuple] = {}
+        self._posed: dict[tuple, np.ndarray] = {}
+        self._hair: dict[tuple, tuple | None] = {}
 
     def get(self, body: int, posture: str | None, fit: DeviceFit | None = None):
         """``posture`` a device class, :data:`BENCH` or None (walking); ``fit`` None: the device fitted to the body."""
@@ -280,4 +283,14 @@ class BodyParts:
                         used, inverse = np.unique(tris, return_inverse=True)
                         parts[(name, region_name)] = (pts[used], inverse.reshape(-1, 3))
             self._cache[key] = (fit, base, parts)
+            self._posed[key] = pts
         return self._cache[key]
+
+    def hair(self, body: int, posture: str | None, fit: DeviceFit | None, style: str):
+        """The hair mesh ``(points, triangles)`` of ``body`` in ``style`` (:func:`synthua_usd.assets.hair.hair_mesh`)
+        in the frame of its ``Torso`` segment in the base posture, or None for ``"none"``."""
+        key = (body, posture, fit, style)
+        if key not in self._hair:
+            self.get(body, posture, fit)
+            self._hair[key] = hair_mesh(self.bank, body, self._posed[(body, posture, fit)], style)
+        return self._hair[key]
