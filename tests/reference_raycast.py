@@ -14,17 +14,20 @@ def reference_labels(snapshot, camera, width: int, height: int):
 
 def labels_of_rays(snapshot, origins, dirs, width: int, height: int):
     """(class_ids, instance_ids) as (H, W) arrays from first hits of the rays (H*W, 3), row-major."""
+    mesh_index = meshes_hit(snapshot, origins, dirs).reshape(height, width)
+    class_of = np.array([0] + [m.class_id for m in snapshot.meshes])
+    inst_of = np.array([0] + [m.instance_id for m in snapshot.meshes])
+    return class_of[mesh_index + 1], inst_of[mesh_index + 1]
+
+
+def meshes_hit(snapshot, origins, dirs):
+    """(N,) index into ``snapshot.meshes`` of the first mesh each ray (N, 3) hits, -1 on a miss."""
     from trimesh.ray.ray_pyembree import RayMeshIntersector
 
     verts, faces, owner = snapshot.world_triangles()
     mesh = trimesh.Trimesh(verts, faces, process=False, validate=False)
     tri = RayMeshIntersector(mesh).intersects_first(origins, dirs)
-    hit = tri >= 0
-    mesh_index = np.where(hit, owner[np.maximum(tri, 0)], -1)
-    class_of = np.array([0] + [m.class_id for m in snapshot.meshes])
-    inst_of = np.array([0] + [m.instance_id for m in snapshot.meshes])
-    shape = (height, width)
-    return class_of[mesh_index + 1].reshape(shape), inst_of[mesh_index + 1].reshape(shape)
+    return np.where(tri >= 0, owner[np.maximum(tri, 0)], -1)
 
 
 def reference_z_depth(snapshot, camera, width: int, height: int):

@@ -140,3 +140,10 @@ DEVICE_FINISHES = {
 #: Seat and backrest fabrics of wheelchairs.
 SEAT_FABRICS = ((0.03, 0.05, 0.15), (0.02, 0.02, 0.02), (0.15, 0.15, 0.16), (0.3, 0.04, 0.04), (0.04, 0.15, 0.06),
                 (0.25, 0.18, 0.1))
+#: Natural hair colours, linear Rec.709 base colour: name -> (colour, roughness). Grey is drawn more with age
+#: (:func:`synthua_usd.randomisation.scene.draw_hair`).
+HAIR_COLOURS = {
+    "black": ((0.012, 0.009, 0.008), 0.5), "dark_brown": ((0.035, 0.02, 0.012), 0.55),
+    "brown": ((0.09, 0.05, 0.025), 0.55), "light_brown": ((0.2, 0.12, 0.06), 0.55),
+    "blonde": ((0.42, 0.3, 0.15), 0.6), "auburn": ((0.2, 0.06, 0.025), 0.55), "grey": ((0.32, 0.31, 0.3), 0.6),
+}

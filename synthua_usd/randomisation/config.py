@@ -15,7 +15,8 @@ from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
 from synthua_usd.core.errors import InputError, echo
-from synthua_usd.model.materials import DEVICE_FINISHES, RECOLOUR_PALETTES
+from synthua_usd.assets.hair import HAIR_STYLES
+from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES
 
 #: The mobility-aid classes a randomised crowd can use (the device classes of the agent profiles).
 AID_CLASSES = ("manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
@@ -103,6 +104,25 @@ class DeviceRandomisation:
 
 
 @dataclass(frozen=True)
+class HairRandomisation:
+    """Each person's hair (with crowd on): a style among ``styles`` (``none`` is bald) and a colour among
+    ``colours``; off, everyone is bald, as the body bank's bodies are."""
+
+    enabled: bool = True
+    styles: tuple[str, ...] = HAIR_STYLES
+    colours: tuple[str, ...] = tuple(HAIR_COLOURS)
+
+    def __post_init__(self) -> None:
+        for name, known in (("styles", HAIR_STYLES), ("colours", tuple(HAIR_COLOURS))):
+            values = tuple(getattr(self, name))
+            unknown = [v for v in values if v not in known]
+            if unknown or not values:
+                raise InputError(f"hair.{name}: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
+                                 f"{', '.join(known)}")
+            object.__setattr__(self, name, values)
+
+
+@dataclass(frozen=True)
 class MaterialRandomisation:
     """Each twin object of ``classes`` gets its own variant of its main material: a colour from its class's
     palette (façades, car paints, canvas, ...) or, for a textured material, its texture tinted; ``value_jitter``
@@ -183,7 +203,8 @@ class DistrictRandomisation:
         object.__setattr__(self, "seeds", seeds)
 
 
-_PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "materials": MaterialRandomisation,
+_PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "hair": HairRandomisation,
+          "materials": MaterialRandomisation,
           "light": LightRandomisation, "camera": CameraRandomisation, "district": DistrictRandomisation}
 
 
@@ -195,6 +216,7 @@ class RandomisationConfig:
     seed: int = 0
     crowd: CrowdRandomisation = field(default_factory=CrowdRandomisation)
     devices: DeviceRandomisation = field(default_factory=DeviceRandomisation)
+    hair: HairRandomisation = field(default_factory=HairRandomisation)
     materials: MaterialRandomisation = field(default_factory=MaterialRandomisation)
     light: LightRandomisation = field(default_factory=LightRandomisation)
     camera: CameraRandomisation = field(default_factory=CameraRandomisation)
@@ -204,6 +226,8 @@ class RandomisationConfig:
         if self.devices.enabled and not self.crowd.enabled:
             # devices belong to the randomised crowd's aid users
             object.__setattr__(self, "devices", DeviceRandomisation(enabled=False, finishes=self.devices.finishes))
+        if self.hair.enabled and not self.crowd.enabled:  # hair belongs to the randomised crowd's people
+            object.__setattr__(self, "hair", HairRandomisation(False, self.hair.styles, self.hair.colours))
         if self.district.enabled and not self.crowd.enabled:
             raise InputError("randomise.district: enabled while randomise.crowd is not; expected the crowd randomised "
                              "too (the scenario's own crowd walks the routes of its own district)")

@@ -1,5 +1,5 @@
-"""One randomised scene as plain data: who is in the crowd and how they look, each aid user's device, each
-twin object's material variant, and the district seed.
+"""One randomised scene as plain data: who is in the crowd and how they look (hair too), each aid user's
+device, each twin object's material variant, and the district seed.
 
 A scene is shared by the images of one seed (:mod:`synthua_usd.randomisation.streams`): a worker loads it
 once and every (camera, time code) then places its crowd anew (:mod:`synthua_usd.randomisation.view`). Every
@@ -9,15 +9,17 @@ choice is recorded (:meth:`SceneDraw.to_dict`) so a record names it; the USD sid
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
 from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.agents.seats import SeatPlace
+from synthua_usd.assets.bodies import load_bank
 from synthua_usd.assets.devices import DEVICE_MODELS
+from synthua_usd.assets.hair import HAIR_STYLES
 from synthua_usd.assets.people import PersonLook
-from synthua_usd.model.materials import (DEVICE_FINISHES, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
+from synthua_usd.model.materials import (DEVICE_FINISHES, HAIR_COLOURS, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
                                    WOOD_COLOURS)
 from synthua_usd.randomisation.config import RandomisationConfig
 
@@ -26,6 +28,12 @@ RGB = tuple[float, float, float]
 MAX_CAST = 2000
 #: Group sizes of pedestrians walking together.
 GROUP_SIZES = (2, 3)
+#: Weights of the hair styles (order of :data:`HAIR_STYLES`: none, short, medium, long) for women and men.
+HAIR_STYLE_WEIGHTS = {True: (0.03, 0.2, 0.35, 0.42), False: (0.2, 0.55, 0.2, 0.05)}
+#: Weights of the hair colours other than grey (keys of :data:`HAIR_COLOURS`); grey is drawn with probability
+#: (years - 45) / 40, within [0, 0.85].
+HAIR_COLOUR_WEIGHTS = {"black": 0.3, "dark_brown": 0.35, "brown": 0.18, "light_brown": 0.07, "blonde": 0.06,
+                       "auburn": 0.04}
 #: The profile of each aid class.
 PROFILE_OF_AID = {p.device: p.name for p in PROFILES.values() if p.device is not None}
 
@@ -62,11 +70,23 @@ class DeviceLook:
 
 
 @dataclass(frozen=True)
+class HairLook:
+    """A person's hair: ``style`` one of :data:`synthua_usd.assets.hair.HAIR_STYLES`, and (None when bald) its
+    colour's name (a key of :data:`synthua_usd.model.materials.HAIR_COLOURS`), linear Rec.709 base colour and
+    roughness."""
+
+    style: str
+    colour: str | None = None
+    base_color: RGB | None = None
+    roughness: float | None = None
+
+
+@dataclass(frozen=True)
 class CastMember:
     """One person of the scene: profile (a key of :data:`synthua_usd.agents.profiles.PROFILES`), body index into
     the body bank, skin tone (a Monk swatch's palette key), garment colours, sleeve and leg length, the device
     of an aid user, the bench place of a sitter (kept for the whole scene), and the group of pedestrians
-    walking together."""
+    walking together, and the hair (None: not randomised, bald)."""
 
     profile: str
     body: int
@@ -79,6 +99,7 @@ class CastMember:
     device: DeviceLook | None = None
     seat: SeatPlace | None = None
     group: int | None = None
+    hair: HairLook | None = None
 
     @property
     def aid(self) -> str | None:
@@ -150,6 +171,33 @@ def _device_look(rng: np.random.Generator, aid: str, config: RandomisationConfig
     return DeviceLook(model, frame, seat)
 
 
+def _weighted(u: float, names, weights: dict) -> str:
+    """The name of ``names`` at ``u`` in [0, 1) of their ``weights``' cumulative distribution."""
+    w = np.array([weights[n] for n in names], float)
+    return names[min(int(np.searchsorted(np.cumsum(w / w.sum()), u, side="right")), len(names) - 1)]
+
+
+def draw_hair(rng: np.random.Generator, body: int, config: RandomisationConfig) -> HairLook:
+    """A style among the config's (weighted by the body's sex, :data:`HAIR_STYLE_WEIGHTS`) and a colour among
+    the config's: grey with a probability rising with the body's age, else by :data:`HAIR_COLOUR_WEIGHTS`,
+    each channel scaled by 1 + U(-0.1, 0.1). Always five numbers of ``rng``, whatever is drawn."""
+    bank = load_bank()
+    hair = config.hair
+    u_style, u_grey, u_colour = rng.random(3)
+    scale = 1.0 + rng.uniform(-0.1, 0.1, 2)
+    weights = dict(zip(HAIR_STYLES, HAIR_STYLE_WEIGHTS[bool(bank.female[body])]))
+    style = _weighted(float(u_style), hair.styles, weights)
+    if style == "none":
+        return HairLook(style)
+    coloured = tuple(c for c in hair.colours if c != "grey")
+    grey = float(np.clip((float(bank.years[body]) - 45.0) / 40.0, 0.0, 0.85)) if "grey" in hair.colours else 0.0
+    name = "grey" if not coloured or u_grey < grey else _weighted(float(u_colour), coloured, HAIR_COLOUR_WEIGHTS)
+    rgb, roughness = HAIR_COLOURS[name]
+    value, hue = scale  # brightness, and a warmer or cooler shift of red against blue
+    colour = np.clip(np.asarray(rgb, float) * value * np.array([hue, 1.0, 2.0 - hue]), 0.0, 1.0)
+    return HairLook(style, name, tuple(float(c) for c in colour), roughness)
+
+
 def _member(rng: np.random.Generator, profile: str, config: RandomisationConfig, seat=None,
             group=None) -> CastMember:
     aid = PROFILES[profile].device
@@ -167,7 +215,8 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
     """(density, aid share, members): N ~ Poisson(density x ``walkable_area_m2``) people (at most
     :data:`MAX_CAST`), each an aid user with probability ``aid share`` (the aid uniform over the config's
     aids), else a pedestrian who sits on a free bench place of ``seats`` with probability ``seated_share`` or
-    walks in a group of 2-3 with probability ``group_share``."""
+    walks in a group of 2-3 with probability ``group_share``; then, with hair on, each member's hair
+    (:func:`draw_hair`) from a child stream of ``rng``."""
     crowd = config.crowd
     density = float(rng.uniform(*crowd.density_per_m2))
     aid_share = float(rng.uniform(*crowd.aid_share))
@@ -188,6 +237,11 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
             groups += 1
         else:
             members.append(_member(rng, "pedestrian", config))
+    if config.hair.enabled:
+        # one child stream for everyone's hair, spawned after the devices' (theirs stay as they were): no other
+        # draw of the scene moves
+        hair_rng = rng.spawn(1)[0]
+        members = [replace(m, hair=draw_hair(hair_rng, m.body, config)) for m in members]
     return density, aid_share, tuple(members)
 
 

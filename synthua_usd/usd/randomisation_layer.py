@@ -10,7 +10,7 @@ Three layers, strongest first, each sublayering the next:
   (``/World/Agents``, ``active = false``) and a new one under :data:`CROWD_ROOT` (labelled people and devices
   linked by ``synthua:uses``, instances of the prototypes, their clothes and finishes as UsdPreviewSurface
   materials under :data:`LOOKS_ROOT`), and twin objects rebound to variants of their materials;
-- the **prototypes layer** (``.usdc``): the meshes of the crowd's body segments and devices, under the
+- the **prototypes layer** (``.usdc``): the meshes of the crowd's body segments, hair and devices, under the
   ``class`` prim :data:`PROTOTYPES_ROOT` (USD scenegraph instancing, as the agents layer).
 
 Nothing else is touched: the scenario's layers stay as they are, and a viewer or ``synthua render --layer``
@@ -54,6 +54,8 @@ PROTOTYPES_ROOT = f"{RANDOM_ROOT}/Prototypes"
 _DEVICE_ROLES = {"Frame": "frame", "Wood": "frame", "Seat": "seat"}
 _ROOT_OPS = ("xformOp:translate", "xformOp:rotateZ")
 _SEGMENT_OPS = ("xformOp:translate", "xformOp:orient")
+#: The segment holding the head, whose part a person's hair is.
+HAIR_SEGMENT = "Torso"
 
 
 def agent_path(k: int) -> str:
@@ -174,8 +176,8 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
         for region, rough in (("upper", 0.85), ("lower", 0.85), ("shoes", 0.5)):
             looks[region] = _material(stage, f"{LOOKS_ROOT}/{name}_{region.title()}", f"{name}_{region}",
                                       member.region_colour(region), rough)
-        posture, fit = posture_of(member)
-        fit, _, parts = bodies.get(member.body, posture, fit)
+        posture, asked = posture_of(member)
+        fit, _, parts = bodies.get(member.body, posture, asked)
         instances = []
         for seg in SEGMENTS:
             for region in REGIONS:
@@ -185,6 +187,13 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
                     look = looks["skin"] if isinstance(colour, str) else looks[
                         {"forearm": "upper", "shin": "lower"}.get(region, region)]
                     instances.append((seg, region.title(), library.part(shape, parts[(seg, region)]), look))
+        hair = member.hair
+        if hair is not None and hair.style != "none":
+            # a part of the segment holding the head, bound to the person's own hair material
+            shape = f"Body{member.body:02d}{posture_name(posture)}Hair{hair.style.title()}"
+            look = _material(stage, f"{LOOKS_ROOT}/{name}_Hair", f"{name}_hair", hair.base_color, hair.roughness)
+            instances.append((HAIR_SEGMENT, "Hair", library.part(shape, bodies.hair(member.body, posture, asked,
+                                                                                    hair.style)), look))
         device = None
         if member.aid is not None and member.device is not None:
             look = member.device

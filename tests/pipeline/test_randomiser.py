@@ -4,21 +4,24 @@ camera are seen, and the layers written out compose to the same scene."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
+from pxr import Sdf
 
 from conftest import SCENARIO
-from reference_raycast import reference_labels
+from reference_raycast import meshes_hit, reference_labels
 from snapshot_checks import assert_same_snapshot
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.model.conditions import Condition
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.pipeline.randomiser import Randomiser
-from synthua_usd.randomisation.config import RandomisationConfig
+from synthua_usd.randomisation.config import HairRandomisation, RandomisationConfig
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
 from synthua_usd.usd.cameras import read_camera
 from synthua_usd.usd.conditions import read_condition
-from synthua_usd.usd.randomisation_layer import CROWD_ROOT, LOOKS_ROOT
+from synthua_usd.usd.randomisation_layer import CROWD_ROOT, HAIR_SEGMENT, LOOKS_ROOT, scene_layers
 from synthua_usd.usd.reader import StageReader, read_snapshot
 from synthua_usd.usd.stage_io import open_stage
 
@@ -67,8 +70,11 @@ def test_an_image_is_the_same_whatever_came_before(class_map, variant):
 
 
 def test_randomised_labels_agree_with_an_independent_ray_cast(class_map):
+    """Labels agree with Embree's first hits, the hair meshes' pixels too: the hair's pixels carry the class
+    person and the instance id of the person whose hair it is."""
     stage, reader, randomiser = randomised(class_map)
     session = RenderSession(RenderConfig(width=160, height=120, spp=1))
+    hair_pixels = agree = 0
     for seed, camera in ((0, CCTV), (2, EYE), (2, CCTV)):
         randomiser.apply(seed, camera, 24.0, None)
         snapshot, cam = reader.snapshot(24.0), read_camera(stage, camera, 24.0)
@@ -77,6 +83,18 @@ def test_randomised_labels_agree_with_an_independent_ray_cast(class_map):
         assert np.mean(ref_class == frame.class_ids) >= 0.9999 and np.mean(ref_inst == frame.instance_ids) >= 0.9999
         people = {i.id for i in snapshot.instances if i.prim_path.startswith(CROWD_ROOT) and i.class_name == "person"}
         assert people & set(np.unique(frame.instance_ids).tolist())  # the new crowd is in the picture
+        hit = meshes_hit(snapshot, *cam.pixel_center_rays(160, 120)).reshape(120, 160)
+        by_path = {i.prim_path: i for i in snapshot.instances}
+        person_class = class_map.resolve("person").id
+        for k, mesh in enumerate(snapshot.meshes):
+            if f"/{HAIR_SEGMENT}/Hair/" not in mesh.prim_path:
+                continue
+            owner = by_path[mesh.prim_path.split(f"/{HAIR_SEGMENT}/")[0]]
+            assert (mesh.class_id, mesh.instance_id) == (person_class, owner.id) and owner.class_name == "person"
+            pixels = hit == k
+            hair_pixels += int(pixels.sum())
+            agree += int(((frame.instance_ids[pixels] == owner.id) & (frame.class_ids[pixels] == person_class)).sum())
+    assert hair_pixels >= 10 and agree >= 0.95 * hair_pixels, (hair_pixels, agree)  # hair in the pictures, the person's
 
 
 def test_the_scenes_crowd_replaces_the_scenarios(class_map):
@@ -157,3 +175,36 @@ def test_randomise_refuses_a_malformed_record_with_one_line_naming_its_field(tmp
                                          r"required property; expected a document matching \$defs/image of "
                                          r"record\.schema\.json"):
         randomise_image(RandomiseRequest(scenario=SCENARIO, out=tmp_path / "layer.usda", record_path=record))
+
+
+def test_hair_off_authors_the_layers_of_a_bald_crowd(class_map):
+    """With hair off the scene's layers are those of the same cast drawn with hair and then made bald (the
+    hair draws nothing else); with hair on, each haired person's head segment holds a Hair part bound to its
+    own Hair material."""
+    stage, reader, randomiser = randomised(class_map)
+    off = Randomiser(open_stage(SCENARIO), dataclasses.replace(CONFIG, hair=HairRandomisation(enabled=False)),
+                     class_map, (W, H))
+    drawn, bald = randomiser.scene(4), off.scene(4)
+    assert [dataclasses.replace(m, hair=None) for m in drawn.cast] == list(bald.cast)
+    assert {m.hair.style for m in drawn.cast} - {"none"}
+    prototypes, scene, _ = scene_layers(dataclasses.replace(drawn, cast=bald.cast), off.meta, class_map.taxonomy,
+                                        off.bodies, off.materials, off.bound, deactivate_agents=off.has_agents)
+    assert prototypes.ExportToString() == off.prototypes.ExportToString()
+    assert _without_sublayers(scene) == _without_sublayers(off.scene_layer)
+    snapshot = reader.snapshot(24.0)
+    hair = [m for m in snapshot.meshes if f"/{HAIR_SEGMENT}/Hair/" in m.prim_path]
+    haired = [k for k, m in enumerate(drawn.cast) if m.hair.style != "none"]
+    assert sorted({m.prim_path.split("/Person/")[0] for m in hair}) == [f"{CROWD_ROOT}/Agent_{k:04d}" for k in haired]
+    for m in hair:
+        k = int(m.prim_path.split("Agent_")[1][:4])
+        assert m.material_key == f"{LOOKS_ROOT}/Agent_{k:04d}_Hair"
+        material = snapshot.materials[m.material_key]
+        assert material.base_color == pytest.approx(drawn.cast[k].hair.base_color, abs=1e-6)
+        assert 0.4 <= material.roughness <= 0.6 + 1e-6
+
+
+def _without_sublayers(layer):
+    copy = Sdf.Layer.CreateAnonymous("copy.usda")
+    copy.TransferContent(layer)
+    copy.subLayerPaths.clear()
+    return copy.ExportToString()
