@@ -67,16 +67,16 @@ def test_a_dataset_over_two_districts(tmp_path):
     assert "scenes/district_5/twin.usdc" in listed
     from synthua_usd.pipeline.verify import replay
 
-    for r in recs:
-        result = replay(out, str(r["id"]))
-        assert result.ok and result.identical, result
+    # replay of the image in the district the generator made (district 0's takes the same path: about 20 s more)
+    record = next(r for r in recs if r["randomisation"]["district_seed"] == 5)
+    result = replay(out, str(record["id"]))
+    assert result.ok and result.identical, result
     # synthua randomise of a district image writes its layers over that district's copy in the dataset, and
     # rendering them gives the image's labels
     from synthua_usd.backends.images import read_image
     from synthua_usd.pipeline.frame import FrameRequest, run_frames
     from synthua_usd.pipeline.randomiser import RandomiseRequest, randomise_image
 
-    record = next(r for r in recs if r["randomisation"]["district_seed"] == 5)
     result = randomise_image(RandomiseRequest(scenario=DISTRICT / "scenario.usda", out=tmp_path / "r" / "layer.usda",
                                               record_path=out / "records" / f"{record['name']}.json"))
     scenario = Path(result.render_args[2])
