@@ -103,6 +103,8 @@ def read_image(path: str | Path) -> tuple[np.ndarray, oiio.ImageSpec]:
     try:
         spec = inp.spec()
         pixels = inp.read_image(spec.format)
+        if pixels is None:  # the header read, the pixels not: a truncated or damaged file
+            raise OSError(f"{path}: OpenImageIO cannot read its pixels: {inp.geterror() or oiio.geterror()}")
     finally:
         inp.close()
     return np.asarray(pixels), spec

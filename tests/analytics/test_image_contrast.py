@@ -155,12 +155,16 @@ def test_the_statistics_of_the_tiny_dataset(tmp_path):
     (np.zeros((6, 8), np.uint8), "8x6 pixels, 1 channel(s) of uint8"),
     (np.zeros((6, 8, 3), np.uint16), "8x6 pixels, 3 channel(s) of uint16"),
     (None, "not an image OpenImageIO can read"),
+    ("truncated", "not an image OpenImageIO can read"),
 ])
 def test_a_wrong_rgb_is_one_error(run_cli, tmp_path, bad, found):
     root = tiny_dataset.write(tmp_path / "ds")
     path = root / "images" / "val" / f"{tiny_dataset.NAMES[1]}.png"
     if bad is None:
         path.write_bytes(b"not a png")
+    elif isinstance(bad, str):  # its header intact (OpenImageIO opens it), its pixels cut off inside IDAT
+        data = path.read_bytes()
+        path.write_bytes(data[:data.index(b"IDAT") + 8])
     else:
         assert oiio.ImageBuf(np.ascontiguousarray(bad)).write(str(path), str(bad.dtype))
     code, _, err = run_cli("stats", root, "--out", tmp_path / "r")
