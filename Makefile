@@ -50,7 +50,7 @@ TEST_WORKERS ?= $(shell n=$$(nproc 2>/dev/null || echo 1); echo $$(( n + 1 > 8 ?
 
 test: setup
 	-@TRAIN_VENV=$(TRAIN_VENV) bash tools/setup_train.sh
-	SYNTHUA_TRAIN_PYTHON=$(TRAIN_VENV)/bin/python $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile
+	SYNTHUA_TRAIN_PYTHON=$(TRAIN_VENV)/bin/python $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder
 	$(BIN)/lint-imports
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet --site-dir build/site
 

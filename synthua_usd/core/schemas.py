@@ -26,10 +26,16 @@ def bundled_path(name: str) -> Path:
 
 @lru_cache(maxsize=None)
 def load_schema(name: str) -> dict:
-    """The JSON Schema ``schemas/<name>.schema.json`` as a dict, checked to be a valid schema."""
-    schema = json.loads(bundled_path(f"{name}.schema.json").read_text(encoding="utf-8"))
-    jsonschema.Draft202012Validator.check_schema(schema)
-    return schema
+    """The JSON Schema ``schemas/<name>.schema.json`` as a dict. Not checked against the metaschema here (that
+    took ~1 s of every process, which reads all of them): ``tests/core/test_schemas.py`` checks every bundled
+    schema."""
+    return json.loads(bundled_path(f"{name}.schema.json").read_text(encoding="utf-8"))
+
+
+def bundled_schema_names() -> list[str]:
+    """The names of every bundled schema (``generate`` for ``schemas/generate.schema.json``), sorted."""
+    suffix = ".schema.json"
+    return sorted(f.name[:-len(suffix)] for f in resources.files(SCHEMA_PACKAGE).iterdir() if f.name.endswith(suffix))
 
 
 #: Where the bundled schemas live as URIs: one refers to a part of another by its file name, e.g.
@@ -43,10 +49,8 @@ def _registry():
     from referencing import Registry
     from referencing.jsonschema import DRAFT202012
 
-    suffix = ".schema.json"
-    names = sorted(f.name[:-len(suffix)] for f in resources.files(SCHEMA_PACKAGE).iterdir() if f.name.endswith(suffix))
-    return Registry().with_resources((f"{SCHEMA_BASE}{name}{suffix}", DRAFT202012.create_resource(load_schema(name)))
-                                     for name in names)
+    return Registry().with_resources((f"{SCHEMA_BASE}{name}.schema.json", DRAFT202012.create_resource(load_schema(name)))
+                                     for name in bundled_schema_names())
 
 
 #: Deepest nesting of arrays and objects accepted in a JSON document. CityJSON's MultiSolid boundaries, the

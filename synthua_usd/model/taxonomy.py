@@ -51,10 +51,10 @@ class ClassMap:
     def from_document(cls, document: dict, source: str = "(in memory)") -> "ClassMap":
         # Imported here: the rules module builds on this one's data types.
         from synthua_usd.core.findings import Severity
-        from synthua_usd.model.classmap_checks import check_classmap_rules
+        from synthua_usd.model.classmap_checks import REFUSING_RULES, check_classmap_rules
 
         validate_document(document, "classmap", source)
-        errors = [f for f in check_classmap_rules(document) if f.severity is Severity.ERROR]
+        errors = [f for f in check_classmap_rules(document, REFUSING_RULES) if f.severity is Severity.ERROR]
         if errors:
             more = f" (and {len(errors) - 1} more; run `synthua validate classes {source}`)" if len(errors) > 1 else ""
             raise InputError(f"{shown(source)}: {errors[0].where}: {errors[0].message}{more}")

@@ -1,38 +1,24 @@
-"""``synthua generate`` end to end on the demo street: reproducible bytes (reruns, more workers, Ray),
-resumption after kills at several points, ``verify`` catching damage, quotas, QA lists, resampling, replay,
-and hostile configs and folders. The formats themselves are read by the real tools in
+"""``synthua generate`` end to end on the demo street: reproducible bytes (reruns, more workers), ``verify``
+catching damage, quotas, QA lists, resampling, replay, and hostile configs and folders (resumption:
+``test_generate_resume.py``; Ray: ``test_generate_ray.py``). The formats themselves are read by the real tools in
 ``test_generate_readers.py``."""
 
 from __future__ import annotations
 
 import hashlib
 import json
-import os
 import shutil
-import signal
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from conftest import SCENARIO, TINY_CONFIG, generate_dataset
+from dataset_runs import records, tree_bytes
 from hostile import assert_refused, run_synthua, tree_state
 from synthua_usd.backends.images import read_image
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.pipeline.verify import verify
-
-
-def tree_bytes(root: Path) -> dict[str, str]:
-    """SHA-256 of every file below ``root`` by relative path."""
-    return {p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(root.rglob("*")) if p.is_file()}
-
-
-def records(root: Path) -> list[dict]:
-    return [json.loads(p.read_text(encoding="utf-8")) for p in sorted((root / "records").glob("*.json"))]
 
 
 # --- what a run writes -----------------------------------------------------------------------------------
@@ -153,82 +139,10 @@ def test_denoised_dataset_is_byte_identical_on_one_and_two_workers(tmp_path):
     assert all(r["render"]["denoise"] for r in records(tmp_path / "one"))
 
 
-@pytest.mark.slow
-def test_ray_executor_gives_the_same_bytes(generated, tmp_path):
-    pytest.importorskip("ray")
-    out = tmp_path / "ray"
-    generate_dataset(out, executor="ray", workers=1)
-    assert tree_bytes(out) == tree_bytes(generated)
-
-
 def test_replay_is_byte_identical(generated, run_cli):
     code, out, err = run_cli("replay", generated, "2")
     assert code == 0, out + err
     assert "byte-identical" in out
-
-
-# --- resumption ---------------------------------------------------------------------------------------------
-
-def _generate_command(out: Path) -> list[str]:
-    return [sys.executable, "-m", "synthua_usd", "generate", str(SCENARIO), "--config", str(TINY_CONFIG), "--out",
-            str(out)]
-
-
-def _kill_when(out: Path, ready, timeout: float = 120.0) -> bool:
-    """Start generate, SIGKILL it and its workers as soon as ``ready(out)``; True if it was killed in time."""
-    proc = subprocess.Popen(_generate_command(out), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            start_new_session=True)
-    deadline = time.monotonic() + timeout
-    try:
-        while proc.poll() is None and time.monotonic() < deadline:
-            if ready(out):
-                os.killpg(proc.pid, signal.SIGKILL)
-                proc.wait()
-                return True
-            time.sleep(0.02)
-        return False
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
-
-
-KILL_POINTS = {
-    "planned": lambda out: (out / "generate.json").exists(),
-    "mid-images": lambda out: len(list((out / "records").glob("*.json"))) >= 2 if (out / "records").exists() else False,
-    "assembling": lambda out: (out / "data.yaml").exists(),
-    # QA rejected an image and the plan holds its replacement (round 1), not rendered yet
-    "replacing": lambda out: (out / "generate.json").exists() and '"round": 1' in (out / "generate.json").read_text(),
-}
-
-
-@pytest.mark.parametrize("point", list(KILL_POINTS))
-def test_resume_after_kill_gives_the_same_dataset(generated, tmp_path, point):
-    out = tmp_path / "killed"
-    killed = _kill_when(out, KILL_POINTS[point])
-    assert killed or (out / "manifest.json").exists()
-    generate_dataset(out)
-    assert verify(out).ok
-    assert tree_bytes(out) == tree_bytes(generated), "no missing, duplicate, stray or different file"
-
-
-def test_disk_error_is_one_line_and_resumable(generated, tmp_path):
-    """Files may not grow past 20 KiB (RLIMIT_FSIZE: writes fail with EFBIG, as on a full disk): one line,
-    exit 2; the same command without the limit then finishes the dataset."""
-    import resource
-
-    def limit():
-        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
-
-    out = tmp_path / "limited"
-    proc = subprocess.run(_generate_command(out), capture_output=True, timeout=180, preexec_fn=limit)
-    stderr = proc.stderr.decode()
-    assert proc.returncode == 2, stderr
-    assert "Traceback" not in stderr
-    assert stderr.strip().splitlines()[-1].startswith("synthua: error: "), stderr
-    generate_dataset(out)
-    assert tree_bytes(out) == tree_bytes(generated)
 
 
 # --- verify -------------------------------------------------------------------------------------------------
@@ -309,21 +223,6 @@ def test_verify_counts_yolo_lines_against_the_instances(damaged):
     _rewrite_with_checksum(damaged, label, "".join(lines[1:]).encode())
     result = verify(damaged)
     assert [p for p in result.problems if "YOLO" in p and label.name in p], result.problems
-
-
-def test_leftover_temporary_file_does_not_block_a_new_run_and_occlusion_quota_is_planned(tmp_path):
-    """A run killed while writing its first generate.json leaves only a dot file: the same command then
-    starts. A quota with max_occlusion is planned for (the planner knows pixels, not occlusion) and met."""
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / ".generate.k3j2.json").write_text("{")
-    config = _config(tmp_path, quotas={"aid_users": {"min_share": 0.5, "min_pixels": 5, "max_occlusion": 0.95}})
-    generate_dataset(out, config=config)
-    assert not (out / ".generate.k3j2.json").exists()
-    job = json.loads((out / "generate.json").read_text())
-    assert job["pool"]["aid_users"] > 0
-    quotas = {q["quota"]: q for q in json.loads((out / "coverage.json").read_text())["quotas"]}
-    assert quotas["aid_users"]["met"], quotas
 
 
 # --- render settings -----------------------------------------------------------------------------------------
@@ -450,7 +349,7 @@ def test_hostile_config_name_is_refused(tmp_path):
 def test_scene_names_stay_inside(tmp_path):
     """A camera whose prim name is not ASCII (USD allows Unicode identifiers) and a scenario outside the
     output folder: every file of the dataset lies below --out with a safe name."""
-    from pxr import Sdf, Usd, UsdGeom
+    from pxr import Usd, UsdGeom
 
     root = tmp_path / "scenario.usda"
     stage = Usd.Stage.CreateNew(str(root))
@@ -475,10 +374,3 @@ def test_scene_names_stay_inside(tmp_path):
         assert path.resolve().is_relative_to(out.resolve())
 
 
-def test_unreachable_ray_head_is_refused_before_anything_is_written(tmp_path):
-    pytest.importorskip("ray")
-    out = tmp_path / "out"
-    result = run_synthua("generate", SCENARIO, "--config", TINY_CONFIG, "--out", out, "--executor", "ray",
-                         "--address", "127.0.0.1:9")
-    assert_refused(result, "--address", "127.0.0.1:9")
-    assert result.seconds < 30 and not out.exists()

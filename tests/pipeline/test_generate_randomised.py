@@ -15,7 +15,7 @@ from conftest import DATA, RANDOM_CONFIG, SCENARIO, generate_dataset
 from hostile import assert_refused, run_synthua
 from synthua_usd.backends.images import read_image
 from synthua_usd.pipeline.verify import verify
-from test_generate import _kill_when, records, tree_bytes
+from dataset_runs import kill_when, records, tree_bytes
 
 def _files(dataset: Path, record: dict) -> dict[str, Path]:
     return {k: dataset / v["path"] for k, v in record["checksums"].items()}
@@ -111,7 +111,7 @@ def test_resume_after_kill_gives_the_same_randomised_dataset(generated_random, t
 
     out = tmp_path / "killed"
     monkeypatch.setattr(test_generate, "TINY_CONFIG", RANDOM_CONFIG)
-    killed = _kill_when(out, lambda o: len(list((o / "records").glob("*.json"))) >= 2 if (o / "records").exists()
+    killed = kill_when(out, lambda o: len(list((o / "records").glob("*.json"))) >= 2 if (o / "records").exists()
                         else False)
     assert killed or (out / "manifest.json").exists()
     generate_dataset(out, config=RANDOM_CONFIG)

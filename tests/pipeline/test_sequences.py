@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import DATA, SCENARIO, generate_dataset
+from conftest import DATA, generate_dataset
 from synthua_usd.pipeline.verify import verify
-from test_generate import _kill_when, tree_bytes
+from dataset_runs import kill_when, tree_bytes
 
 SEQUENCE_CONFIG = DATA / "configs" / "sequences.json"
 
@@ -184,7 +184,7 @@ def test_resume_after_kill_mid_sequence_gives_the_same_bytes(sequences, tmp_path
     out = tmp_path / "killed"
     monkeypatch.setattr(test_generate, "TINY_CONFIG", SEQUENCE_CONFIG)
     frames = lambda o: len(list(o.glob("sequences/*/records/*.json")))  # noqa: E731
-    killed = _kill_when(out, lambda o: frames(o) >= 3)
+    killed = kill_when(out, lambda o: frames(o) >= 3)
     assert killed or (out / "manifest.json").exists()
     generate_dataset(out, config=SEQUENCE_CONFIG)
     ours, theirs = tree_bytes(out), tree_bytes(sequences)
