@@ -25,14 +25,14 @@ def records(root: Path) -> list[dict]:
     return [json.loads(p.read_text(encoding="utf-8")) for p in sorted((root / "records").glob("*.json"))]
 
 
-def generate_command(out: Path) -> list[str]:
-    return [sys.executable, "-m", "synthua_usd", "generate", str(SCENARIO), "--config", str(TINY_CONFIG), "--out",
-            str(out)]
+def generate_command(out: Path, config: Path = TINY_CONFIG) -> list[str]:
+    return [sys.executable, "-m", "synthua_usd", "generate", str(SCENARIO), "--config", str(config), "--out", str(out)]
 
 
-def kill_when(out: Path, ready, timeout: float = 120.0) -> bool:
-    """Start generate, SIGKILL it and its workers as soon as ``ready(out)``; True if it was killed in time."""
-    proc = subprocess.Popen(generate_command(out), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+def kill_when(out: Path, ready, timeout: float = 120.0, config: Path = TINY_CONFIG) -> bool:
+    """Start generate of ``config``, SIGKILL it and its workers as soon as ``ready(out)``; True if it was killed in
+    time."""
+    proc = subprocess.Popen(generate_command(out, config), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             start_new_session=True)
     deadline = time.monotonic() + timeout
     try:

@@ -22,8 +22,8 @@ INSTANCES = (
     Instance(5, "/World/Agents/W1", 29, "manual_wheelchair", True),
     Instance(7, "/World/Car", 19, "car", True),
     Instance(8, "/World/Pole", 12, "light_pole", True),
-    Instance(9, "/World/Agents/P2", 18, "person", True),
-    Instance(11, "/World/Agents/P3", 18, "person", True),
+    Instance(9, "/World/Agents/P2", 18, "person", True, (("pushes", "/World/Agents/W1"),)),
+    Instance(11, "/World/Agents/P3", 18, "person", True, (("accompanies", "/World/Agents/P1"),)),
     Instance(12, "/World/Agents/Hidden", 18, "person", True, (("uses", "/World/Agents/W1"),)),
     Instance(13, "/World/Bike", 22, "bicycle", True),
 )

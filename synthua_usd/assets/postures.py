@@ -4,7 +4,8 @@ A posture is a function of the body, its device fit and a cycle phase: walking (
 the speed), walking with a walker (both hands on its handles), with forearm crutches (hands on the grips),
 with a cane (cane hand on its grip), seated in a manual wheelchair (hands on the push rims, a push cycle),
 seated in an electric wheelchair (left hand on the joystick), seated on a bench (hands on the thighs, feet on
-the ground). Frames as in :mod:`bodies`: feet on z = 0 (standing), facing +X; a seated body sits on the seat
+the ground), and walking behind a manual wheelchair pushing it (both hands on its push handles). Frames as in
+:mod:`bodies`: feet on z = 0 (standing), facing +X; a seated body sits on the seat
 its :class:`DeviceFit` gives, its back at x = -0.15.
 
 Fitting follows clinical practice: cane, crutch and walker grips at the wrist crease of the standing user
@@ -45,6 +46,15 @@ AID_STANCE = 0.4
 AID_STANCE_START = np.pi - AID_STANCE * np.pi
 #: Where the hand holds a stepping aid: its grip's distance ahead of the aid's origin, m.
 GRIP_DX = {"crutch": 0.08, **{cane: -0.03 for cane in CANES}}
+#: The posture of a companion walking behind a manual wheelchair with both hands on its push handles (not a
+#: device of its own: its fit is the pushed chair's, :func:`push_handles`).
+PUSHING = "pushing"
+#: A manual wheelchair's push handles in its frame: where the hand grips them, behind the backrest
+#: (x, metres; inside the grips of both models, :mod:`synthua_usd.assets.devices`) and above the seat top (z).
+PUSH_HANDLE_X = -0.29
+PUSH_HANDLE_DZ = 0.46
+#: How far behind the pushed chair's origin its pusher's origin walks, m: the handles 0.35 m ahead of the pusher.
+PUSH_DISTANCE_M = 0.64
 
 
 @dataclass(frozen=True)
@@ -77,6 +87,8 @@ def _standing(bank: Bank, body: int) -> Pose:
 
 def fit_device(bank: Bank, body: int, device: str | None) -> DeviceFit:
     """The device of class ``device`` sized to ``body``."""
+    if device == PUSHING:
+        raise ValueError("the pushing posture has no device of its own: pass the pushed chair's fit")
     if device is None:
         return DeviceFit()
     rest = bank.joints[body]
@@ -135,6 +147,46 @@ def _bench_shank_deg(bank: Bank, body: int, seat_height_m: float) -> float:
     return hi
 
 
+def push_handles(fit: DeviceFit) -> np.ndarray:
+    """(2, 3) where the hands grip a manual wheelchair of ``fit``'s push handles (left, then right; chair frame,
+    metres): behind the backrest at :data:`PUSH_HANDLE_X`, :data:`PUSH_HANDLE_DZ` above the seat top, over the
+    seat's sides."""
+    y = fit.seat_width_m / 2 + 0.005
+    z = fit.seat_height_m + PUSH_HANDLE_DZ
+    return np.array([[PUSH_HANDLE_X, y, z], [PUSH_HANDLE_X, -y, z]])
+
+
+#: Share of the arm's length (shoulder to wrist, straight) at which a pusher holds the handles.
+PUSH_REACH = 0.97
+#: The most a pusher leans forward to reach the handles, degrees.
+MAX_PUSH_LEAN_DEG = 35.0
+
+
+def push_lean_deg(bank: Bank, body: int, fit: DeviceFit) -> float:
+    """How far (degrees, about the pelvis) ``body`` leans forward to hold the push handles of a chair of ``fit``
+    :data:`PUSH_DISTANCE_M` ahead with its arms at :data:`PUSH_REACH` of their length: 0 when it reaches them
+    upright, more for a tall person over low handles (at most :data:`MAX_PUSH_LEAN_DEG`). From the rest joints
+    (standing), whatever the gait phase, so one pusher leans the same at every step."""
+    rest = bank.joints[body]
+    root, shoulder = rest[0], rest[BONES.index("upperarm.L")]
+    arm = (np.linalg.norm(rest[BONES.index("lowerarm.L")] - shoulder)
+           + np.linalg.norm(rest[BONES.index("hand.L")] - rest[BONES.index("lowerarm.L")]))
+    handle = push_handles(fit)[0] + np.array([PUSH_DISTANCE_M, 0.0, 0.0])
+
+    def short(deg: float) -> float:  # > 0 while the handle is out of reach
+        return float(np.linalg.norm(handle - (root + rot_y(deg) @ (shoulder - root)))) - PUSH_REACH * arm
+
+    if short(0.0) <= 0.0:
+        return 0.0
+    if short(MAX_PUSH_LEAN_DEG) > 0.0:
+        return MAX_PUSH_LEAN_DEG
+    lo, hi = 0.0, MAX_PUSH_LEAN_DEG
+    for _ in range(30):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if short(mid) > 0.0 else (lo, mid)
+    return hi
+
+
 def bench_fit(seat_height_m: float) -> DeviceFit:
     """The fit of a bench posture: the seat's top above the ground the sitter's feet stand on."""
     return DeviceFit(seat_height_m=round(float(seat_height_m), 2))
@@ -184,7 +236,8 @@ def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float
          aid_shift: float = 0.0) -> Pose:
     """The body's pose at cycle ``phase`` (radians; gait cycle walking, push cycle in a manual chair) with
     the motion scaled by ``amplitude`` (0 still, 1 full stride); a walking aid moved ``aid_shift`` metres
-    forward (:func:`aid_shift_m`) takes the hands on it along."""
+    forward (:func:`aid_shift_m`) takes the hands on it along. ``device`` :data:`PUSHING` walks with both hands
+    on the push handles of a manual wheelchair of ``fit`` whose origin is :data:`PUSH_DISTANCE_M` ahead."""
     rest = bank.joints[body]
     if device in SEATED or device == BENCH:
         base = _seated_legs(bank, body, 0.0, _bench_shank_deg(bank, body, fit.seat_height_m) if device == BENCH else 12.0)
@@ -226,10 +279,15 @@ def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float
         arm = -0.7 * hip
         aims[f"upperarm.{side}"] = rot_y(-arm) @ aims[f"upperarm.{side}"]
         aims[f"lowerarm.{side}"] = rot_y(-arm) @ aims[f"lowerarm.{side}"]
+    if device == PUSHING:
+        aims["torso"] = rot_y(push_lean_deg(bank, body, fit))
     walking = forward_kinematics(rest, aims)
     targets = {}
     if device == "walker":
         targets = {s: np.array([0.3, sign * 0.26, fit.grip_height_m + 0.03]) for s, sign in (("L", 1.0), ("R", -1.0))}
+    elif device == PUSHING:  # the chair's handles, seen from PUSH_DISTANCE_M behind its origin
+        handles = push_handles(fit) + np.array([PUSH_DISTANCE_M, 0.0, 0.0])
+        targets = {"L": handles[0], "R": handles[1]}
     elif device == "crutch":
         targets = {s: np.array([AID_OFFSETS["crutch"][k][0] + GRIP_DX["crutch"] + aid_shift, AID_OFFSETS["crutch"][k][1],
                                 fit.grip_height_m + 0.03]) for k, s in enumerate(("L", "R"))}
@@ -240,7 +298,24 @@ def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float
     pts = skin(bank.points[body], bank, walking.skinning(rest))
     low = pts[_segment_vertices(bank, ("ShankL", "ShankR")), 2].min()
     walking = forward_kinematics(rest, aims, walking.joints[0] - np.array([0.0, 0.0, low]))
+    if device == PUSHING:
+        return _palms_on(bank, body, walking, targets, aims)
     return _with_arms(bank, body, walking, targets, aims) if targets else walking
+
+
+def _palms_on(bank: Bank, body: int, pose_: Pose, targets: dict[str, np.ndarray], aims: dict) -> Pose:
+    """``pose_`` with the centre of each named hand's mesh (not its wrist joint) on its target: the wrists are
+    aimed at the targets less the hand's offset as the last solution turns it, twice."""
+    rest = bank.joints[body]
+    now = _with_arms(bank, body, pose_, targets, aims)
+    for _ in range(2):
+        wrists = {}
+        for side, target in targets.items():
+            k = BONES.index(f"hand.{side}")
+            centre = bank.points[body][np.unique(bank.triangles[bank.face_bone == k])].mean(axis=0)
+            wrists[side] = target - now.rotations[k] @ (centre - rest[k])
+        now = _with_arms(bank, body, pose_, wrists, aims)
+    return now
 
 
 def segment_motion(bank: Bank, body: int, base: Pose, now: Pose) -> dict[str, np.ndarray]:

@@ -182,7 +182,7 @@ def annotate(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
     -------
     list of dicts with keys id, category_id, class_name, isthing, prim_path, area, bbox, segmentation,
     amodal_area, amodal_bbox, amodal_segmentation, occlusion (1 - area / amodal_area), truncation,
-    relations.
+    relations (:func:`relation_entries`).
 
     The whole map is read a few times (counts and boxes, column-major runs, one class check), never once
     per instance: a full-size mask per instance cost more than a second an image for 230 instances at
@@ -201,6 +201,7 @@ def annotate(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
     wrong_class = (class_ids != classes[instance_ids]) & (instance_ids != 0)
     mixed = set(np.unique(instance_ids[wrong_class]).tolist()) if wrong_class.any() else set()
     runs = column_runs(instance_ids)
+    class_of = {inst.prim_path: inst.class_name for inst in instances}
     out = []
     for inst in instances:
         if not 0 < inst.id < counts.size or not counts[inst.id]:
@@ -237,8 +238,19 @@ def annotate(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequenc
             area=area, bbox=bbox, segmentation=segmentation,
             amodal_area=amodal_area, amodal_bbox=amodal_bbox, amodal_segmentation=amodal_segmentation,
             occlusion=1.0 - area / amodal_area, truncation=trunc,
-            relations={name: target for name, target in inst.relations},
+            relations=relation_entries(inst.relations, class_of),
         ))
+    return out
+
+
+def relation_entries(relations, class_of: dict[str, str]) -> dict[str, str]:
+    """An instance's ``synthua:*`` relations ((name, target prim path) pairs) as a record holds them: ``name`` ->
+    the target's path, and ``name_class`` -> the target's class where ``class_of`` (labelled prim path -> class
+    name, in view or not) has it: the class of what a person uses or pushes, of the person it accompanies."""
+    out = {name: target for name, target in relations}
+    for name, target in relations:
+        if target in class_of:
+            out[f"{name}_class"] = class_of[target]
     return out
 
 

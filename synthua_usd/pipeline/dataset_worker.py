@@ -223,11 +223,6 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
     annotations.mark_ignored(instances, job.config.min_instance_px)
     keypoints.annotate_keypoints(instances, snapshot.keypoints, camera, (job.render.width, job.render.height),
                                  instance_ids, depth)
-    by_path = {inst.prim_path: inst for inst in snapshot.instances}
-    for entry in instances:  # the class of what a person uses, also when it is out of view
-        used = by_path.get(entry.get("relations", {}).get("uses", ""))
-        if used is not None:
-            entry["relations"]["uses_class"] = used.class_name
     seconds["annotate"] = time.perf_counter() - t0
     return AnnotatedFrame(snapshot, camera, condition, rendered, rgb, class_ids, instance_ids, depth, instances,
                           width, height, seconds, randomised)

@@ -35,6 +35,7 @@ from synthua_usd.core.atomic import write_json_atomic, write_text_atomic
 from synthua_usd.core.errors import InputError, OutputError, StageError, echo
 from synthua_usd.core.resources import check_frame_memory
 from synthua_usd.dataset import coverage, qa, sampling
+from synthua_usd.dataset.annotations import relation_entries
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, coco, panoptic, tables, yolo
 from synthua_usd.dataset.formats.records import is_rejected
@@ -183,11 +184,9 @@ def score_views(stage, pool, render: RenderConfig, output_size: tuple[int, int],
             visible = []
             for inst in snapshot.instances:
                 if counts[inst.id]:
-                    relations = dict(inst.relations)
-                    if relations.get("uses") in class_of:
-                        relations["uses_class"] = class_of[relations["uses"]]
                     visible.append({"class_name": inst.class_name, "prim_path": inst.prim_path,
-                                    "area": int(round(counts[inst.id] * scale)), "relations": relations})
+                                    "area": int(round(counts[inst.id] * scale)),
+                                    "relations": relation_entries(inst.relations, class_of)})
             users = tuple(sampling.AidUserView(aid_type=u.aid_type, person_pixels=u.person_pixels,
                                                device_pixels=u.device_pixels) for u in qa.aid_users(visible))
             scores.append(sampling.ViewScore(camera_path=path, time_code=tc, aid_users=users, seed=seed))

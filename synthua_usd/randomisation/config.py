@@ -48,10 +48,11 @@ def _range(name: str, value, lo: float | None = None, hi: float | None = None) -
 
 @dataclass(frozen=True)
 class CrowdRandomisation:
-    """A new crowd per scene (who: density, aid share, which aids, bodies, clothes) placed anew per view
-    (where: position, heading, gait phase on the walkable surfaces; some aid users where the camera sees
-    them at a projected height within ``view_height_share`` of the image's). Densities are persons per m² of
-    walkable area."""
+    """A new crowd per scene (who: density, aid share, which aids, bodies, clothes; manual wheelchair users
+    pushed by a companion, aid users accompanied by companions) placed anew per view (where: position, heading,
+    gait phase on the walkable surfaces; some aid users where the camera sees them at a projected height within
+    ``view_height_share`` of the image's; companions behind or beside their aid user). Densities are persons per
+    m² of walkable area."""
 
     enabled: bool = True
     density_per_m2: Range = (0.01, 0.05)
@@ -61,6 +62,8 @@ class CrowdRandomisation:
     view_height_share: Range = (0.03, 0.6)
     seated_share: Range = (0.0, 0.1)
     group_share: Range = (0.1, 0.4)
+    pushed_share: Range = (0.2, 0.5)
+    accompanied_share: Range = (0.1, 0.4)
     clothing_jitter: float = 0.15
 
     def __post_init__(self) -> None:
@@ -69,7 +72,7 @@ class CrowdRandomisation:
         if self.density_per_m2[0] <= 0:
             raise InputError(f"crowd.density_per_m2: [{self.density_per_m2[0]:g}, {self.density_per_m2[1]:g}]; "
                              f"expected a low end > 0 persons/m²")
-        for name in ("aid_share", "seated_share", "group_share"):
+        for name in ("aid_share", "seated_share", "group_share", "pushed_share", "accompanied_share"):
             object.__setattr__(self, name, _range(f"crowd.{name}", getattr(self, name), 0.0, 1.0))
         users = _range("crowd.aid_users_in_view", self.aid_users_in_view, 0, 50)
         if not all(float(v).is_integer() for v in users):

@@ -12,8 +12,8 @@ import numpy as np
 
 from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points
-from synthua_usd.assets.postures import (BENCH, STEPPING_AIDS, BodyParts, DeviceFit, aid_shift_m, bench_fit, pose,
-                                         segment_motion, step_length_m)
+from synthua_usd.assets.postures import (BENCH, PUSHING, STEPPING_AIDS, BodyParts, DeviceFit, aid_shift_m, bench_fit,
+                                         pose, segment_motion, step_length_m)
 from synthua_usd.randomisation.scene import CastMember
 from synthua_usd.randomisation.view import Placement
 
@@ -22,10 +22,13 @@ PUSH_CYCLE_M = 1.2
 
 
 def posture_of(member: CastMember) -> tuple[str | None, DeviceFit | None]:
-    """(posture, fit) of ``member``: :data:`BENCH` with the bench's fit for a sitter, else its device (None
-    walking) with the fit to its body (None: fitted by :class:`BodyParts`)."""
+    """(posture, fit) of ``member``: :data:`BENCH` with the bench's fit for a sitter, :data:`PUSHING` with the
+    pushed chair's fit for a pusher, else its device (None walking) with the fit to its body (None: fitted by
+    :class:`BodyParts`)."""
     if member.seat is not None:
         return BENCH, bench_fit(member.seat.seat_height_m)
+    if member.pushes is not None:
+        return PUSHING, member.pushing
     return member.aid, None
 
 
@@ -44,12 +47,14 @@ class MemberPose:
 
 
 def pose_member(bodies: BodyParts, member: CastMember, placement: Placement) -> MemberPose:
-    """``member`` at ``placement``'s phase and amplitude (an electric wheelchair's user sits still; a manual one
-    pushes once per :data:`PUSH_CYCLE_M`; walkers stride by their speed and height)."""
+    """``member`` at ``placement``'s phase and amplitude (an electric wheelchair's user sits still, and so does a
+    manual one who is pushed, hands on the rims; one who is not pushes once per :data:`PUSH_CYCLE_M`; walkers,
+    pushers among them, stride by their speed and height)."""
     posture, fit = posture_of(member)
     fit, base, _ = bodies.get(member.body, posture, fit)
     device = member.aid if member.seat is None else None
-    amplitude = 0.0 if device == "electric_wheelchair" else placement.amplitude
+    still = device == "electric_wheelchair" or (device == "manual_wheelchair" and member.pushed_by is not None)
+    amplitude = 0.0 if still else placement.amplitude
     height = float(bodies.bank.height_m[member.body])
     cycle = PUSH_CYCLE_M if device == "manual_wheelchair" else 2 * step_length_m(
         placement.speed_mps or PROFILES[member.profile].speed_mps, height)

@@ -19,6 +19,7 @@ from synthua_usd.assets.bodies import load_bank
 from synthua_usd.assets.devices import DEVICE_MODELS
 from synthua_usd.assets.hair import HAIR_STYLES
 from synthua_usd.assets.people import PersonLook
+from synthua_usd.assets.postures import DeviceFit, fit_device
 from synthua_usd.model.materials import (DEVICE_FINISHES, HAIR_COLOURS, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
                                    WOOD_COLOURS)
 from synthua_usd.randomisation.config import RandomisationConfig
@@ -28,6 +29,10 @@ RGB = tuple[float, float, float]
 MAX_CAST = 2000
 #: Group sizes of pedestrians walking together.
 GROUP_SIZES = (2, 3)
+#: How many companions walk beside an accompanied aid user.
+COMPANIONS = (1, 2)
+#: Shortest companion who pushes a wheelchair, m (the handles are about 0.9-1.1 m high).
+PUSHER_MIN_HEIGHT_M = 1.5
 #: Weights of the hair styles (order of :data:`HAIR_STYLES`: none, short, medium, long) for women and men.
 HAIR_STYLE_WEIGHTS = {True: (0.03, 0.2, 0.35, 0.42), False: (0.2, 0.55, 0.2, 0.05)}
 #: Weights of the hair colours other than grey (keys of :data:`HAIR_COLOURS`); grey is drawn with probability
@@ -85,8 +90,10 @@ class HairLook:
 class CastMember:
     """One person of the scene: profile (a key of :data:`synthua_usd.agents.profiles.PROFILES`), body index into
     the body bank, skin tone (a Monk swatch's palette key), garment colours, sleeve and leg length, the device
-    of an aid user, the bench place of a sitter (kept for the whole scene), and the group of pedestrians
-    walking together, and the hair (None: not randomised, bald)."""
+    of an aid user, the bench place of a sitter (kept for the whole scene), the group of people walking
+    together, and the hair (None: not randomised, bald). A companion of an aid user has the aid user's index in
+    the cast in ``pushes`` (it walks behind a manual wheelchair, hands on its push handles, ``pushing`` that
+    chair's fit) or in ``accompanies`` (it walks beside); the pushed user has its pusher's in ``pushed_by``."""
 
     profile: str
     body: int
@@ -100,6 +107,10 @@ class CastMember:
     seat: SeatPlace | None = None
     group: int | None = None
     hair: HairLook | None = None
+    pushes: int | None = None
+    pushing: DeviceFit | None = None
+    pushed_by: int | None = None
+    accompanies: int | None = None
 
     @property
     def aid(self) -> str | None:
@@ -199,9 +210,9 @@ def draw_hair(rng: np.random.Generator, body: int, config: RandomisationConfig) 
 
 
 def _member(rng: np.random.Generator, profile: str, config: RandomisationConfig, seat=None,
-            group=None) -> CastMember:
+            group=None, min_height_m: float = 0.0) -> CastMember:
     aid = PROFILES[profile].device
-    look = PersonLook.random(rng, aid_user=aid is not None)
+    look = PersonLook.random(rng, aid_user=aid is not None, min_height_m=min_height_m)
     jitter = config.crowd.clothing_jitter
     colour = {"Shirt": SHIRTS, "Trousers": TROUSERS, "Shoes": SHOES}
     upper, lower, shoes = (_jitter(rng, _pick(rng, colour[kind]).base_color, jitter) for kind in colour)
@@ -210,13 +221,39 @@ def _member(rng: np.random.Generator, profile: str, config: RandomisationConfig,
                       long_sleeves=look.long_sleeves, long_legs=look.long_legs, device=device, seat=seat, group=group)
 
 
+def _companions(rng: np.random.Generator, config: RandomisationConfig, members: list[CastMember], room: int,
+                pushed_share: float, accompanied_share: float, group: int) -> bool:
+    """Maybe add companions to the aid user last in ``members`` (at most ``room`` people), drawing from ``rng``
+    (the scene's companion stream): a manual wheelchair's user is pushed with probability ``pushed_share`` (a
+    pusher at least :data:`PUSHER_MIN_HEIGHT_M` tall), any other aid user (and a chair user not pushed) walks
+    with 1-2 companions with probability ``accompanied_share``. The user and its companions take ``group``;
+    True when any were added. Always the same numbers of ``rng`` drawn for the decisions, whatever is added."""
+    k = len(members) - 1
+    user = members[k]
+    push, accompany, many = rng.random(3)
+    if user.aid == "manual_wheelchair" and push < pushed_share and room >= 1:
+        chair = fit_device(load_bank(), user.body, "manual_wheelchair")
+        pusher = replace(_member(rng, "pedestrian", config, group=group, min_height_m=PUSHER_MIN_HEIGHT_M),
+                         pushes=k, pushing=chair)
+        members[k] = replace(user, group=group, pushed_by=k + 1)
+        members.append(pusher)
+        return True
+    if accompany < accompanied_share and room >= 1:
+        size = min(COMPANIONS[int(many * len(COMPANIONS))], room)
+        members[k] = replace(user, group=group)
+        members += [replace(_member(rng, "pedestrian", config, group=group), accompanies=k) for _ in range(size)]
+        return True
+    return False
+
+
 def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_area_m2: float,
               seats: list[SeatPlace]) -> tuple[float, float, tuple[CastMember, ...]]:
     """(density, aid share, members): N ~ Poisson(density x ``walkable_area_m2``) people (at most
     :data:`MAX_CAST`), each an aid user with probability ``aid share`` (the aid uniform over the config's
-    aids), else a pedestrian who sits on a free bench place of ``seats`` with probability ``seated_share`` or
-    walks in a group of 2-3 with probability ``group_share``; then, with hair on, each member's hair
-    (:func:`draw_hair`) from a child stream of ``rng``."""
+    aids; then maybe pushed or accompanied by companions among the N, :func:`_companions`, drawn from a child
+    stream of ``rng``), else a pedestrian who sits on a free bench place of ``seats`` with probability
+    ``seated_share`` or walks in a group of 2-3 with probability ``group_share``; then, with hair on, each
+    member's hair (:func:`draw_hair`) from a child stream of ``rng``."""
     crowd = config.crowd
     density = float(rng.uniform(*crowd.density_per_m2))
     aid_share = float(rng.uniform(*crowd.aid_share))
@@ -226,9 +263,16 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
     free = list(range(len(seats)))
     members: list[CastMember] = []
     groups = 0
+    # the companions' own stream, spawned after the devices' (spawning draws nothing from rng)
+    companion_rng = rng.spawn(1)[0]
+    pushed_share = float(companion_rng.uniform(*crowd.pushed_share))
+    accompanied_share = float(companion_rng.uniform(*crowd.accompanied_share))
     while len(members) < count:
         if rng.random() < aid_share:
             members.append(_member(rng, PROFILE_OF_AID[_pick(rng, crowd.aids)], config))
+            if _companions(companion_rng, config, members, count - len(members), pushed_share, accompanied_share,
+                           groups):
+                groups += 1
         elif free and rng.random() < seated_share:
             members.append(_member(rng, "pedestrian", config, seat=seats[free.pop(int(rng.integers(len(free))))]))
         elif rng.random() < group_share and count - len(members) >= 2:

@@ -18,6 +18,7 @@ from synthua_usd.agents.motion import MARGIN_M
 from synthua_usd.agents.profiles import PROFILES, AgentProfile
 from synthua_usd.agents.seats import SeatPlace, find_seat_places
 from synthua_usd.agents.walkable import WALKABLE, WalkableGrid, build_grid, walkable_graph
+from synthua_usd.assets.postures import PUSH_DISTANCE_M
 from synthua_usd.composition.rigs import RIG_TYPES
 from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.randomisation.config import CameraRandomisation, CrowdRandomisation
@@ -244,6 +245,23 @@ def _free(xy: np.ndarray, radius: float, taken: list[tuple[float, float, float]]
     return all((xy[0] - x) ** 2 + (xy[1] - y) ** 2 >= (radius + r + MARGIN_M) ** 2 for x, y, r in taken)
 
 
+def companion_offsets(cast: tuple[CastMember, ...], k: int) -> list[tuple[int, float, float]]:
+    """The members placed with aid user ``k`` as (cast index, metres ahead, metres to the left) in its frame:
+    itself at the origin, its pusher :data:`PUSH_DISTANCE_M` behind, its companions beside it (left, then
+    right, then in line behind), each far enough from it for their discs to keep :data:`MARGIN_M` apart."""
+    user = PROFILES[cast[k].profile].radius_m
+    out = [(k, 0.0, 0.0)]
+    side = 0
+    for j, member in enumerate(cast):
+        if member.pushes == k:
+            out.append((j, -PUSH_DISTANCE_M, 0.0))
+        elif member.accompanies == k:
+            gap = max(GROUP_SPACING_M, user + PROFILES[member.profile].radius_m + MARGIN_M)
+            out.append((j, 0.0, gap) if side == 0 else (j, 0.0, -gap) if side == 1 else (j, -gap * (side - 1), 0.0))
+            side += 1
+    return out
+
+
 def place_cast(rng: np.random.Generator, cast: tuple[CastMember, ...], area: WalkArea, camera: PinholeCamera,
                size: tuple[int, int], config: CrowdRandomisation) -> tuple[Placement, ...]:
     """A placement for every member of ``cast``, no two discs (profile radii) within 0.1 m.
@@ -253,7 +271,9 @@ def place_cast(rng: np.random.Generator, cast: tuple[CastMember, ...], area: Wal
     stand on, groups side by side, bench sitters on their seats. Each takes a heading along an edge it can
     travel, a random phase, and stands still with probability :data:`STANDING_SHARE`. A person for whom no
     free place turns up in :data:`PLACE_TRIES` tries takes the freest of them; ``in_view`` says who was placed
-    free in view."""
+    free in view. An aid user with companions is placed with them as one unit (:func:`companion_offsets`: its
+    pusher behind it, the others beside it, all at its heading and pace, every one of them on a walkable
+    cell), each companion with a phase of its own."""
     taken: list[tuple[float, float, float]] = []
     placements: list[Placement | None] = [None] * len(cast)
     aid_users = [k for k, m in enumerate(cast) if m.aid is not None]
@@ -271,6 +291,8 @@ def place_cast(rng: np.random.Generator, cast: tuple[CastMember, ...], area: Wal
                               1.5 * profile.speed_mps))
         phase = float(rng.uniform(0.0, 2 * np.pi))
         amplitude = 0.0 if rng.random() < STANDING_SHARE else 1.0
+        if placements[k] is not None:  # a companion, placed with its aid user
+            continue
         if member.seat is not None:
             seat = member.seat
             taken.append((seat.origin[0], seat.origin[1], profile.radius_m))
@@ -299,6 +321,11 @@ def place_cast(rng: np.random.Generator, cast: tuple[CastMember, ...], area: Wal
                 seen = area.seen(area.centres + [0.0, 0.0, SEEN_HEIGHT_M], camera, *size, config.view_height_share)
             visible = cells[seen[cells]]
             pool, aimed = (visible, True) if len(visible) else (cells, False)
+        unit = companion_offsets(cast, k) if member.aid is not None else [(k, 0.0, 0.0)]
+        if len(unit) > 1:
+            _place_unit(rng, cast, unit, area, cells, headings, pool, taken, placements, phase, amplitude, speed,
+                        aimed)
+            continue
         best, best_gap = None, -np.inf
         for _ in range(PLACE_TRIES):
             c = int(pool[int(rng.integers(len(pool)))])
@@ -322,3 +349,43 @@ def place_cast(rng: np.random.Generator, cast: tuple[CastMember, ...], area: Wal
         if member.group is not None:
             group_lead[member.group] = placements[k]
     return tuple(placements)
+
+
+def _place_unit(rng: np.random.Generator, cast: tuple[CastMember, ...], unit: list[tuple[int, float, float]],
+                area: WalkArea, cells: np.ndarray, headings: list[np.ndarray], pool: np.ndarray, taken: list,
+                placements: list, phase: float, amplitude: float, speed: float, aimed: bool) -> None:
+    """Place an aid user and its companions (``unit``, :func:`companion_offsets`) as :func:`place_cast` places one
+    person, trying a cell, a jitter and a heading together: the freest of :data:`PLACE_TRIES` arrangements
+    whose every member stands on a walkable cell (any arrangement when none is)."""
+    cell = area.grid.cell_m
+    radii = np.array([PROFILES[cast[j].profile].radius_m for j, _, _ in unit])
+    offsets = np.array([(ahead, left) for _, ahead, left in unit])
+    best, best_key = None, (-1, -np.inf)
+    for _ in range(PLACE_TRIES):
+        c = int(pool[int(rng.integers(len(pool)))])
+        i, j = area.nodes[c]
+        xy = area.grid.centre(i, j)[:2] + rng.uniform(-0.3 * cell, 0.3 * cell, 2)
+        dirs = headings[int(np.searchsorted(cells, c))]
+        d = dirs[int(rng.integers(len(dirs)))]
+        spots = xy + offsets[:, :1] * d + offsets[:, 1:] * np.array([-d[1], d[0]])
+        index = [area.grid.cell_of(float(x), float(y)) for x, y in spots]
+        rows, cols = area.grid.z.shape
+        walkable = sum(0 <= a < rows and 0 <= b < cols and bool(area.grid.walkable[a, b]) for a, b in index)
+        gap = min((math.hypot(p[0] - x, p[1] - y) - r - rr for p, rr in zip(spots, radii) for x, y, r in taken),
+                  default=np.inf)
+        key = (walkable, gap)
+        if key > best_key:
+            best, best_key = (spots, index, d), key
+        if walkable == len(unit) and gap >= MARGIN_M:
+            break
+    spots, index, d = best
+    heading = float(np.degrees(np.arctan2(d[1], d[0])))
+    near = np.array([area.grid.z[min(max(a, 0), area.grid.z.shape[0] - 1), min(max(b, 0), area.grid.z.shape[1] - 1)]
+                     for a, b in index])
+    z = area.ground_z(spots, near)
+    free = best_key[0] == len(unit) and best_key[1] >= MARGIN_M
+    for n, ((member, _, _), spot, r) in enumerate(zip(unit, spots, radii)):
+        taken.append((float(spot[0]), float(spot[1]), float(r)))
+        own_phase = phase if n == 0 else float(rng.uniform(0.0, 2 * np.pi))
+        placements[member] = Placement((float(spot[0]), float(spot[1]), float(z[n])), heading, own_phase, amplitude,
+                                       speed, in_view=aimed and free and n == 0)

@@ -8,7 +8,8 @@ Three layers, strongest first, each sublayering the next:
   ``condition`` selection with its sun, turbidity and night sky;
 - the **scene layer** (``.usda``): what the images of one scene share: the scenario's own crowd deactivated
   (``/World/Agents``, ``active = false``) and a new one under :data:`CROWD_ROOT` (labelled people and devices
-  linked by ``synthua:uses``, instances of the prototypes, their clothes and finishes as UsdPreviewSurface
+  linked by ``synthua:uses``, companions linked to their aid user by ``synthua:pushes`` (the chair) or
+  ``synthua:accompanies`` (the person), instances of the prototypes, their clothes and finishes as UsdPreviewSurface
   materials under :data:`LOOKS_ROOT`), and twin objects rebound to variants of their materials;
 - the **prototypes layer** (``.usdc``): the meshes of the crowd's body segments, hair and devices, under the
   ``class`` prim :data:`PROTOTYPES_ROOT` (USD scenegraph instancing, as the agents layer).
@@ -215,6 +216,10 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
                 _attr(root, "synthua:behaviour", Sdf.ValueTypeNames.String, "sits_on_bench", custom=True)
             if member.group is not None:
                 _attr(root, "synthua:group", Sdf.ValueTypeNames.Int, member.group, custom=True)
+            if member.pushes is not None:
+                _attr(root, "synthua:behaviour", Sdf.ValueTypeNames.String, "pushes_wheelchair", custom=True)
+            elif member.accompanies is not None:
+                _attr(root, "synthua:behaviour", Sdf.ValueTypeNames.String, "accompanies_aid_user", custom=True)
             person_path = f"{agent_path(k)}/Person"
             person = _define(layer, person_path, kind=Kind.Tokens.component)
             _label(person, taxonomy, "person")
@@ -233,6 +238,14 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
                       list(KEYPOINT_CLASSES[member.aid].names), uniform=True, custom=True)
                 uses = Sdf.RelationshipSpec(person, "synthua:uses", True)
                 uses.targetPathList.explicitItems = [Sdf.Path(device)]
+            # a companion's relation to its aid user: the chair it pushes, or the person it walks beside
+            if member.pushes is not None:
+                pushed = scene.cast[member.pushes]
+                pushes = Sdf.RelationshipSpec(person, "synthua:pushes", True)
+                pushes.targetPathList.explicitItems = [Sdf.Path(f"{agent_path(member.pushes)}/{prim_name(pushed.aid)}")]
+            if member.accompanies is not None:
+                with_ = Sdf.RelationshipSpec(person, "synthua:accompanies", True)
+                with_.targetPathList.explicitItems = [Sdf.Path(f"{agent_path(member.accompanies)}/Person")]
             agents.append(agent_path(k))
             persons.append(person_path)
             device_paths.append(device)

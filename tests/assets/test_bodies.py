@@ -12,8 +12,9 @@ from scipy import stats
 from synthua_usd.assets import body_bank, devices
 from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.assets.bodies import BONES, SEGMENTS, load_bank, skin
-from synthua_usd.assets.postures import (AID_OFFSETS, AID_STANCE, AID_STANCE_START, GRIP_DX, SEATED, STEPPING_AIDS,
-                                         aid_shift_m, fit_device, pose, segment_motion, step_length_m)
+from synthua_usd.assets.postures import (AID_OFFSETS, AID_STANCE, AID_STANCE_START, GRIP_DX, MAX_PUSH_LEAN_DEG,
+                                         PUSH_DISTANCE_M, PUSHING, SEATED, STEPPING_AIDS, aid_shift_m, fit_device, pose,
+                                         push_handles, push_lean_deg, segment_motion, step_length_m)
 
 #: How deep a body vertex may sit inside its own device: hands close round grips and push rims, whose
 #: boxes and cylinders are solid here.
@@ -210,3 +211,40 @@ def test_seated_on_a_bench_the_pelvis_rests_on_the_seat_and_the_feet_on_the_grou
     assert feet > -SEAT_TOLERANCE_M
     if bank.height_m[body] > 1.6:
         assert feet < 0.04
+
+
+def _outside(point: np.ndarray, solids: list[trimesh.Trimesh]) -> float:
+    """How far ``point`` lies outside the nearest of ``solids`` (convex), along its farthest face plane (a lower
+    bound of the distance; <= 0 inside)."""
+    return min(float(((point - s.triangles[:, 0]) * s.face_normals).sum(axis=1).max()) for s in solids)
+
+
+@pytest.mark.parametrize("model", ["standard", "detailed"])
+@pytest.mark.parametrize("user", [52, 60, 66])
+def test_the_push_handles_are_where_the_pusher_holds_them(bank, user, model):
+    fit = fit_device(bank, user, "manual_wheelchair")
+    solids = _device_solids("manual_wheelchair", fit, model)
+    for handle in push_handles(fit):
+        assert _outside(handle, solids) <= 0.015, (handle, model)
+
+
+@pytest.mark.parametrize("model", ["standard", "detailed"])
+@pytest.mark.parametrize("pusher, user", [(8, 52), (40, 60), (17, 66), (30, 52)])
+def test_a_pusher_holds_the_handles_walks_on_the_ground_and_stays_out_of_the_chair(bank, pusher, user, model):
+    """At twelve phases of the gait, a pusher (1.93 m, 1.76 m, 1.50 m, 1.83 m tall) behind the chair of a user:
+    the centre of both hands' meshes on the push handles (within 2 cm), a foot on the ground, and no
+    vertex of the rendered body deeper than the device tolerance inside the chair (each model), which stands
+    PUSH_DISTANCE_M ahead; a tall pusher leans forward to reach low handles, at most MAX_PUSH_LEAN_DEG."""
+    fit = fit_device(bank, user, "manual_wheelchair")
+    solids = _device_solids("manual_wheelchair", fit, model)
+    handles = push_handles(fit) + [PUSH_DISTANCE_M, 0.0, 0.0]
+    assert 0.0 <= push_lean_deg(bank, pusher, fit) <= MAX_PUSH_LEAN_DEG
+    for phase in np.linspace(0, 2 * np.pi, 12, endpoint=False):
+        now = pose(bank, pusher, PUSHING, fit, phase, 1.0)
+        posed = skin(bank.points[pusher], bank, now.skinning(bank.joints[pusher]))
+        for side, handle in zip("LR", handles):
+            hand = np.unique(bank.triangles[bank.face_bone == BONES.index(f"hand.{side}")])
+            assert np.linalg.norm(posed[hand].mean(axis=0) - handle) < 0.02, (phase, side)
+        assert abs(posed[:, 2].min()) < 1e-6, phase  # as walking: the lower foot on the ground
+        pts = _animated(bank, pusher, PUSHING, fit, phase, 1.0, 0.0)
+        assert _penetration(pts - [PUSH_DISTANCE_M, 0.0, 0.0], solids) <= DEVICE_TOLERANCE_M, phase

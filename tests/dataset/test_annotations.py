@@ -9,7 +9,7 @@ from pycocotools import mask as mask_utils
 
 from label_scenes import INSTANCES, H, W, crowded_scene, scene
 from synthua_usd.core.errors import InputError
-from synthua_usd.dataset.annotations import STUFF_ID_BASE, annotate, panoptic
+from synthua_usd.dataset.annotations import STUFF_ID_BASE, annotate, panoptic, relation_entries
 from synthua_usd.model.scene import Instance
 
 
@@ -37,7 +37,12 @@ def test_instances_match_masks_decoded_by_pycocotools():
         assert e["truncation"] == trunc.get(e["id"], 0.0)
         assert isinstance(e["segmentation"]["counts"], str)
     by_id = {e["id"]: e for e in entries}
-    assert by_id[3]["relations"] == {"uses": "/World/Agents/W1"} and by_id[5]["relations"] == {}
+    # each relation with its target's class, whether or not the target is in view
+    assert by_id[3]["relations"] == {"uses": "/World/Agents/W1", "uses_class": "manual_wheelchair"}
+    assert by_id[9]["relations"] == {"pushes": "/World/Agents/W1", "pushes_class": "manual_wheelchair"}
+    assert by_id[11]["relations"] == {"accompanies": "/World/Agents/P1", "accompanies_class": "person"}
+    assert by_id[5]["relations"] == {}
+    assert relation_entries((("uses", "/Nowhere"),), {}) == {"uses": "/Nowhere"}
     assert by_id[7]["occlusion"] == pytest.approx(18 / 144)  # two pole columns over nine car rows
     assert by_id[9]["occlusion"] == 0.0
     assert by_id[1]["isthing"] is False

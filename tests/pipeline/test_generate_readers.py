@@ -203,13 +203,17 @@ def test_coco_amodal_masks_contain_the_visible_ones_and_occlusion_is_their_ratio
             occluded += a["amodal_area"] > a["area"]
             ys, xs = np.nonzero(visible)
             assert a["bbox"] == [xs.min(), ys.min(), xs.max() - xs.min() + 1, ys.max() - ys.min() + 1], (split, a["id"])
-            if a["relations"].get("uses_annotation_id") is not None:
-                used = by_id[a["relations"]["uses_annotation_id"]]
-                assert used["image_id"] == a["image_id"] and used["prim_path"] == a["relations"]["uses"]
-                relations += 1
-            elif a["relations"]:  # the device it uses is not in the picture (hidden, out of frame)
-                assert not any(b["image_id"] == a["image_id"] and b.get("prim_path") == a["relations"]["uses"]
-                               for b in doc["annotations"]), (split, a["id"])
+            for name in ("uses", "pushes", "accompanies"):  # what a person uses, a companion pushes or accompanies
+                if name not in a["relations"]:
+                    continue
+                target = a["relations"][name]
+                if a["relations"].get(f"{name}_annotation_id") is not None:
+                    other = by_id[a["relations"][f"{name}_annotation_id"]]
+                    assert other["image_id"] == a["image_id"] and other["prim_path"] == target
+                    relations += 1
+                else:  # the target is not in the picture (hidden, out of frame)
+                    assert not any(b["image_id"] == a["image_id"] and b.get("prim_path") == target
+                                   for b in doc["annotations"]), (split, a["id"], name)
     assert occluded >= 1, "no annotation is occluded: the amodal checks above would be vacuous"
     assert relations >= 1, "the demo street has mobility-aid users: some annotation should carry a 'uses' relation"
 

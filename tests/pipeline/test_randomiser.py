@@ -208,3 +208,49 @@ def _without_sublayers(layer):
     copy.TransferContent(layer)
     copy.subLayerPaths.clear()
     return copy.ExportToString()
+
+
+def test_companions_are_linked_to_their_aid_user_and_hold_the_chair(class_map):
+    """A pusher's person prim names the chair it pushes (synthua:pushes), an accompanying companion's the aid user
+    it walks beside (synthua:accompanies); a record's relations give their classes; and in the composed scene
+    the pusher's wrists (its COCO keypoints) are at the chair's push handles (postures.push_handles, placed by the
+    chair's own world transform), within the hand's length."""
+    from pxr import UsdGeom
+
+    from synthua_usd.assets.postures import push_handles
+    from synthua_usd.dataset.annotations import relation_entries
+    from synthua_usd.model.keypoint_classes import PERSON_KEYPOINTS
+    from synthua_usd.randomisation.config import CrowdRandomisation
+
+    crowd = CrowdRandomisation(density_per_m2=(0.1, 0.1), aid_share=(0.6, 0.6), pushed_share=(1.0, 1.0),
+                               accompanied_share=(1.0, 1.0), aids=("manual_wheelchair", "walker"))
+    stage = open_stage(SCENARIO)
+    reader = StageReader(stage, class_map)
+    randomiser = Randomiser(stage, dataclasses.replace(CONFIG, crowd=crowd), class_map, (W, H))
+    pushers = companions = 0
+    for seed in range(3):
+        drawn = randomiser.apply(seed, CCTV, 24.0, None)
+        snapshot = reader.snapshot(24.0)
+        by_path = {i.prim_path: i for i in snapshot.instances}
+        class_of = {p: i.class_name for p, i in by_path.items()}
+        wrists = [PERSON_KEYPOINTS.index(n) for n in ("left_wrist", "right_wrist")]
+        for k, member in enumerate(drawn.scene.cast):
+            person = by_path[f"{CROWD_ROOT}/Agent_{k:04d}/Person"]
+            relations = relation_entries(person.relations, class_of)
+            if member.pushes is not None:
+                pushers += 1
+                chair = f"{CROWD_ROOT}/Agent_{member.pushes:04d}/ManualWheelchair"
+                assert relations["pushes"] == chair and relations["pushes_class"] == "manual_wheelchair"
+                user = dict(by_path[f"{CROWD_ROOT}/Agent_{member.pushes:04d}/Person"].relations)
+                assert user["uses"] == chair
+                m = np.array(UsdGeom.Xformable(stage.GetPrimAtPath(chair)).ComputeLocalToWorldTransform(24.0))
+                handles = push_handles(member.pushing) @ m[:3, :3] + m[3, :3]
+                hands = snapshot.keypoints[person.id].points[wrists]
+                assert np.linalg.norm(hands - handles, axis=1).max() < 0.15, (hands, handles)
+            elif member.accompanies is not None:
+                companions += 1
+                assert relations["accompanies"] == f"{CROWD_ROOT}/Agent_{member.accompanies:04d}/Person"
+                assert relations["accompanies_class"] == "person"
+            else:
+                assert not {"pushes", "accompanies"} & set(relations)
+    assert pushers >= 2 and companions >= 2, (pushers, companions)

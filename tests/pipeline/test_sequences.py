@@ -178,13 +178,10 @@ def test_a_shard_of_frames_renders_from_one_scene_load(tmp_path):
             assert (scratch / entry["path"]).read_bytes() == (out / entry["path"]).read_bytes(), entry["path"]
 
 
-def test_resume_after_kill_mid_sequence_gives_the_same_bytes(sequences, tmp_path, monkeypatch):
-    import test_generate
-
+def test_resume_after_kill_mid_sequence_gives_the_same_bytes(sequences, tmp_path):
     out = tmp_path / "killed"
-    monkeypatch.setattr(test_generate, "TINY_CONFIG", SEQUENCE_CONFIG)
     frames = lambda o: len(list(o.glob("sequences/*/records/*.json")))  # noqa: E731
-    killed = kill_when(out, lambda o: frames(o) >= 3)
+    killed = kill_when(out, lambda o: frames(o) >= 3, config=SEQUENCE_CONFIG)
     assert killed or (out / "manifest.json").exists()
     generate_dataset(out, config=SEQUENCE_CONFIG)
     ours, theirs = tree_bytes(out), tree_bytes(sequences)

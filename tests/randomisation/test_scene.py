@@ -60,3 +60,36 @@ def test_the_hair_draw_shifts_no_other_draw():
     assert [dataclasses.replace(m, hair=None) for m in on] == list(off)
     bald = dataclasses.replace(CONFIG, hair=HairRandomisation(styles=("none",)))
     assert [dataclasses.replace(m, hair=None) for m in draw_cast(np.random.default_rng(3), bald, 4000.0, [])[2]] == list(off)
+
+
+def test_companions_push_chairs_and_walk_beside_aid_users():
+    """Shares of 1: every manual wheelchair user with room left in the cast is pushed by an adult pedestrian (at
+    least 1.5 m tall, holding that user's chair fit), every other aid user walks with 1-2 pedestrians; shares of
+    0: nobody does. Companions count among the Poisson number of people and share their aid user's group."""
+    from synthua_usd.assets.bodies import load_bank
+    from synthua_usd.assets.postures import fit_device
+    from synthua_usd.randomisation.scene import PUSHER_MIN_HEIGHT_M
+
+    bank = load_bank()
+    every = dataclasses.replace(CONFIG, crowd=dataclasses.replace(CONFIG.crowd, pushed_share=(1.0, 1.0),
+                                                                  accompanied_share=(1.0, 1.0)))
+    cast = draw_cast(np.random.default_rng(5), every, 4000.0, [])[2]
+    pushed = [k for k, m in enumerate(cast) if m.pushed_by is not None]
+    assert len(pushed) >= 3
+    for k, m in enumerate(cast):
+        if m.aid is not None and k < len(cast) - 1:  # the last one may have had no room left
+            if m.aid == "manual_wheelchair":
+                pusher = cast[m.pushed_by]
+                assert m.pushed_by == k + 1 and pusher.pushes == k and pusher.profile == "pedestrian"
+                assert bank.height_m[pusher.body] >= PUSHER_MIN_HEIGHT_M
+                assert pusher.pushing == fit_device(bank, m.body, "manual_wheelchair")
+                assert pusher.group == m.group is not None
+            else:
+                companions = [c for c in cast if c.accompanies == k]
+                assert 1 <= len(companions) <= 2
+                assert all(c.profile == "pedestrian" and c.group == m.group for c in companions)
+    none = dataclasses.replace(CONFIG, crowd=dataclasses.replace(CONFIG.crowd, pushed_share=(0.0, 0.0),
+                                                                 accompanied_share=(0.0, 0.0)))
+    alone = draw_cast(np.random.default_rng(5), none, 4000.0, [])[2]
+    assert not any(m.pushes is not None or m.accompanies is not None or m.pushed_by is not None for m in alone)
+    assert abs(len(alone) - len(cast)) < 0.1 * len(cast)  # the same Poisson draw of people, companions among them

@@ -68,6 +68,9 @@ def test_people_stand_apart_on_walkable_cells(street):
         radii = np.array([PROFILES[m.profile].radius_m for m in cast])
         gap = np.linalg.norm(xy[:, None] - xy[None], axis=-1) - radii[:, None] - radii[None]
         np.fill_diagonal(gap, np.inf)
+        for k, m in enumerate(cast):  # a pusher holds its chair's handles: their bodies, not discs, are kept apart
+            if m.pushes is not None:  # (tests/assets/test_bodies.py)
+                gap[k, m.pushes] = gap[m.pushes, k] = np.inf
         assert gap.min() >= MARGIN_M - 1e-9
         for p, m in zip(placements, cast):
             if m.seat is not None:
@@ -147,3 +150,42 @@ def test_camera_moves_within_its_envelope(street, path):
         assert np.allclose(np.linalg.det(moved.camera_to_world[:3, :3]), np.linalg.det(camera.camera_to_world[:3, :3]))
         assert config.focal_length_factor[0] * camera.focal_length_mm - 1e-9 <= moved.focal_length_mm
         assert moved.focal_length_mm <= config.focal_length_factor[1] * camera.focal_length_mm + 1e-9
+
+
+def test_companions_walk_behind_or_beside_their_aid_user(street):
+    """A pusher stands PUSH_DISTANCE_M behind its chair's origin along the chair's heading; an accompanying
+    companion beside its aid user (left or right, or in line behind where the side is not walkable), its disc
+    clear of the user's; both at the user's heading, pace and stride (moving or standing with it)."""
+    from synthua_usd.assets.postures import PUSH_DISTANCE_M
+    from synthua_usd.randomisation.config import CrowdRandomisation
+
+    stage, area = street
+    config = RandomisationConfig(crowd=CrowdRandomisation(
+        density_per_m2=(0.1, 0.1), aid_share=(0.6, 0.6), pushed_share=(0.8, 0.8), accompanied_share=(0.8, 0.8),
+        aids=("manual_wheelchair", "walker", "crutch")))
+    camera = read_camera(stage, "/World/Cameras/CCTV", 24.0)
+    pushed = accompanied = 0
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        _, _, cast = draw_cast(rng, config, area.area_m2(), list(area.seats))
+        placements = place_cast(rng, cast, area, camera, (320, 240), config.crowd)
+        for k, (m, p) in enumerate(zip(cast, placements)):
+            user = m.pushes if m.pushes is not None else m.accompanies
+            if user is None:
+                continue
+            lead = placements[user]
+            assert cast[user].aid is not None and cast[user].group == m.group is not None
+            assert (p.heading_deg, p.speed_mps, p.amplitude) == (lead.heading_deg, lead.speed_mps, lead.amplitude)
+            h = math.radians(lead.heading_deg)
+            ahead, left = np.array([math.cos(h), math.sin(h)]), np.array([-math.sin(h), math.cos(h)])
+            d = np.array(p.position[:2]) - np.array(lead.position[:2])
+            if m.pushes is not None:
+                pushed += 1
+                assert cast[user].aid == "manual_wheelchair" and cast[user].pushed_by == k
+                assert np.allclose([d @ ahead, d @ left], [-PUSH_DISTANCE_M, 0.0], atol=1e-9)
+            else:
+                accompanied += 1
+                clear = PROFILES[m.profile].radius_m + PROFILES[cast[user].profile].radius_m + MARGIN_M
+                assert abs(d @ ahead) < 1e-9 or abs(d @ left) < 1e-9  # beside, or in line behind
+                assert np.linalg.norm(d) >= clear - 1e-9
+    assert pushed >= 3 and accompanied >= 3

@@ -6,8 +6,10 @@ pixels, ``iscrowd`` 0, or 1 for an instance too small to learn from (fewer visib
 MMDetection leave it out of training. Only thing classes are annotated (COCO's instances task has no stuff); stuff is in
 the panoptic and Cityscapes formats. Extra fields per annotation, which COCO readers ignore:
 ``amodal_segmentation``, ``amodal_bbox``, ``amodal_area``, ``occlusion``, ``truncation``, ``prim_path``,
-``instance_id`` (the pixel value in the image's instance map) and ``relations`` (``{"uses": prim path,
-"uses_annotation_id": id}``; the id only when the used device or person is annotated in the same image).
+``instance_id`` (the pixel value in the image's instance map) and ``relations``: each ``synthua:*`` relation of
+the instance's prim (``uses``: the device a person uses; ``pushes``: the wheelchair a companion pushes;
+``accompanies``: the aid user a companion walks beside) as its target's prim path, ``<relation>_class`` its
+class, and ``<relation>_annotation_id`` the target's annotation id when it is annotated in the same image.
 
 Keypoints (COCO's person-keypoints fields): a category with keypoints (:mod:`synthua_usd.model.keypoint_classes`:
 the person's 17 COCO body keypoints, a mobility aid's contact points) lists their ``keypoints`` names and
@@ -106,9 +108,10 @@ def coco_instances(records: Iterable[ImageRecord], class_map: ClassMap, split: s
                 continue
             name = class_map.by_id(int(inst["category_id"])).name
             relations = dict(inst.get("relations") or {})
-            used = by_path.get(relations.get("uses"))
-            if used is not None:
-                relations["uses_annotation_id"] = used
+            for relation, target in sorted(relations.items()):  # uses, pushes, accompanies -> annotated target
+                annotated = None if relation.endswith("_class") else by_path.get(target)
+                if annotated is not None:
+                    relations[f"{relation}_annotation_id"] = annotated
             annotations.append({
                 "id": ann_id, "image_id": int(record["id"]), "category_id": int(inst["category_id"]),
                 "segmentation": inst["segmentation"], "area": int(inst["area"]),

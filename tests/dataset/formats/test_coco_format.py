@@ -62,11 +62,16 @@ def test_annotation_ids_are_unique_across_splits_and_relations_point_to_annotati
     assert coco_instances(list(reversed(records)), class_map, "train") == docs["train"]  # order-free
     for doc in (docs["train"], docs["val"]):
         by_id = {a["id"]: a for a in doc["annotations"]}
-        users = [a for a in doc["annotations"] if a["relations"]]
-        assert users
-        for a in users:
-            used = by_id[a["relations"]["uses_annotation_id"]]
-            assert used["prim_path"] == a["relations"]["uses"] and used["image_id"] == a["image_id"]
+        related = [a for a in doc["annotations"] if a["relations"]]
+        assert {"uses", "pushes", "accompanies"} <= {name for a in related for name in a["relations"]}
+        for a in related:
+            for name in ("uses", "pushes", "accompanies"):
+                if name not in a["relations"]:
+                    continue
+                target = by_id[a["relations"][f"{name}_annotation_id"]]  # every target here is in view
+                assert target["prim_path"] == a["relations"][name] and target["image_id"] == a["image_id"]
+                assert a["relations"][f"{name}_class"] == {"uses": "manual_wheelchair", "pushes": "manual_wheelchair",
+                                                           "accompanies": "person"}[name]
         occluded = [a for a in doc["annotations"] if a["prim_path"] == "/World/Car"][0]
         assert 0 < occluded["occlusion"] < 1
         assert mask_utils.area(occluded["amodal_segmentation"]) == occluded["amodal_area"] > occluded["area"]
