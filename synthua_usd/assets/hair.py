@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from synthua_usd.assets.bodies import BONES, Bank
+from synthua_usd.model import meshes as geo
 
 #: Hair styles: none (bald), short, medium, long.
 HAIR_STYLES = ("none", "short", "medium", "long")
@@ -27,16 +28,6 @@ TAPER_M = 0.03
 
 # COCO keypoints (bank.keypoints' order): eyes and ears
 _EYES, _EARS = (1, 2), (3, 4)
-
-
-def _vertex_normals(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """(V, 3) area-weighted unit vertex normals of the (outward-wound) mesh."""
-    tri = points[triangles]
-    face = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    out = np.zeros_like(points)
-    for k in range(3):
-        np.add.at(out, triangles[:, k], face)
-    return out / np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-12)
 
 
 def _hairline_drop(bank: Bank, body: int, style: str) -> tuple[np.ndarray, np.ndarray]:
@@ -72,7 +63,7 @@ def hair_mesh(bank: Bank, body: int, posed: np.ndarray, style: str) -> tuple[np.
     scalp = _largest_component(scalp)
     used, local = np.unique(scalp, return_inverse=True)
     local = local.reshape(-1, 3)
-    normals = _vertex_normals(posed, bank.triangles)[used]
+    normals = geo.vertex_normals(posed, bank.triangles)[used]
     thickness, _ = STYLE_SHAPES[style]
     share = HAIRLINE_SHARE + (1 - HAIRLINE_SHARE) * np.clip(above[used] / TAPER_M, 0.0, 1.0)
     if style == "long":  # fuller at the back

@@ -21,7 +21,9 @@ import numpy as np
 
 from synthua_usd.assets.bodies import (BONES, REGIONS, SEGMENTS, Bank, Pose, forward_kinematics, load_bank, rot_y,
                                        rotation_between, skin, two_bone_aims)
+from synthua_usd.assets.garments import corner_uvs
 from synthua_usd.assets.hair import hair_mesh
+from synthua_usd.model import meshes as geo
 
 #: Walk ratio (step length / cadence) of adults, m per (steps/min), for a 1.7 m person (Sekiya & Nagasaki 1998).
 WALK_RATIO = 0.0064
@@ -340,6 +342,7 @@ class BodyParts:
         self._cache: dict[tuple, tuple] = {}
         self._posed: dict[tuple, np.ndarray] = {}
         self._hair: dict[tuple, tuple | None] = {}
+        self._surfaces: dict[tuple, dict] = {}
 
     def get(self, body: int, posture: str | None, fit: DeviceFit | None = None):
         """``posture`` a device class, :data:`BENCH` or None (walking); ``fit`` None: the device fitted to the body."""
@@ -360,6 +363,32 @@ class BodyParts:
             self._cache[key] = (fit, base, parts)
             self._posed[key] = pts
         return self._cache[key]
+
+    def surfaces(self, body: int, posture: str | None, fit: DeviceFit | None = None) -> dict:
+        """Per (segment, region) of :meth:`get`'s parts, the part as a smooth textured mesh: ``(points (k, 3),
+        triangles (m, 3), uvs (k, 2) float32, normals (k, 3) float32)``, points split where the texture
+        coordinates of its corners disagree (:func:`synthua_usd.assets.garments.corner_uvs`; at bone boundaries
+        and the fabric's back seam), normals the whole posed body's (:func:`synthua_usd.model.meshes.vertex_normals`:
+        smooth across the parts' edges too)."""
+        key = (body, posture, fit)
+        if key not in self._surfaces:
+            self.get(body, posture, fit)
+            pts = self._posed[key]
+            normals = geo.vertex_normals(pts, self.bank.triangles).astype(np.float32)
+            uvs = corner_uvs(self.bank, body)
+            region = self.bank.face_region(body)
+            segment_faces = self.bank.segment_faces(body)
+            out = {}
+            for k, name in enumerate(SEGMENTS):
+                for r, region_name in enumerate(REGIONS):
+                    faces = np.flatnonzero(segment_faces[k] & (region == r))
+                    if len(faces):
+                        tris = self.bank.triangles[faces]
+                        data = np.concatenate([uvs[faces], normals[tris]], axis=2)  # (m, 3, 5) per corner
+                        points, local, per_point = geo.split_corners(pts, tris, data)
+                        out[(name, region_name)] = (points, local, per_point[:, :2].copy(), per_point[:, 2:].copy())
+            self._surfaces[key] = out
+        return self._surfaces[key]
 
     def hair(self, body: int, posture: str | None, fit: DeviceFit | None, style: str):
         """The hair mesh ``(points, triangles)`` of ``body`` in ``style`` (:func:`synthua_usd.assets.hair.hair_mesh`)

@@ -44,7 +44,8 @@ def randomise(scenario: Path, config_path: Path | None, record_path: Path | None
     Three files, each sublayering the next: OUT (this view: where every person stands and how, the camera's
     pose, focal length and exposure, the condition's sun and sky), OUT's stem + .scene.usda (this seed's
     scene: the new crowd with its clothes and devices, the twin's objects rebound to material variants, the
-    scenario's own crowd deactivated) and + .prototypes.usdc (the crowd's meshes). Open OUT over the scenario
+    scenario's own crowd deactivated) and + .prototypes.usdc (the crowd's meshes); with looks on, the images the
+    people wear (fabrics, shoes, faces) copied into OUT's stem + .looks/ beside them. Open OUT over the scenario
     in any USD tool (synthua compose view.usda OUT SCENARIO), or render it with synthua render --layer OUT;
     with the printed settings the render reproduces the dataset's image.
     """

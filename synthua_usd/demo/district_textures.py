@@ -22,7 +22,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from synthua_usd.core.texture_images import texture_path
-from synthua_usd.demo.textures import SIZE, decode_srgb8, district_images, encode_normals8, encode_srgb8, paving
+from synthua_usd.demo.textures import SIZE, district_images, paving
+from synthua_usd.model.normal_maps import NORMAL_BIAS, NORMAL_SCALE, encode_normals8
+from synthua_usd.model.srgb import decode_srgb8, encode_srgb8
 from synthua_usd.geometry.uv import box_uvs, planar_uvs
 from synthua_usd.model.materials import PALETTE
 from synthua_usd.model.scene import Texture
@@ -97,8 +99,7 @@ def add_textures(model: TwinModel, seed: int) -> TwinModel:
         used.add(name)
         if name in PAVED:
             materials[key] = replace(materials[key], normal_texture=Texture(
-                texture_path(f"{name}_normal.png"), color_space="raw", scale=(2.0, 2.0, 2.0, 1.0),
-                bias=(-1.0, -1.0, -1.0, 0.0)))
+                texture_path(f"{name}_normal.png"), color_space="raw", scale=NORMAL_SCALE, bias=NORMAL_BIAS))
             used.add(f"{name}_normal")
     objects = tuple(TwinObject(o.path, o.label, tuple(_mapped(p) for p in o.parts), o.attributes)
                     for o in model.objects)

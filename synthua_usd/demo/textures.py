@@ -22,7 +22,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from synthua_usd.model import srgb
+from synthua_usd.model.normal_maps import height_normals
+from synthua_usd.model.srgb import encode_srgb8
 
 SIZE = 512
 #: Image name → function of (rng, size) → (size, size, 3) linear values around 1.
@@ -128,33 +129,12 @@ def paving(rng: np.random.Generator, size: int, tile_m: float, stones: int, rows
     inside = np.minimum(np.minimum(fs, 1 - fs) * tile_m / stones, np.minimum(ft, 1 - ft) * tile_m / rows)
     inside = inside - joint_m / 2
     height = np.where(inside <= 0, -depth_m, -depth_m * np.clip(1 - inside / bevel_m, 0, 1) ** 2)
-    dh_ds = (np.roll(height, -1, axis=1) - np.roll(height, 1, axis=1)) / (2 * texel)
-    dh_dt = (np.roll(height, 1, axis=0) - np.roll(height, -1, axis=0)) / (2 * texel)  # row - 1 is higher t
-    normals = np.stack([-dh_ds, -dh_dt, np.ones_like(height)], axis=2)
-    normals /= np.linalg.norm(normals, axis=2, keepdims=True)
+    normals = height_normals(height, texel)
     shade = np.asarray(shades, np.float64)[rng.integers(len(shades), size=rows * stones)[row * stones + col]]
     grain = stone(rng, size)
     sand = np.clip(1.0 + 0.15 * rng.standard_normal((size, size)), 0.6, 1.4)[:, :, None]
     colour = np.where((inside <= 0)[:, :, None], np.asarray(joint_tone, np.float64) * sand, shade * grain)
     return colour, normals
-
-
-def encode_normals8(normals: np.ndarray) -> np.ndarray:
-    """(H, W, 3) unit normals in [-1, 1] → 8-bit ``n * 0.5 + 0.5`` (read back with scale 2 and bias -1, as
-    UsdPreviewSurface's normal input expects)."""
-    return np.round((np.clip(normals, -1.0, 1.0) * 0.5 + 0.5) * 255.0).astype(np.uint8)
-
-
-def encode_srgb8(linear: np.ndarray) -> np.ndarray:
-    """(H, W, 3) linear values in [0, 1] → 8-bit sRGB."""
-    c = np.clip(linear, 0.0, 1.0)
-    return np.round(srgb.from_linear(c) * 255.0).astype(np.uint8)
-
-
-def decode_srgb8(pixels: np.ndarray) -> np.ndarray:
-    """8-bit sRGB → linear float64 (what a renderer decodes)."""
-    c = pixels / 255.0
-    return srgb.to_linear(c)
 
 
 def district_images(seed: int, size: int = SIZE) -> dict[str, np.ndarray]:

@@ -1,5 +1,5 @@
-"""Texture coordinates of triangle meshes, as plain arrays: projections for procedural geometry, and splitting
-points where per-corner coordinates disagree (texture seams).
+"""Texture coordinates of triangle meshes, as plain arrays: projections for procedural geometry (points split where
+per-corner coordinates disagree, :func:`synthua_usd.model.meshes.split_corners`).
 
 Coordinates follow USD's ``st``: (0, 0) at an image's bottom-left corner, t up the image. Projections scale
 metres to texture repeats by ``tile_m`` (the size of one repeat of the image on the surface).
@@ -8,6 +8,8 @@ metres to texture repeats by ``tile_m`` (the size of one repeat of the image on 
 from __future__ import annotations
 
 import numpy as np
+
+from synthua_usd.model.meshes import split_corners
 
 #: Faces whose normal is within about 45° of up take the ground projection (x, y) in :func:`box_uvs`.
 _FLAT = np.cos(np.radians(45.0))
@@ -39,21 +41,3 @@ def box_uvs(points: np.ndarray, triangles: np.ndarray, tile_m: float) -> tuple[n
     t = np.where(flat[:, None], corners[:, :, 1], corners[:, :, 2])
     corner_uvs = (np.stack([s, t], axis=2) / tile_m).astype(np.float32)
     return split_corners(p, tris, corner_uvs)
-
-
-def split_corners(points: np.ndarray, triangles: np.ndarray, corner_uvs: np.ndarray
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per-corner coordinates ``corner_uvs`` (m, 3, 2) float32 of ``triangles`` (m, 3) → (points, triangles,
-    uvs) with one point per distinct (point, uv) pair, in first-use order: points split only at seams, every
-    triangle keeps its three positions."""
-    flat_uv = np.ascontiguousarray(np.asarray(corner_uvs, np.float32).reshape(-1, 2))
-    keys = np.concatenate([triangles.reshape(-1, 1).astype(np.int64),
-                           flat_uv.view(np.uint32).astype(np.int64)], axis=1)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    # np.unique sorts; renumber in order of first use so that a mesh without seams keeps its point order.
-    order = np.argsort(first, kind="stable")
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    chosen = first[order]
-    new_triangles = rank[inverse.reshape(-1)].reshape(-1, 3).astype(np.int64)
-    return points[triangles.reshape(-1)[chosen]], new_triangles, flat_uv[chosen]

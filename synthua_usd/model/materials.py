@@ -147,3 +147,17 @@ HAIR_COLOURS = {
     "brown": ((0.09, 0.05, 0.025), 0.55), "light_brown": ((0.2, 0.12, 0.06), 0.55),
     "blonde": ((0.42, 0.3, 0.15), 0.6), "auburn": ((0.2, 0.06, 0.025), 0.55), "grey": ((0.32, 0.31, 0.3), 0.6),
 }
+#: Fabrics whose second colour is a lighter shade of the garment's (its colour times this, plus 0.01, clipped):
+#: a knit's heather, a melange's light fibres, a twill's and a corduroy's lighter crowns, denim's faded white weft.
+#: The others (stripes, checks) take a contrasting colour of :data:`CONTRAST_COLOURS`.
+FABRIC_SHADE = {"jersey": 1.2, "melange": 1.7, "twill": 1.35, "denim": 2.4, "corduroy": 1.6}
+CONTRAST_COLOURS = ((0.8, 0.8, 0.78), (0.02, 0.02, 0.02), (0.05, 0.15, 0.45), (0.5, 0.06, 0.05), (0.7, 0.6, 0.1),
+                    (0.12, 0.35, 0.15), (0.6, 0.6, 0.6), (0.45, 0.15, 0.4))
+#: Sole colours per kind of shoe: a sneaker's white, black, gum or grey rubber; a shoe's black or brown leather.
+SOLE_COLOURS = {"sneaker": ((0.78, 0.78, 0.76), (0.02, 0.02, 0.02), (0.32, 0.2, 0.1), (0.5, 0.5, 0.5)),
+                "shoe": ((0.02, 0.02, 0.02), (0.15, 0.08, 0.04))}
+#: The face image's dark colour (irises, lash lines, brows, nostrils; lips and blush part way towards it).
+FACE_FEATURES = (0.025, 0.015, 0.01)
+#: Skin's clear coat: (weight, roughness) of UsdPreviewSurface's clearcoat over the skin's base (an oily sheen).
+SKIN_CLEARCOAT = (0.3, 0.35)
+

@@ -110,6 +110,17 @@ def torus(center, major_radius: float, minor_radius: float, axis: str = "z", maj
     return points + np.asarray(center, float), tris
 
 
+def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(n, 3) float64 area-weighted unit vertex normals of the outward-wound mesh ``points`` (n, 3),
+    ``triangles`` (m, 3); a point no triangle uses gets (0, 0, 0)."""
+    tri = np.asarray(points, np.float64)[triangles]
+    face = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    out = np.zeros((len(points), 3))
+    for k in range(3):
+        np.add.at(out, triangles[:, k], face)
+    return out / np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-12)
+
+
 def merge(*parts: Mesh) -> Mesh:
     """Concatenate meshes into one (no welding)."""
     points, tris, offset = [], [], 0
@@ -161,3 +172,22 @@ def _along(mesh: trimesh.Trimesh, axis: str) -> Mesh:
     elif axis != "z":
         raise ValueError(f"axis should be 'X', 'Y' or 'Z', but was {axis!r}")
     return _arrays(mesh)
+
+
+def split_corners(points: np.ndarray, triangles: np.ndarray, corner_uvs: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per-corner data ``corner_uvs`` (m, 3, c) float32 of ``triangles`` (m, 3) (texture coordinates, c = 2, or
+    those and normals side by side) → (points, triangles, data (k, c)) with one point per distinct (point, data)
+    pair, in first-use order: points split only at seams, every triangle keeps its three positions."""
+    corner_uvs = np.asarray(corner_uvs, np.float32)
+    flat_uv = np.ascontiguousarray(corner_uvs.reshape(-1, corner_uvs.shape[-1]))
+    keys = np.concatenate([triangles.reshape(-1, 1).astype(np.int64),
+                           flat_uv.view(np.uint32).astype(np.int64)], axis=1)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    # np.unique sorts; renumber in order of first use so that a mesh without seams keeps its point order.
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    chosen = first[order]
+    new_triangles = rank[inverse.reshape(-1)].reshape(-1, 3).astype(np.int64)
+    return points[triangles.reshape(-1)[chosen]], new_triangles, flat_uv[chosen]

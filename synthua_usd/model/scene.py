@@ -59,7 +59,9 @@ class Material:
     fallback: meshes without them render with it). ``normal_texture`` is a tangent-space normal map whose
     values (after scale and bias) lie in [-1, 1]. ``opacity`` below ``opacity_threshold`` cuts the surface
     away when the threshold is above 0 (UsdPreviewSurface's cutout); otherwise it is partial coverage.
-    ``uv_primvar`` names the mesh primvar holding the texture coordinates.
+    ``uv_primvar`` names the mesh primvar holding the texture coordinates. ``clearcoat`` (0..1) weighs a second,
+    clear specular layer of ``clearcoat_roughness`` over the base (skin's oily sheen, lacquer), as
+    UsdPreviewSurface's inputs of those names.
     """
 
     key: str
@@ -75,6 +77,8 @@ class Material:
     normal_texture: Texture | None = None
     opacity_texture: Texture | None = None
     uv_primvar: str = "st"
+    clearcoat: float = 0.0
+    clearcoat_roughness: float = 0.01
 
     @property
     def textures(self) -> dict[str, Texture]:
@@ -128,6 +132,8 @@ class MeshItem:
     uvs : (n, 2) float32 texture coordinates per point in USD's ``st`` convention (origin at the image's
         bottom-left), or None when the mesh has none or its material has no textures. Face-varying
         coordinates arrive here already per point: the reader splits points where corners disagree.
+    normals : (n, 3) float32 unit shading normals per point, world space, from the mesh's authored normals
+        (smooth shading between them), or None: the mesh is shaded flat (its faces' own normals).
     """
 
     prim_path: str
@@ -140,6 +146,7 @@ class MeshItem:
     uvs: np.ndarray | None = field(default=None, repr=False)
     #: The gprim's ``doubleSided``: its back faces are shaded like its front faces.
     double_sided: bool = False
+    normals: np.ndarray | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)

@@ -18,3 +18,15 @@ def to_linear(values: np.ndarray) -> np.ndarray:
 def from_linear(values: np.ndarray) -> np.ndarray:
     """Linear values in [0, 1] → sRGB-encoded."""
     return np.where(values <= 0.0031308, 12.92 * values, 1.055 * values ** (1 / 2.4) - 0.055)
+
+
+def encode_srgb8(linear: np.ndarray) -> np.ndarray:
+    """(H, W, 3) linear values in [0, 1] → 8-bit sRGB."""
+    c = np.clip(linear, 0.0, 1.0)
+    return np.round(from_linear(c) * 255.0).astype(np.uint8)
+
+
+def decode_srgb8(pixels: np.ndarray) -> np.ndarray:
+    """8-bit sRGB → linear float64 (what a renderer decodes)."""
+    c = pixels / 255.0
+    return to_linear(c)

@@ -11,11 +11,12 @@ the schema's documentation to them.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.assets.hair import HAIR_STYLES
+from synthua_usd.assets.look_images import LOWER_FABRICS, SHOES, UPPER_FABRICS
 from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES
 
 #: The mobility-aid classes a randomised crowd can use (the device classes of the agent profiles).
@@ -126,6 +127,30 @@ class HairRandomisation:
 
 
 @dataclass(frozen=True)
+class LooksRandomisation:
+    """How each person of the crowd (with crowd on) looks beyond colours: smooth shading (normals authored on
+    the body's meshes), a fabric per garment among ``upper_fabrics`` and ``lower_fabrics`` (a pattern in a second
+    colour, the weave and folds in a normal map), shoes among ``shoes`` on soles of another colour, a face
+    (eyes, brows, nostrils, lips, cheeks as an image on the head) and skin with a clear coat; drawn from a stream
+    of its own (switching it off or narrowing it moves no other draw). Off: flat-coloured garments and shoes,
+    faceless matte skin, faceted bodies, as before."""
+
+    enabled: bool = True
+    upper_fabrics: tuple[str, ...] = UPPER_FABRICS
+    lower_fabrics: tuple[str, ...] = LOWER_FABRICS
+    shoes: tuple[str, ...] = SHOES
+
+    def __post_init__(self) -> None:
+        for name, known in (("upper_fabrics", UPPER_FABRICS), ("lower_fabrics", LOWER_FABRICS), ("shoes", SHOES)):
+            values = tuple(getattr(self, name))
+            unknown = [v for v in values if v not in known]
+            if unknown or not values:
+                raise InputError(f"looks.{name}: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
+                                 f"{', '.join(known)}")
+            object.__setattr__(self, name, values)
+
+
+@dataclass(frozen=True)
 class MaterialRandomisation:
     """Each twin object of ``classes`` gets its own variant of its main material: a colour from its class's
     palette (façades, car paints, canvas, ...) or, for a textured material, its texture tinted; ``value_jitter``
@@ -207,7 +232,7 @@ class DistrictRandomisation:
 
 
 _PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "hair": HairRandomisation,
-          "materials": MaterialRandomisation,
+          "looks": LooksRandomisation, "materials": MaterialRandomisation,
           "light": LightRandomisation, "camera": CameraRandomisation, "district": DistrictRandomisation}
 
 
@@ -220,6 +245,7 @@ class RandomisationConfig:
     crowd: CrowdRandomisation = field(default_factory=CrowdRandomisation)
     devices: DeviceRandomisation = field(default_factory=DeviceRandomisation)
     hair: HairRandomisation = field(default_factory=HairRandomisation)
+    looks: LooksRandomisation = field(default_factory=LooksRandomisation)
     materials: MaterialRandomisation = field(default_factory=MaterialRandomisation)
     light: LightRandomisation = field(default_factory=LightRandomisation)
     camera: CameraRandomisation = field(default_factory=CameraRandomisation)
@@ -231,6 +257,8 @@ class RandomisationConfig:
             object.__setattr__(self, "devices", DeviceRandomisation(enabled=False, finishes=self.devices.finishes))
         if self.hair.enabled and not self.crowd.enabled:  # hair belongs to the randomised crowd's people
             object.__setattr__(self, "hair", HairRandomisation(False, self.hair.styles, self.hair.colours))
+        if self.looks.enabled and not self.crowd.enabled:  # so do looks
+            object.__setattr__(self, "looks", replace(self.looks, enabled=False))
         if self.district.enabled and not self.crowd.enabled:
             raise InputError("randomise.district: enabled while randomise.crowd is not; expected the crowd randomised "
                              "too (the scenario's own crowd walks the routes of its own district)")

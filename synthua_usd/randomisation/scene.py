@@ -23,6 +23,7 @@ from synthua_usd.assets.postures import DeviceFit, fit_device
 from synthua_usd.model.materials import (DEVICE_FINISHES, HAIR_COLOURS, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
                                    WOOD_COLOURS)
 from synthua_usd.randomisation.config import RandomisationConfig
+from synthua_usd.randomisation.wear import Wear, draw_wear
 
 RGB = tuple[float, float, float]
 #: Most people one randomised scene holds (a bound on the layers and the render, whatever the walkable area).
@@ -91,7 +92,8 @@ class CastMember:
     """One person of the scene: profile (a key of :data:`synthua_usd.agents.profiles.PROFILES`), body index into
     the body bank, skin tone (a Monk swatch's palette key), garment colours, sleeve and leg length, the device
     of an aid user, the bench place of a sitter (kept for the whole scene), the group of people walking
-    together, and the hair (None: not randomised, bald). A companion of an aid user has the aid user's index in
+    together, the hair (None: not randomised, bald) and the wear (fabrics, shoes; None: the looks are not
+    randomised, flat colours). A companion of an aid user has the aid user's index in
     the cast in ``pushes`` (it walks behind a manual wheelchair, hands on its push handles, ``pushing`` that
     chair's fit) or in ``accompanies`` (it walks beside); the pushed user has its pusher's in ``pushed_by``."""
 
@@ -111,6 +113,7 @@ class CastMember:
     pushing: DeviceFit | None = None
     pushed_by: int | None = None
     accompanies: int | None = None
+    wear: Wear | None = None
 
     @property
     def aid(self) -> str | None:
@@ -253,7 +256,8 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
     aids; then maybe pushed or accompanied by companions among the N, :func:`_companions`, drawn from a child
     stream of ``rng``), else a pedestrian who sits on a free bench place of ``seats`` with probability
     ``seated_share`` or walks in a group of 2-3 with probability ``group_share``; then, with hair on, each
-    member's hair (:func:`draw_hair`) from a child stream of ``rng``."""
+    member's hair (:func:`draw_hair`), and with looks on their wear (:func:`synthua_usd.randomisation.wear.draw_wear`),
+    each from a child stream of ``rng``."""
     crowd = config.crowd
     density = float(rng.uniform(*crowd.density_per_m2))
     aid_share = float(rng.uniform(*crowd.aid_share))
@@ -281,11 +285,13 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
             groups += 1
         else:
             members.append(_member(rng, "pedestrian", config))
+    # one child stream for everyone's hair and one for their wear, spawned after the devices' (theirs stay as they
+    # were) whether or not they are used: no other draw of the scene moves
+    hair_rng, wear_rng = rng.spawn(2)
     if config.hair.enabled:
-        # one child stream for everyone's hair, spawned after the devices' (theirs stay as they were): no other
-        # draw of the scene moves
-        hair_rng = rng.spawn(1)[0]
         members = [replace(m, hair=draw_hair(hair_rng, m.body, config)) for m in members]
+    if config.looks.enabled:
+        members = [replace(m, wear=draw_wear(wear_rng, m.upper, m.lower, config.looks)) for m in members]
     return density, aid_share, tuple(members)
 
 

@@ -83,17 +83,20 @@ class PrototypeLibrary:
         self._paths: dict[tuple, Sdf.Path] = {}
         self._counts: Counter[str] = Counter()
 
-    def part(self, shape: str, mesh: geo.Mesh) -> Sdf.Path:
+    def part(self, shape: str, mesh: geo.Mesh, uvs: np.ndarray | None = None,
+             normals: np.ndarray | None = None) -> Sdf.Path:
         """The prototype of a part mesh ``(points (n, 3), triangles (m, 3))``, metres, in the frame of the
-        prim that will reference it."""
+        prim that will reference it, with its texture coordinates ``uvs`` (n, 2) and shading ``normals`` (n, 3)
+        when given."""
         points = np.ascontiguousarray(mesh[0], np.float32)  # what define_mesh stores: equal here means equal there
         tris = np.ascontiguousarray(mesh[1], np.int32)
-        key = ("part", shape, points.tobytes(), tris.tobytes())
+        extra = tuple(np.ascontiguousarray(a, np.float32).tobytes() if a is not None else b"" for a in (uvs, normals))
+        key = ("part", shape, points.tobytes(), tris.tobytes(), *extra)
         if key not in self._paths:
             path = Sdf.Path(f"{self.root}/{shape}_{self._counts[shape]}")
             self._counts[shape] += 1
             define_xform(self.stage, str(path))
-            define_mesh(self.stage, f"{path}/Mesh", points, tris)
+            define_mesh(self.stage, f"{path}/Mesh", points, tris, uvs=uvs, normals=normals)
             self._paths[key] = path
         return self._paths[key]
 

@@ -90,9 +90,10 @@ def define_xform(stage: Usd.Stage, path: str, kind: str | None = None,
 
 def define_mesh(stage: Usd.Stage, path: str, points: np.ndarray, triangles: np.ndarray,
                 material: UsdShade.Material | None = None, uvs: np.ndarray | None = None,
-                uv_primvar: str = "st") -> UsdGeom.Mesh:
+                uv_primvar: str = "st", normals: np.ndarray | None = None) -> UsdGeom.Mesh:
     """A triangle mesh. ``points`` (n, 3) float, local metres; ``triangles`` (m, 3) int, CCW front faces;
-    ``uvs`` (n, 2) texture coordinates per point, authored as ``primvars:<uv_primvar>`` (texCoord2f, vertex)."""
+    ``uvs`` (n, 2) texture coordinates per point, authored as ``primvars:<uv_primvar>`` (texCoord2f, vertex);
+    ``normals`` (n, 3) unit shading normals per point (``normals``, vertex interpolation: smooth shading)."""
     mesh = UsdGeom.Mesh.Define(stage, path)
     pts = np.asarray(points, np.float32)
     tris = np.asarray(triangles, np.int32)
@@ -105,6 +106,9 @@ def define_mesh(stage: Usd.Stage, path: str, points: np.ndarray, triangles: np.n
         UsdGeom.PrimvarsAPI(mesh).CreatePrimvar(uv_primvar, Sdf.ValueTypeNames.TexCoord2fArray,
                                                 UsdGeom.Tokens.vertex).Set(
             Vt.Vec2fArray.FromNumpy(np.ascontiguousarray(uvs, np.float32)))
+    if normals is not None:
+        mesh.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(normals, np.float32)))
+        mesh.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
     if material is not None:
         bind_material(mesh.GetPrim(), material)
     return mesh
@@ -137,6 +141,9 @@ def define_preview_material(stage: Usd.Stage, path: str, spec: Material) -> UsdS
         shader.CreateInput("opacity", Sdf.ValueTypeNames.Float).Set(float(spec.opacity))
     if spec.opacity_threshold != 0.0:
         shader.CreateInput("opacityThreshold", Sdf.ValueTypeNames.Float).Set(float(spec.opacity_threshold))
+    if spec.clearcoat != 0.0:
+        shader.CreateInput("clearcoat", Sdf.ValueTypeNames.Float).Set(float(spec.clearcoat))
+        shader.CreateInput("clearcoatRoughness", Sdf.ValueTypeNames.Float).Set(float(spec.clearcoat_roughness))
     if spec.textures:
         _define_textures(stage, material, shader, spec)
     material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")

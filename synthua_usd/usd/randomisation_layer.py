@@ -25,18 +25,19 @@ differs, so the same structure with new values re-places the crowd without recom
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdShade, Vt
+from pxr import Gf, Kind, Sdf, Usd, UsdGeom, Vt
 
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS
 from synthua_usd.assets.devices import DEVICE_MODELS
+from synthua_usd.assets.look_images import LOOKS_DIR
 from synthua_usd.assets.postures import STEPPING_AIDS, BodyParts
 from synthua_usd.composition.scenario import CROWD_ROOT, ENVIRONMENT_PATH, RANDOM_ROOT, StageMetadata
+from synthua_usd.model import meshes as geo
 from synthua_usd.model.conditions import Condition
 from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.model.materials import PALETTE
@@ -44,6 +45,7 @@ from synthua_usd.model.scene import Material, SceneSnapshot
 from synthua_usd.randomisation.poses import posture_of, pose_member
 from synthua_usd.randomisation.scene import CastMember, Recolour, Recolourable, SceneDraw
 from synthua_usd.randomisation.view import Placement
+from synthua_usd.randomisation.wear import skin_material, wear_materials
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, PrototypeLibrary, posture_name, prim_name, quat
 from synthua_usd.usd.authoring import apply_metadata, bind_material_path, define_preview_material, define_xform
 from synthua_usd.usd.conditions import SUN, VARIANT_SET, attribute_name
@@ -169,16 +171,31 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
             shared[key] = _material(stage, f"{LOOKS_ROOT}/{key}", key, spec.base_color, spec.roughness, spec.metallic)
         return shared[key]
 
+    def skin_with_face(key: str) -> str:  # one per skin tone, shared
+        if f"{key}Face" not in shared:
+            path = f"{LOOKS_ROOT}/{key}Face"
+            define_preview_material(stage, path, skin_material(path, PALETTE[key].base_color))
+            shared[f"{key}Face"] = path
+        return shared[f"{key}Face"]
+
     # materials and prototypes through the Usd API first; then the crowd's ~20 prims a person as plain specs
     plans = []
     for k, member in enumerate(scene.cast):
         name = f"Agent_{k:04d}"
-        looks = {"skin": palette_material(member.skin)}
-        for region, rough in (("upper", 0.85), ("lower", 0.85), ("shoes", 0.5)):
-            looks[region] = _material(stage, f"{LOOKS_ROOT}/{name}_{region.title()}", f"{name}_{region}",
-                                      member.region_colour(region), rough)
+        if member.wear is None:  # flat colours, faceless matte skin, faceted
+            looks = {"skin": palette_material(member.skin)}
+            for region, rough in (("upper", 0.85), ("lower", 0.85), ("shoes", 0.5)):
+                looks[region] = _material(stage, f"{LOOKS_ROOT}/{name}_{region.title()}", f"{name}_{region}",
+                                          member.region_colour(region), rough)
+        else:
+            looks = {"skin": skin_with_face(member.skin)}
+            for region, spec in wear_materials(f"{LOOKS_ROOT}/{name}", member.upper, member.lower, member.shoes,
+                                               member.wear).items():
+                define_preview_material(stage, spec.key, spec)
+                looks[region] = spec.key
         posture, asked = posture_of(member)
         fit, _, parts = bodies.get(member.body, posture, asked)
+        surfaces = bodies.surfaces(member.body, posture, asked) if member.wear is not None else None
         instances = []
         for seg in SEGMENTS:
             for region in REGIONS:
@@ -187,14 +204,20 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
                     colour = member.region_colour(region)
                     look = looks["skin"] if isinstance(colour, str) else looks[
                         {"forearm": "upper", "shin": "lower"}.get(region, region)]
-                    instances.append((seg, region.title(), library.part(shape, parts[(seg, region)]), look))
+                    if surfaces is None:
+                        prototype = library.part(shape, parts[(seg, region)])
+                    else:
+                        points, triangles, uvs, normals = surfaces[(seg, region)]
+                        prototype = library.part(shape, (points, triangles), uvs, normals)
+                    instances.append((seg, region.title(), prototype, look))
         hair = member.hair
         if hair is not None and hair.style != "none":
             # a part of the segment holding the head, bound to the person's own hair material
             shape = f"Body{member.body:02d}{posture_name(posture)}Hair{hair.style.title()}"
             look = _material(stage, f"{LOOKS_ROOT}/{name}_Hair", f"{name}_hair", hair.base_color, hair.roughness)
-            instances.append((HAIR_SEGMENT, "Hair", library.part(shape, bodies.hair(member.body, posture, asked,
-                                                                                    hair.style)), look))
+            mesh = bodies.hair(member.body, posture, asked, hair.style)
+            normals = None if member.wear is None else geo.vertex_normals(*mesh)  # smooth with the looks
+            instances.append((HAIR_SEGMENT, "Hair", library.part(shape, mesh, normals=normals), look))
         device = None
         if member.aid is not None and member.device is not None:
             look = member.device
@@ -411,12 +434,34 @@ def _relative_assets(layer: Sdf.Layer, root: Path) -> None:
     layer.Traverse(Sdf.Path.absoluteRootPath, visit)
 
 
+def _local_looks(layer: Sdf.Layer, folder: Path, name: str) -> None:
+    """Copy the package's look images (:mod:`synthua_usd.assets.look_images`) that ``layer``'s textures read into
+    ``folder / name`` and point the textures at the copies (``./<name>/<file>``): the written layers then hold
+    every file they read in their own folder tree, as ``synthua render --layer`` asks."""
+    import shutil
+
+    looks = LOOKS_DIR.resolve()
+
+    def visit(path: Sdf.Path) -> None:
+        spec = layer.GetAttributeAtPath(path) if path.IsPropertyPath() else None
+        if not spec or spec.typeName != Sdf.ValueTypeNames.Asset or not isinstance(spec.default, Sdf.AssetPath):
+            return
+        source = Path(spec.default.path)
+        if source.is_absolute() and source.resolve().parent == looks:
+            (folder / name).mkdir(exist_ok=True)
+            shutil.copyfile(source, folder / name / source.name)
+            spec.default = Sdf.AssetPath(f"./{name}/{source.name}")
+
+    layer.Traverse(Sdf.Path.absoluteRootPath, visit)
+
+
 def export_layers(view: Sdf.Layer, scene: Sdf.Layer, prototypes: Sdf.Layer, out: Path,
                   anchor: Path | None = None) -> tuple[Path, Path, Path]:
     """Write ``view`` to ``out`` (``.usda``), ``scene`` beside it as ``<stem>.scene.usda`` and ``prototypes`` as
     ``<stem>.prototypes.usdc``, each sublayering the next by a relative path, asset paths relative to ``anchor``
-    (the folder they will be read from, default ``out``'s); returns the three paths. The caller writes them as
-    one output set (they are useless apart)."""
+    (the folder they will be read from, default ``out``'s), and the look images the scene's people wear copied
+    into ``<stem>.looks/`` beside them; returns the three layers' paths. The caller writes them as one output
+    set (they are useless apart)."""
     out = Path(out)
     scene_path = out.with_name(f"{out.stem}.scene.usda")
     proto_path = out.with_name(f"{out.stem}.prototypes.usdc")
@@ -427,6 +472,7 @@ def export_layers(view: Sdf.Layer, scene: Sdf.Layer, prototypes: Sdf.Layer, out:
         layer.subLayerPaths.clear()
         if sub is not None:
             layer.subLayerPaths.append(f"./{sub}")
+        _local_looks(layer, target.parent, f"{out.stem}.looks")
         _relative_assets(layer, Path(anchor) if anchor is not None else target.parent)
         if not layer.Export(str(target)):
             raise OSError(f"{target}: USD could not write the layer")

@@ -27,7 +27,7 @@ from synthua_usd.usd.prim_checks import label_findings, mesh_topology, raise_fir
 from synthua_usd.usd.semantics import label_sites, renderable_gprims
 from synthua_usd.usd.shading import Materials
 from synthua_usd.usd.stage_io import check_time_code, meters_per_unit
-from synthua_usd.usd.texcoords import fan_corners, read_uvs
+from synthua_usd.usd.texcoords import corner_normals, corner_uvs, fan_corners, split_attributes
 
 log = logging.getLogger(__name__)
 
@@ -473,12 +473,12 @@ class StageReader:
             raise UnsupportedPrimError(f"{prim.GetPath()}: {message}")
         raise_first_error(shape_findings(prim, t))
         material = self._materials.of(prim, t)
-        points, tris, uvs = self._geometry(prim, t, material)
+        points, tris, uvs, normals = self._geometry(prim, t, material)
         if len(tris) == 0:
             return None
         sites = label_sites(prim, self.class_map.taxonomy)
         inst = self.instances.get(sites[0].prim_path) if sites else None
-        return _LocalGprim(points=points, triangles=tris, uvs=uvs, material_key=material.key,
+        return _LocalGprim(points=points, triangles=tris, uvs=uvs, normals=normals, material_key=material.key,
                            material_base=self._materials.base_of(material.key), textured=bool(material.textures),
                            instance_path=sites[0].prim_path if sites else None,
                            instance_id=inst.id if inst else 0, class_id=inst.class_id if inst else 0,
@@ -509,7 +509,8 @@ class StageReader:
             raise StageError(f"{prim.GetPath()}: has non-finite point coordinates at time {t.GetValue():g}")
         return MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
                         material_key=local.material_key, instance_id=local.instance_id, class_id=local.class_id,
-                        lamp=local.lamp, uvs=local.uvs, double_sided=local.double_sided)
+                        lamp=local.lamp, uvs=local.uvs, double_sided=local.double_sided,
+                        normals=_world_normals(local.normals, m[None, :3, :3], None))
 
     def _mesh_item(self, prim: Usd.Prim, t: Usd.TimeCode, xcache: UsdGeom.XformCache, keep: bool = False
                    ) -> MeshItem | None:
@@ -554,29 +555,31 @@ class StageReader:
             if (before is not None and (before.instance_id, before.class_id, before.material_key, before.uvs) ==
                     (gprim.instance_id, gprim.class_id, gprim.material_key, gprim.uvs)
                     and np.array_equal(before.points, points) and np.array_equal(before.triangles, tris)):
-                out.append(before)
+                out.append(before)  # the same local gprim, placed where it was: its normals too
                 continue
             out.append(MeshItem(prim_path=key, points=points, triangles=np.ascontiguousarray(tris),
                                 material_key=gprim.material_key, instance_id=gprim.instance_id,
                                 class_id=gprim.class_id, lamp=gprim.lamp, uvs=gprim.uvs,
-                                double_sided=gprim.double_sided))
+                                double_sided=gprim.double_sided,
+                                normals=_world_normals(gprim.normals, m[k:k + 1, :3, :3], None)))
         return out
 
     def _geometry(self, prim: Usd.Prim, t: Usd.TimeCode, material: Material
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-        """Local points, triangles and, when ``material`` has textures and the gprim is a Mesh with its texture
-        coordinates, (n, 2) float32 uvs (points split at face-varying seams); else uvs is None."""
-        if not material.textures:
-            points, tris = GPRIM_HANDLERS[prim.GetTypeName()](prim, t)
-            return points, tris, None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+        """Local points, triangles, and for a Mesh, (n, 2) float32 uvs when ``material`` has textures and the mesh
+        its texture coordinates, and (n, 3) float32 unit normals when it has authored normals (points split at
+        face-varying seams of either); else those are None."""
         if prim.GetTypeName() != "Mesh":
-            log.warning("%s: a %s has no texture coordinates; rendering the constants of its textured material %s",
-                        prim.GetPath(), prim.GetTypeName(), material.key)
+            if material.textures:
+                log.warning("%s: a %s has no texture coordinates; rendering the constants of its textured material %s",
+                            prim.GetPath(), prim.GetTypeName(), material.key)
             points, tris = GPRIM_HANDLERS[prim.GetTypeName()](prim, t)
-            return points, tris, None
+            return points, tris, None, None
         points, indices, corners = _mesh_corners(prim, t)
-        found = read_uvs(prim, t, material.uv_primvar, indices, corners, points)
-        return (points, indices[corners], None) if found is None else found
+        uvs = corner_uvs(prim, t, material.uv_primvar, indices, corners, len(points)) if material.textures else None
+        normals = corner_normals(prim, t, indices, corners, len(points))
+        points, tris, (uvs, normals) = split_attributes(points, indices[corners], uvs, normals)
+        return points, tris, uvs, normals
 
     def snapshot(self, time_code: float) -> SceneSnapshot:
         """Everything renderable at ``time_code`` (checked against the stage's time range). Asking for the
@@ -615,7 +618,7 @@ class StageReader:
                         and np.array_equal(before.triangles, item.triangles)
                         and (before.instance_id, before.class_id, before.material_key, before.lamp) ==
                         (item.instance_id, item.class_id, item.material_key, item.lamp)
-                        and _same_uvs(before.uvs, item.uvs)):
+                        and _same_uvs(before.uvs, item.uvs) and _same_uvs(before.normals, item.normals)):
                     item = before
             else:
                 if key not in self._static:
@@ -652,12 +655,14 @@ class StageReader:
 @dataclass(frozen=True, eq=False)
 class _LocalGprim:
     """A gprim in its own space: ``points`` (n, 3) float64 in stage units, ``triangles`` (m, 3) int64 as authored
-    (winding not yet flipped for a mirroring transform), ``uvs`` as :attr:`MeshItem.uvs`, and the material key,
+    (winding not yet flipped for a mirroring transform), ``uvs`` as :attr:`MeshItem.uvs`, ``normals`` (n, 3) float32
+    unit normals in the gprim's space or None, and the material key,
     instance, class, lamp role and sidedness of the :class:`MeshItem` it becomes."""
 
     points: np.ndarray
     triangles: np.ndarray
     uvs: np.ndarray | None
+    normals: np.ndarray | None
     material_key: str
     #: The bound material's own key (``material_key`` less a per-gprim colour), and the labelled prim above.
     material_base: str
@@ -675,6 +680,20 @@ def _prefixes(path: str):
     while path and path != "/":
         yield path
         path = path.rsplit("/", 1)[0]
+
+
+def _world_normals(normals: np.ndarray | None, rotations: np.ndarray, owner: np.ndarray | None) -> np.ndarray | None:
+    """``normals`` (n, 3) of gprim space in world space, (n, 3) float32 unit vectors: each times the inverse
+    transpose of its gprim's linear part (``rotations`` (k, 3, 3), USD's row-vector convention; ``owner`` (n,)
+    the gprim of each normal, None for one gprim), which keeps them perpendicular to surfaces that a transform
+    scales unevenly (and mirrors them with it)."""
+    if normals is None:
+        return None
+    if np.any(np.abs(np.linalg.det(rotations)) < 1e-12):  # a flattened gprim: no direction is its normal
+        return None
+    inverse = np.linalg.inv(rotations).transpose(0, 2, 1)  # row vectors: n' = n @ inv(M).T
+    turned = normals @ inverse[0] if owner is None else np.matmul(normals[:, None, :], inverse[owner])[:, 0]
+    return (turned / np.maximum(np.linalg.norm(turned, axis=1, keepdims=True), 1e-12)).astype(np.float32)
 
 
 def _same_uvs(a: np.ndarray | None, b: np.ndarray | None) -> bool:

@@ -128,7 +128,7 @@ def preview_surface(material: UsdShade.Material, key: str) -> Material:
     fields: dict = {}
     primvars: list[str] = []
     defaults = {"diffuseColor": Gf.Vec3f(0.18), "roughness": 0.5, "metallic": 0.0, "emissiveColor": Gf.Vec3f(0.0),
-                "opacity": 1.0, "opacityThreshold": 0.0, "normal": None}
+                "opacity": 1.0, "opacityThreshold": 0.0, "normal": None, "clearcoat": 0.0, "clearcoatRoughness": 0.01}
     values = {}
     for name, fallback in defaults.items():
         value, texture, primvar = _input(shader, name, fallback)
@@ -143,6 +143,7 @@ def preview_surface(material: UsdShade.Material, key: str) -> Material:
                     roughness=float(values["roughness"]), metallic=float(values["metallic"]),
                     emissive_color=tuple(float(c) for c in values["emissiveColor"]),
                     opacity=float(values["opacity"]), opacity_threshold=float(values["opacityThreshold"]),
+                    clearcoat=float(values["clearcoat"]), clearcoat_roughness=float(values["clearcoatRoughness"]),
                     uv_primvar=primvars[0] if primvars else "st", **fields)
 
 

@@ -8,7 +8,8 @@ import pytest
 from conftest import DISTRICT
 from synthua_usd.demo.district import build_district
 from synthua_usd.demo.district_textures import PAVED, TEXTURED, paving_images
-from synthua_usd.demo.textures import SIZE, decode_srgb8, district_images, paving
+from synthua_usd.demo.textures import SIZE, district_images, paving
+from synthua_usd.model.srgb import decode_srgb8
 from synthua_usd.model.materials import PALETTE
 
 

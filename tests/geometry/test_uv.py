@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from synthua_usd.geometry.uv import box_uvs, planar_uvs, split_corners
+from synthua_usd.geometry.uv import box_uvs, planar_uvs
+from synthua_usd.model.meshes import split_corners
 from synthua_usd.model import meshes as geo
 
 

@@ -83,14 +83,16 @@ def _noise_of_another_sampler_seed(dataset: Path, record: dict, seed: int) -> fl
 
 
 def test_randomise_and_render_reproduce_the_images_bytes(generated_random, tmp_path):
-    """`synthua randomise --record` writes the image's three layers and prints the render command; that command
-    writes the dataset's RGB, class and instance files byte for byte."""
+    """`synthua randomise --record` writes the image's three layers and the look images its people wear beside them
+    (the layers read nothing outside their folder) and prints the render command; that command writes the
+    dataset's RGB, class and instance files byte for byte."""
     record = records(generated_random)[-1]
     result = run_synthua("randomise", SCENARIO, "--record", generated_random / "records" / f"{record['name']}.json",
                          "--out", tmp_path / "r" / "layer.usda")
     assert result.code == 0, result.stderr
-    assert sorted(p.name for p in (tmp_path / "r").iterdir()) == ["layer.prototypes.usdc", "layer.scene.usda",
-                                                                  "layer.usda"]
+    assert sorted(p.name for p in (tmp_path / "r").iterdir()) == ["layer.looks", "layer.prototypes.usdc",
+                                                                  "layer.scene.usda", "layer.usda"]
+    assert {p.name for p in (tmp_path / "r" / "layer.looks").iterdir()} >= {"face.png"}
     args = result.stdout.split("render it with: ", 1)[1].split()[1:]
     args[args.index("--out") + 1] = str(tmp_path / "frame")
     rendered = run_synthua(*args)

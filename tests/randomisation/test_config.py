@@ -34,7 +34,7 @@ def test_round_trip_and_off_by_default():
     assert GenerationConfig.from_document(config.to_document()) == config
     plain = GenerationConfig.from_document({"name": "x", "images": 2})
     assert plain.randomise is None and "randomise" not in plain.to_document()
-    assert config.randomise.enabled_parts == ("crowd", "devices", "hair", "materials", "camera")
+    assert config.randomise.enabled_parts == ("crowd", "devices", "hair", "looks", "materials", "camera")
 
 
 @pytest.mark.parametrize("block, mentions", [

@@ -103,6 +103,7 @@ class RenderSession:
                      or all(old.materials[k] == snapshot.materials.get(k) for k in {m.material_key for m in old.meshes}))
                 and all(a is b or (a.prim_path == b.prim_path and a.material_key == b.material_key
                                    and a.points.shape == b.points.shape
+                                   and (a.normals is None) == (b.normals is None)
                                    and (a.triangles is b.triangles or np.array_equal(a.triangles, b.triangles)))
                         for a, b in zip(old.meshes, snapshot.meshes)))
 
@@ -122,6 +123,9 @@ class RenderSession:
             name = f"{key}.vertex_positions"
             # The parameter's own array type: mi.Float is a plain float on scalar variants.
             params[name] = type(params[name])(np.ascontiguousarray(new.points, np.float32).ravel())
+            if new.normals is not None:  # with the positions: alone they would make Mitsuba recompute its own
+                normals = f"{key}.vertex_normals"
+                params[normals] = type(params[normals])(np.ascontiguousarray(new.normals, np.float32).ravel())
             moved += 1
         self._snapshot = snapshot
         if condition is not None and condition != self._condition:

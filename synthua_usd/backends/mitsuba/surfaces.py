@@ -132,9 +132,13 @@ def principled_dict(material: Material, images: TextureImages | None = None,
             return images.node(texture, lambda d: clip(d) * np.float32(factor), f"{field}{name}")
         return float(np.clip(constant, 0.0, 1.0)) * factor
 
-    return {"type": "principled", "base_color": colour(),
-            "roughness": scalar(material.roughness_texture, material.roughness, roughness_factor, "roughness"),
-            "metallic": scalar(material.metallic_texture, material.metallic, field="metallic")}
+    out = {"type": "principled", "base_color": colour(),
+           "roughness": scalar(material.roughness_texture, material.roughness, roughness_factor, "roughness"),
+           "metallic": scalar(material.metallic_texture, material.metallic, field="metallic")}
+    if material.clearcoat > 0.0:  # Mitsuba's gloss is UsdPreviewSurface's 1 - roughness
+        out["clearcoat"] = float(np.clip(material.clearcoat, 0.0, 1.0))
+        out["clearcoat_gloss"] = float(np.clip(1.0 - material.clearcoat_roughness, 0.0, 1.0))
+    return out
 
 
 def wrapped(bsdf: dict, material: Material, images: TextureImages | None = None) -> dict:
