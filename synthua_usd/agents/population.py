@@ -15,7 +15,7 @@ import numpy as np
 
 from synthua_usd.agents.profiles import AID_PROFILES, PROFILES, AgentProfile
 from synthua_usd.agents.seats import SeatPlace
-from synthua_usd.agents.walkable import WalkableGrid, shortest_path
+from synthua_usd.agents.walkable import Router, WalkableGrid
 from synthua_usd.core.errors import InputError
 
 log = logging.getLogger(__name__)
@@ -81,6 +81,9 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
                          "curb_ramp, street_road); for twins whose roads include sidewalks add --walk-on road")
     pos = np.array([graph.nodes[n]["pos"] for n in nodes])
     benches = sorted(set(grid.cells_beside("furniture")) & set(graph.nodes))
+    index = {n: k for k, n in enumerate(nodes)}
+    bench_index = [index[n] for n in benches]
+    router = Router(graph)  # each profile's edge costs once for all routes
     plans: list[Plan] = []
     free = list(seats)
     resting_pedestrians = 0
@@ -90,7 +93,7 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
         is_aid = rng.random() < aid_share
         profile = PROFILES[AID_PROFILES[int(rng.integers(len(AID_PROFILES)))]] if is_aid else PROFILES["pedestrian"]
         rests = bool(benches) and rng.random() < rest_share
-        route = _route(rng, graph, nodes, pos, profile, min_route_m, benches if rests else None)
+        route = _route(rng, router, nodes, pos, profile, min_route_m, bench_index if rests else None)
         if route is None:
             misses += 1
             if misses > MAX_ROUTE_MISSES:
@@ -123,16 +126,18 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
     return plans
 
 
-def _route(rng, graph, nodes, pos, profile, min_route_m, goals=None):
-    index = {n: k for k, n in enumerate(nodes)}
+def _route(rng, router, nodes, pos, profile, min_route_m, goals=None):
+    """Waypoints (k, 3) and surfaces of a route of ``profile`` between two random nodes at least ``min_route_m``
+    apart (the second one of ``goals``, indices into ``nodes``, if given); None after 20 tries."""
+    graph = router.graph
     for _ in range(20):
         a, b = rng.integers(len(nodes), size=2)
         if goals:
-            b = index[goals[int(rng.integers(len(goals)))]]
+            b = goals[int(rng.integers(len(goals)))]
         if np.linalg.norm(pos[a, :2] - pos[b, :2]) < min_route_m:
             continue
         try:
-            path = shortest_path(graph, nodes[a], nodes[b], profile)
+            path = router.path(nodes[a], nodes[b], profile)
         except nx.NetworkXNoPath:
             continue
         return (np.array([graph.nodes[n]["pos"] for n in path]), tuple(graph.nodes[n]["surface"] for n in path))

@@ -9,6 +9,8 @@ benches, poles and stands block their cells while tent canopies do not.
 
 from __future__ import annotations
 
+import heapq
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -183,27 +185,113 @@ def walkable_graph(grid: WalkableGrid) -> nx.Graph:
     return g
 
 
+def travel_times_s(profile: AgentProfile, length_m, slope, kerb, cobbles) -> np.ndarray:
+    """Travel time in seconds along edges of ``length_m`` (e,) float64 metres, ``slope`` (e,) float64 rise/run,
+    ``kerb`` and ``cobbles`` (e,) bool (the edge attributes of :func:`walkable_graph`), for ``profile``:
+    (e,) float64, inf where it cannot pass. Every operation is one IEEE operation per element, in the order
+    scalar Python would do it, so an element equals what the same formula gives for one edge."""
+    length_m, slope = np.asarray(length_m, np.float64), np.asarray(slope, np.float64)
+    t = length_m / profile.speed_mps
+    t = t * (1.0 + profile.slope_penalty * np.maximum(0.0, slope - 0.02))
+    t = np.where(cobbles, t * profile.cobble_factor, t)
+    t = np.where(slope > profile.max_slope, np.inf, t)
+    stepped = length_m / profile.speed_mps + 0.5 if profile.can_step_kerb else np.inf  # a step costs a moment
+    return np.where(kerb, stepped, t)
+
+
 def edge_cost(profile: AgentProfile):
-    """networkx weight function: travel time in seconds, or None where ``profile`` cannot pass."""
+    """networkx weight function: travel time in seconds (:func:`travel_times_s`), or None where ``profile``
+    cannot pass."""
     def cost(u, v, data) -> float | None:
-        if data["kerb"]:
-            if not profile.can_step_kerb:
-                return None
-            return data["length_m"] / profile.speed_mps + 0.5  # a step costs a moment
-        if data["slope"] > profile.max_slope:
-            return None
-        t = data["length_m"] / profile.speed_mps
-        t *= 1.0 + profile.slope_penalty * max(0.0, data["slope"] - 0.02)
-        if data["cobbles"]:
-            t *= profile.cobble_factor
-        return t
+        t = float(travel_times_s(profile, data["length_m"], data["slope"], data["kerb"], data["cobbles"]))
+        return None if t == math.inf else t
     return cost
+
+
+class Router:
+    """Shortest paths over travel time on one walkable graph, for any profile.
+
+    The search is networkx's ``astar_path`` with :func:`edge_cost` as its weight, step for step: the same
+    queue entries (priority, push counter, node, cost so far, parent) pushed in the same order, neighbours
+    taken in the graph's adjacency order, the same heuristic value, so the same path comes out, ties
+    included (a route is part of the committed stages). What differs is the bookkeeping: edges are held as
+    arrays over the graph's adjacency, each profile's costs are computed for every edge at once on first use
+    (not once per edge a search relaxes), and nodes are list indices.
+    """
+
+    def __init__(self, graph: nx.Graph) -> None:
+        self.graph = graph
+        self.nodes = list(graph)
+        self._index = {n: k for k, n in enumerate(self.nodes)}
+        # Each node's position as its own contiguous (2,) array: the heuristic takes the same dot product
+        # as np.linalg.norm of a subtraction of two ``pos[:2]`` does.
+        self._xy = [np.array(graph.nodes[n]["pos"][:2], np.float64) for n in self.nodes]
+        first, neighbour, attributes = [0], [], []
+        for n in self.nodes:
+            for m, data in graph.adj[n].items():
+                neighbour.append(self._index[m])
+                attributes.append((data["length_m"], data["slope"], data["kerb"], data["cobbles"]))
+            first.append(len(neighbour))
+        self._first = first  # node k's neighbours are entries first[k]:first[k + 1], in adjacency order
+        self._neighbour = neighbour
+        columns = list(zip(*attributes)) or [(), (), (), ()]
+        self._length_m, self._slope = np.array(columns[0], np.float64), np.array(columns[1], np.float64)
+        self._kerb, self._cobbles = np.array(columns[2], bool), np.array(columns[3], bool)
+        self._costs: dict[AgentProfile, list[float]] = {}
+
+    def costs(self, profile: AgentProfile) -> list[float]:
+        """Travel time (s) per adjacency entry for ``profile``, inf where it cannot pass; computed once."""
+        if profile not in self._costs:
+            self._costs[profile] = travel_times_s(profile, self._length_m, self._slope, self._kerb,
+                                                  self._cobbles).tolist()
+        return self._costs[profile]
+
+    def path(self, start, goal, profile: AgentProfile) -> list:
+        """The nodes from ``start`` to ``goal`` (both included) that :func:`shortest_path` returns; raises
+        ``networkx.NodeNotFound`` and ``networkx.NetworkXNoPath`` as it does."""
+        for role, node in (("Source", start), ("Target", goal)):
+            if node not in self._index:
+                raise nx.NodeNotFound(f"{role} {node} is not in G")
+        source, target = self._index[start], self._index[goal]
+        cost, first, neighbour, xy = self.costs(profile), self._first, self._neighbour, self._xy
+        goal_xy, speed, inf = xy[target], profile.speed_mps, math.inf
+        # networkx keeps the source out of its ``enqueued`` map: a neighbour re-queues it, and the pops
+        # count. Unqueued nodes have an infinite queued cost here; -2 marks unexplored, -1 the source's None.
+        queued_cost, queued_h, parent_of = [inf] * len(self.nodes), [0.0] * len(self.nodes), [-2] * len(self.nodes)
+        counter = itertools.count()
+        queue = [(0, next(counter), source, 0, -1)]
+        while queue:
+            _, __, node, dist, parent = heapq.heappop(queue)
+            if node == target:
+                path = [node]
+                while parent != -1:
+                    path.append(parent)
+                    parent = parent_of[parent]
+                return [self.nodes[k] for k in reversed(path)]
+            if parent_of[node] != -2:
+                if parent_of[node] == -1 or queued_cost[node] < dist:
+                    continue
+            parent_of[node] = parent
+            for e in range(first[node], first[node + 1]):
+                c = cost[e]
+                if c == inf:
+                    continue
+                m = neighbour[e]
+                total = dist + c
+                if queued_cost[m] != inf:
+                    if queued_cost[m] <= total:
+                        continue
+                    h = queued_h[m]
+                else:
+                    d = xy[m] - goal_xy
+                    h = math.sqrt(d.dot(d)) / speed
+                queued_cost[m], queued_h[m] = total, h
+                heapq.heappush(queue, (total + h, next(counter), m, total, node))
+        raise nx.NetworkXNoPath(f"Node {goal} not reachable from {start}")
 
 
 def shortest_path(graph: nx.Graph, start, goal, profile: AgentProfile) -> list[tuple[int, int]]:
     """A* over travel time; the heuristic (straight-line distance at the profile's speed) never
-    overestimates, since every cost multiplier is at least 1."""
-    def heuristic(a, b):
-        return float(np.linalg.norm(graph.nodes[a]["pos"][:2] - graph.nodes[b]["pos"][:2])) / profile.speed_mps
-
-    return nx.astar_path(graph, start, goal, heuristic=heuristic, weight=edge_cost(profile))
+    overestimates, since every cost multiplier is at least 1. One search: for many on one graph, keep a
+    :class:`Router`, which computes each profile's edge costs once."""
+    return Router(graph).path(start, goal, profile)

@@ -29,6 +29,8 @@ PARENT = {"torso": None, "head": "torso", "upperleg.L": "torso", "upperleg.R": "
           "lowerleg.R": "upperleg.R", "foot.L": "lowerleg.L", "foot.R": "lowerleg.R", "upperarm.L": "torso",
           "upperarm.R": "torso", "lowerarm.L": "upperarm.L", "lowerarm.R": "upperarm.R", "hand.L": "lowerarm.L",
           "hand.R": "lowerarm.R"}
+#: Index into BONES of each bone's parent (the root's own index for the root).
+_PARENT_INDEX = tuple(k if PARENT[b] is None else BONES.index(PARENT[b]) for k, b in enumerate(BONES))
 #: Segment name -> (bones it holds, its primary bone whose motion moves it).
 SEGMENTS = {
     "Torso": (("torso", "head"), "torso"),
@@ -167,15 +169,15 @@ def forward_kinematics(rest_joints: np.ndarray, aims: dict[str, np.ndarray], roo
     ``root`` moves the torso joint (default: where it rests)."""
     rots = np.zeros((len(BONES), 3, 3))
     joints = np.zeros((len(BONES), 3))
+    offsets = rest_joints - rest_joints[list(_PARENT_INDEX)]  # each bone's rest joint from its parent's (the root's: 0)
     for k, bone in enumerate(BONES):  # parents come first in BONES
-        parent = PARENT[bone]
-        if parent is None:
+        p = _PARENT_INDEX[k]
+        if p == k:
             rots[k] = aims.get(bone, np.eye(3))
             joints[k] = rest_joints[k] if root is None else root
             continue
-        p = BONES.index(parent)
         rots[k] = aims.get(bone, rots[p])
-        joints[k] = joints[p] + rots[p] @ (rest_joints[k] - rest_joints[p])
+        joints[k] = joints[p] + rots[p] @ offsets[k]
     return Pose(rots, joints)
 
 
@@ -199,9 +201,14 @@ def two_bone_aims(rest_joints: np.ndarray, upper: str, lower: str, end: str, sta
     return {upper: ru, lower: rl}
 
 
-def skin(points: np.ndarray, bank: Bank, matrices: np.ndarray) -> np.ndarray:
-    """Linear blend skinning of ``points`` (V, 3) by bone ``matrices`` (14, 3, 4)."""
-    m = np.einsum("vk,vkij->vij", bank.skin_weights, matrices[bank.skin_bones])
+def skin(points: np.ndarray, bank: Bank, matrices: np.ndarray, vertices: np.ndarray | None = None) -> np.ndarray:
+    """Linear blend skinning of ``points`` (V, 3) by bone ``matrices`` (14, 3, 4): (V, 3); only ``vertices``
+    ((n,) int indices, n >= 2) if given: (n, 3), the same values as those rows of the whole (each vertex's
+    sums are its own, whatever else is skinned; tests/assets/test_bodies.py checks it bit for bit)."""
+    weights, bones = bank.skin_weights, bank.skin_bones
+    if vertices is not None:
+        points, weights, bones = points[vertices], weights[vertices], bones[vertices]
+    m = np.einsum("vk,vkij->vij", weights, matrices[bones])
     return np.einsum("vij,vj->vi", m[:, :, :3], points) + m[:, :, 3]
 
 

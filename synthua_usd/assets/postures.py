@@ -15,6 +15,7 @@ clearance, as wide as the hips plus 2 cm a side.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -234,75 +235,113 @@ def aid_shift_m(device: str | None, phase: float, amplitude: float, cycle_m: flo
     return centre + travel * (v * v * (3 - 2 * v) - 0.5)
 
 
+#: A posture of one body and fit: (phase, amplitude, aid_shift) -> the body's pose (:func:`pose`'s last three).
+PostureCycle = Callable[[float, float, float], Pose]
+
+
 def pose(bank: Bank, body: int, device: str | None, fit: DeviceFit, phase: float, amplitude: float,
          aid_shift: float = 0.0) -> Pose:
     """The body's pose at cycle ``phase`` (radians; gait cycle walking, push cycle in a manual chair) with
     the motion scaled by ``amplitude`` (0 still, 1 full stride); a walking aid moved ``aid_shift`` metres
     forward (:func:`aid_shift_m`) takes the hands on it along. ``device`` :data:`PUSHING` walks with both hands
-    on the push handles of a manual wheelchair of ``fit`` whose origin is :data:`PUSH_DISTANCE_M` ahead."""
-    rest = bank.joints[body]
+    on the push handles of a manual wheelchair of ``fit`` whose origin is :data:`PUSH_DISTANCE_M` ahead.
+    For many poses of one body and fit, keep its :func:`posture_cycle` (as :meth:`BodyParts.posture_cycle` does)."""
+    return posture_cycle(bank, body, device, fit)(phase, amplitude, aid_shift)
+
+
+def posture_cycle(bank: Bank, body: int, device: str | None, fit: DeviceFit) -> PostureCycle:
+    """The posture of ``body`` with ``device`` fitted by ``fit`` as a function of the cycle (:data:`PostureCycle`,
+    giving what :func:`pose` gives). What does not depend on the cycle (the seated base, the hanging arms, a
+    pusher's lean, the shank vertices) is worked out here, once."""
     if device in SEATED or device == BENCH:
-        base = _seated_legs(bank, body, 0.0, _bench_shank_deg(bank, body, fit.seat_height_m) if device == BENCH else 12.0)
-        pts = skin(bank.points[body], bank, base.skinning(rest))
-        seat_bottom = pts[_hip_vertices(bank, pts, base), 2].min()
-        back = pts[_segment_vertices(bank, ("Torso",)), 0].min()
-        # Sit on the seat (its top at seat height), the back 3 cm in front of the backrest (x = -0.18).
-        shift = np.array([-0.15 - back, 0.0, fit.seat_height_m - seat_bottom])
-        seated = forward_kinematics(rest, {b: base.rotations[k] for k, b in enumerate(BONES)}, rest[0] + shift)
-        aims = {b: seated.rotations[k] for k, b in enumerate(BONES) if not b.startswith(("upperarm", "lowerarm", "hand"))}
-        half = fit.seat_width_m / 2
-        if device == BENCH:  # hands resting on the thighs
-            hip = seated.joints[BONES.index("upperleg.L")]
-            targets = {side: np.array([hip[0] + 0.24, sign * 0.12, fit.seat_height_m + 0.17])
-                       for side, sign in (("L", 1.0), ("R", -1.0))}
-        elif device == "manual_wheelchair":
+        return _seated_posture(bank, body, device, fit)
+    return _walking_posture(bank, body, device, fit)
+
+
+def _seated_posture(bank: Bank, body: int, device: str, fit: DeviceFit) -> PostureCycle:
+    """In a wheelchair or on a bench: seated once; only a manual wheelchair's hands follow the cycle."""
+    rest = bank.joints[body]
+    base = _seated_legs(bank, body, 0.0, _bench_shank_deg(bank, body, fit.seat_height_m) if device == BENCH else 12.0)
+    pts = skin(bank.points[body], bank, base.skinning(rest))
+    seat_bottom = pts[_hip_vertices(bank, pts, base), 2].min()
+    back = pts[_segment_vertices(bank, ("Torso",)), 0].min()
+    # Sit on the seat (its top at seat height), the back 3 cm in front of the backrest (x = -0.18).
+    shift = np.array([-0.15 - back, 0.0, fit.seat_height_m - seat_bottom])
+    seated = forward_kinematics(rest, {b: base.rotations[k] for k, b in enumerate(BONES)}, rest[0] + shift)
+    aims = {b: seated.rotations[k] for k, b in enumerate(BONES) if not b.startswith(("upperarm", "lowerarm", "hand"))}
+    half = fit.seat_width_m / 2
+    if device == "manual_wheelchair":  # hands on the push rims, along the push cycle
+        def at(phase: float, amplitude: float, aid_shift: float = 0.0) -> Pose:
             targets = {}
             for side, sign in (("L", 1.0), ("R", -1.0)):
                 angle = np.radians(20.0 + 35.0 * amplitude * np.sin(phase))
                 targets[side] = np.array([REAR_WHEEL_X + (RIM_RADIUS_M + 0.02) * np.sin(angle), sign * (half + 0.07),
                                           0.3 + (RIM_RADIUS_M + 0.02) * np.cos(angle)])
-        else:
-            targets = {"L": np.array([0.22, half + 0.03, fit.seat_height_m + 0.3]),
-                       "R": np.array([shift[0] + rest[0, 0] + 0.32, -0.1, fit.seat_height_m + 0.2])}
-        return _with_arms(bank, body, seated, targets, aims)
+            return _with_arms(bank, body, seated, targets, aims)
+        return at
+    if device == BENCH:  # hands resting on the thighs
+        hip = seated.joints[BONES.index("upperleg.L")]
+        targets = {side: np.array([hip[0] + 0.24, sign * 0.12, fit.seat_height_m + 0.17])
+                   for side, sign in (("L", 1.0), ("R", -1.0))}
+    else:
+        targets = {"L": np.array([0.22, half + 0.03, fit.seat_height_m + 0.3]),
+                   "R": np.array([shift[0] + rest[0, 0] + 0.32, -0.1, fit.seat_height_m + 0.2])}
+    still = _with_arms(bank, body, seated, targets, aims)  # the same at every phase
+
+    def at_rest(phase: float, amplitude: float, aid_shift: float = 0.0) -> Pose:
+        return Pose(still.rotations.copy(), still.joints.copy())
+    return at_rest
+
+
+def _walking_posture(bank: Bank, body: int, device: str | None, fit: DeviceFit) -> PostureCycle:
+    """On foot, with or without a walking aid, or pushing a wheelchair: legs and arms swing with the cycle."""
+    rest = bank.joints[body]
     height = float(bank.height_m[body])
     step = step_length_m(1.0, height)
     leg = float(np.linalg.norm(rest[BONES.index("foot.L")] - rest[BONES.index("upperleg.L")]))
-    hip_amp = np.degrees(np.arctan2(0.5 * step, leg)) * amplitude
-    aims = _arms_down(rest)
-    for side, sign in (("L", 1.0), ("R", -1.0)):
-        swing = sign * np.sin(phase)
-        swinging = max(0.0, sign * np.cos(phase))  # the leg moving forward bends its knee
-        hip = hip_amp * swing
-        knee = amplitude * (5.0 + 40.0 * swinging ** 2)
-        aims[f"upperleg.{side}"] = rot_y(-hip)
-        aims[f"lowerleg.{side}"] = rot_y(-(hip - knee))
-        aims[f"foot.{side}"] = rot_y(-(hip - knee) * 0.5)
-        arm = -0.7 * hip
-        aims[f"upperarm.{side}"] = rot_y(-arm) @ aims[f"upperarm.{side}"]
-        aims[f"lowerarm.{side}"] = rot_y(-arm) @ aims[f"lowerarm.{side}"]
-    if device == PUSHING:
-        aims["torso"] = rot_y(push_lean_deg(bank, body, fit))
-    walking = forward_kinematics(rest, aims)
-    targets = {}
-    if device == "walker":
-        targets = {s: np.array([0.3, sign * 0.26, fit.grip_height_m + 0.03]) for s, sign in (("L", 1.0), ("R", -1.0))}
-    elif device == PUSHING:  # the chair's handles, seen from PUSH_DISTANCE_M behind its origin
-        handles = push_handles(fit) + np.array([PUSH_DISTANCE_M, 0.0, 0.0])
-        targets = {"L": handles[0], "R": handles[1]}
-    elif device == "crutch":
-        targets = {s: np.array([AID_OFFSETS["crutch"][k][0] + GRIP_DX["crutch"] + aid_shift, AID_OFFSETS["crutch"][k][1],
-                                fit.grip_height_m + 0.03]) for k, s in enumerate(("L", "R"))}
-    elif device in CANES:
-        x, y = AID_OFFSETS[device][0]
-        targets = {"R": np.array([x + GRIP_DX[device] + aid_shift, y, fit.grip_height_m + 0.04])}
-    # Keep the lower foot on the ground, then put the hands on the aid (whose grips do not bob with the body).
-    pts = skin(bank.points[body], bank, walking.skinning(rest))
-    low = pts[_segment_vertices(bank, ("ShankL", "ShankR")), 2].min()
-    walking = forward_kinematics(rest, aims, walking.joints[0] - np.array([0.0, 0.0, low]))
-    if device == PUSHING:
-        return _palms_on(bank, body, walking, targets, aims)
-    return _with_arms(bank, body, walking, targets, aims) if targets else walking
+    full_hip_deg = np.degrees(np.arctan2(0.5 * step, leg))  # the hip's swing at amplitude 1
+    arms_down = _arms_down(rest)
+    lean = rot_y(push_lean_deg(bank, body, fit)) if device == PUSHING else None
+    shanks = _segment_vertices(bank, ("ShankL", "ShankR"))
+
+    def at(phase: float, amplitude: float, aid_shift: float = 0.0) -> Pose:
+        hip_amp = full_hip_deg * amplitude
+        aims = dict(arms_down)
+        for side, sign in (("L", 1.0), ("R", -1.0)):
+            swing = sign * np.sin(phase)
+            swinging = max(0.0, sign * np.cos(phase))  # the leg moving forward bends its knee
+            hip = hip_amp * swing
+            knee = amplitude * (5.0 + 40.0 * swinging ** 2)
+            aims[f"upperleg.{side}"] = rot_y(-hip)
+            aims[f"lowerleg.{side}"] = rot_y(-(hip - knee))
+            aims[f"foot.{side}"] = rot_y(-(hip - knee) * 0.5)
+            arm = -0.7 * hip
+            aims[f"upperarm.{side}"] = rot_y(-arm) @ aims[f"upperarm.{side}"]
+            aims[f"lowerarm.{side}"] = rot_y(-arm) @ aims[f"lowerarm.{side}"]
+        if lean is not None:
+            aims["torso"] = lean
+        walking = forward_kinematics(rest, aims)
+        targets = {}
+        if device == "walker":
+            targets = {s: np.array([0.3, sign * 0.26, fit.grip_height_m + 0.03])
+                       for s, sign in (("L", 1.0), ("R", -1.0))}
+        elif device == PUSHING:  # the chair's handles, seen from PUSH_DISTANCE_M behind its origin
+            handles = push_handles(fit) + np.array([PUSH_DISTANCE_M, 0.0, 0.0])
+            targets = {"L": handles[0], "R": handles[1]}
+        elif device == "crutch":
+            targets = {s: np.array([AID_OFFSETS["crutch"][k][0] + GRIP_DX["crutch"] + aid_shift,
+                                    AID_OFFSETS["crutch"][k][1], fit.grip_height_m + 0.03])
+                       for k, s in enumerate(("L", "R"))}
+        elif device in CANES:
+            x, y = AID_OFFSETS[device][0]
+            targets = {"R": np.array([x + GRIP_DX[device] + aid_shift, y, fit.grip_height_m + 0.04])}
+        # Keep the lower foot on the ground, then put the hands on the aid (whose grips do not bob with the body).
+        low = skin(bank.points[body], bank, walking.skinning(rest), shanks)[:, 2].min()
+        walking = forward_kinematics(rest, aims, walking.joints[0] - np.array([0.0, 0.0, low]))
+        if device == PUSHING:
+            return _palms_on(bank, body, walking, targets, aims)
+        return _with_arms(bank, body, walking, targets, aims) if targets else walking
+    return at
 
 
 def _palms_on(bank: Bank, body: int, pose_: Pose, targets: dict[str, np.ndarray], aims: dict) -> Pose:
@@ -343,13 +382,22 @@ class BodyParts:
         self._posed: dict[tuple, np.ndarray] = {}
         self._hair: dict[tuple, tuple | None] = {}
         self._surfaces: dict[tuple, dict] = {}
+        self._postures: dict[tuple, PostureCycle] = {}
+
+    def posture_cycle(self, body: int, posture: str | None, fit: DeviceFit) -> PostureCycle:
+        """:func:`posture_cycle` of ``body`` in ``posture`` (a device class, :data:`BENCH`, :data:`PUSHING` or None)
+        fitted by ``fit``, made once: a crowd poses each body at every time code."""
+        key = (body, posture, fit)
+        if key not in self._postures:
+            self._postures[key] = posture_cycle(self.bank, body, posture, fit)
+        return self._postures[key]
 
     def get(self, body: int, posture: str | None, fit: DeviceFit | None = None):
         """``posture`` a device class, :data:`BENCH` or None (walking); ``fit`` None: the device fitted to the body."""
         key = (body, posture, fit)
         if key not in self._cache:
             fit = fit or fit_device(self.bank, body, posture)
-            base = pose(self.bank, body, posture, fit, 0.0, 0.0)
+            base = self.posture_cycle(body, posture, fit)(0.0, 0.0, 0.0)
             pts = skin(self.bank.points[body], self.bank, base.skinning(self.bank.joints[body]))
             region = self.bank.face_region(body)
             segment_faces = self.bank.segment_faces(body)

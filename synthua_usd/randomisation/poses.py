@@ -13,7 +13,7 @@ import numpy as np
 from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points
 from synthua_usd.assets.postures import (BENCH, PUSHING, STEPPING_AIDS, BodyParts, DeviceFit, aid_shift_m, bench_fit,
-                                         pose, segment_motion, step_length_m)
+                                         segment_motion, step_length_m)
 from synthua_usd.randomisation.scene import CastMember
 from synthua_usd.randomisation.view import Placement
 
@@ -59,7 +59,7 @@ def pose_member(bodies: BodyParts, member: CastMember, placement: Placement) -> 
     cycle = PUSH_CYCLE_M if device == "manual_wheelchair" else 2 * step_length_m(
         placement.speed_mps or PROFILES[member.profile].speed_mps, height)
     shift = aid_shift_m(device, placement.phase, amplitude, cycle)
-    now = pose(bodies.bank, member.body, posture, fit, placement.phase, amplitude, shift)
+    now = bodies.posture_cycle(member.body, posture, fit)(placement.phase, amplitude, shift)
     motion = segment_motion(bodies.bank, member.body, base, now)
     keypoints = body_keypoints(bodies.bank, member.body, base, [motion])[0]
     contacts = None

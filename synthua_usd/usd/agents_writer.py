@@ -46,7 +46,7 @@ from synthua_usd.assets import devices
 from synthua_usd.assets.agent_keypoints import body_keypoints, contact_points
 from synthua_usd.assets.bodies import REGIONS, SEGMENTS
 from synthua_usd.assets.postures import (AID_OFFSETS, BENCH, STEPPING_AIDS, BodyParts, DeviceFit, aid_shift_m,
-                                       bench_fit, pose, segment_motion, step_length_m)
+                                       bench_fit, segment_motion, step_length_m)
 from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.model import meshes as geo
 from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
@@ -151,7 +151,7 @@ def posture_name(device: str | None) -> str:
 
 def quat(r: np.ndarray) -> Gf.Quatf:
     q = Gf.Matrix3d(*r.T.ravel().tolist()).ExtractRotation().GetQuat()  # Gf matrices act on row vectors
-    return Gf.Quatf(float(q.GetReal()), *map(float, q.GetImaginary()))
+    return Gf.Quatf(q)  # each component rounded to float, as Quatf(real, i, j, k) would; without iterating a Vec3d
 
 
 def author_keypoints(prim: Usd.Prim, names, points: np.ndarray, times) -> None:
@@ -210,7 +210,8 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str, root_pa
         if device == "electric_wheelchair":
             amplitude = np.zeros_like(amplitude)
         shifts = [aid_shift_m(device, p, a, cycle) for p, a in zip(phase, amplitude)]
-        motions = [segment_motion(bodies.bank, look.body, base, pose(bodies.bank, look.body, posture, fit, p, a, x))
+        posed = bodies.posture_cycle(look.body, posture, fit)
+        motions = [segment_motion(bodies.bank, look.body, base, posed(p, a, x))
                    for p, a, x in zip(phase, amplitude, shifts)]
         # The Person prim has no transform of its own: the agent frame is its frame.
         author_keypoints(person_xf.GetPrim(), KEYPOINT_CLASSES["person"].names,

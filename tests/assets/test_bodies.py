@@ -11,10 +11,11 @@ from scipy import stats
 
 from synthua_usd.assets import body_bank, devices
 from synthua_usd.agents.profiles import PROFILES
-from synthua_usd.assets.bodies import BONES, SEGMENTS, load_bank, skin
-from synthua_usd.assets.postures import (AID_OFFSETS, AID_STANCE, AID_STANCE_START, GRIP_DX, MAX_PUSH_LEAN_DEG,
-                                         PUSH_DISTANCE_M, PUSHING, SEATED, STEPPING_AIDS, aid_shift_m, fit_device, pose,
-                                         push_handles, push_lean_deg, segment_motion, step_length_m)
+from synthua_usd.assets.bodies import BONES, SEGMENTS, forward_kinematics, load_bank, rot_y, rotation_between, skin
+from synthua_usd.assets.postures import (AID_OFFSETS, AID_STANCE, AID_STANCE_START, BENCH, GRIP_DX, MAX_PUSH_LEAN_DEG,
+                                         PUSH_DISTANCE_M, PUSHING, SEATED, STEPPING_AIDS, BodyParts, aid_shift_m,
+                                         bench_fit, fit_device, pose, push_handles, push_lean_deg, segment_motion,
+                                         step_length_m)
 
 #: How deep a body vertex may sit inside its own device: hands close round grips and push rims, whose
 #: boxes and cylinders are solid here.
@@ -191,7 +192,6 @@ def test_seated_on_a_bench_the_pelvis_rests_on_the_seat_and_the_feet_on_the_grou
     it (a child's dangle)."""
     from synthua_usd.agents.seats import ORIGIN_FROM_BACK_M
     from synthua_usd.assets import street
-    from synthua_usd.assets.postures import BENCH, bench_fit
 
     dx = 0.22 - ORIGIN_FROM_BACK_M  # the bench's centre in the sitter's frame
     solids = []
@@ -248,3 +248,39 @@ def test_a_pusher_holds_the_handles_walks_on_the_ground_and_stays_out_of_the_cha
         assert abs(posed[:, 2].min()) < 1e-6, phase  # as walking: the lower foot on the ground
         pts = _animated(bank, pusher, PUSHING, fit, phase, 1.0, 0.0)
         assert _penetration(pts - [PUSH_DISTANCE_M, 0.0, 0.0], solids) <= DEVICE_TOLERANCE_M, phase
+
+
+def test_skinning_some_vertices_gives_those_rows_of_the_whole(bank):
+    """``skin(..., vertices)`` (what keeps a walking foot on the ground) is bit for bit the skinning of the
+    whole body at those rows, for every body in random poses and any subset."""
+    rng = np.random.default_rng(7)
+    for body in range(len(bank)):
+        rest = bank.joints[body]
+        aims = {b: rot_y(rng.uniform(-60, 60)) @ rotation_between(rng.normal(size=3), rng.normal(size=3))
+                for b in BONES if rng.random() < 0.7}
+        matrices = forward_kinematics(rest, aims, rest[0] + rng.normal(0, 0.1, 3)).skinning(rest)
+        whole = skin(bank.points[body], bank, matrices)
+        for vertices in (np.sort(rng.choice(len(whole), rng.integers(2, len(whole)), replace=False)),
+                         np.arange(len(whole))):
+            assert skin(bank.points[body], bank, matrices, vertices).tobytes() == whole[vertices].tobytes()
+
+
+@pytest.mark.parametrize("device", [None, "walker", "crutch", "tripod_cane", "manual_wheelchair",
+                                    "electric_wheelchair", BENCH, PUSHING])
+def test_a_kept_posture_poses_as_a_fresh_one_in_any_order(bank, device):
+    """A crowd keeps one posture per body and fit (BodyParts.posture_cycle) and poses it at every time code: what
+    it computes once is never changed by a pose, so poses in any order equal, bit for bit, fresh ones."""
+    body = 11
+    fit = (bench_fit(0.45) if device == BENCH else fit_device(bank, body, "manual_wheelchair") if device == PUSHING
+           else fit_device(bank, body, device))
+    bodies = BodyParts()
+    cycle = bodies.posture_cycle(body, device, fit)
+    assert bodies.posture_cycle(body, device, fit) is cycle
+    rng = np.random.default_rng(3)
+    times = [(rng.uniform(0, 2 * np.pi), rng.uniform(0, 1), rng.uniform(-0.1, 0.1)) for _ in range(6)]
+    for phase, amplitude, shift in times + times[::-1]:
+        kept = cycle(phase, amplitude, shift)
+        fresh = pose(bank, body, device, fit, phase, amplitude, shift)
+        assert kept.rotations.tobytes() == fresh.rotations.tobytes()
+        assert kept.joints.tobytes() == fresh.joints.tobytes()
+        kept.joints[:] = np.nan  # a caller's scribbles do not reach the next pose

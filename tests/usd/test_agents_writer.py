@@ -8,7 +8,7 @@ import dataclasses
 import numpy as np
 import pytest
 from conftest import STAGES
-from pxr import Sdf, Usd, UsdGeom, UsdShade
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 
 from synthua_usd.agents.crowd import CrowdParams, scripted_crowd
 from synthua_usd.agents.motion import simulate
@@ -308,3 +308,18 @@ def test_crutches_and_canes_step_with_the_gait_and_the_hands_go_with_them(stage,
         assert max(gaps) < 0.05, (device, gaps)
         checked += 1
     assert checked == 5  # crutches and four canes
+
+
+def test_segment_orientations_round_each_quaternion_component_to_float():
+    """quat() converts Gf's double quaternion with Quatf(Quatd): the same floats as rounding the real part and
+    each imaginary component one by one (what the layers were written with before), for any rotation."""
+    from scipy.spatial.transform import Rotation
+
+    from synthua_usd.usd.agents_writer import quat
+
+    rng = np.random.default_rng(5)
+    rotations = Rotation.random(2000, random_state=6).as_matrix()
+    for r in np.concatenate([rotations, rotations + rng.normal(0, 1e-7, rotations.shape), np.eye(3)[None]]):
+        q = Gf.Matrix3d(*r.T.ravel().tolist()).ExtractRotation().GetQuat()
+        expected = Gf.Quatf(float(q.GetReal()), *(float(q.GetImaginary()[i]) for i in range(3)))
+        assert quat(r) == expected, r

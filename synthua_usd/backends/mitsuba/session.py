@@ -101,11 +101,13 @@ class RenderSession:
                 and weather_scene.own_lights(old, condition) == weather_scene.own_lights(snapshot, condition)
                 and (old.materials is snapshot.materials
                      or all(old.materials[k] == snapshot.materials.get(k) for k in {m.material_key for m in old.meshes}))
-                and all(a is b or (a.prim_path == b.prim_path and a.material_key == b.material_key
-                                   and a.points.shape == b.points.shape
-                                   and (a.normals is None) == (b.normals is None)
-                                   and (a.triangles is b.triangles or np.array_equal(a.triangles, b.triangles)))
-                        for a, b in zip(old.meshes, snapshot.meshes)))
+                # (the same meshes: every pair below is one object; label passes ask this for every view)
+                and (old.meshes is snapshot.meshes
+                     or all(a is b or (a.prim_path == b.prim_path and a.material_key == b.material_key
+                                       and a.points.shape == b.points.shape
+                                       and (a.normals is None) == (b.normals is None)
+                                       and (a.triangles is b.triangles or np.array_equal(a.triangles, b.triangles)))
+                            for a, b in zip(old.meshes, snapshot.meshes))))
 
     def _update(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> int:
         """Point the sensor at ``camera``, move what moved and switch to ``condition`` if it is another;
