@@ -35,7 +35,9 @@ def test_the_wheel_installed_alone_creates_the_district_and_generates_from_it(tm
         carried = set(archive.namelist())
     sources = {p.relative_to(REPO).as_posix() for p in (REPO / "synthua_usd").rglob("*.py")}
     schemas = {f"synthua_usd/schema_files/{p.name}" for p in (REPO / "schemas").glob("*.json")}
-    assert sources | schemas | {"synthua_usd/assets/data/bodies.npz"} <= carried, sorted(sources | schemas - carried)
+    data = {p.relative_to(REPO).as_posix() for p in (REPO / "synthua_usd" / "assets" / "data").rglob("*") if p.is_file()}
+    assert len(data) > 10 and "synthua_usd/assets/data/bodies.npz" in data  # the body bank and the look images
+    assert sources | schemas | data <= carried, sorted(sources | schemas | data - carried)
     venv = tmp_path / "venv"
     run([sys._base_executable, "-m", "venv", venv], tmp_path)
     python = venv / "bin" / "python"

@@ -130,7 +130,8 @@ class HairRandomisation:
 class LooksRandomisation:
     """How each person of the crowd (with crowd on) looks beyond colours: smooth shading (normals authored on
     the body's meshes), a fabric per garment among ``upper_fabrics`` and ``lower_fabrics`` (a pattern in a second
-    colour, the weave and folds in a normal map), shoes among ``shoes`` on soles of another colour, a face
+    colour, the weave and folds in a normal map; ``wardrobe`` upper and lower garments per scene, which its
+    people pick from), shoes among ``shoes`` on soles of another colour, a face
     (eyes, brows, nostrils, lips, cheeks as an image on the head) and skin with a clear coat; drawn from a stream
     of its own (switching it off or narrowing it moves no other draw). Off: flat-coloured garments and shoes,
     faceless matte skin, faceted bodies, as before."""
@@ -139,8 +140,11 @@ class LooksRandomisation:
     upper_fabrics: tuple[str, ...] = UPPER_FABRICS
     lower_fabrics: tuple[str, ...] = LOWER_FABRICS
     shoes: tuple[str, ...] = SHOES
+    wardrobe: int = 24
 
     def __post_init__(self) -> None:
+        if isinstance(self.wardrobe, bool) or not isinstance(self.wardrobe, int) or not 1 <= self.wardrobe <= 256:
+            raise InputError(f"looks.wardrobe: {self.wardrobe!r}; expected a whole number of garments in [1, 256]")
         for name, known in (("upper_fabrics", UPPER_FABRICS), ("lower_fabrics", LOWER_FABRICS), ("shoes", SHOES)):
             values = tuple(getattr(self, name))
             unknown = [v for v in values if v not in known]

@@ -23,7 +23,7 @@ from synthua_usd.assets.postures import DeviceFit, fit_device
 from synthua_usd.model.materials import (DEVICE_FINISHES, HAIR_COLOURS, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
                                    WOOD_COLOURS)
 from synthua_usd.randomisation.config import RandomisationConfig
-from synthua_usd.randomisation.wear import Wear, draw_wear
+from synthua_usd.randomisation.wear import Wardrobe, Wear, draw_wardrobe, draw_wear, jitter, pick
 
 RGB = tuple[float, float, float]
 #: Most people one randomised scene holds (a bound on the layers and the render, whatever the walkable area).
@@ -42,17 +42,6 @@ HAIR_COLOUR_WEIGHTS = {"black": 0.3, "dark_brown": 0.35, "brown": 0.18, "light_b
                        "auburn": 0.04}
 #: The profile of each aid class.
 PROFILE_OF_AID = {p.device: p.name for p in PROFILES.values() if p.device is not None}
-
-
-def _jitter(rng: np.random.Generator, rgb, amount: float) -> RGB:
-    """``rgb`` with each channel scaled by 1 + U(-amount, amount) (hue and value both move a little), clipped
-    to [0, 1]."""
-    scale = 1.0 + rng.uniform(-amount, amount, 3)
-    return tuple(float(v) for v in np.clip(np.asarray(rgb, float) * scale, 0.0, 1.0))
-
-
-def _pick(rng: np.random.Generator, palette):
-    return palette[int(rng.integers(len(palette)))]
 
 
 @dataclass(frozen=True)
@@ -152,7 +141,8 @@ class Recolourable:
 
 @dataclass(frozen=True)
 class SceneDraw:
-    """Everything one scene drew. ``cast`` empty and ``density_per_m2`` None when the crowd is not randomised."""
+    """Everything one scene drew. ``cast`` empty and ``density_per_m2`` None when the crowd is not randomised;
+    ``wardrobe`` None without looks."""
 
     scene_seed: int
     district_seed: int | None
@@ -160,6 +150,7 @@ class SceneDraw:
     aid_share: float | None
     cast: tuple[CastMember, ...]
     recolours: tuple[Recolour, ...]
+    wardrobe: Wardrobe | None = None
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -169,19 +160,19 @@ def _device_look(rng: np.random.Generator, aid: str, config: RandomisationConfig
     """The model (uniform over the class's models, drawn from a child stream of ``rng``: ``rng`` itself draws
     as many numbers whatever the number of models, so adding a model changes no other draw of the scene),
     then the finishes."""
-    model = _pick(rng.spawn(1)[0], sorted(DEVICE_MODELS[aid]))
+    model = pick(rng.spawn(1)[0], sorted(DEVICE_MODELS[aid]))
     if not config.devices.enabled:
         base = PALETTE["Frame"]
         seat = PALETTE["Seat"]
         return DeviceLook(model, Finish("standard", base.base_color, base.roughness, base.metallic),
                           Finish("standard", seat.base_color, seat.roughness, seat.metallic))
     if aid == "wooden_cane":
-        frame = Finish("wood", _jitter(rng, _pick(rng, WOOD_COLOURS), 0.15), 0.6, 0.0)
+        frame = Finish("wood", jitter(rng, pick(rng, WOOD_COLOURS), 0.15), 0.6, 0.0)
     else:
-        name = _pick(rng, config.devices.finishes)
+        name = pick(rng, config.devices.finishes)
         palette, roughness, metallic = DEVICE_FINISHES[name]
-        frame = Finish(name, _jitter(rng, _pick(rng, palette), 0.1), roughness, metallic)
-    seat = Finish("fabric", _jitter(rng, _pick(rng, SEAT_FABRICS), 0.2), 0.9, 0.0)
+        frame = Finish(name, jitter(rng, pick(rng, palette), 0.1), roughness, metallic)
+    seat = Finish("fabric", jitter(rng, pick(rng, SEAT_FABRICS), 0.2), 0.9, 0.0)
     return DeviceLook(model, frame, seat)
 
 
@@ -216,9 +207,9 @@ def _member(rng: np.random.Generator, profile: str, config: RandomisationConfig,
             group=None, min_height_m: float = 0.0) -> CastMember:
     aid = PROFILES[profile].device
     look = PersonLook.random(rng, aid_user=aid is not None, min_height_m=min_height_m)
-    jitter = config.crowd.clothing_jitter
+    amount = config.crowd.clothing_jitter
     colour = {"Shirt": SHIRTS, "Trousers": TROUSERS, "Shoes": SHOES}
-    upper, lower, shoes = (_jitter(rng, _pick(rng, colour[kind]).base_color, jitter) for kind in colour)
+    upper, lower, shoes = (jitter(rng, pick(rng, colour[kind]).base_color, amount) for kind in colour)
     device = _device_look(rng, aid, config) if aid is not None else None
     return CastMember(profile=profile, body=look.body, skin=look.skin, upper=upper, lower=lower, shoes=shoes,
                       long_sleeves=look.long_sleeves, long_legs=look.long_legs, device=device, seat=seat, group=group)
@@ -250,14 +241,14 @@ def _companions(rng: np.random.Generator, config: RandomisationConfig, members: 
 
 
 def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_area_m2: float,
-              seats: list[SeatPlace]) -> tuple[float, float, tuple[CastMember, ...]]:
-    """(density, aid share, members): N ~ Poisson(density x ``walkable_area_m2``) people (at most
+              seats: list[SeatPlace]) -> tuple[float, float, tuple[CastMember, ...], Wardrobe | None]:
+    """(density, aid share, members, wardrobe): N ~ Poisson(density x ``walkable_area_m2``) people (at most
     :data:`MAX_CAST`), each an aid user with probability ``aid share`` (the aid uniform over the config's
     aids; then maybe pushed or accompanied by companions among the N, :func:`_companions`, drawn from a child
     stream of ``rng``), else a pedestrian who sits on a free bench place of ``seats`` with probability
     ``seated_share`` or walks in a group of 2-3 with probability ``group_share``; then, with hair on, each
-    member's hair (:func:`draw_hair`), and with looks on their wear (:func:`synthua_usd.randomisation.wear.draw_wear`),
-    each from a child stream of ``rng``."""
+    member's hair (:func:`draw_hair`), and with looks on the scene's wardrobe and each member's pick from it
+    (:mod:`synthua_usd.randomisation.wear`; None without looks), each from a child stream of ``rng``."""
     crowd = config.crowd
     density = float(rng.uniform(*crowd.density_per_m2))
     aid_share = float(rng.uniform(*crowd.aid_share))
@@ -273,14 +264,14 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
     accompanied_share = float(companion_rng.uniform(*crowd.accompanied_share))
     while len(members) < count:
         if rng.random() < aid_share:
-            members.append(_member(rng, PROFILE_OF_AID[_pick(rng, crowd.aids)], config))
+            members.append(_member(rng, PROFILE_OF_AID[pick(rng, crowd.aids)], config))
             if _companions(companion_rng, config, members, count - len(members), pushed_share, accompanied_share,
                            groups):
                 groups += 1
         elif free and rng.random() < seated_share:
             members.append(_member(rng, "pedestrian", config, seat=seats[free.pop(int(rng.integers(len(free))))]))
         elif rng.random() < group_share and count - len(members) >= 2:
-            size = min(int(_pick(rng, GROUP_SIZES)), count - len(members))
+            size = min(int(pick(rng, GROUP_SIZES)), count - len(members))
             members += [_member(rng, "pedestrian", config, group=groups) for _ in range(size)]
             groups += 1
         else:
@@ -290,9 +281,17 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
     hair_rng, wear_rng = rng.spawn(2)
     if config.hair.enabled:
         members = [replace(m, hair=draw_hair(hair_rng, m.body, config)) for m in members]
-    if config.looks.enabled:
-        members = [replace(m, wear=draw_wear(wear_rng, m.upper, m.lower, config.looks)) for m in members]
-    return density, aid_share, tuple(members)
+    wardrobe = None
+    if config.looks.enabled:  # people dress from the scene's wardrobe: its garments' colours replace their own
+        wardrobe = draw_wardrobe(wear_rng, config.looks, config.crowd.clothing_jitter)
+        members = [dressed(m, draw_wear(wear_rng, wardrobe), wardrobe) for m in members]
+    return density, aid_share, tuple(members), wardrobe
+
+
+def dressed(member: CastMember, wear: Wear, wardrobe: Wardrobe) -> CastMember:
+    """``member`` wearing ``wear`` from ``wardrobe``: its garment and shoe colours those of what it picked."""
+    return replace(member, upper=wardrobe.uppers[wear.upper].colour, lower=wardrobe.lowers[wear.lower].colour,
+                   shoes=wardrobe.shoes[wear.shoes].colour, wear=wear)
 
 
 def draw_recolours(rng: np.random.Generator, config: RandomisationConfig,
@@ -307,7 +306,7 @@ def draw_recolours(rng: np.random.Generator, config: RandomisationConfig,
             continue
         kind, palette = RECOLOUR_PALETTES[obj.class_name]
         value = 1.0 + float(rng.uniform(-materials.value_jitter, materials.value_jitter))
-        chosen = np.asarray(_pick(rng, palette), float)
+        chosen = np.asarray(pick(rng, palette), float)
         if kind == "tint":
             out.append(Recolour(obj.prim_path, obj.class_name, obj.material, tint=tuple(float(v) for v in chosen * value)))
         elif obj.textured:
@@ -327,8 +326,9 @@ def draw_scene(rng: np.random.Generator, config: RandomisationConfig, scene_seed
     are), drawn from ``rng`` in that order."""
     density = aid_share = None
     cast: tuple[CastMember, ...] = ()
+    wardrobe = None
     if config.crowd.enabled:
-        density, aid_share, cast = draw_cast(rng, config, walkable_area_m2, seats)
+        density, aid_share, cast, wardrobe = draw_cast(rng, config, walkable_area_m2, seats)
     recolours = draw_recolours(rng, config, objects) if config.materials.enabled else ()
     return SceneDraw(scene_seed=scene_seed, district_seed=district_seed, density_per_m2=density, aid_share=aid_share,
-                     cast=cast, recolours=recolours)
+                     cast=cast, recolours=recolours, wardrobe=wardrobe)

@@ -45,7 +45,7 @@ from synthua_usd.model.scene import Material, SceneSnapshot
 from synthua_usd.randomisation.poses import posture_of, pose_member
 from synthua_usd.randomisation.scene import CastMember, Recolour, Recolourable, SceneDraw
 from synthua_usd.randomisation.view import Placement
-from synthua_usd.randomisation.wear import skin_material, wear_materials
+from synthua_usd.randomisation.wear import garment_material, shoes_material, skin_material
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, PrototypeLibrary, posture_name, prim_name, quat
 from synthua_usd.usd.authoring import apply_metadata, bind_material_path, define_preview_material, define_xform
 from synthua_usd.usd.conditions import SUN, VARIANT_SET, attribute_name
@@ -171,6 +171,16 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
             shared[key] = _material(stage, f"{LOOKS_ROOT}/{key}", key, spec.base_color, spec.roughness, spec.metallic)
         return shared[key]
 
+    def wardrobe_material(kind: str, k: int) -> str:  # one per garment of the scene's wardrobe, shared
+        path = f"{LOOKS_ROOT}/{kind}_{k:02d}"
+        if path not in shared:
+            wardrobe = scene.wardrobe
+            spec = (shoes_material(path, wardrobe.shoes[k]) if kind == "Shoes" else
+                    garment_material(path, (wardrobe.uppers if kind == "Upper" else wardrobe.lowers)[k]))
+            define_preview_material(stage, path, spec)
+            shared[path] = path
+        return shared[path]
+
     def skin_with_face(key: str) -> str:  # one per skin tone, shared
         if f"{key}Face" not in shared:
             path = f"{LOOKS_ROOT}/{key}Face"
@@ -188,11 +198,9 @@ def scene_layers(scene: SceneDraw, meta: StageMetadata, taxonomy: str, bodies: B
                 looks[region] = _material(stage, f"{LOOKS_ROOT}/{name}_{region.title()}", f"{name}_{region}",
                                           member.region_colour(region), rough)
         else:
-            looks = {"skin": skin_with_face(member.skin)}
-            for region, spec in wear_materials(f"{LOOKS_ROOT}/{name}", member.upper, member.lower, member.shoes,
-                                               member.wear).items():
-                define_preview_material(stage, spec.key, spec)
-                looks[region] = spec.key
+            looks = {"skin": skin_with_face(member.skin), "upper": wardrobe_material("Upper", member.wear.upper),
+                     "lower": wardrobe_material("Lower", member.wear.lower),
+                     "shoes": wardrobe_material("Shoes", member.wear.shoes)}
         posture, asked = posture_of(member)
         fit, _, parts = bodies.get(member.body, posture, asked)
         surfaces = bodies.surfaces(member.body, posture, asked) if member.wear is not None else None

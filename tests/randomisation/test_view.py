@@ -61,7 +61,7 @@ def test_people_stand_apart_on_walkable_cells(street):
     camera = read_camera(stage, "/World/Cameras/CCTV", 24.0)
     for seed in range(4):
         rng = np.random.default_rng(seed)
-        _, _, cast = draw_cast(rng, config, area.area_m2(), list(area.seats))
+        _, _, cast, _ = draw_cast(rng, config, area.area_m2(), list(area.seats))
         placements = place_cast(rng, cast, area, camera, (320, 240), config.crowd)
         assert len(placements) == len(cast) > 0
         xy = np.array([p.position[:2] for p in placements])
@@ -95,7 +95,7 @@ def test_aid_users_are_placed_where_the_camera_sees_them(street):
     seen = 0
     for seed in range(6):
         rng = np.random.default_rng(100 + seed)
-        _, _, cast = draw_cast(rng, config, area.area_m2(), list(area.seats))
+        _, _, cast, _ = draw_cast(rng, config, area.area_m2(), list(area.seats))
         for p in place_cast(rng, cast, area, camera, (width, height), config.crowd):
             if not p.in_view:
                 continue
@@ -118,7 +118,7 @@ def test_placement_is_a_function_of_its_stream(street):
     config = RandomisationConfig()
     camera = read_camera(stage, "/World/Cameras/CCTV", 24.0)
     rng = np.random.default_rng(7)
-    _, _, cast = draw_cast(rng, config, area.area_m2(), list(area.seats))
+    _, _, cast, _ = draw_cast(rng, config, area.area_m2(), list(area.seats))
     a = place_cast(np.random.default_rng(1), cast, area, camera, (320, 240), config.crowd)
     b = place_cast(np.random.default_rng(1), cast, area, camera, (320, 240), config.crowd)
     c = place_cast(np.random.default_rng(2), cast, area, camera, (320, 240), config.crowd)
@@ -167,7 +167,7 @@ def test_companions_walk_behind_or_beside_their_aid_user(street):
     pushed = accompanied = 0
     for seed in range(4):
         rng = np.random.default_rng(seed)
-        _, _, cast = draw_cast(rng, config, area.area_m2(), list(area.seats))
+        _, _, cast, _ = draw_cast(rng, config, area.area_m2(), list(area.seats))
         placements = place_cast(rng, cast, area, camera, (320, 240), config.crowd)
         for k, (m, p) in enumerate(zip(cast, placements)):
             user = m.pushes if m.pushes is not None else m.accompanies

@@ -5,7 +5,10 @@ Texture files are decoded here, once per file and colour space per translation (
 OpenImageIO (files inside USDZ packages too: :mod:`synthua_usd.core.texture_files`): 8-bit sRGB images (and ``sRGB`` textures) through the exact sRGB transfer function, alpha never;
 raw images as stored. Then UsdUVTexture's ``scale`` and ``bias`` and the chosen channel, and the result goes
 to Mitsuba as a float bitmap with ``raw=True``: Mitsuba never converts it again, and a single channel stays
-single (Mitsuba would take an RGB bitmap's luminance for a roughness, not its green). Mitsuba's bitmap puts
+single (Mitsuba would take an RGB bitmap's luminance for a roughness, not its green). A tinted base colour
+(``scale`` and ``bias`` on an RGB texture) is instead an ``affine`` texture over the image's one shared bitmap
+(:mod:`synthua_usd.backends.mitsuba.affine_texture`): a crowd's garments, or a district's recoloured façades,
+do not each copy their image. Mitsuba's bitmap puts
 v = 0 on the image's first (top) row, USD's t = 0 on its bottom row: meshes get (s, 1 − t)
 (:func:`mitsuba_uvs`).
 """
@@ -13,10 +16,12 @@ v = 0 on the image's first (top) row, USD's t = 0 on its bottom row: meshes get 
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
 
+from synthua_usd.backends.mitsuba import affine_texture
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.texture_files import MAX_TEXELS, TextureFileError, open_image
 from synthua_usd.model import srgb
@@ -49,6 +54,7 @@ class TextureImages:
         self.mi = mi
         self._rgba: dict[tuple[str, str], np.ndarray] = {}
         self._nodes: dict[tuple, object] = {}
+        affine_texture.register(mi)
 
     def rgba(self, path: str, color_space: str) -> np.ndarray:
         """(H, W, 4) float32 linear RGBA of the image at ``path`` (grey fills RGB, missing alpha is 1), decoded
@@ -111,6 +117,21 @@ class TextureImages:
                 "filter_type": "bilinear", "wrap_mode": WRAP[texture.wrap_s]})
         return self._nodes[key]
 
+    def tinted(self, texture: Texture):
+        """``texture`` (RGB) as an ``affine`` texture (:mod:`affine_texture`: its ``scale`` and ``bias``, clipped to
+        [0, 1]) over its image's bitmap, which every material tinting that image shares; a texture without scale
+        and bias is its bitmap. One copy of an image however many materials tint it."""
+        plain = replace(texture, scale=(1.0, 1.0, 1.0, 1.0), bias=(0.0, 0.0, 0.0, 0.0))
+        if texture == plain:
+            return self.node(texture, lambda d: np.clip(d, 0.0, 1.0), "albedo")
+        key = ("affine", texture)
+        if key not in self._nodes:
+            mi = self.mi
+            self._nodes[key] = mi.load_dict({"type": "affine", "texture": self.node(plain, None, "plain"),
+                                             "scale": mi.ScalarColor3f(*texture.scale[:3]),
+                                             "bias": mi.ScalarColor3f(*texture.bias[:3])})
+        return self._nodes[key]
+
 
 def principled_dict(material: Material, images: TextureImages | None = None,
                     albedo: Callable[[np.ndarray], np.ndarray] | None = None, roughness_factor: float = 1.0,
@@ -123,6 +144,8 @@ def principled_dict(material: Material, images: TextureImages | None = None,
 
     def colour():
         if material.base_color_texture is not None and images is not None:
+            if albedo is None and material.base_color_texture.channel == "rgb":
+                return images.tinted(material.base_color_texture)
             return images.node(material.base_color_texture, lambda d: (albedo or clip)(clip(d)), f"albedo{name}")
         value = np.asarray(material.base_color, np.float64)
         return {"type": "rgb", "value": (albedo(value) if albedo else value).tolist()}
