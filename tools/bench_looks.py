@@ -3,15 +3,16 @@
 the skin's clear coat), measured side by side against the same images without them.
 
 Usage: python tools/bench_looks.py [--scenario stages/district/scenario.usda] [--width 1280 --height 960]
-       [--spp 32] [--scenes 2] [--views 3] [--rounds 2] [--json docs/measured/bench_looks.json]
+       [--spp 32] [--scenes 2] [--views 3] [--rounds 2] [--settings plain,hair,looks]
+       [--json docs/measured/bench_looks.json]
 
-Two settings of the `randomise` block, everything else the same draws: ``plain`` (``looks`` and ``hair`` off: flat
-colours, bald, faceted) and ``looks`` (both on, the defaults). Each round runs one fresh process per setting, in
-alternating order (plain first in even rounds), and each process renders the same --scenes x --views images as
+Three settings of the `randomise` block, everything else the same draws: ``plain`` (``looks`` and ``hair`` off: flat
+colours, bald, faceted), ``hair`` (hair on, looks off) and ``looks`` (both on, the defaults). Each round runs one
+fresh process per setting, the order rotating from round to round, and each process renders the same --scenes x --views images as
 `synthua generate`'s worker does (a Randomiser, a StageReader, a RenderSession at the default quality: box filter,
 OIDN): per image the randomisation (apply), the reader (read), the session's load (a new scene) or update (a view
 of it), the label pass and the RGB pass. Reported: the medians over the rounds of each process's total and per-part
-seconds, the looks/plain ratio, each process's peak resident memory, and CPU seconds (all threads; the figure to
+seconds, the hair/plain and looks/plain ratios, each process's peak resident memory, and CPU seconds (all threads; the figure to
 trust on a shared machine). Not a test: the numbers depend on the machine; the ratios come from one run.
 """
 
@@ -27,7 +28,8 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-SETTINGS = {"plain": {"looks": {"enabled": False}, "hair": {"enabled": False}}, "looks": {}}
+SETTINGS = {"plain": {"looks": {"enabled": False}, "hair": {"enabled": False}}, "hair": {"looks": {"enabled": False}},
+            "looks": {}}
 
 
 def run_one(args) -> dict:
@@ -89,16 +91,21 @@ def main() -> int:
     parser.add_argument("--scenes", type=int, default=2)
     parser.add_argument("--views", type=int, default=3)
     parser.add_argument("--rounds", type=int, default=2)
+    parser.add_argument("--settings", default=",".join(SETTINGS),
+                        help=f"which settings to run, comma-separated, plain first [default: {','.join(SETTINGS)}]")
     parser.add_argument("--json", type=Path, help="write the measurements here")
     parser.add_argument("--setting", choices=sorted(SETTINGS), help=argparse.SUPPRESS)  # one process's side
     args = parser.parse_args()
+    order = tuple(s for s in args.settings.split(",") if s)
+    if order[:1] != ("plain",) or not set(order) <= set(SETTINGS) or len(order) < 2:
+        parser.error(f"--settings: {args.settings!r}; expected plain and one or more of hair, looks")
     if args.setting:
         print(json.dumps(run_one(args)))
         return 0
 
-    runs: dict[str, list[dict]] = {name: [] for name in SETTINGS}
+    runs: dict[str, list[dict]] = {name: [] for name in order}
     for r in range(args.rounds):
-        for setting in (("plain", "looks") if r % 2 == 0 else ("looks", "plain")):
+        for setting in order[r % len(order):] + order[:r % len(order)]:
             command = [sys.executable, __file__, "--setting", setting, "--scenario", str(args.scenario), "--width",
                        str(args.width), "--height", str(args.height), "--scenes", str(args.scenes), "--views",
                        str(args.views), *(["--spp", str(args.spp)] if args.spp else [])]
@@ -114,17 +121,21 @@ def main() -> int:
 
     print(f"\n{args.scenario.name}, {args.width}x{args.height}, {runs['looks'][0]['spp']} spp + OIDN, "
           f"{args.scenes} scenes x {args.views} views, medians of {args.rounds} rounds")
-    print(f"{'measure':34} {'plain':>10} {'looks':>10} {'ratio':>7}")
+    others = order[1:]
+    print(f"{'measure':34} " + " ".join(f"{s:>10}" for s in order) + " " + " ".join(f"{s + '/plain':>12}" for s in others))
     rows = [("wall seconds, all images", "total_s", None), ("CPU seconds (all threads)", "cpu_s", None),
             ("peak resident memory, MiB", "peak_rss_mib", None)]
     rows += [(f"  of which {part}", "parts_s", part) for part in ("apply", "read", "load", "update", "labels", "rgb")]
     table = {}
     for name, key, part in rows:
-        a, b = median("plain", key, part), median("looks", key, part)
-        table[name.strip()] = {"plain": a, "looks": b, "ratio": b / a if a else None}
-        print(f"{name:34} {a:10.2f} {b:10.2f} {b / a if a else float('nan'):7.3f}")
+        values = {setting: median(setting, key, part) for setting in order}
+        a = values["plain"]
+        ratios = {f"{s}_ratio": values[s] / a if a else None for s in others}
+        table[name.strip()] = {**values, **ratios}
+        print(f"{name:34} " + " ".join(f"{values[s]:10.2f}" for s in order) + " "
+              + " ".join(f"{r:12.3f}" if r is not None else f"{'-':>12}" for r in ratios.values()))
     for key in ("people_per_scene", "crowd_meshes_per_scene", "textured_meshes_per_scene"):
-        print(f"{key:34} {runs['plain'][0][key]:10.1f} {runs['looks'][0][key]:10.1f}")
+        print(f"{key:34} " + " ".join(f"{runs[setting][0][key]:10.1f}" for setting in order))
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps({"scenario": args.scenario.name, "size": [args.width, args.height],
