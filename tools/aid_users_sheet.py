@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from randomised_sheet import save_grid  # tools/ is the script's own folder on sys.path
+
 REPO = Path(__file__).resolve().parents[1]
 #: The randomise block of the sheet (a generation config's; its schema documents each part).
 RANDOMISE = {"seed": 5, "crowd": {"density_per_m2": [0.03, 0.05], "aid_share": [0.4, 0.6], "aid_users_in_view": [2, 3],
@@ -117,24 +119,9 @@ def main() -> int:
             captions.append(f"{member.aid.replace('_', ' ')}, {who} (seed {seed})")
             print(captions[-1], flush=True)
 
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    rows = -(-len(cells) // args.columns)
-    fig, axes = plt.subplots(rows, args.columns, figsize=(args.columns * 4.0, rows * 2.2))
-    for ax, cell, caption in zip(np.ravel(axes), cells, captions):
-        ax.imshow(cell)
-        ax.set_title(caption, fontsize=7)
-        ax.axis("off")
-    for ax in np.ravel(axes)[len(cells):]:
-        ax.axis("off")
-    fig.suptitle(f"Mobility-aid users in randomised images of {args.scenario.parent.name}/{args.scenario.name}: "
-                 f"RGB ({args.width}x{args.height}, {args.spp} spp + OIDN) beside the class overlay", fontsize=9)
-    fig.tight_layout()
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(args.out, dpi=110, pil_kwargs={"quality": 85})
+    save_grid(cells, captions, args.columns, 2.2, 7, f"Mobility-aid users in randomised images of "
+              f"{args.scenario.parent.name}/{args.scenario.name}: RGB ({args.width}x{args.height}, {args.spp} spp + "
+              f"OIDN) beside the class overlay", args.out)
     print(f"wrote {args.out}")
     return 0
 

@@ -22,6 +22,28 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 
 
+def save_grid(cells, captions, columns: int, row_inches: float, caption_size: float, title: str, out: Path) -> None:
+    """``cells`` (images) in a grid of ``columns``, each under its caption, with ``title`` above, saved to ``out``
+    (JPEG quality 85 or PNG by its suffix); also used by tools/aid_users_sheet.py."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    rows = -(-len(cells) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(columns * 4.0, rows * row_inches))
+    for ax, cell, caption in zip(np.ravel(axes), cells, captions):
+        ax.imshow(cell)
+        ax.set_title(caption, fontsize=caption_size)
+        ax.axis("off")
+    for ax in np.ravel(axes)[len(cells):]:
+        ax.axis("off")
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110, pil_kwargs={"quality": 85})
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenario", type=Path, default=REPO / "stages" / "district" / "scenario.usda")
@@ -69,24 +91,8 @@ def main() -> int:
                         f"{drawn.light.exposure_ev:+.1f} EV")
         print(captions[-1], flush=True)
 
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    rows = -(-len(cells) // args.columns)
-    fig, axes = plt.subplots(rows, args.columns, figsize=(args.columns * 4.0, rows * 3.25))
-    for ax, cell, caption in zip(np.ravel(axes), cells, captions):
-        ax.imshow(cell)
-        ax.set_title(caption, fontsize=6.5)
-        ax.axis("off")
-    for ax in np.ravel(axes)[len(cells):]:
-        ax.axis("off")
-    fig.suptitle(f"{args.camera} at time code {args.time_code:g}, {args.condition}: one scene per seed "
-                 f"({args.config.name} randomise block)", fontsize=9)
-    fig.tight_layout()
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(args.out, dpi=110, pil_kwargs={"quality": 85})
+    save_grid(cells, captions, args.columns, 3.25, 6.5, f"{args.camera} at time code {args.time_code:g}, "
+              f"{args.condition}: one scene per seed ({args.config.name} randomise block)", args.out)
     print(f"wrote {args.out}")
     return 0
 
