@@ -25,6 +25,9 @@ Guarantees:
   shard continues at the first item not delivered on another worker, an idle one (state built, nothing left
   to do) or else a new one with a fresh state; after ``retries`` such losses of one shard the run stops with
   :class:`WorkerLostError`;
+- with ``more``, when every shard given so far is done, ``more()`` is asked for the next ones (a round that
+  depends on the results so far: replacements for rejected images); they run on the same workers, whose
+  states are built, numbered after the earlier shards; an empty answer ends the run;
 - on any exit, KeyboardInterrupt included, every worker is ended before :func:`run_shards` returns.
 
 Which worker runs which shard, and what a worker's state did before, varies from run to run: a caller
@@ -62,7 +65,8 @@ STOP_GRACE_S = 5.0
 
 
 def run_shards(shards: Sequence[Sequence[T]], init: Callable[[], S], work: Callable[[S, T], R],
-               on_result: Callable[[ItemResult[R]], None], config: ExecutorConfig = ExecutorConfig()) -> RunSummary:
+               on_result: Callable[[ItemResult[R]], None], config: ExecutorConfig = ExecutorConfig(),
+               more: Callable[[], Sequence[Sequence[T]]] | None = None) -> RunSummary:
     """Run every item of every shard (see the module's docstring for the guarantees).
 
     ``init`` and ``work`` must be picklable: top-level functions, bound with :func:`functools.partial`.
@@ -78,13 +82,16 @@ def run_shards(shards: Sequence[Sequence[T]], init: Callable[[], S], work: Calla
                             f"top-level function, bound with functools.partial") from exc
     summary = RunSummary(shards=len(shards))
     t0 = time.perf_counter()
+    if more is not None and not any(shards):  # nothing to start with: the first round may still come
+        shards = [list(s) for s in more()]
+        summary.shards = len(shards)
     if any(shards):
         if config.kind == "local":
-            _LocalPool(shards, init, work, on_result, config, summary).run()
+            _LocalPool(shards, init, work, on_result, config, summary, more).run()
         else:
             from synthua_usd.pipeline.ray_executor import run_on_ray
 
-            run_on_ray(shards, init, work, on_result, config, summary)
+            run_on_ray(shards, init, work, on_result, config, summary, more)
     summary.seconds = time.perf_counter() - t0
     return summary
 
@@ -147,29 +154,49 @@ class _Slot:
 
 
 class _LocalPool:
-    def __init__(self, shards, init, work, on_result, config: ExecutorConfig, summary: RunSummary) -> None:
-        self.shards, self.init, self.work, self.on_result = shards, init, work, on_result
+    def __init__(self, shards, init, work, on_result, config: ExecutorConfig, summary: RunSummary,
+                 more: Callable[[], Sequence[Sequence[T]]] | None = None) -> None:
+        self.init, self.work, self.on_result, self.more = init, work, on_result, more
         self.summary = summary
-        self.retries = config.retries
-        self.count = min(config.workers, sum(1 for s in shards if s))
+        self.retries, self.workers = config.retries, config.workers
         self.context = multiprocessing.get_context("spawn")
-        self.queue = deque((i, 0) for i, s in enumerate(shards) if s)  # (shard, first item not yet delivered)
-        self.attempts = {i: 0 for i in range(len(shards))}
+        self.shards: list[list] = []
+        self.queue: deque = deque()  # (shard, first item not yet delivered)
+        self.attempts: dict[int, int] = {}
         self.slots: list[_Slot] = []
+        self._add(shards)
+
+    def _add(self, shards) -> None:
+        """Queue ``shards`` after those already given; idle workers take them, new ones start for the rest."""
+        first = len(self.shards)
+        self.shards.extend(list(s) for s in shards)
+        self.attempts.update((first + i, 0) for i in range(len(shards)))
+        self.queue.extend((first + i, 0) for i, s in enumerate(shards) if s)
+        for slot in self.slots:
+            if slot.status == "idle" and self.queue:
+                self._dispatch(slot)
+        waiting = sum(1 for s in self.slots if s.status == "starting")
+        live = sum(1 for s in self.slots if s.status != "stopped")
+        for _ in range(min(len(self.queue) - waiting, self.workers - live)):
+            self.slots.append(self._start())
 
     def run(self) -> None:
         try:
-            for _ in range(self.count):
-                self.slots.append(self._start())
-            while any(s.status == "busy" for s in self.slots) or self.queue:
-                for conn in wait([s.conn for s in self.slots if s.status != "stopped"]):
-                    slot = next(s for s in self.slots if s.conn is conn)
-                    try:
-                        message = conn.recv()
-                    except (EOFError, OSError):
-                        self._lost(slot)
-                        continue
-                    self._handle(slot, message)
+            while True:
+                while any(s.status == "busy" for s in self.slots) or self.queue:
+                    for conn in wait([s.conn for s in self.slots if s.status != "stopped"]):
+                        slot = next(s for s in self.slots if s.conn is conn)
+                        try:
+                            message = conn.recv()
+                        except (EOFError, OSError):
+                            self._lost(slot)
+                            continue
+                        self._handle(slot, message)
+                shards = [] if self.more is None else [list(s) for s in self.more()]
+                if not any(shards):
+                    return
+                self.summary.shards += len(shards)
+                self._add(shards)
         finally:
             self._stop_all()
 

@@ -26,13 +26,14 @@ import os
 import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from synthua_usd import __version__
 from synthua_usd.composition.scenario import ROOT_FILE
 from synthua_usd.core.atomic import write_json_atomic, write_text_atomic
-from synthua_usd.core.errors import InputError, OutputError, StageError, echo
+from synthua_usd.core.errors import InputError, OutputError, StageError
 from synthua_usd.core.resources import check_frame_memory
 from synthua_usd.dataset import coverage, qa, sampling
 from synthua_usd.dataset.annotations import relation_entries
@@ -293,21 +294,22 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
         peaks[result.worker] = max(peaks.get(result.worker, 0.0), result.peak_rss_mib)
         summary.rss_trace.append((summary.rendered, result.worker, result.peak_rss_mib))
 
-    # Images QA rejects are replaced by others of the pool (their quotas counted), round by round; the plan
-    # records each image's round, so a resumed run goes on where the killed one stood.
-    while True:
-        _render_all(todo, done, job, request, config_workers, collect, out)
+    # Images QA rejects are replaced by others of the pool (their quotas counted), round by round, on the same
+    # workers; the plan records each image's round, so a resumed run goes on where the killed one stood.
+    def next_round() -> list:
         rejected = {p.id for p in plan if is_rejected(done[p.id])}
         last_round = max((p.round for p in plan), default=0)
         todo = (sampling.replacements(pool, scores, config, plan, rejected, round=last_round + 1)
                 if rejected and last_round < REPLACEMENT_ROUNDS else [])
-        if not todo:
-            break
-        plan += todo
-        job_document["plan"] = [p.to_dict() for p in plan]
-        _write_job(out, job_document)
-        bar.total += len(todo)
-        bar.refresh()
+        if todo:
+            plan.extend(todo)
+            job_document["plan"] = [p.to_dict() for p in plan]
+            _write_job(out, job_document)
+            bar.total += len(todo)
+            bar.refresh()
+        return todo
+
+    _render_all(todo, done, job, request, config_workers, collect, out, next_round)
     bar.close()
     summary.planned = len(plan)
     records = [done[p.id] for p in plan]
@@ -402,9 +404,11 @@ def worker_job_from_document(document: dict, out_dir: Path, scenario: Path | Non
                      scenes=scenes)
 
 
-def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, workers: int, collect, out: Path) -> None:
-    """Render every planned image of ``todo`` on the executor, in shards; rounds repeat for images a lost
-    worker took with it."""
+def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, workers: int, collect, out: Path,
+                next_round: Callable[[], list]) -> None:
+    """Render every planned image of ``todo`` on the executor, in shards, and then the images of each
+    ``next_round()`` until it gives none; one pool of workers (their scenes loaded) runs every round. A round
+    repeats the images a lost worker took with it before the next one starts."""
     from synthua_usd.pipeline.executors import run_shards
     from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 
@@ -419,17 +423,24 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
             return (-1 if district is None else district, p.seed, p.condition or "", p.camera_path, p.time_code, p.id)
     else:
         order = lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id)  # noqa: E731
-    while todo:
-        ordered = sorted(todo, key=order)
-        shards = [ordered[i:i + SHARD_IMAGES] + [FLUSH] for i in range(0, len(ordered), SHARD_IMAGES)]
-        executor = ExecutorConfig(kind=request.executor, workers=min(workers, len(shards)), address=request.address,
-                                  cpus_per_worker=request.cpus_per_worker)
-        run_shards(shards, functools.partial(init_worker, job), work, collect, executor)
-        missing = [p for p in todo if p.id not in done]
-        if len(missing) == len(todo):
+    def shards_of(images) -> list:
+        ordered = sorted(images, key=order)
+        return [ordered[i:i + SHARD_IMAGES] + [FLUSH] for i in range(0, len(ordered), SHARD_IMAGES)]
+
+    current = list(todo)
+
+    def more() -> list:
+        nonlocal current
+        missing = [p for p in current if p.id not in done]
+        if missing and len(missing) == len(current):
             raise OutputError(f"{out}: {len(missing)} images were rendered but none was written; expected "
                               f"their records in {out / 'records'}")
-        todo = missing
+        current = missing or next_round()
+        return shards_of(current)
+
+    executor = ExecutorConfig(kind=request.executor, workers=workers, address=request.address,
+                              cpus_per_worker=request.cpus_per_worker)
+    run_shards(shards_of(current), functools.partial(init_worker, job), work, collect, executor, more=more)
 
 
 def _score_from_dict(document: dict) -> sampling.ViewScore:

@@ -110,7 +110,7 @@ def check_reachable(address: str) -> None:
 
 
 def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Callable[[ItemResult], None],
-               config: ExecutorConfig, summary: RunSummary) -> None:
+               config: ExecutorConfig, summary: RunSummary, more: Callable[[], list] | None = None) -> None:
     """Run ``shards`` on ``config.workers`` actors (see :func:`~synthua_usd.pipeline.executors.run_shards`)."""
     import ray
 
@@ -167,45 +167,26 @@ def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Ca
         else:
             actors.append(start())
 
+    def add(more_shards) -> None:  # a next round: idle actors take it, new ones start for the rest
+        first = len(shards)
+        shards.extend(list(s) for s in more_shards)
+        attempts.update((first + i, 0) for i in range(len(more_shards)))
+        queue.extend((first + i, 0) for i, s in enumerate(more_shards) if s)
+        for actor in actors:
+            if actor.ready_ref is None and actor.shard is None and queue:
+                dispatch(actor)
+        waiting = sum(1 for a in actors if a.ready_ref is not None)
+        actors.extend(start() for _ in range(min(len(queue) - waiting, config.workers - len(actors))))
+
     try:
         actors.extend(start() for _ in range(min(config.workers, len(queue))))
-        while queue or any(a.shard is not None for a in actors):
-            heads = {(a.ready_ref if a.ready_ref is not None else a.in_flight[0]): a
-                     for a in actors if a.ready_ref is not None or a.in_flight}
-            if not heads:  # every actor idle and the queue empty: cannot happen while the loop runs
-                raise WorkerError("ray executor: no actor is working but shards remain (a bug)")
-            done = []
-            while not done:  # a wait without a timeout blocks in Ray's C++ code, deaf to Ctrl-C
-                done, _ = ray.wait(list(heads), num_returns=1, timeout=WAIT_S)
-            actor = heads[done[0]]
-            try:
-                envelope = ray.get(done[0])
-            except ray.exceptions.RayTaskError as exc:  # the actor's answer itself failed (it cannot be sent)
-                first = _ANSI.sub("", str(exc)).strip().splitlines()[:1]
-                raise WorkerError(f"Ray actor {actor.name}: {type(exc).__name__}: {echo(''.join(first))}") from exc
-            except ray.exceptions.RayError as exc:
-                lost(actor, exc)
-                continue
-            if actor.ready_ref is not None:
-                actor.ready_ref = None
-                if envelope[0] == "error":
-                    raise_failure(envelope, "Ray actor, building its state")
-                _, actor.name, actor.peak = envelope
-                summary.peak_rss_mib[actor.name] = actor.peak
-                dispatch(actor)
-                continue
-            actor.in_flight.popleft()
-            if envelope[0] == "error":
-                raise_failure(envelope, f"Ray actor {actor.name}, item {actor.next_index} of shard {actor.shard}")
-            _, value, actor.peak, seconds = envelope
-            summary.peak_rss_mib[actor.name] = actor.peak
-            on_result(ItemResult(actor.shard, actor.next_index, value, actor.name, actor.peak, seconds))
-            summary.items += 1
-            actor.next_index += 1
-            if actor.next_index < len(shards[actor.shard]):
-                feed(actor)
-            else:
-                dispatch(actor)
+        while True:
+            _drain(ray, actors, queue, shards, on_result, summary, dispatch, feed, lost)
+            following = [] if more is None else [list(s) for s in more()]
+            if not any(following):
+                break
+            summary.shards += len(following)
+            add(following)
     finally:
         for actor in actors:
             try:
@@ -214,3 +195,45 @@ def run_on_ray(shards: list[list], init: Callable, work: Callable, on_result: Ca
                 log.debug("could not kill Ray actor %s: %s", actor.name, exc)
         if started:
             ray.shutdown()
+
+
+def _drain(ray, actors: list, queue: deque, shards: list[list], on_result: Callable[[ItemResult], None],
+           summary: RunSummary, dispatch: Callable, feed: Callable, lost: Callable) -> None:
+    """Run until every queued shard is done: deliver each answer, keep each actor fed."""
+    while queue or any(a.shard is not None for a in actors):
+        heads = {(a.ready_ref if a.ready_ref is not None else a.in_flight[0]): a
+                 for a in actors if a.ready_ref is not None or a.in_flight}
+        if not heads:  # every actor idle and the queue empty: cannot happen while the loop runs
+            raise WorkerError("ray executor: no actor is working but shards remain (a bug)")
+        done = []
+        while not done:  # a wait without a timeout blocks in Ray's C++ code, deaf to Ctrl-C
+            done, _ = ray.wait(list(heads), num_returns=1, timeout=WAIT_S)
+        actor = heads[done[0]]
+        try:
+            envelope = ray.get(done[0])
+        except ray.exceptions.RayTaskError as exc:  # the actor's answer itself failed (it cannot be sent)
+            first = _ANSI.sub("", str(exc)).strip().splitlines()[:1]
+            raise WorkerError(f"Ray actor {actor.name}: {type(exc).__name__}: {echo(''.join(first))}") from exc
+        except ray.exceptions.RayError as exc:
+            lost(actor, exc)
+            continue
+        if actor.ready_ref is not None:
+            actor.ready_ref = None
+            if envelope[0] == "error":
+                raise_failure(envelope, "Ray actor, building its state")
+            _, actor.name, actor.peak = envelope
+            summary.peak_rss_mib[actor.name] = actor.peak
+            dispatch(actor)
+            continue
+        actor.in_flight.popleft()
+        if envelope[0] == "error":
+            raise_failure(envelope, f"Ray actor {actor.name}, item {actor.next_index} of shard {actor.shard}")
+        _, value, actor.peak, seconds = envelope
+        summary.peak_rss_mib[actor.name] = actor.peak
+        on_result(ItemResult(actor.shard, actor.next_index, value, actor.name, actor.peak, seconds))
+        summary.items += 1
+        actor.next_index += 1
+        if actor.next_index < len(shards[actor.shard]):
+            feed(actor)
+        else:
+            dispatch(actor)

@@ -144,6 +144,51 @@ def test_local_runs_every_item_once_in_shard_order_on_states_built_once(workers,
     assert all(gone(pid, 0.5) for pid in pids)
 
 
+def rounds_of(*rounds):
+    """A ``more`` that hands out ``rounds`` one by one (then nothing), and the shards in the order given."""
+    given, left = [], list(rounds)
+
+    def more():
+        shards = left.pop(0) if left else []
+        given.extend(shards)
+        return shards
+
+    return more, given
+
+
+@pytest.mark.parametrize("kind", ["local", "ray"])
+def test_later_rounds_run_on_the_same_workers_and_states(kind, tmp_path, request):
+    if kind == "ray":
+        request.getfixturevalue("ray_instance")
+    more, given = rounds_of([[14, 15], [16]], [], [[17]])  # an empty answer ends the run: [[17]] is never asked
+    got, order = {}, []
+
+    def on_result(r):
+        assert (r.shard, r.index) not in got, "a result delivered twice"
+        got[(r.shard, r.index)] = r.value
+        order.append(r)
+
+    init = functools.partial(make_state, SEED, meet=(str(tmp_path), 2))
+    summary = run_shards(SHARDS, init, toy_work, on_result, ExecutorConfig(kind, workers=2), more=more)
+    shards = SHARDS + given
+    assert given == [[14, 15], [16]] and summary.shards == 6 and summary.items == 17
+    check_run(got, order, shards)
+    # the rounds came after every earlier result, on the two states built for the first round
+    assert [r.shard for r in order][-3:].count(4) == 2 and {r.shard for r in order[-3:]} == {4, 5}
+    assert len({v[1] for v in got.values()}) == 2
+    if kind == "local":
+        assert len(worker_pids(order)) == 2
+
+
+def test_a_first_round_from_more_alone_starts_the_workers():
+    more, given = rounds_of([[1, 2]])
+    got = {}
+    summary = run_shards([], INIT, toy_work, lambda r: got.setdefault((r.shard, r.index), r.value),
+                         ExecutorConfig("local"), more=more)
+    assert given == [[1, 2]] and summary.items == 2 and summary.shards == 1
+    assert got[(0, 1)][0] == expected_value(2)
+
+
 def test_peak_rss_grows_with_an_allocation():
     before = peak_rss_mib()
     block = np.ones(64 * 2**20 // 8)  # 64 MiB, touched
