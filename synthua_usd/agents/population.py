@@ -9,14 +9,17 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import networkx as nx
 import numpy as np
 
 from synthua_usd.agents.profiles import AID_PROFILES, PROFILES, AgentProfile
 from synthua_usd.agents.seats import SeatPlace
 from synthua_usd.agents.walkable import Router, WalkableGrid
 from synthua_usd.core.errors import InputError
+
+if TYPE_CHECKING:  # imported where used (~0.2 s that most processes never need)
+    import networkx as nx
 
 log = logging.getLogger(__name__)
 
@@ -129,6 +132,7 @@ def plan_agents(rng: np.random.Generator, graph: nx.Graph, grid: WalkableGrid, c
 def _route(rng, router, nodes, pos, profile, min_route_m, goals=None):
     """Waypoints (k, 3) and surfaces of a route of ``profile`` between two random nodes at least ``min_route_m``
     apart (the second one of ``goals``, indices into ``nodes``, if given); None after 20 tries."""
+    import networkx as nx
     graph = router.graph
     for _ in range(20):
         a, b = rng.integers(len(nodes), size=2)

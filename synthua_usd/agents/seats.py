@@ -10,7 +10,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import trimesh
 
 from synthua_usd.agents.walkable import WalkableGrid
 
@@ -36,6 +35,7 @@ class SeatPlace:
 def find_seat_places(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, grid: WalkableGrid,
                      furniture: str = "furniture") -> list[SeatPlace]:
     """Places on every seat of ``furniture`` objects (see the module's docstring), in a fixed order."""
+    import trimesh
     mask = face_class == furniture
     if not mask.any():
         return []

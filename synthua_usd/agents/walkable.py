@@ -13,13 +13,15 @@ import heapq
 import itertools
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import networkx as nx
 import numpy as np
-import trimesh
 
 from synthua_usd.agents.profiles import AgentProfile
 from synthua_usd.core.errors import InputError
+
+if TYPE_CHECKING:  # imported where used (~0.2 s that most processes never need)
+    import networkx as nx
 
 WALKABLE = ("sidewalk", "crosswalk", "curb_ramp", "street_road")
 CROSSING_ONLY = "road"
@@ -78,6 +80,7 @@ def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, 
     """Rasterise walkable surfaces. ``vertices`` (n, 3) world metres, Z up; ``faces`` (m, 3); ``face_class``
     (m,) class name per face; ``walkable`` the classes people walk on (the road counts inside crosswalks
     whatever this says; add ``road`` for twins whose roads include their sidewalks, as CityJSON's often do)."""
+    import trimesh
     if len(faces) == 0:
         raise InputError("the twin has no geometry to walk on")
     mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
@@ -132,6 +135,7 @@ def build_grid(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, 
 
 def _footprints(vertices, faces, classes, name) -> list[tuple[float, float, float, float]]:
     """x/y bounding boxes of connected groups of ``name`` faces (one per crosswalk, roughly)."""
+    import trimesh
     idx = np.flatnonzero(classes == name)
     if len(idx) == 0:
         return []
@@ -164,6 +168,7 @@ def _inside(xy, boxes) -> bool:
 def walkable_graph(grid: WalkableGrid) -> nx.Graph:
     """Nodes (i, j) with ``pos`` (3,) and ``surface``; edges with ``length_m`` (3-D), ``dz_m``, ``slope``,
     ``kerb`` (a step: see STEP_M, KERB_SLOPE) and ``cobbles``. Rises above MAX_STEP_M are not edges."""
+    import networkx as nx
     g = nx.Graph()
     ok = grid.walkable
     ny_, nx_ = ok.shape
@@ -249,6 +254,7 @@ class Router:
     def path(self, start, goal, profile: AgentProfile) -> list:
         """The nodes from ``start`` to ``goal`` (both included) that :func:`shortest_path` returns; raises
         ``networkx.NodeNotFound`` and ``networkx.NetworkXNoPath`` as it does."""
+        import networkx as nx
         for role, node in (("Source", start), ("Target", goal)):
             if node not in self._index:
                 raise nx.NodeNotFound(f"{role} {node} is not in G")

@@ -26,7 +26,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import trimesh
 from scipy import ndimage
 
 from synthua_usd.agents.walkable import WALKABLE, WalkableGrid, build_grid
@@ -81,6 +80,7 @@ class Terrain:
     built on first use, a 1 m grid of the surfaces rigs stand on and the road network."""
 
     def __init__(self, vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray, source: str) -> None:
+        import trimesh
         if len(faces) == 0:
             raise InputError(f"{source}: has no static geometry to place cameras in")
         self.vertices, self.faces, self.face_class, self.source = vertices, faces, np.asarray(face_class, object), source

@@ -14,13 +14,16 @@ only where it stays on cells with room for the car.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import networkx as nx
 import numpy as np
 from scipy import ndimage
 
 from synthua_usd.agents.walkable import WalkableGrid, build_grid, walkable_graph
 from synthua_usd.core.errors import InputError
+
+if TYPE_CHECKING:  # imported where used (~0.2 s that most processes never need)
+    import networkx as nx
 
 ROAD_CLASSES = ("road", "street_road", "crosswalk")
 VEHICLE_HALF_WIDTH_M = 0.9
@@ -54,6 +57,7 @@ def road_network(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray
                  source: str = "scenario") -> RoadNetwork:
     """Rasterise the road surfaces of triangles ``vertices`` (n, 3), ``faces`` (m, 3) with class names
     ``face_class`` (m,). Raises :class:`InputError` naming ``source`` when there is no road a car fits on."""
+    import networkx as nx
     if not np.isin(np.asarray(face_class, object), ROAD_CLASSES).any():
         raise InputError(f"{source}: has no road surfaces (classes {', '.join(ROAD_CLASSES)}); expected a twin with "
                          f"roads for a dashcam to drive on")
@@ -77,6 +81,7 @@ def road_network(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray
 def longest_route(net: RoadNetwork) -> np.ndarray:
     """(k, 3) float64 world points along the centre of the road's longest drive (the largest connected part
     of the graph, double sweep), smoothed where the smoothing keeps the car on the road."""
+    import networkx as nx
     part = net.graph.subgraph(max(nx.connected_components(net.graph), key=len))
     # Ends on the centreline: cells whose clearance no neighbour exceeds (the ridge of the distance map).
     ridge = net.clearance_m >= ndimage.maximum_filter(net.clearance_m, size=3)

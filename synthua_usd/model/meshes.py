@@ -6,8 +6,12 @@ counter-clockwise winding seen from outside. Z is up.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import trimesh
+
+if TYPE_CHECKING:  # imported where used (with scipy.spatial, ~0.6 s that most processes never need)
+    import trimesh
 
 Mesh = tuple[np.ndarray, np.ndarray]
 
@@ -34,11 +38,13 @@ def box(min_corner, max_corner) -> Mesh:
 
 def cylinder(center, radius: float, height: float, axis: str = "z", sections: int = 16) -> Mesh:
     """Closed cylinder of ``radius`` and ``height`` (metres) centred at ``center`` along ``axis``."""
+    import trimesh
     points, tris = _along(trimesh.creation.cylinder(radius=radius, height=height, sections=sections), axis)
     return points + np.asarray(center, float), tris
 
 
 def sphere(center, radius: float, subdivisions: int = 2) -> Mesh:
+    import trimesh
     mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
     mesh.apply_translation(center)
     return _arrays(mesh)
@@ -54,6 +60,7 @@ def ramp(x0: float, x1: float, y_low: float, y_high: float, z_low: float, z_high
 
     The base is at ``z_base``. Used for curb ramps. ``y_low`` may be greater than ``y_high``.
     """
+    import trimesh
     pts = np.array([
         [x0, y_low, z_base], [x1, y_low, z_base], [x1, y_high, z_base], [x0, y_high, z_base],
         [x0, y_low, z_low], [x1, y_low, z_low], [x1, y_high, z_high], [x0, y_high, z_high],
@@ -98,6 +105,7 @@ def torus(center, major_radius: float, minor_radius: float, axis: str = "z", maj
     """Closed torus centred at ``center`` around ``axis`` (a tyre, a rim), metres. With ``major_sections`` a
     multiple of 4 its points reach exactly ``major_radius + minor_radius`` from the axis along the other two
     axes (a wheel of that radius touches the ground)."""
+    import trimesh
     u = np.linspace(0.0, 2 * np.pi, major_sections, endpoint=False)[:, None]
     v = np.linspace(0.0, 2 * np.pi, minor_sections, endpoint=False)[None, :]
     ring = major_radius + minor_radius * np.cos(v)
@@ -153,6 +161,7 @@ def look_at(eye, target, up=(0.0, 0.0, 1.0)) -> np.ndarray:
 
 def cone(radius: float, height: float, axis: str = "z", sections: int = 16) -> Mesh:
     """Closed cone centred at the origin along ``axis``, apex towards +axis (USD's UsdGeom.Cone)."""
+    import trimesh
     mesh = trimesh.creation.cone(radius=radius, height=height, sections=sections)
     mesh.apply_translation((0.0, 0.0, -height / 2.0))
     return _along(mesh, axis)
@@ -160,11 +169,13 @@ def cone(radius: float, height: float, axis: str = "z", sections: int = 16) -> M
 
 def capsule(radius: float, height: float, axis: str = "z", sections: int = 16) -> Mesh:
     """Capsule centred at the origin: a cylinder of ``height`` capped by hemispheres (USD's UsdGeom.Capsule)."""
+    import trimesh
     mesh = trimesh.creation.capsule(height=height, radius=radius, count=[sections, sections])
     return _along(mesh, axis)
 
 
 def _along(mesh: trimesh.Trimesh, axis: str) -> Mesh:
+    import trimesh
     if axis == "x":
         mesh.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
     elif axis == "y":

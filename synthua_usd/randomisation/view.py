@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
 
 from synthua_usd.agents.motion import MARGIN_M
 from synthua_usd.agents.profiles import PROFILES, AgentProfile
@@ -23,6 +23,9 @@ from synthua_usd.composition.rigs import RIG_TYPES
 from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.randomisation.config import CameraRandomisation, CrowdRandomisation
 from synthua_usd.randomisation.scene import CastMember
+
+if TYPE_CHECKING:  # imported where used (with scipy.spatial, ~0.6 s that most processes never need)
+    import trimesh
 
 #: A person is "seen" when this point above its feet projects inside the image (a margin of 5 % of each side
 #: left free) with nothing of the twin in front of it, and a person of PERSON_HEIGHT_M standing there would
@@ -63,6 +66,7 @@ class WalkArea:
               walkable: tuple[str, ...] = WALKABLE, cell_m: float = 0.5) -> "WalkArea":
         """From the twin's triangles: ``vertices`` (n, 3) float64 world metres Z up, ``faces`` (m, 3) int64,
         ``face_class`` (m,) object class names."""
+        import trimesh
         grid = build_grid(vertices, faces, face_class, cell_m, walkable)
         graph = walkable_graph(grid)
         nodes = np.array(sorted(graph.nodes), np.int64).reshape(-1, 2)
