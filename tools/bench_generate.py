@@ -17,7 +17,7 @@ per image, and the peak memory of each worker.
 
 ``--memory N``: generates N images of the demo street (a temporary config from configs/demo.json: images N,
 WIDTHxHEIGHT at 1 spp, time codes 1:48:1, as many seeds as N needs, quotas relaxed to balanced conditions,
-QA flagging only, so that no rejected image is replaced by a later round on fresh workers)
+QA flagging only, so that no rejected image is replaced by images of a later round)
 and prints, per worker, its memory after 10 %, 50 % and 100 % of the images and the growth from 10 % to
 100 %, which must stay near zero.
 
@@ -90,8 +90,14 @@ class Probe:
         run_shards = executors.run_shards
         host = socket.gethostname()
 
-        def run_shards_probed(shards, init, work, on_result, config=ExecutorConfig()):
+        def run_shards_probed(shards, init, work, on_result, config=ExecutorConfig(), more=None):
             probe.rounds += 1
+
+            def more_probed():
+                following = more()
+                probe.rounds += bool(any(following))
+                return following
+
             t0, seen = time.perf_counter(), set()
 
             def on_result_probed(result):
@@ -104,7 +110,8 @@ class Probe:
                 probe.samples.append((probe.delivered, result.worker, probe.own[result.worker],
                                       status.get("VmRSS", 0), status.get("VmHWM", 0), result.peak_rss_mib))
             try:
-                return run_shards(shards, init, work, on_result_probed, config)
+                rounds = {} if more is None else {"more": more_probed}  # (a library from before rounds had none)
+                return run_shards(shards, init, work, on_result_probed, config, **rounds)
             finally:
                 probe.capacity += (time.perf_counter() - t0) * len(seen)
 
@@ -153,7 +160,7 @@ def memory_config(base: Path, scenario: Path, images: int, width: int, height: i
     doc["quotas"] = {"aid_users": None, "per_condition": "balanced" if conditions != [None] else None,
                      "per_rig_type": None}
     # QA flags instead of rejecting: at 1 spp many clear-day eye-level frames fail the highlights check, and
-    # rejected images are replaced in further rounds on fresh workers; N images on long-lived workers it is.
+    # rejected images are replaced in further rounds; N images it is.
     doc["qa"] = {**doc.get("qa", {}), "reject": []}
     notes = [f"from {base.name}: images {images}, {width}x{height} at 1 spp, time codes 1:48:1, seeds {seeds[0]}.."
              f"{seeds[-1]} ({cameras} cameras x 48 x {n_conditions} conditions per seed), quotas: balanced conditions only, QA flags only"]

@@ -84,8 +84,12 @@ def _penetration(points: np.ndarray, solids: list[trimesh.Trimesh]) -> float:
     """Deepest any point lies inside any solid (0 if none), metres: the least plane distance of the hull."""
     deepest = 0.0
     for solid in solids:
+        lo, hi = solid.bounds
+        near = points[np.all((points >= lo) & (points <= hi), axis=1)]  # outside its box, outside the solid
+        if not len(near):
+            continue
         normals, origins = solid.face_normals, solid.triangles[:, 0]
-        d = np.einsum("pfk,fk->pf", points[:, None, :] - origins[None], normals)
+        d = np.einsum("pfk,fk->pf", near[:, None, :] - origins[None], normals)
         inside = d.max(axis=1)
         deepest = max(deepest, float(-inside.min()) if (inside < 0).any() else 0.0)
     return deepest

@@ -71,20 +71,15 @@ def test_a_dataset_over_two_districts(tmp_path):
     record = next(r for r in recs if r["randomisation"]["district_seed"] == 5)
     result = replay(out, str(record["id"]))
     assert result.ok and result.identical, result
-    # synthua randomise of a district image writes its layers over that district's copy in the dataset, and
-    # rendering them gives the image's labels
-    from synthua_usd.backends.images import read_image
-    from synthua_usd.pipeline.frame import FrameRequest, run_frames
+    # synthua randomise of a district image writes its layers over that district's copy in the dataset (that
+    # rendering such layers gives the image's bytes: test_generate_randomised, on the street)
     from synthua_usd.pipeline.randomiser import RandomiseRequest, randomise_image
 
     result = randomise_image(RandomiseRequest(scenario=DISTRICT / "scenario.usda", out=tmp_path / "r" / "layer.usda",
                                               record_path=out / "records" / f"{record['name']}.json"))
     scenario = Path(result.render_args[2])
     assert scenario == out / "scenes" / "district_5" / "scenario.usda"
-    run_frames(FrameRequest(stage_path=scenario, out_dir=tmp_path / "frame", camera_paths=("/World/Cameras/CCTV_Largo",),
-                            time_codes=(24.0,), width=64, height=48, spp=1, layers=(tmp_path / "r" / "layer.usda",),
-                            allow_external_assets=True))
-    assert (read_image(tmp_path / "frame" / "class.png")[0] == read_image(out / record["files"]["class"])[0]).all()
+    assert result.render_args[result.render_args.index("--layer") + 1] == str(tmp_path / "r" / "layer.usda")
     # the districts differ: their twins' houses are other widths and colours
     assert (out / "scenes/district_0/twin.usdc").read_bytes() != (out / "scenes/district_5/twin.usdc").read_bytes()
     shutil.rmtree(out)
