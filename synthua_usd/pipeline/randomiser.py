@@ -81,6 +81,17 @@ def _replace_subtree(target: Sdf.Layer, fresh: Sdf.Layer) -> None:
     target.documentation = fresh.documentation
 
 
+def _without_agents(stage: Usd.Stage) -> Usd.Stage:
+    """``stage``'s root layer composed again with the scenario's own crowd inactive: what the randomiser reads
+    of the stage is the twin (walkable surfaces, recolourable objects, their materials), and the district's
+    crowd is three quarters of its gprims (a snapshot 2.1 -> 0.5 s)."""
+    twin = Usd.Stage.Open(stage.GetRootLayer(), Sdf.Layer.CreateAnonymous("twin-session.usda"))
+    if twin.GetPrimAtPath(AGENTS_ROOT):
+        with Usd.EditContext(twin, twin.GetSessionLayer()):
+            twin.GetPrimAtPath(AGENTS_ROOT).SetActive(False)
+    return twin
+
+
 class Randomiser:
     """Randomises ``stage`` image by image under ``config``: ``size`` (width, height) is the render size (where a
     person counts as seen), ``time_code`` the one the twin is read at (it does not move)."""
@@ -94,7 +105,7 @@ class Randomiser:
         self.base = Usd.Stage.Open(stage.GetRootLayer(), Sdf.Layer.CreateAnonymous("base-session.usda"))
         self.meta = _metadata(self.base)
         t = self.base.GetStartTimeCode() if time_code is None else time_code
-        snapshot = StageReader(self.base, class_map).snapshot(float(t))
+        snapshot = StageReader(_without_agents(stage), class_map).snapshot(float(t))
         twin = [m for m in snapshot.meshes if not m.prim_path.startswith((AGENTS_ROOT + "/", RANDOM_ROOT + "/"))]
         self.area = None
         if config.crowd.enabled or config.camera.enabled:
