@@ -97,13 +97,27 @@ class Bank:
         and that lie in a garment region the segment already has (so it needs no mesh more). Those are drawn
         by both segments (coinciding in the base posture), so that a bending hip or shoulder shows a
         segment's copy instead of a gap into the hollow body."""
+        if body not in self._segment_faces:  # kept per body, read-only: a posed body asks for it once a segment
+            own, held = self._own_and_held
+            region = self.face_region(body)
+            has_region = np.stack([np.isin(region, region[own[k]]) for k in range(len(SEGMENTS))])
+            faces = own | (held & has_region)
+            faces.flags.writeable = False
+            self._segment_faces[body] = faces
+        return self._segment_faces[body]
+
+    @functools.cached_property
+    def _segment_faces(self) -> dict[int, np.ndarray]:
+        return {}
+
+    @functools.cached_property
+    def _own_and_held(self) -> tuple[np.ndarray, np.ndarray]:
+        """(9, F) bool each: a segment's own triangles, and those its bones hold with OVERLAP_WEIGHT at a corner
+        (the same for every body: one mesh topology and skinning)."""
         own = np.arange(len(SEGMENTS))[:, None] == self.face_segment[None]
         per_segment = np.stack([self.vertex_bone_weights[:, [BONES.index(b) for b in bones]].sum(axis=1)
                                 for bones, _ in SEGMENTS.values()])  # (9, V)
-        held = per_segment[:, self.triangles].max(axis=2) >= OVERLAP_WEIGHT
-        region = self.face_region(body)
-        has_region = np.stack([np.isin(region, region[own[k]]) for k in range(len(SEGMENTS))])
-        return own | (held & has_region)
+        return own, per_segment[:, self.triangles].max(axis=2) >= OVERLAP_WEIGHT
 
     def face_region(self, body: int) -> np.ndarray:
         """(F,) index into :data:`REGIONS` of each triangle of ``body``: skin on head and hands, shoes on feet,
