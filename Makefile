@@ -41,8 +41,8 @@ demo: setup
 	@echo "demo: images, labels and frame.json are in $(DEMO_OUT)/{cctv,pedestrian_eye,district_cctv_largo}; a dataset (COCO, panoptic, Cityscapes, YOLO) in $(DEMO_OUT)/dataset, its statistics in $(DEMO_OUT)/dataset_report/report.html; a randomised one (every image a new scene) in $(DEMO_OUT)/dataset_random, its statistics and diversity in $(DEMO_OUT)/dataset_random_report/report.html"
 
 ## The whole test suite (slow tests included) on parallel workers (pytest-xdist: $(TEST_WORKERS), one more than
-## the cores, at most 8: tests that wait on subprocesses, Ray or a killed job leave a core idle, and on 2 cores three
-## workers took 8 min 48 s where two took 11 min 37 s and four 9 min 36 s; each test file runs on one worker, so its
+## the cores, at most 8: tests that wait on subprocesses, Ray or a killed job leave a core idle; on 2 cores three
+## workers are the fastest, docs/tests.md gives the times; each test file runs on one worker, so its
 ## module fixtures are built once), then the package's import layers (import-linter's contracts in pyproject.toml)
 ## and the documentation site built with --strict (a broken link or reference fails). The detector's environment
 ## first: where it cannot be made, its tests skip with the reason. `make test TEST_WORKERS=1` runs it on one worker.
