@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 
@@ -374,7 +375,8 @@ def segment_motion(bank: Bank, body: int, base: Pose, now: Pose) -> dict[str, np
 
 class BodyParts:
     """Base postures, fits and segment meshes per (body, posture, fit), each computed once: what authoring a
-    crowd needs of the body bank (the agents layer, a randomised scene)."""
+    crowd needs of the body bank (the agents layer, a randomised scene). The meshes it hands out are read-only,
+    so one instance may serve every scene of a process (:func:`shared_body_parts`)."""
 
     def __init__(self) -> None:
         self.bank = load_bank()
@@ -407,7 +409,7 @@ class BodyParts:
                     tris = self.bank.triangles[segment_faces[k] & (region == r)]
                     if len(tris):
                         used, inverse = np.unique(tris, return_inverse=True)
-                        parts[(name, region_name)] = (pts[used], inverse.reshape(-1, 3))
+                        parts[(name, region_name)] = _read_only(pts[used], inverse.reshape(-1, 3))
             self._cache[key] = (fit, base, parts)
             self._posed[key] = pts
         return self._cache[key]
@@ -434,7 +436,8 @@ class BodyParts:
                         tris = self.bank.triangles[faces]
                         data = np.concatenate([uvs[faces], normals[tris]], axis=2)  # (m, 3, 5) per corner
                         points, local, per_point = geo.split_corners(pts, tris, data)
-                        out[(name, region_name)] = (points, local, per_point[:, :2].copy(), per_point[:, 2:].copy())
+                        out[(name, region_name)] = _read_only(points, local, per_point[:, :2].copy(),
+                                                              per_point[:, 2:].copy())
             self._surfaces[key] = out
         return self._surfaces[key]
 
@@ -444,5 +447,19 @@ class BodyParts:
         key = (body, posture, fit, style)
         if key not in self._hair:
             self.get(body, posture, fit)
-            self._hair[key] = hair_mesh(self.bank, body, self._posed[(body, posture, fit)], style)
+            mesh = hair_mesh(self.bank, body, self._posed[(body, posture, fit)], style)
+            self._hair[key] = None if mesh is None else _read_only(*mesh)
         return self._hair[key]
+
+
+@cache
+def shared_body_parts() -> BodyParts:
+    """The process's one :class:`BodyParts`: every randomiser of a process (a worker's districts, generate's view
+    scores, a replay) takes each body's parts from it, computed once."""
+    return BodyParts()
+
+
+def _read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays

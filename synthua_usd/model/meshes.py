@@ -192,13 +192,19 @@ def split_corners(points: np.ndarray, triangles: np.ndarray, corner_uvs: np.ndar
     pair, in first-use order: points split only at seams, every triangle keeps its three positions."""
     corner_uvs = np.asarray(corner_uvs, np.float32)
     flat_uv = np.ascontiguousarray(corner_uvs.reshape(-1, corner_uvs.shape[-1]))
-    keys = np.concatenate([triangles.reshape(-1, 1).astype(np.int64),
-                           flat_uv.view(np.uint32).astype(np.int64)], axis=1)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    # np.unique sorts; renumber in order of first use so that a mesh without seams keeps its point order.
-    order = np.argsort(first, kind="stable")
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    chosen = first[order]
-    new_triangles = rank[inverse.reshape(-1)].reshape(-1, 3).astype(np.int64)
+    keys = np.concatenate([triangles.reshape(-1, 1).astype(np.uint32), flat_uv.view(np.uint32)], axis=1)
+    rows = np.ascontiguousarray(keys).view(np.dtype((np.void, keys.shape[1] * 4))).ravel()  # a corner as bytes
+    order = np.argsort(rows, kind="stable")
+    ordered = rows[order]
+    starts = np.ones(len(rows), bool)
+    starts[1:] = ordered[1:] != ordered[:-1]
+    first = order[starts]  # each distinct corner's first use (the sort is stable)
+    inverse = np.empty(len(rows), np.int64)
+    inverse[order] = np.cumsum(starts) - 1
+    # renumber in order of first use, so that a mesh without seams keeps its point order
+    by_use = np.argsort(first, kind="stable")
+    rank = np.empty_like(by_use)
+    rank[by_use] = np.arange(len(by_use))
+    chosen = first[by_use]
+    new_triangles = rank[inverse].reshape(-1, 3).astype(np.int64)
     return points[triangles.reshape(-1)[chosen]], new_triangles, flat_uv[chosen]

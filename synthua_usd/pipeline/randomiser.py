@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
-from synthua_usd.assets.postures import BodyParts
+from synthua_usd.assets.postures import shared_body_parts
 from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.core.errors import StageError
 from synthua_usd.model.taxonomy import ClassMap
@@ -117,7 +117,7 @@ class Randomiser:
         if config.materials.enabled:
             self.objects, self.bound = recolourable_objects(self.base, snapshot, config.materials.classes)
         self.has_agents = bool(self.base.GetPrimAtPath(AGENTS_ROOT))
-        self.bodies = BodyParts()
+        self.bodies = shared_body_parts()
         # the three layers the stage composes, strongest first, each sublayering the next
         self.prototypes = Sdf.Layer.CreateAnonymous("prototypes.usdc")
         self.scene_layer = Sdf.Layer.CreateAnonymous("scene.usda")

@@ -288,3 +288,20 @@ def test_a_kept_posture_poses_as_a_fresh_one_in_any_order(bank, device):
         assert kept.rotations.tobytes() == fresh.rotations.tobytes()
         assert kept.joints.tobytes() == fresh.joints.tobytes()
         kept.joints[:] = np.nan  # a caller's scribbles do not reach the next pose
+
+
+def test_the_shared_body_parts_hand_out_read_only_meshes():
+    """Every randomiser of a process takes its parts from one BodyParts (shared_body_parts): no scene can change a
+    mesh another scene is given."""
+    from synthua_usd.assets.postures import shared_body_parts
+
+    bodies = shared_body_parts()
+    assert shared_body_parts() is bodies
+    _, _, parts = bodies.get(4, "manual_wheelchair")
+    surfaces = bodies.surfaces(4, "manual_wheelchair")
+    hair = bodies.hair(4, "manual_wheelchair", None, "short")
+    arrays = [a for mesh in [*parts.values(), *surfaces.values(), hair] for a in mesh]
+    assert len(arrays) > 20
+    for a in arrays:
+        with pytest.raises(ValueError, match="read-only"):
+            a[...] = 0
