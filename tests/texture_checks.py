@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import shutil
 
-import colour
 import numpy as np
 import OpenImageIO as oiio
 import trimesh
@@ -95,11 +94,15 @@ def mitsuba_albedo(mi, snapshot, camera, W: int, H: int):
 
 
 def srgb_decoded(texels: np.ndarray) -> np.ndarray:
+    import colour  # colour-science: imported by the tests that decode, not by every worker's collection
+
     return colour.models.eotf_sRGB(texels / 255.0)
 
 
 def srgb_decoded(texels: np.ndarray) -> np.ndarray:
     """Linear values of 8-bit sRGB ``texels`` (colour-science, not synthua's decoder)."""
+    import colour  # colour-science: imported by the tests that decode, not by every worker's collection
+
     return colour.models.eotf_sRGB(texels / 255.0)
 
 

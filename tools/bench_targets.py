@@ -204,7 +204,7 @@ def measure_session(args, stage, reader, views, psnr, ssim) -> dict:
     # the denoised mode, where the denoiser is built: the fewest spp that reach 16 spp's PSNR
     out["denoise"] = None
     target = np.mean([r["rgb16_psnr_db"] for r in out["views"].values()])
-    for spp in DENOISE_SPPS:
+    for spp in args.denoise_spps:
         dn = RenderSession(dataclasses.replace(base, spp=spp, denoise=True))
         results = []
         for v in views:
@@ -478,6 +478,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--reference-spp", type=int, default=512, help="spp of both renderers' references")
     parser.add_argument("--repeat", type=int, default=3, help="best of N for the label pass and the raw bound")
     parser.add_argument("--pipeline-images", type=int, default=4)
+    parser.add_argument("--denoise-spps", type=_counts, default=list(DENOISE_SPPS),
+                        help="Mitsuba spp to try in turn with OIDN until one reaches 16 spp's PSNR [1,2,4,8]")
     parser.add_argument("--cycles-samples", type=_counts, default=[1, 2, 4, 8, 16],
                         help="Cycles sample counts to try with adaptive sampling and OIDN [1,2,4,8,16]")
     parser.add_argument("--cycles-plain-samples", type=_counts, default=[16],

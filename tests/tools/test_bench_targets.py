@@ -45,8 +45,8 @@ def test_a_tiny_run_measures_every_mitsuba_row(tmp_path):
 
     out = tmp_path / "bench.json"
     proc = subprocess.run([sys.executable, str(REPO / "tools" / "bench_targets.py"), "--width", "64", "--height", "48",
-                           "--reference-spp", "8", "--repeat", "1", "--skip-cycles", "--skip-pipeline",
-                           "--json", str(out)], capture_output=True, text=True, timeout=600)
+                           "--reference-spp", "8", "--repeat", "1", "--denoise-spps", "2", "--skip-cycles",
+                           "--skip-pipeline", "--json", str(out)], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr[-2000:]
     rows = {row["measure"].split(" (")[0]: row for row in json.loads(out.read_text())["rows"]}
     for measure in ("label pass", "RGB 16 spp", "first load", "per-frame update, next time code",
