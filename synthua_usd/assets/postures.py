@@ -376,7 +376,11 @@ def segment_motion(bank: Bank, body: int, base: Pose, now: Pose) -> dict[str, np
 class BodyParts:
     """Base postures, fits and segment meshes per (body, posture, fit), each computed once: what authoring a
     crowd needs of the body bank (the agents layer, a randomised scene). The meshes it hands out are read-only,
-    so one instance may serve every scene of a process (:func:`shared_body_parts`)."""
+    so one instance may serve every scene of a process (:func:`shared_body_parts`); it keeps the last
+    :attr:`KEEP` (body, posture, fit) keys (about 340 KB each), so a long run's memory stays bounded (72 bodies
+    pushing each other's chairs alone are 5,184 keys)."""
+
+    KEEP = 256
 
     def __init__(self) -> None:
         self.bank = load_bank()
@@ -392,6 +396,8 @@ class BodyParts:
         key = (body, posture, fit)
         if key not in self._postures:
             self._postures[key] = posture_cycle(self.bank, body, posture, fit)
+            if len(self._postures) > self.KEEP:
+                del self._postures[next(iter(self._postures))]
         return self._postures[key]
 
     def get(self, body: int, posture: str | None, fit: DeviceFit | None = None):
@@ -412,6 +418,12 @@ class BodyParts:
                         parts[(name, region_name)] = _read_only(pts[used], inverse.reshape(-1, 3))
             self._cache[key] = (fit, base, parts)
             self._posed[key] = pts
+            if len(self._cache) > self.KEEP:  # the oldest key goes, with what was made of it
+                oldest = next(iter(self._cache))
+                for kept in (self._cache, self._posed, self._surfaces):
+                    kept.pop(oldest, None)
+                for hair_key in [k for k in self._hair if k[:3] == oldest]:
+                    del self._hair[hair_key]
         return self._cache[key]
 
     def surfaces(self, body: int, posture: str | None, fit: DeviceFit | None = None) -> dict:

@@ -305,3 +305,18 @@ def test_the_shared_body_parts_hand_out_read_only_meshes():
     for a in arrays:
         with pytest.raises(ValueError, match="read-only"):
             a[...] = 0
+
+
+def test_body_parts_keep_a_bounded_number_of_keys_and_remake_the_rest_alike():
+    class Few(BodyParts):
+        KEEP = 2
+
+    few, fresh = Few(), BodyParts()
+    keys = [(1, None), (2, "walker"), (3, "manual_wheelchair"), (1, None), (4, None)]
+    for body, posture in keys + keys[::-1]:
+        made = few.surfaces(body, posture)
+        hair = few.hair(body, posture, None, "long")
+        assert len(few._cache) <= 2 and len(few._surfaces) <= 2 and len({k[:3] for k in few._hair}) <= 2
+        for part, mesh in fresh.surfaces(body, posture).items():
+            assert all(a.tobytes() == b.tobytes() for a, b in zip(mesh, made[part]))
+        assert all(a.tobytes() == b.tobytes() for a, b in zip(hair, fresh.hair(body, posture, None, "long")))
