@@ -7,7 +7,6 @@ malformed file, unknown camera, time code out of range, bad option, an output th
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 from pathlib import Path
@@ -27,6 +26,7 @@ from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
 from synthua_usd.cli.train_commands import evaluate_real, train
 from synthua_usd.cli.twin_commands import twin
+from synthua_usd.core import json_text
 from synthua_usd.core.findings import Finding, Severity
 from synthua_usd.model.render_config import MAX_SIDE, MAX_SPP, RenderConfig
 
@@ -34,7 +34,7 @@ from synthua_usd.model.render_config import MAX_SIDE, MAX_SPP, RenderConfig
 def _report(findings: list[Finding], as_json: bool, strict: bool) -> int:
     """Print findings; 1 when any is a warning or error (or any at all with --strict), else 0."""
     if as_json:
-        click.echo(json.dumps([f.to_dict() for f in findings], indent=2))
+        click.echo(json_text.dumps([f.to_dict() for f in findings], indent=2, ascii_only=True))
     else:
         for f in findings:
             say(f.format())

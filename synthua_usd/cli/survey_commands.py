@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, say
 from synthua_usd.cli.options import InRange
+from synthua_usd.core import json_text
 from synthua_usd.core.errors import echo
 from synthua_usd.model.survey import LIMITS, THRESHOLD
 
@@ -56,7 +56,7 @@ def survey_flight_plan(as_json: bool, **kwargs) -> int:
     check_flight_input(kwargs, option_name)  # the GSD options go together: named as typed
     plan = plan_flight(FlightPlanInput(**kwargs), option_name)
     if as_json:
-        click.echo(json.dumps(plan.to_dict(), indent=2))
+        click.echo(json_text.dumps(plan.to_dict(), indent=2, ascii_only=True))
     else:
         say(f"footprint W        {plan.footprint_m:.1f} m")
         say(f"frontal spacing    {plan.frontal_spacing_m:.1f} m")
@@ -84,7 +84,7 @@ def survey_gcp(surveyed: Path, model: Path, threshold_m: float, as_json: bool) -
     report = gcp_report(read_points_csv(surveyed), read_points_csv(model), threshold_m,
                         names=(str(surveyed), str(model)))
     if as_json:
-        click.echo(json.dumps(report.to_dict(), indent=2))
+        click.echo(json_text.dumps(report.to_dict(), indent=2, ascii_only=True))
     else:
         say(f"{'id':>10} {'dX m':>9} {'dY m':>9} {'dZ m':>9} {'error m':>9}")
         for i, d, e in zip(report.ids, report.delta_m, report.errors_m):

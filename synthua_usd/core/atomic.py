@@ -119,10 +119,11 @@ def write_text_atomic(path: str | Path, text: str) -> Path:
 
 
 def write_json_atomic(path: str | Path, document, indent: int = 2) -> Path:
-    """Write ``document`` as UTF-8 JSON (a final newline) to ``path`` atomically."""
-    import json
+    """Write ``document`` as UTF-8 JSON (a final newline; :func:`synthua_usd.core.json_text.dumps`, NumPy scalars as
+    their JSON types) to ``path`` atomically."""
+    from synthua_usd.core import json_text
 
-    return write_text_atomic(path, json.dumps(document, indent=indent, ensure_ascii=False) + "\n")
+    return write_text_atomic(path, json_text.dumps(document, indent=indent) + "\n")
 
 
 @contextmanager

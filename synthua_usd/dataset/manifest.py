@@ -39,9 +39,9 @@ def manifest_document(*, provenance: dict, images: list[dict], dataset_files: li
 
 def document_digest(document) -> str:
     """SHA-256 of a JSON-able value in canonical form (sorted keys, no spaces)."""
-    import json
+    from synthua_usd.core import json_text
 
-    text = json.dumps(document, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+    text = json_text.dumps(document, sort_keys=True, compact=True)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 

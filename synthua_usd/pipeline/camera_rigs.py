@@ -15,7 +15,6 @@
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import os
@@ -29,6 +28,7 @@ from synthua_usd import __version__
 from synthua_usd.agents.walkable import WALKABLE
 from synthua_usd.composition.rigs import RigSpec
 from synthua_usd.composition.scenario import StageMetadata
+from synthua_usd.core import json_text
 from synthua_usd.core.atomic import atomic_path
 from synthua_usd.core.errors import InputError, StageError, echo
 from synthua_usd.core.resources import check_frame_memory
@@ -330,4 +330,4 @@ def _write_pair(layer, layer_path: Path, report: dict, report_path: Path) -> Non
     layer_path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(report_path) as tmp_report, atomic_path(layer_path) as tmp_layer:
         export_layer(layer.GetRootLayer(), tmp_layer, layer_path)
-        tmp_report.write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
+        tmp_report.write_text(json_text.dumps(report, indent=2) + "\n", encoding="utf-8")

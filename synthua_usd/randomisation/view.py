@@ -349,7 +349,7 @@ def place_cast(rng: np.random.Generator, cast: tuple[CastMember, ...], area: Wal
         z = float(area.ground_z(np.asarray(xy)[None], np.array([area.grid.z[i, j]]))[0])
         taken.append((float(xy[0]), float(xy[1]), profile.radius_m))
         placements[k] = Placement((float(xy[0]), float(xy[1]), z), heading, phase, amplitude, speed,
-                                  in_view=aimed and best_gap >= MARGIN_M)
+                                  in_view=bool(aimed and best_gap >= MARGIN_M))
         if member.group is not None:
             group_lead[member.group] = placements[k]
     return tuple(placements)
@@ -387,7 +387,8 @@ def _place_unit(rng: np.random.Generator, cast: tuple[CastMember, ...], unit: li
     near = np.array([area.grid.z[min(max(a, 0), area.grid.z.shape[0] - 1), min(max(b, 0), area.grid.z.shape[1] - 1)]
                      for a, b in index])
     z = area.ground_z(spots, near)
-    free = best_key[0] == len(unit) and best_key[1] >= MARGIN_M
+    # the gaps are NumPy floats (the radii are an array): the comparison is a numpy.bool_, which a record refuses
+    free = bool(best_key[0] == len(unit) and best_key[1] >= MARGIN_M)
     for n, ((member, _, _), spot, r) in enumerate(zip(unit, spots, radii)):
         taken.append((float(spot[0]), float(spot[1]), float(r)))
         own_phase = phase if n == 0 else float(rng.uniform(0.0, 2 * np.pi))

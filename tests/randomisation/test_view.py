@@ -189,3 +189,28 @@ def test_companions_walk_behind_or_beside_their_aid_user(street):
                 assert abs(d @ ahead) < 1e-9 or abs(d @ left) < 1e-9  # beside, or in line behind
                 assert np.linalg.norm(d) >= clear - 1e-9
     assert pushed >= 3 and accompanied >= 3
+
+
+def test_a_unit_aimed_into_view_without_a_free_place_is_not_in_view_as_a_python_bool(street):
+    """Issue 39: an aid user aimed into view with its companions, all on walkable cells but crowded by others, got
+    ``in_view`` as a ``numpy.bool_`` (its gaps are NumPy floats), which a record's JSON refused halfway through a
+    dataset. Here every place is taken: the unit is placed, not free, and ``in_view`` is a plain False."""
+    from synthua_usd.randomisation.config import CrowdRandomisation
+    from synthua_usd.randomisation.view import _place_unit, companion_offsets
+
+    stage, area = street
+    config = RandomisationConfig(crowd=CrowdRandomisation(
+        density_per_m2=(0.1, 0.1), aid_share=(0.8, 0.8), pushed_share=(1.0, 1.0), aids=("manual_wheelchair",)))
+    rng = np.random.default_rng(0)
+    _, _, cast, _ = draw_cast(rng, config, area.area_m2(), list(area.seats))
+    k = next(k for k, m in enumerate(cast) if m.aid is not None and m.pushed_by is not None)
+    unit = companion_offsets(cast, k)
+    cells, headings = area.choices(PROFILES[cast[k].profile])
+    # a person on every walkable cell centre: no arrangement of the unit is free
+    taken = [(float(x), float(y), 0.3) for x, y in (area.grid.centre(i, j)[:2] for i, j in area.nodes)]
+    placements = [None] * len(cast)
+    _place_unit(rng, cast, unit, area, cells, headings, cells, taken, placements, 0.0, 1.0, 1.0, aimed=True)
+    placed = [placements[member] for member, _, _ in unit]
+    assert all(p is not None for p in placed)
+    assert [type(p.in_view) for p in placed] == [bool] * len(unit) and not any(p.in_view for p in placed)
+

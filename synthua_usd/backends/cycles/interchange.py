@@ -86,7 +86,9 @@ def write_interchange(snapshot, camera, width: int, height: int, folder: str | P
                    "clip_near_m": camera.clip_near_m, "clip_far_m": camera.clip_far_m},
     }
     np.savez(folder / GEOMETRY, **arrays)
-    (folder / SCENE).write_text(json.dumps(document, indent=1) + "\n", encoding="utf-8")
+    from synthua_usd.core import json_text  # here, not at the top: the Cycles script imports this module alone
+
+    (folder / SCENE).write_text(json_text.dumps(document, indent=1, ascii_only=True) + "\n", encoding="utf-8")
     return folder
 
 

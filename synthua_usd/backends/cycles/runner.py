@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.backends import images
+from synthua_usd.core import json_text
 from synthua_usd.core.errors import SynthuaError
 
 REPO = Path(__file__).resolve().parents[3]
@@ -78,8 +79,8 @@ def render_jobs(python: Path, interchange: Path, jobs: list[CyclesJob], out_dir:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     jobs_path = out_dir / "jobs.json"
-    jobs_path.write_text(json.dumps({"settings": {"threads": threads, "max_bounces": max_bounces},
-                                     "jobs": [vars(j) for j in jobs]}, indent=1), encoding="utf-8")
+    jobs_path.write_text(json_text.dumps({"settings": {"threads": threads, "max_bounces": max_bounces},
+                                          "jobs": [vars(j) for j in jobs]}, indent=1), encoding="utf-8")
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     done = subprocess.run([str(python), str(SCRIPT), str(interchange), str(jobs_path), str(out_dir)],
                           capture_output=True, text=True, timeout=timeout_s, env=env)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from synthua_usd.core import json_text
 from synthua_usd.core.errors import SynthuaError
 
 log = logging.getLogger(__name__)
@@ -82,7 +83,7 @@ def run_job(python: Path, job: dict, folder: Path, name: str, timeout_s: float |
     folder.mkdir(parents=True, exist_ok=True)
     result_path = folder / f"{name}_result.json"
     job_path = folder / f"{name}.json"
-    job_path.write_text(json.dumps(job | {"result": str(result_path)}, indent=1), encoding="utf-8")
+    job_path.write_text(json_text.dumps(job | {"result": str(result_path)}, indent=1, ascii_only=True), encoding="utf-8")
     log_path = folder / f"{name}.log"
     log.info("detector job %s: %s (log %s)", name, job["action"], log_path)
     t0 = time.monotonic()

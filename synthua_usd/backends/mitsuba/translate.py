@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from synthua_usd.backends.mitsuba import surfaces, weather_scene
+from synthua_usd.backends.mitsuba.face_weights import WeightNodes
 from synthua_usd.backends.mitsuba.weather_scene import LampMesh
 from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.model.conditions import Condition
@@ -33,6 +34,16 @@ class Translation:
     #: (:func:`weather_scene.scene_key`).
     lamps: tuple[LampMesh, ...] = ()
     condition_key: tuple | None = None
+    #: The weathering textures and each mesh's per-face weights (:mod:`face_weights`): filled once the scene is
+    #: loaded (:meth:`loaded`).
+    weights: WeightNodes | None = None
+    face_weights: tuple = ()
+
+    def loaded(self, scene) -> None:
+        """What the loaded ``scene`` still needs of the translation: the face-weight tables, by its shapes'
+        registry ids."""
+        if self.weights is not None:
+            self.weights.fill(scene, self.shape_ids, list(self.face_weights))
 
 
 def shape_id(index: int) -> str:
@@ -208,6 +219,7 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
     lamp_indices = {lamp.index for lamp in lamps}
     bsdfs: dict = {}
     images = surfaces.TextureImages(mi)
+    weights = WeightNodes(mi)
     scene: dict = {"type": "scene",
                    "integrator": integrator_dict(config),
                    "sensor": sensor_dict(mi, camera, config)}
@@ -221,15 +233,15 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
         layers = frozenset(face_weights[i])
         key_bsdf = (material.key, textured, layers, item.double_sided)
         if key_bsdf not in bsdfs:
-            bsdfs[key_bsdf] = mi.load_dict(surfaces.sided(weather_scene.surface_bsdf_dict(material, layers, images),
-                                                          item.double_sided))
+            bsdfs[key_bsdf] = mi.load_dict(surfaces.sided(
+                weather_scene.surface_bsdf_dict(material, layers, images, weights), item.double_sided))
         emitter = None
         if i in lamp_indices:
             emitter = weather_scene.dark_area_emitter(mi)
         elif any(material.emissive_color):
             emitter = mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": list(material.emissive_color)}})
         scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[key_bsdf], emitter,
-                           face_weights[i], item.uvs if textured else None, item.normals)
+                           None if weights.table else face_weights[i], item.uvs if textured else None, item.normals)
         shape_ids.append(key)
     # Without a condition the stage's own lights are all there is: sample them by what they bring (with one, the
     # condition's sky and lamps carry weights in other units, set by weather_scene, and these keep Mitsuba's 1).
@@ -240,4 +252,5 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
     if condition is not None:
         scene.update(weather_scene.sky_emitter(mi, snapshot.up_axis))
     return Translation(scene=scene, shape_ids=tuple(shape_ids), lamps=lamps,
-                       condition_key=weather_scene.scene_key(condition))
+                       condition_key=weather_scene.scene_key(condition), weights=weights,
+                       face_weights=tuple(face_weights))

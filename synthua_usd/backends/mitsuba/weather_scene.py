@@ -22,8 +22,9 @@ Built into the scene when it is loaded with a condition (:mod:`synthua_usd.backe
   (:func:`synthua_usd.backends.weather.sun_disk`);
 * an ``area`` emitter on every lamp mesh (:mod:`synthua_usd.model.lamps`), dark until a condition turns it on;
 * weathered surfaces, only when the condition has them: a ``blendbsdf`` per material between the dry
-  ``principled`` BSDF and a wet or snowy one, weighted per face by a mesh attribute (``face_wet``,
-  ``face_snow``) that holds the wetness or snow cover of upward-facing faces.
+  ``principled`` BSDF and a wet or snowy one, weighted per face (``face_wet``, ``face_snow``: the wetness or
+  snow cover of upward-facing faces) by one table of the scene's face weights
+  (:mod:`synthua_usd.backends.mitsuba.face_weights`).
 
 :func:`apply_condition` then sets, through ``traverse()`` parameters and without reloading: the environment
 map (the sky of the sun's direction and turbidity, or the night sky, and the ground under them; fog dims the
@@ -47,6 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from synthua_usd.backends.mitsuba import surfaces
+from synthua_usd.backends.mitsuba.face_weights import WeightNodes
 from synthua_usd.backends.weather import fog_lighting
 from synthua_usd.composition.scenario import ENVIRONMENT_PATH
 from synthua_usd.model.conditions import SNOW_FREE_CLASSES, SNOW_SLOPE_DEG, WET_GROUND_CLASSES, WET_MAX_SLOPE_DEG, Condition
@@ -177,16 +179,21 @@ def _wet_dict(material: Material, images: surfaces.TextureImages | None) -> dict
     return wet
 
 
-def surface_bsdf_dict(material: Material, layers: frozenset[str], images: surfaces.TextureImages | None = None) -> dict:
+def surface_bsdf_dict(material: Material, layers: frozenset[str], images: surfaces.TextureImages | None = None,
+                      weights: WeightNodes | None = None) -> dict:
     """The BSDF dict of ``material`` (:mod:`surfaces`, textured when ``images`` is given) with the weathering
-    ``layers`` (``face_wet``, ``face_snow``) over its dry ``principled`` BSDF; the normal map and the opacity
-    mask wrap the whole (water and snow follow the surface's relief and holes)."""
+    ``layers`` (``face_wet``, ``face_snow``) over its dry ``principled`` BSDF, weighted per face by ``weights``'
+    textures (a :class:`WeightNodes` of the translation; None: Mitsuba's ``mesh_attribute``); the normal map and
+    the opacity mask wrap the whole (water and snow follow the surface's relief and holes)."""
+    def weight(name: str):
+        return weights.node(name) if weights is not None else {"type": "mesh_attribute", "name": name}
+
     node = surfaces.principled_dict(material, images)
     if "face_wet" in layers:
-        node = {"type": "blendbsdf", "weight": {"type": "mesh_attribute", "name": "face_wet"},
+        node = {"type": "blendbsdf", "weight": weight("face_wet"),
                 "bsdf_0": node, "bsdf_1": _wet_dict(material, images)}
     if "face_snow" in layers:
-        node = {"type": "blendbsdf", "weight": {"type": "mesh_attribute", "name": "face_snow"},
+        node = {"type": "blendbsdf", "weight": weight("face_snow"),
                 "bsdf_0": node, "bsdf_1": {"type": "principled", "roughness": 0.7,
                                            "base_color": {"type": "rgb", "value": [SNOW_ALBEDO] * 3}}}
     return surfaces.wrapped(node, material, images)

@@ -18,13 +18,13 @@ A value a record does not have is empty in the CSV and null in Parquet.
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 from typing import Iterable
 
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from synthua_usd.core import json_text
 from synthua_usd.core.atomic import atomic_path
 from synthua_usd.core.errors import OutputError
 from synthua_usd.dataset.formats.records import ordered
@@ -40,7 +40,7 @@ def _matrix(prefix: str, matrix) -> dict:
 
 def _scalar(value):
     if isinstance(value, (list, tuple, dict)):
-        return json.dumps(value, sort_keys=True)
+        return json_text.dumps(value, sort_keys=True, ascii_only=True)
     return value
 
 
