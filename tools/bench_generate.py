@@ -74,6 +74,7 @@ class Probe:
     def install(self) -> None:
         from synthua_usd.pipeline import executors
         from synthua_usd.pipeline import generate as gen
+        from synthua_usd.pipeline import view_scores
         from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 
         probe = self
@@ -116,7 +117,7 @@ class Probe:
                 probe.capacity += (time.perf_counter() - t0) * len(seen)
 
         executors.run_shards = timed("render", run_shards_probed)  # generate() imports it at call time
-        gen.score_views = timed("plan", gen.score_views)
+        view_scores.score_views = timed("plan", view_scores.score_views)
         gen.assemble = timed("assemble", gen.assemble)
 
 

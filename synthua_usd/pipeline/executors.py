@@ -96,6 +96,35 @@ def run_shards(shards: Sequence[Sequence[T]], init: Callable[[], S], work: Calla
     return summary
 
 
+def cut_shards(items: Sequence[T], group_of: Callable[[T], Any], workers: int, most: int) -> list[list[T]]:
+    """``items`` (in the order a worker should take them) cut into shards for ``workers`` workers: about
+    ``len(items) / workers`` items a shard, at most ``most``, so that every worker has work and a lost one costs
+    little; consecutive items of one group (``group_of``: the scene they share) stay in one shard where the size
+    allows, since a worker builds a group's scene once for all its items (a randomised seed's scene: seconds),
+    and a group larger than a shard is cut into near-equal pieces."""
+    items = list(items)
+    if not items:
+        return []
+    size = max(1, min(most, -(-len(items) // max(1, workers))))
+    groups: list[list[T]] = []
+    for item in items:
+        if groups and group_of(groups[-1][-1]) == group_of(item):
+            groups[-1].append(item)
+        else:
+            groups.append([item])
+    shards: list[list[T]] = []
+    for group in groups:
+        pieces = -(-len(group) // size)
+        if pieces > 1:
+            bounds = [round(k * len(group) / pieces) for k in range(pieces + 1)]
+            shards.extend(group[a:b] for a, b in zip(bounds, bounds[1:]))
+        elif shards and len(shards[-1]) + len(group) <= size:
+            shards[-1].extend(group)
+        else:
+            shards.append(list(group))
+    return shards
+
+
 # ---- local: a pool of spawned processes -------------------------------------------------------------------
 
 def _local_worker(conn, init: Callable, work: Callable) -> None:

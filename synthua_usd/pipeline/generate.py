@@ -28,15 +28,13 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
 
 from synthua_usd import __version__
 from synthua_usd.composition.scenario import ROOT_FILE
 from synthua_usd.core.atomic import write_json_atomic, write_text_atomic
 from synthua_usd.core.errors import InputError, OutputError, StageError
 from synthua_usd.core.resources import check_frame_memory
-from synthua_usd.dataset import coverage, qa, sampling
-from synthua_usd.dataset.annotations import relation_entries
+from synthua_usd.dataset import coverage, sampling
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, coco, panoptic, tables, yolo
 from synthua_usd.dataset.formats.records import is_rejected
@@ -45,6 +43,7 @@ from synthua_usd.dataset.manifest import document_digest, file_entry, manifest_d
 from synthua_usd.dataset.record import ImageRecord
 from synthua_usd.model.render_config import RenderConfig, resolve_render
 from synthua_usd.model.taxonomy import ClassMap
+from synthua_usd.pipeline import view_scores
 from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, work
 
 log = logging.getLogger(__name__)
@@ -137,66 +136,6 @@ def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: 
     return stage, pool, chosen, render, layer_stack_digest(stage)
 
 
-def score_views(stage, pool, render: RenderConfig, output_size: tuple[int, int], class_map: ClassMap,
-                show_progress: bool, randomise=None, scenes: dict | None = None) -> list[sampling.ViewScore]:
-    """The sampler's view scores: every mobility-aid user (:func:`synthua_usd.dataset.qa.aid_users`, the one
-    definition QA and coverage use too) visible in each (camera, time code) view, from one label pass each
-    at the render size, pixel counts scaled to the written size (``output_size``). With ``randomise`` (a
-    :class:`RandomisationConfig`), each (seed, camera, time code) view of the pool is scored in its own
-    randomised scene, as a worker will render it: in the district scenario of ``scenes`` (district seed ->
-    scenario path) that the seed draws, when districts are randomised."""
-    from tqdm import tqdm
-
-    from synthua_usd.backends.mitsuba.session import RenderSession
-    from synthua_usd.pipeline.districts import district_of
-    from synthua_usd.usd.cameras import read_camera
-    from synthua_usd.usd.reader import StageReader
-    from synthua_usd.usd.stage_io import open_stage
-
-    session = RenderSession(RenderConfig(width=render.width, height=render.height, spp=1, variant=render.variant))
-    scale = output_size[0] * output_size[1] / (render.width * render.height)
-    if randomise is None:
-        views = [(None, None, tc, path) for tc, path in
-                 sorted(dict.fromkeys((c.time_code, c.camera_path) for c in pool))]
-    else:
-        views = sorted(dict.fromkeys((district_of(randomise, c.seed) if scenes else None, c.seed, c.time_code,
-                                      c.camera_path) for c in pool), key=lambda v: (v[0] is not None, v))
-    scores = []
-    current, reader, randomiser = object(), None, None
-    try:
-        for district, seed, tc, path in tqdm(views, desc="score views", unit="view", disable=not show_progress):
-            if district != current:
-                if randomiser is not None:
-                    randomiser.close()
-                view_stage = stage if district is None else open_stage(scenes[district], allow_external_assets=True)
-                reader = StageReader(view_stage, class_map)
-                randomiser = None
-                if randomise is not None:
-                    from synthua_usd.pipeline.randomiser import Randomiser
-
-                    randomiser = Randomiser(view_stage, randomise, class_map, (render.width, render.height))
-                current = district
-            if randomiser is not None:
-                randomiser.apply(seed, path, tc, None, district)
-            snapshot = reader.snapshot(tc)
-            counts = np.bincount(session.quick_labels(snapshot, read_camera(reader.stage, path, tc)).ravel(),
-                                 minlength=len(snapshot.instances) + 1)
-            class_of = {inst.prim_path: inst.class_name for inst in snapshot.instances}
-            visible = []
-            for inst in snapshot.instances:
-                if counts[inst.id]:
-                    visible.append({"class_name": inst.class_name, "prim_path": inst.prim_path,
-                                    "area": int(round(counts[inst.id] * scale)),
-                                    "relations": relation_entries(inst.relations, class_of)})
-            users = tuple(sampling.AidUserView(aid_type=u.aid_type, person_pixels=u.person_pixels,
-                                               device_pixels=u.device_pixels) for u in qa.aid_users(visible))
-            scores.append(sampling.ViewScore(camera_path=path, time_code=tc, aid_users=users, seed=seed))
-    finally:
-        if randomiser is not None:
-            randomiser.close()
-    return scores
-
-
 def write_scenes(request: GenerateRequest, config: GenerationConfig, pool, class_map: ClassMap,
                  out: Path) -> dict[int, Path]:
     """With randomised districts: every district the pool's seeds draw, written into the dataset's ``scenes/``
@@ -253,8 +192,14 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
                           f"resume: pick another --out or remove it")
     scenes = write_scenes(request, config, pool, class_map, out)
     if job_document is None:
-        scores = (score_views(stage, pool, render, output_size, class_map, show_progress, config.randomise, scenes)
-                  if config.images else [])
+        scores = []
+        if config.images:
+            score_job = view_scores.ScoreJob(
+                scenario=str(Path(request.scenario).resolve()), render=render, output_size=output_size,
+                class_map_document=class_map.document(), randomise=config.randomise,
+                scenes={d: str(p) for d, p in scenes.items()}, allow_external_assets=request.allow_external_assets)
+            scores = view_scores.score_views(score_job, view_scores.pool_views(pool, config.randomise, scenes),
+                                             _executor(request, config), stage, show_progress)
         plan = sampling.plan(pool, scores, config) if config.images else []
         job_document = {"synthua": __version__, "job_key": job_key, "job_key_digest": document_digest(job_key),
                         "scenario": str(Path(request.scenario).resolve()),
@@ -269,7 +214,7 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
             job_document["sequences"] = [q.to_dict() for q in plan_stage_sequences(stage, config)]
         _write_job(out, job_document)
     plan = [sampling.PlannedImage(**p) for p in job_document["plan"]]
-    scores = [_score_from_dict(s) for s in job_document["scores"]]
+    scores = [view_scores.score_from_dict(s) for s in job_document["scores"]]
     summary = GenerateSummary(out_dir=out)
     _remove_partial_files(out)
     done = _complete_records(layout, plan)
@@ -409,7 +354,7 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
     """Render every planned image of ``todo`` on the executor, in shards, and then the images of each
     ``next_round()`` until it gives none; one pool of workers (their scenes loaded) runs every round. A round
     repeats the images a lost worker took with it before the next one starts."""
-    from synthua_usd.pipeline.executors import run_shards
+    from synthua_usd.pipeline.executors import cut_shards, run_shards
     from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 
     # a shard's images follow one another in the order that changes least in its loaded scene: the condition
@@ -421,11 +366,16 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
         def order(p):
             district = district_of(job.config.randomise, p.seed)
             return (-1 if district is None else district, p.seed, p.condition or "", p.camera_path, p.time_code, p.id)
+
+        def scene(p):  # each seed is a scene of its own
+            return order(p)[:2]
     else:
         order = lambda p: (p.condition or "", p.camera_path, p.time_code, p.seed, p.id)  # noqa: E731
+        scene = lambda p: p.condition or ""  # noqa: E731
+
     def shards_of(images) -> list:
-        ordered = sorted(images, key=order)
-        return [ordered[i:i + SHARD_IMAGES] + [FLUSH] for i in range(0, len(ordered), SHARD_IMAGES)]
+        # every worker gets work (a job of few images too), and a seed's scene is built once where it fits a shard
+        return [shard + [FLUSH] for shard in cut_shards(sorted(images, key=order), scene, workers, SHARD_IMAGES)]
 
     current = list(todo)
 
@@ -443,10 +393,12 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
     run_shards(shards_of(current), functools.partial(init_worker, job), work, collect, executor, more=more)
 
 
-def _score_from_dict(document: dict) -> sampling.ViewScore:
-    return sampling.ViewScore(camera_path=document["camera_path"], time_code=document["time_code"],
-                              aid_users=tuple(sampling.AidUserView(**a) for a in document["aid_users"]),
-                              seed=document.get("seed"))
+def _executor(request: GenerateRequest, config: GenerationConfig):
+    """The executor of the job's workers: ``--workers``, else the config's, else :func:`default_workers`."""
+    from synthua_usd.pipeline.worker_protocol import ExecutorConfig
+
+    return ExecutorConfig(kind=request.executor, workers=request.workers or config.workers or default_workers(),
+                          address=request.address, cpus_per_worker=request.cpus_per_worker)
 
 
 def default_workers() -> int:

@@ -407,3 +407,27 @@ def test_ray_says_so_when_a_worker_cannot_import_the_job(ray_instance, tmp_path,
     with pytest.raises(InputError, match=r"^--executor ray: a worker could not start on the cluster "
                                          r"\(ModuleNotFoundError: No module named 'driver_only'\); expected"):
         run([[1]], ExecutorConfig("ray"), init=driver_only.init)
+
+
+def test_cut_shards_spreads_a_job_over_the_workers_and_keeps_scenes_whole():
+    from synthua_usd.pipeline.executors import cut_shards
+
+    def scene(item):
+        return item[0]
+
+    # 16 images of 4 seeds (scenes) for 2 workers: a shard per two seeds, none cut apart (before: one shard of 16,
+    # so one of the two workers rendered everything)
+    items = [(seed, k) for seed in range(4) for k in range(4)]
+    shards = cut_shards(items, scene, workers=2, most=16)
+    assert [len(s) for s in shards] == [8, 8] and sum(shards, []) == items
+    assert all(len({scene(i) for i in s}) == 2 for s in shards)
+    # a scene larger than a shard is cut into near-equal pieces, in order
+    big = [(0, k) for k in range(10)] + [(1, 0)]
+    assert [len(s) for s in cut_shards(big, scene, workers=2, most=4)] == [3, 4, 4]  # the next scene joins the last piece
+    assert sum(cut_shards(big, scene, workers=2, most=4), []) == big
+    # one worker: shards of at most `most`, scenes packed while they fit
+    uneven = [(0, k) for k in range(5)] + [(1, k) for k in range(5)] + [(2, k) for k in range(3)]
+    assert [len(s) for s in cut_shards(uneven, scene, workers=1, most=8)] == [5, 8]
+    assert cut_shards([], scene, workers=3, most=8) == []
+    # more workers than items: one item a shard
+    assert cut_shards([(0, 0), (1, 0)], scene, workers=8, most=16) == [[(0, 0)], [(1, 0)]]
