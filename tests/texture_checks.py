@@ -78,7 +78,7 @@ def reference_albedo(snapshot, camera, linear_texels: np.ndarray, W: int, H: int
 def mitsuba_albedo(mi, snapshot, camera, W: int, H: int):
     """(H*W, 3) diffuse reflectance of the BSDF at the first hit of every pixel-centre ray, and the hit mask."""
     tr = translate(mi, snapshot, camera, RenderConfig(width=W, height=H, spp=1))
-    scene = mi.load_dict(tr.scene, optimize=False)
+    scene = tr.load(mi)
     origins, dirs = (a.astype(np.float32) for a in camera.pixel_center_rays(W, H))
     if mi.variant().startswith("scalar"):
         albedo, hit = np.zeros((W * H, 3)), np.zeros(W * H, bool)

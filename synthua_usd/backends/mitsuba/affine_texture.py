@@ -25,20 +25,32 @@ def register(mi) -> None:
             def __init__(self, props) -> None:
                 base.__init__(self, props)
                 self.texture = props["texture"]
-                self.scale = mi.Color3f(props["scale"])
-                self.bias = mi.Color3f(props["bias"])
-                # opaque, not constants of the kernel: every tint of a scene (a wardrobe of garments) shares one
-                # piece of the path tracer's code, and a new scene's tints compile no new kernel (issue 39: a
-                # randomised district scene compiled 17.5 s of kernels with literal tints, about 1 s now)
-                dr.make_opaque(self.scale, self.bias)
+                scale, bias = props["scale"], props["bias"]
+                # a scale and bias of their own, or textures giving the shape's (the rows of shape tables)
+                self.per_shape = isinstance(scale, mi.Texture)
+                if self.per_shape:
+                    self.scale, self.bias = scale, bias
+                else:
+                    self.scale, self.bias = mi.Color3f(scale), mi.Color3f(bias)
+                    # opaque, not constants of the kernel: every tint shares one piece of the path tracer's code
+                    # (issue 39: a randomised district scene compiled 17.5 s of kernels with literal tints)
+                    dr.make_opaque(self.scale, self.bias)
+
+            def _tint(self, si, active):
+                if self.per_shape:
+                    return self.scale.eval(si, active), self.bias.eval(si, active)
+                return self.scale, self.bias
 
             def eval(self, si, active=True):
-                return dr.clip(self.texture.eval(si, active) * self.scale + self.bias, 0.0, 1.0)
+                scale, bias = self._tint(si, active)
+                return dr.clip(self.texture.eval(si, active) * scale + bias, 0.0, 1.0)
 
             def eval_1(self, si, active=True):
                 return mi.luminance(self.eval(si, active))
 
             def mean(self):
+                if self.per_shape:
+                    return float(dr.mean(dr.clip(self.texture.mean() * self.scale.mean() + self.bias.mean(), 0.0, 1.0)))
                 return float(dr.mean(dr.clip(self.texture.mean() * self.scale + self.bias, 0.0, 1.0)))
 
             def to_string(self) -> str:

@@ -73,8 +73,7 @@ class RenderSession:
     def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
         self._translation = translate(self.mi, snapshot, camera, self.config, condition)
         # optimize=False: Mitsuba would otherwise merge meshes and lose the identity labels depend on.
-        self._scene = self.mi.load_dict(self._translation.scene, optimize=False)
-        self._translation.loaded(self._scene)
+        self._scene = self._translation.load(self.mi)
         self._params = self.mi.traverse(self._scene)
         self._snapshot = snapshot
         self._condition = None

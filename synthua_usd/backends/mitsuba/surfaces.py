@@ -22,6 +22,7 @@ from typing import Callable
 import numpy as np
 
 from synthua_usd.backends.mitsuba import affine_texture
+from synthua_usd.backends.mitsuba.shape_tables import ShapeTables
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.texture_files import MAX_TEXELS, TextureFileError, open_image
 from synthua_usd.model import srgb
@@ -117,58 +118,89 @@ class TextureImages:
                 "filter_type": "bilinear", "wrap_mode": WRAP[texture.wrap_s]})
         return self._nodes[key]
 
-    def tinted(self, texture: Texture):
-        """``texture`` (RGB) as an ``affine`` texture (:mod:`affine_texture`: its ``scale`` and ``bias``, clipped to
-        [0, 1]) over its image's bitmap, which every material tinting that image shares; a texture without scale
-        and bias is its bitmap. One copy of an image however many materials tint it."""
-        plain = replace(texture, scale=(1.0, 1.0, 1.0, 1.0), bias=(0.0, 0.0, 0.0, 0.0))
+    def tinted(self, texture: Texture, tables: ShapeTables | None = None):
+        """``texture`` (RGB) as an ``affine`` texture (:mod:`affine_texture`: a scale and a bias, clipped to [0, 1])
+        over its image's bitmap, which every material tinting that image shares; a texture without scale and bias
+        is its bitmap. One copy of an image however many materials tint it. With ``tables`` (enabled), the scale
+        and bias are the shape's rows of the ``tint_scale`` and ``tint_bias`` columns, and every tint of the
+        image is one texture; else they are the texture's own."""
+        plain = untinted(texture)
         if texture == plain:
             return self.node(texture, lambda d: np.clip(d, 0.0, 1.0), "albedo")
+        mi = self.mi
+        if tables is not None and tables.enabled:
+            key = ("affine", plain)
+            if key not in self._nodes:
+                self._nodes[key] = mi.load_dict({"type": "affine", "texture": self.node(plain, None, "plain"),
+                                                 "scale": tables.value("tint_scale", 3),
+                                                 "bias": tables.value("tint_bias", 3)})
+            return self._nodes[key]
         key = ("affine", texture)
         if key not in self._nodes:
-            mi = self.mi
             self._nodes[key] = mi.load_dict({"type": "affine", "texture": self.node(plain, None, "plain"),
                                              "scale": mi.ScalarColor3f(*texture.scale[:3]),
                                              "bias": mi.ScalarColor3f(*texture.bias[:3])})
         return self._nodes[key]
 
 
-def principled_dict(material: Material, images: TextureImages | None = None,
+def untinted(texture: Texture) -> Texture:
+    """``texture`` without its scale and bias: the image as it is."""
+    return replace(texture, scale=(1.0, 1.0, 1.0, 1.0), bias=(0.0, 0.0, 0.0, 0.0))
+
+
+def principled_dict(material: Material, images: TextureImages | None = None, tables: ShapeTables | None = None,
                     albedo: Callable[[np.ndarray], np.ndarray] | None = None, roughness_factor: float = 1.0,
-                    name: str = "") -> dict:
-    """Mitsuba ``principled`` of ``material``: constants, or bitmaps where it has textures and ``images`` is
-    given. ``albedo`` maps base colours (weathering), ``roughness_factor`` scales roughness; ``name`` keys
-    those variants' bitmaps."""
+                    name: str = "") -> tuple[dict, dict]:
+    """Mitsuba ``principled`` of ``material`` and the shape's values it reads from ``tables``: constants, or
+    bitmaps where it has textures and ``images`` is given. With ``tables`` (enabled), each constant is a column of
+    the tables (``base_color``, ``roughness``, ... with ``name`` appended) and its value goes into the returned
+    values (column -> value), so that materials differing only in constants give equal dicts; else the dict holds
+    the constants and the values are empty. ``albedo`` maps base colours (weathering), ``roughness_factor`` scales
+    roughness; ``name`` keys those variants' bitmaps and columns."""
+    values: dict = {}
+    tabled = tables is not None and tables.enabled
+
     def clip(v):
         return np.clip(v, 0.0, 1.0)
 
-    def colour():
-        if material.base_color_texture is not None and images is not None:
-            if albedo is None and material.base_color_texture.channel == "rgb":
-                return images.tinted(material.base_color_texture)
-            return images.node(material.base_color_texture, lambda d: (albedo or clip)(clip(d)), f"albedo{name}")
-        value = np.asarray(material.base_color, np.float64)
-        return {"type": "rgb", "value": (albedo(value) if albedo else value).tolist()}
+    def constant(column: str, value, channels: int = 1):
+        if not tabled:
+            return {"type": "rgb", "value": value} if channels == 3 else value
+        values[f"{column}{name}"] = value
+        return tables.value(f"{column}{name}", channels)
 
-    def scalar(texture: Texture | None, constant: float, factor: float = 1.0, field: str = ""):
+    def colour():
+        texture = material.base_color_texture
+        if texture is not None and images is not None:
+            if albedo is None and texture.channel == "rgb":
+                if tabled and texture != untinted(texture):
+                    values["tint_scale"], values["tint_bias"] = tuple(texture.scale[:3]), tuple(texture.bias[:3])
+                return images.tinted(texture, tables)
+            return images.node(texture, lambda d: (albedo or clip)(clip(d)), f"albedo{name}")
+        value = np.asarray(material.base_color, np.float64)
+        return constant("base_color", (albedo(value) if albedo else value).tolist(), 3)
+
+    def scalar(texture: Texture | None, value: float, factor: float = 1.0, field: str = ""):
         if texture is not None and images is not None:
             return images.node(texture, lambda d: clip(d) * np.float32(factor), f"{field}{name}")
-        return float(np.clip(constant, 0.0, 1.0)) * factor
+        return constant(field, float(np.clip(value, 0.0, 1.0)) * factor)
 
     out = {"type": "principled", "base_color": colour(),
            "roughness": scalar(material.roughness_texture, material.roughness, roughness_factor, "roughness"),
            "metallic": scalar(material.metallic_texture, material.metallic, field="metallic")}
     if material.clearcoat > 0.0:  # Mitsuba's gloss is UsdPreviewSurface's 1 - roughness
-        out["clearcoat"] = float(np.clip(material.clearcoat, 0.0, 1.0))
-        out["clearcoat_gloss"] = float(np.clip(1.0 - material.clearcoat_roughness, 0.0, 1.0))
-    return out
+        out["clearcoat"] = constant("clearcoat", float(np.clip(material.clearcoat, 0.0, 1.0)))
+        out["clearcoat_gloss"] = constant("clearcoat_gloss", float(np.clip(1.0 - material.clearcoat_roughness, 0.0, 1.0)))
+    return out, values
 
 
-def wrapped(bsdf: dict, material: Material, images: TextureImages | None = None) -> dict:
+def wrapped(bsdf: dict, material: Material, images: TextureImages | None = None,
+            tables: ShapeTables | None = None) -> tuple[dict, dict]:
     """``bsdf`` under ``material``'s normal map (Mitsuba's ``normalmap`` reads [0, 1]-encoded tangent-space
     normals: UsdPreviewSurface's [-1, 1] values are mapped there) and its opacity (``mask``; with
-    ``opacity_threshold`` > 0 a cutout: coverage 0 below it, 1 from it on)."""
-    node = bsdf
+    ``opacity_threshold`` > 0 a cutout: coverage 0 below it, 1 from it on); and the shape's values it reads from
+    ``tables`` (a constant opacity's column, as :func:`principled_dict`)."""
+    node, values = bsdf, {}
     if material.normal_texture is not None and images is not None:
         node = {"type": "normalmap", "bsdf": node,
                 "normalmap": images.node(material.normal_texture, _encoded_normals, "normal")}
@@ -181,8 +213,12 @@ def wrapped(bsdf: dict, material: Material, images: TextureImages | None = None)
     if material.opacity_texture is not None and images is not None:
         node = {"type": "mask", "bsdf": node, "opacity": images.node(material.opacity_texture, coverage, "opacity")}
     elif float(coverage(np.float32(material.opacity))) < 1.0:
-        node = {"type": "mask", "bsdf": node, "opacity": float(coverage(np.float32(material.opacity)))}
-    return node
+        opacity = float(coverage(np.float32(material.opacity)))
+        if tables is not None and tables.enabled:
+            values["opacity"] = opacity
+            opacity = tables.value("opacity", 1)
+        node = {"type": "mask", "bsdf": node, "opacity": opacity}
+    return node, values
 
 
 def sided(bsdf: dict, double_sided: bool) -> dict:

@@ -14,19 +14,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from synthua_usd.backends.mitsuba import surfaces, weather_scene
-from synthua_usd.backends.mitsuba.face_weights import WeightNodes
+from synthua_usd.backends.mitsuba.shape_tables import ShapeTables
 from synthua_usd.backends.mitsuba.weather_scene import LampMesh
 from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.model.conditions import Condition
 from synthua_usd.model.render_config import RenderConfig
-from synthua_usd.model.scene import Light, Material, SceneSnapshot
+from synthua_usd.model.scene import Light, SceneSnapshot
 
 
 @dataclass(frozen=True, eq=False)
 class Translation:
-    """``scene`` is the dict for ``mi.load_dict(scene, optimize=False)``; ``shape_ids`` (the Mitsuba shape
-    ids) is aligned with the snapshot's meshes. Loading must keep ``optimize=False``: merging meshes would
-    lose the instance identity labels depend on."""
+    """``scene`` is the dict :meth:`load` loads; ``shape_ids`` (the Mitsuba shape ids) is aligned with the
+    snapshot's meshes. Loading keeps ``optimize=False``: merging meshes would lose the instance identity labels
+    depend on."""
 
     scene: dict
     shape_ids: tuple[str, ...]
@@ -34,26 +34,19 @@ class Translation:
     #: (:func:`weather_scene.scene_key`).
     lamps: tuple[LampMesh, ...] = ()
     condition_key: tuple | None = None
-    #: The weathering textures and each mesh's per-face weights (:mod:`face_weights`): filled once the scene is
-    #: loaded (:meth:`loaded`).
-    weights: WeightNodes | None = None
-    face_weights: tuple = ()
+    #: The materials' constants and face weights by shape (:mod:`shape_tables`), filled by :meth:`load`.
+    tables: ShapeTables | None = None
 
-    def loaded(self, scene) -> None:
-        """What the loaded ``scene`` still needs of the translation: the face-weight tables, by its shapes'
-        registry ids."""
-        if self.weights is not None:
-            self.weights.fill(scene, self.shape_ids, list(self.face_weights))
+    def load(self, mi):
+        """The loaded Mitsuba scene (``mi`` with the translation's variant active), its tables filled."""
+        scene = mi.load_dict(self.scene, optimize=False)
+        if self.tables is not None:
+            self.tables.fill(scene, self.shape_ids)
+        return scene
 
 
 def shape_id(index: int) -> str:
     return f"mesh_{index:06d}"
-
-
-def bsdf_dict(material: Material) -> dict:
-    """UsdPreviewSurface constants → Mitsuba ``principled`` BSDF (linear Rec.709 base colour); textured
-    materials are built by :mod:`surfaces` with the translation's :class:`surfaces.TextureImages`."""
-    return surfaces.principled_dict(material)
 
 
 #: The share of a dome's illuminance its emitter-sampling weight gets (see :func:`light_sampling_weight`).
@@ -219,7 +212,7 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
     lamp_indices = {lamp.index for lamp in lamps}
     bsdfs: dict = {}
     images = surfaces.TextureImages(mi)
-    weights = WeightNodes(mi)
+    tables = ShapeTables(mi)
     scene: dict = {"type": "scene",
                    "integrator": integrator_dict(config),
                    "sensor": sensor_dict(mi, camera, config)}
@@ -230,18 +223,22 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
         textured = item.uvs is not None and bool(material.textures)
         if not textured:  # a mesh without texture coordinates renders its material's constants
             material = material.untextured()
-        layers = frozenset(face_weights[i])
-        key_bsdf = (material.key, textured, layers, item.double_sided)
-        if key_bsdf not in bsdfs:
-            bsdfs[key_bsdf] = mi.load_dict(surfaces.sided(
-                weather_scene.surface_bsdf_dict(material, layers, images, weights), item.double_sided))
+        node, values = weather_scene.surface_bsdf_dict(material, frozenset(face_weights[i]), images, tables)
+        node = surfaces.sided(node, item.double_sided)
+        # one BSDF for every material of one kind: their constants are the shapes' rows of the tables
+        kind = _kind(node)
+        if kind not in bsdfs:
+            bsdfs[kind] = mi.load_dict(node)
+        tables.put(i, values)
         emitter = None
         if i in lamp_indices:
             emitter = weather_scene.dark_area_emitter(mi)
         elif any(material.emissive_color):
             emitter = mi.load_dict({"type": "area", "radiance": {"type": "rgb", "value": list(material.emissive_color)}})
-        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[key_bsdf], emitter,
-                           None if weights.table else face_weights[i], item.uvs if textured else None, item.normals)
+        if tables.enabled:
+            tables.put_weights(i, face_weights[i])
+        scene[key] = _mesh(mi, key, item.points, item.triangles, bsdfs[kind], emitter,
+                           None if tables.enabled else face_weights[i], item.uvs if textured else None, item.normals)
         shape_ids.append(key)
     # Without a condition the stage's own lights are all there is: sample them by what they bring (with one, the
     # condition's sky and lamps carry weights in other units, set by weather_scene, and these keep Mitsuba's 1).
@@ -252,5 +249,16 @@ def translate(mi, snapshot: SceneSnapshot, camera: PinholeCamera, config: Render
     if condition is not None:
         scene.update(weather_scene.sky_emitter(mi, snapshot.up_axis))
     return Translation(scene=scene, shape_ids=tuple(shape_ids), lamps=lamps,
-                       condition_key=weather_scene.scene_key(condition), weights=weights,
-                       face_weights=tuple(face_weights))
+                       condition_key=weather_scene.scene_key(condition), tables=tables)
+
+
+def _kind(node):
+    """What tells BSDF dicts apart: their structure and constants, Mitsuba objects (bitmaps, table textures) by
+    identity."""
+    if isinstance(node, dict):
+        return tuple(sorted((k, _kind(v)) for k, v in node.items()))
+    if isinstance(node, (list, tuple)):
+        return tuple(_kind(v) for v in node)
+    if isinstance(node, (str, int, float, bool)) or node is None:
+        return node
+    return ("object", id(node))

@@ -23,8 +23,8 @@ Built into the scene when it is loaded with a condition (:mod:`synthua_usd.backe
 * an ``area`` emitter on every lamp mesh (:mod:`synthua_usd.model.lamps`), dark until a condition turns it on;
 * weathered surfaces, only when the condition has them: a ``blendbsdf`` per material between the dry
   ``principled`` BSDF and a wet or snowy one, weighted per face (``face_wet``, ``face_snow``: the wetness or
-  snow cover of upward-facing faces) by one table of the scene's face weights
-  (:mod:`synthua_usd.backends.mitsuba.face_weights`).
+  snow cover of upward-facing faces) read from the scene's tables of face weights
+  (:mod:`synthua_usd.backends.mitsuba.shape_tables`).
 
 :func:`apply_condition` then sets, through ``traverse()`` parameters and without reloading: the environment
 map (the sky of the sun's direction and turbidity, or the night sky, and the ground under them; fog dims the
@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from synthua_usd.backends.mitsuba import surfaces
-from synthua_usd.backends.mitsuba.face_weights import WeightNodes
+from synthua_usd.backends.mitsuba.shape_tables import ShapeTables
 from synthua_usd.backends.weather import fog_lighting
 from synthua_usd.composition.scenario import ENVIRONMENT_PATH
 from synthua_usd.model.conditions import SNOW_FREE_CLASSES, SNOW_SLOPE_DEG, WET_GROUND_CLASSES, WET_MAX_SLOPE_DEG, Condition
@@ -172,31 +172,37 @@ def face_weights(item, class_name: str, up: np.ndarray, condition: Condition) ->
     return {k: v.astype(np.float32) for k, v in out.items() if np.any(v > 0)}
 
 
-def _wet_dict(material: Material, images: surfaces.TextureImages | None) -> dict:
-    wet = surfaces.principled_dict(material, images, albedo=wet_albedo, roughness_factor=0.5, name="wet")
+def _wet_dict(material: Material, images: surfaces.TextureImages | None,
+              tables: ShapeTables | None = None) -> tuple[dict, dict]:
+    wet, values = surfaces.principled_dict(material, images, tables, albedo=wet_albedo, roughness_factor=0.5,
+                                           name="_wet")
     wet["clearcoat"] = 1.0
     wet["clearcoat_gloss"] = 0.9
-    return wet
+    return wet, values
 
 
 def surface_bsdf_dict(material: Material, layers: frozenset[str], images: surfaces.TextureImages | None = None,
-                      weights: WeightNodes | None = None) -> dict:
+                      tables: ShapeTables | None = None) -> tuple[dict, dict]:
     """The BSDF dict of ``material`` (:mod:`surfaces`, textured when ``images`` is given) with the weathering
-    ``layers`` (``face_wet``, ``face_snow``) over its dry ``principled`` BSDF, weighted per face by ``weights``'
-    textures (a :class:`WeightNodes` of the translation; None: Mitsuba's ``mesh_attribute``); the normal map and
-    the opacity mask wrap the whole (water and snow follow the surface's relief and holes)."""
+    ``layers`` (``face_wet``, ``face_snow``) over its dry ``principled`` BSDF, weighted per face; the normal map
+    and the opacity mask wrap the whole (water and snow follow the surface's relief and holes). With ``tables``
+    (:class:`~synthua_usd.backends.mitsuba.shape_tables.ShapeTables`) the material's constants and the face
+    weights are the shape's rows of its tables (returned: column -> value), so materials of one kind share one
+    BSDF; without, constants and Mitsuba's ``mesh_attribute`` are in the dict."""
     def weight(name: str):
-        return weights.node(name) if weights is not None else {"type": "mesh_attribute", "name": name}
+        return tables.weight(name) if tables is not None else {"type": "mesh_attribute", "name": name}
 
-    node = surfaces.principled_dict(material, images)
+    node, values = surfaces.principled_dict(material, images, tables)
     if "face_wet" in layers:
-        node = {"type": "blendbsdf", "weight": weight("face_wet"),
-                "bsdf_0": node, "bsdf_1": _wet_dict(material, images)}
+        wet, wet_values = _wet_dict(material, images, tables)
+        node = {"type": "blendbsdf", "weight": weight("face_wet"), "bsdf_0": node, "bsdf_1": wet}
+        values.update(wet_values)
     if "face_snow" in layers:
         node = {"type": "blendbsdf", "weight": weight("face_snow"),
                 "bsdf_0": node, "bsdf_1": {"type": "principled", "roughness": 0.7,
                                            "base_color": {"type": "rgb", "value": [SNOW_ALBEDO] * 3}}}
-    return surfaces.wrapped(node, material, images)
+    node, wrap_values = surfaces.wrapped(node, material, images, tables)
+    return node, {**values, **wrap_values}
 
 
 def mesh_face_weights(snapshot: SceneSnapshot, condition: Condition | None) -> list[dict[str, np.ndarray]]:

@@ -11,7 +11,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from synthua_usd.backends.mitsuba import face_weights, variants
+from synthua_usd.backends.mitsuba import shape_tables, variants
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.usd.cameras import read_camera
@@ -108,7 +108,7 @@ def test_face_weights_from_the_table_render_what_mesh_attributes_render(street, 
     """The table holds the same float32 weights Mitsuba's ``mesh_attribute`` reads: the same image, bit for bit."""
     snapshot, own, camera, conditions = street
     table = render(own, camera, conditions[name])
-    monkeypatch.setattr(face_weights, "uses_table", lambda mi: False)
+    monkeypatch.setattr(shape_tables, "enabled", lambda mi: False)
     attributes = render(own, camera, conditions[name])
     weathered = table.rgb[table.class_ids > 0]
     assert np.array_equal(table.rgb, attributes.rgb) and weathered.std() > 0

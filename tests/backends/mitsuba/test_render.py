@@ -16,7 +16,7 @@ def test_scalar_and_jit_labels_are_identical(tiny):
     for name in ("scalar_rgb", "llvm_ad_rgb"):
         mi = activate_variant(name)
         tr = translate(mi, snap, cam, config)
-        results[name] = trace_pixel_centres(mi, mi.load_dict(tr.scene, optimize=False), tr.shape_ids, cam, 32, 24)
+        results[name] = trace_pixel_centres(mi, tr.load(mi), tr.shape_ids, cam, 32, 24)
     a, b = results.values()
     # Scalar uses Mitsuba's own kd-tree, the JIT variants Embree/OptiX: both in float32, so a ray grazing
     # the far edge of the ground may land on either side. Everywhere else they agree exactly.

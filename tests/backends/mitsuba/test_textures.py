@@ -117,8 +117,8 @@ def test_wet_weathering_darkens_every_texel(quads, class_map):
     mi = variants.activate("scalar_rgb")
     material = read_snapshot(open_stage(quads), 1.0, class_map).materials["/World/Looks/Quadrants"]
     images = surfaces.TextureImages(mi)
-    node = weather_scene.surface_bsdf_dict(material, frozenset({"face_wet"}), images)
-    assert node["type"] == "blendbsdf"
+    node, values = weather_scene.surface_bsdf_dict(material, frozenset({"face_wet"}), images)
+    assert node["type"] == "blendbsdf" and values == {}  # scalar variants: constants in the dict
     dry = np.asarray(mi.traverse(node["bsdf_0"]["base_color"])["data"])
     wet = np.asarray(mi.traverse(node["bsdf_1"]["base_color"])["data"])
     assert np.allclose(dry, srgb_decoded(TEXELS), atol=1e-6)

@@ -7,7 +7,8 @@ import pytest
 from pxr import UsdGeom
 
 from synthua_usd.backends.mitsuba import variants
-from synthua_usd.backends.mitsuba.translate import DOME_WEIGHT_SHARE, bsdf_dict, translate
+from synthua_usd.backends.mitsuba.surfaces import principled_dict
+from synthua_usd.backends.mitsuba.translate import DOME_WEIGHT_SHARE, translate
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.scene import Material
 from synthua_usd.usd.cameras import read_camera
@@ -17,7 +18,7 @@ from synthua_usd.usd.semantics import renderable_gprims
 
 def loaded_shapes(mi, translation) -> dict:
     """The loaded scene's shapes by Mitsuba id (``optimize=False``, as the render session loads it)."""
-    scene = mi.load_dict(translation.scene, optimize=False)
+    scene = translation.load(mi)
     return {s.id(): s for s in scene.shapes()}
 
 
@@ -63,9 +64,27 @@ def test_loading_keeps_one_shape_per_gprim(demo_stage, class_map, variant):
 
 
 def test_preview_surface_to_principled():
-    d = bsdf_dict(Material("m", (0.2, 0.3, 0.4), roughness=1.5, metallic=0.25))
+    material = Material("m", (0.2, 0.3, 0.4), roughness=1.5, metallic=0.25)
+    d, values = principled_dict(material)
     assert d == {"type": "principled", "base_color": {"type": "rgb", "value": [0.2, 0.3, 0.4]},
-                 "roughness": 1.0, "metallic": 0.25}
+                 "roughness": 1.0, "metallic": 0.25} and values == {}
+
+
+def test_materials_of_one_kind_are_one_bsdf_reading_the_shapes_rows(class_map):
+    """With shape tables (JIT variants) a material's constants are columns of the tables, the same for every
+    material of one kind: the BSDF dicts of two colours are equal and the values are the constants."""
+    from conftest import activate_variant
+    from synthua_usd.backends.mitsuba.shape_tables import ShapeTables
+
+    mi = activate_variant("llvm_ad_rgb")
+    tables = ShapeTables(mi)
+    a, values_a = principled_dict(Material("a", (0.2, 0.3, 0.4), roughness=1.5, metallic=0.25), tables=tables)
+    b, values_b = principled_dict(Material("b", (0.9, 0.1, 0.0), roughness=0.2), tables=tables)
+    assert a == b and a["base_color"] is tables.value("base_color", 3)
+    assert values_a == {"base_color": [0.2, 0.3, 0.4], "roughness": 1.0, "metallic": 0.25}
+    assert values_b == {"base_color": [0.9, 0.1, 0.0], "roughness": 0.2, "metallic": 0.0}
+    coated, values_c = principled_dict(Material("c", clearcoat=0.5, clearcoat_roughness=0.25), tables=tables)
+    assert coated != a and values_c["clearcoat"] == 0.5 and values_c["clearcoat_gloss"] == 0.75
 
 
 def test_sun_and_sky_are_sampled_by_the_illuminance_they_bring(class_map, variant):

@@ -37,8 +37,7 @@ def _render(mi, snapshot, eye_z: float) -> float:
     snap = dataclasses.replace(snapshot, lights=(sun,))
     camera = PinholeCamera("/Cam", 50.0, 36.0, 36.0, 0.05, 100.0,
                            look_at((0.3, 0.2, eye_z), (0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0)))
-    scene = mi.load_dict(translate(mi, snap, camera, RenderConfig(width=16, height=16, spp=8)).scene,
-                         optimize=False)
+    scene = translate(mi, snap, camera, RenderConfig(width=16, height=16, spp=8)).load(mi)
     return float(np.asarray(mi.render(scene, seed=0)).mean())
 
 
