@@ -78,9 +78,9 @@ class Jpeg:
     quality: int
 
 
-_KINDS = {"defocus": Defocus, "motion_blur": MotionBlur, "vignetting": Vignetting, "exposure": Exposure,
-          "noise": Noise, "white_balance": WhiteBalance, "jpeg": Jpeg}
-assert tuple(_KINDS) == EFFECTS  # one order: the config's, the draw's and the application's
+#: Each effect's values, in :data:`EFFECTS` order (one order: the config's, the draw's and the application's).
+KINDS = {"defocus": Defocus, "motion_blur": MotionBlur, "vignetting": Vignetting, "exposure": Exposure,
+         "noise": Noise, "white_balance": WhiteBalance, "jpeg": Jpeg}
 
 
 @dataclass(frozen=True)
@@ -114,7 +114,7 @@ class EffectsDraw:
         if unknown:
             raise InputError(f"{source}: unknown keys {unknown}; expected among {list(EFFECTS)}")
         out = {}
-        for name, kind in _KINDS.items():
+        for name, kind in KINDS.items():
             values = doc.get(name)
             if values is None:
                 continue

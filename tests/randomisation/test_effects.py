@@ -70,6 +70,16 @@ def test_one_effects_settings_move_no_other_effects_draw():
                 assert getattr(a, effect) == getattr(b, effect), (change, effect)
 
 
+def test_one_order_of_effects():
+    from dataclasses import fields
+
+    from synthua_usd.randomisation.effects import KINDS
+
+    assert tuple(KINDS) == EFFECTS == tuple(f.name for f in fields(EffectsDraw))
+    assert [f.name for f in fields(EffectsRandomisation) if f.name.endswith("_probability")] == \
+        [f"{e}_probability" for e in EFFECTS]
+
+
 def test_the_record_round_trips_and_refuses_what_it_cannot_read():
     draw = _draws(ALL, 1)[0]
     doc = draw.to_dict()
