@@ -8,7 +8,9 @@
 
 Each model is scored by `synthua evaluate-real` on ``--test`` (a YOLO folder or COCO .json of real photos; with
 ``--map`` for (a), whose classes are ours, while (b) and (c) learn the real set's own names), and (a) also on the
-generated dataset's held-out test split (the boxes it was trained with). The table (markdown and JSON) gives per
+generated dataset's held-out test split (the boxes it was trained with). The synthetic set's boxes follow
+``--convention`` (default ``wheelchair-sets``, the real wheelchair sets': the seated user inside the wheelchair's box,
+no person box; :mod:`synthua_usd.model.box_conventions`), and so do the stand-in's. The table (markdown and JSON) gives per
 scored class AP50, AP50-95, precision and recall at the fixed confidence, with each run's epochs, seconds and
 device, and the command lines; every run folder keeps its train.json (dataset id, config, versions, seed, budget).
 
@@ -29,21 +31,23 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from synthua_usd.analytics.detection_targets import DetectionTargets  # noqa: E402
+from synthua_usd.analytics.detection_targets import targets_for  # noqa: E402
+from synthua_usd.model.box_conventions import CONVENTIONS  # noqa: E402
 from synthua_usd.pipeline.evaluate_real import EvaluateRequest, evaluate_real  # noqa: E402
 from synthua_usd.pipeline.train import Budget, TrainRequest, train  # noqa: E402
 
 
-def stand_in(dataset: Path, out: Path, test_split: str = "test") -> tuple[Path, Path]:
+def stand_in(dataset: Path, out: Path, test_split: str = "test", convention: str = "wheelchair-sets") -> tuple[Path, Path]:
     """A generated dataset written as a third party's YOLO sets (train, test) with the classes ``person`` and
     ``wheelchair`` (both wheelchair classes, each box covering the chair and its user, as a real annotator draws
-    it): no synthua file is read through them, only data.yaml, images/ and labels/."""
+    it; the seated user a person too or not, by ``convention``): no synthua file is read through them, only
+    data.yaml, images/ and labels/."""
     from dataclasses import replace
 
     from synthua_usd.analytics.detection_targets import read_generated
     from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
 
-    targets = DetectionTargets(classes=("person", "manual_wheelchair", "electric_wheelchair"))
+    targets = targets_for(convention, ("person", "manual_wheelchair", "electric_wheelchair"))
     rename = {"manual_wheelchair": "wheelchair", "electric_wheelchair": "wheelchair"}
     folders = []
     for split in ("train", test_split):
@@ -121,6 +125,8 @@ def main(argv: list[str] | None = None) -> int:
                         "person and wheelchair (its train split as --real-train, its test split as --test)")
     p.add_argument("--stand-in-test-split", default="test", help="the stand-in's split used as --test [test]")
     p.add_argument("--map", dest="maps", action="append", default=[], help="--map of evaluate-real for (a) on --test")
+    p.add_argument("--convention", choices=list(CONVENTIONS), default="wheelchair-sets",
+                   help="box convention of --synthetic's training boxes and of the stand-in [wheelchair-sets]")
     p.add_argument("--minutes", type=float, default=30.0, help="budget of every training [30]")
     p.add_argument("--real-minutes", type=float, help="budget of (b) and (c), the same for both [--minutes]")
     p.add_argument("--imgsz", type=int, default=320)
@@ -137,12 +143,12 @@ def main(argv: list[str] | None = None) -> int:
     commands = [" ".join(["python tools/sim2real.py"] + (sys.argv[1:] if argv is None else argv))]
     t0 = time.perf_counter()
     if args.stand_in:
-        args.real_train, args.test = stand_in(args.stand_in, work / "stand_in", args.stand_in_test_split)
+        args.real_train, args.test = stand_in(args.stand_in, work / "stand_in", args.stand_in_test_split, args.convention)
 
     def trained(name: str, train_set: Path, init: Path | None = None, budget: Budget = budget) -> Path:
         out = work / "runs" / name
         if not (out / "train.json").is_file():          # a finished run is kept: rerun to redo the scoring only
-            train(TrainRequest(train_set, out, budget, DetectionTargets(), init=init, seed=args.seed))
+            train(TrainRequest(train_set, out, budget, targets_for(args.convention), init=init, seed=args.seed))
         runs[name] = json.loads((out / "train.json").read_text())
         return out
 

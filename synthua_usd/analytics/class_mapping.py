@@ -62,20 +62,21 @@ def parse_map_options(options: Iterable[str]) -> dict[str, tuple[str, ...]]:
     return out
 
 
-def build_mapping(options: Sequence[str], test_names: Sequence[str], model_names: Sequence[str]) -> ClassMapping:
+def build_mapping(options: Sequence[str], test_names: Sequence[str], model_names: Sequence[str],
+                  test_side: str = "the test set", model_side: str = "the model") -> ClassMapping:
     """The mapping of ``options`` (``--map`` values; none: same names and :data:`DEFAULT_ALIASES`) between a test
     set's classes and a model's. Every name must exist on its side, a model class may score as one test class only,
-    and at least one test class must be scored."""
+    and at least one test class must be scored. ``test_side`` and ``model_side`` name the two sides in messages."""
     given = parse_map_options(options)
     tests, models = list(test_names), set(model_names)
     model_list = ", ".join(model_names)
     for test, chosen in given.items():
         if test not in tests:
-            raise InputError(f"--map {echo(test)}=...: {echo(test)!r} is not a class of the test set; expected one of "
+            raise InputError(f"--map {echo(test)}=...: {echo(test)!r} is not a class of {test_side}; expected one of "
                              f"{echo(', '.join(tests), 200)}")
         unknown = [m for m in chosen if m not in models]
         if unknown:
-            raise InputError(f"--map {echo(test)}=...: {echo(', '.join(unknown))}: not a class of the model; expected "
+            raise InputError(f"--map {echo(test)}=...: {echo(', '.join(unknown))}: not a class of {model_side}; expected "
                              f"some of {model_list}")
     if not given:
         for test in tests:
@@ -91,7 +92,7 @@ def build_mapping(options: Sequence[str], test_names: Sequence[str], model_names
                                  f"model class in one test class")
             taken[m] = test
     if not given:
-        raise InputError(f"the test set's classes ({echo(', '.join(tests), 200)}) share no name with the model's "
-                         f"({model_list}); expected --map TEST_CLASS=MODEL_CLASS[,...], e.g. "
+        raise InputError(f"the classes of {test_side} ({echo(', '.join(tests), 200)}) share no name with those of "
+                         f"{model_side} ({model_list}); expected --map TEST_CLASS=MODEL_CLASS[,...], e.g. "
                          f"--map wheelchair=manual_wheelchair,electric_wheelchair --map person=person")
     return ClassMapping(tuple((t, tuple(dict.fromkeys(given[t]))) for t in tests if t in given))

@@ -7,7 +7,11 @@ A :class:`DetectionSet` is plain data read from any of the layouts people keep d
   of image paths, or a list of either, relative to ``path`` or to the file's folder); each image's labels are the
   ``.txt`` file at the same place under ``labels/`` (Ultralytics' rule: the last ``images`` folder of the path
   becomes ``labels``), one object a line, ``k cx cy w h`` normalised by the image's size, or ``k x1 y1 x2 y2 ...``, a
-  polygon (boxed by its extreme points). No label file: an image without objects.
+  polygon (boxed by its extreme points). No label file: an image without objects. The split :data:`ALL_SPLITS`
+  takes every split the file names, each image once. A folder with ``images/`` and ``labels/`` but no ``data.yaml``
+  is read the same way, every image below ``images/`` (or ``images/<split>``), its classes named by a
+  ``classes.txt`` (one name a line, in the folder or in ``labels/``, as labelling tools write it) or else by their
+  indices (``0``, ``1``, ...).
 * **COCO JSON** (``images``, ``annotations`` with ``bbox`` = [x, y, width, height] in pixels, ``categories``), the
   images in the file's folder or ``images_dir``.
 * a dataset ``synthua generate`` wrote, through :mod:`synthua_usd.analytics.detection_targets` (the boxes a
@@ -33,6 +37,8 @@ from synthua_usd.core.schemas import read_json
 IMAGE_SUFFIXES = (".bmp", ".jpeg", ".jpg", ".png", ".tif", ".tiff", ".webp")
 #: Splits a set may name, in the order a test set is looked for when none is asked for.
 TEST_SPLITS = ("test", "val")
+#: The split that takes every split of a YOLO set.
+ALL_SPLITS = "all"
 #: Most images read from one set (a real benchmark holds thousands; this bounds a mistaken folder).
 MAX_IMAGES = 200_000
 #: Normalised coordinates may overshoot [0, 1] by this much (rounding of the tools that wrote them).
@@ -215,10 +221,61 @@ def parse_yolo_labels(text: str, names: tuple[str, ...], width: int, height: int
     return tuple(boxes)
 
 
+def _set_images(paths: list[Path], names: tuple[str, ...], texts: list[str] | None = None) -> tuple[SetImage, ...]:
+    """The images at ``paths`` with the boxes of their label files (``texts``: those files' text, when read)."""
+    images = []
+    for i, path in enumerate(paths, 1):
+        width, height = _image_size(path)
+        labels = label_path(path)
+        if texts is not None:
+            text = texts[i - 1]
+        else:
+            text = read_input_text(labels, MAX_DOCUMENT_BYTES, "a YOLO label file") if labels.is_file() else ""
+        images.append(SetImage(i, path, width, height, parse_yolo_labels(text, names, width, height, shown(labels))))
+    return tuple(images)
+
+
+def read_yolo_folder(root: str | Path, split: str | None = None) -> DetectionSet:
+    """The images and boxes of a YOLO folder without ``data.yaml``: every image below ``images/`` (``split``:
+    below ``images/<split>``), classes from ``classes.txt`` or else their indices."""
+    root = Path(root)
+    folder = root / "images" if split in (None, ALL_SPLITS) else root / "images" / split
+    where = shown(folder)
+    if not folder.is_dir():
+        raise InputError(f"{where}: not a folder; expected the images of the split below images/")
+    paths = _split_images(root, str(folder), where)
+    if not paths:
+        raise InputError(f"{where}: no images; expected images in a format OpenImageIO reads ({', '.join(IMAGE_SUFFIXES)})")
+    texts = [read_input_text(label_path(p), MAX_DOCUMENT_BYTES, "a YOLO label file") if label_path(p).is_file() else ""
+             for p in paths]
+    listed = next((c for c in (root / "classes.txt", root / "labels" / "classes.txt") if c.is_file()), None)
+    if listed is not None:
+        names = tuple(n.strip() for n in read_input_text(listed, MAX_DOCUMENT_BYTES, "a list of class names")
+                      .splitlines() if n.strip())
+        if not names or len(set(names)) != len(names):
+            raise InputError(f"{shown(listed)}: {', '.join(names)[:80] or 'empty'}; expected class names, one a line, "
+                             f"each once")
+    else:
+        top = -1
+        for path, text in zip(paths, texts):
+            for n, line in enumerate(text.splitlines(), 1):
+                first = line.split()[:1]
+                if first:
+                    try:
+                        top = max(top, int(first[0]))
+                    except ValueError:
+                        raise InputError(f"{shown(label_path(path))}: line {n}: {line[:80]!r}; expected a class index "
+                                         f"and normalised coordinates") from None
+        names = tuple(str(k) for k in range(max(top + 1, 1)))
+    return DetectionSet(names, _set_images(paths, names, texts), "yolo", str(root), split)
+
+
 def read_yolo(data_yaml: str | Path, split: str | None = None) -> DetectionSet:
     """The images and boxes of one split of an Ultralytics YOLO dataset (``split`` default: ``test``, else
-    ``val``)."""
+    ``val``; :data:`ALL_SPLITS`: every split); a folder without ``data.yaml`` is :func:`read_yolo_folder`'s."""
     data_yaml = Path(data_yaml)
+    if data_yaml.is_dir() and not (data_yaml / "data.yaml").is_file() and (data_yaml / "images").is_dir():
+        return read_yolo_folder(data_yaml, split)
     if data_yaml.is_dir():
         data_yaml = data_yaml / "data.yaml"
     where = shown(data_yaml)
@@ -228,23 +285,25 @@ def read_yolo(data_yaml: str | Path, split: str | None = None) -> DetectionSet:
     if isinstance(doc.get("path"), str) and doc["path"]:
         p = Path(doc["path"])
         base = p if p.is_absolute() else base / p
-    wanted = [split] if split else [s for s in TEST_SPLITS if doc.get(s)]
-    if not wanted or not doc.get(wanted[0]):
-        found = ", ".join(s for s in ("train", "val", "test") if doc.get(s)) or "none"
-        raise InputError(f"{where}: {split or 'test/val'}: not in the file (splits: {found}); expected the split "
-                         f"to score, e.g. --split {next((s for s in ('test', 'val', 'train') if doc.get(s)), 'test')}")
-    split = wanted[0]
-    paths = _split_images(base, doc[split], f"{where}: {split}")
-    if not paths:
-        raise InputError(f"{where}: {split}: no images; expected images in a format OpenImageIO reads "
-                         f"({', '.join(IMAGE_SUFFIXES)})")
-    images = []
-    for i, path in enumerate(paths, 1):
-        width, height = _image_size(path)
-        labels = label_path(path)
-        text = read_input_text(labels, MAX_DOCUMENT_BYTES, "a YOLO label file") if labels.is_file() else ""
-        images.append(SetImage(i, path, width, height, parse_yolo_labels(text, names, width, height, shown(labels))))
-    return DetectionSet(names, tuple(images), "yolo", str(data_yaml), split)
+    present = [s for s in ("train", "val", "test") if doc.get(s)]
+    if split == ALL_SPLITS:
+        wanted = present
+    else:
+        wanted = [split] if split else [s for s in TEST_SPLITS if doc.get(s)][:1]
+    if not wanted or not all(doc.get(s) for s in wanted):
+        raise InputError(f"{where}: {split or 'test/val'}: not in the file (splits: {', '.join(present) or 'none'}); "
+                         f"expected the split to score, e.g. --split "
+                         f"{next((s for s in ('test', 'val', 'train') if doc.get(s)), 'test')}")
+    paths: list[Path] = []
+    for name in wanted:
+        found = _split_images(base, doc[name], f"{where}: {name}")
+        if not found:
+            raise InputError(f"{where}: {name}: no images; expected images in a format OpenImageIO reads "
+                             f"({', '.join(IMAGE_SUFFIXES)})")
+        paths += found
+    if len(wanted) > 1:
+        paths = list(dict.fromkeys(paths))      # an image two splits list is one image
+    return DetectionSet(names, _set_images(paths, names), "yolo", str(data_yaml), "+".join(wanted))
 
 
 # --- COCO JSON ---------------------------------------------------------------------------------------------------

@@ -2,7 +2,7 @@
 
 ``auto`` takes a ``.json`` file as COCO instances, a folder holding ``manifest.json`` and ``records/`` as a dataset
 ``synthua generate`` wrote (its boxes derived for the detector, :mod:`.detection_targets`), and a ``data.yaml`` (or
-a folder holding one) as Ultralytics YOLO. A generated dataset is also a YOLO dataset (its ``data.yaml`` and
+a folder holding one, or ``images/`` and ``labels/``) as Ultralytics YOLO. A generated dataset is also a YOLO dataset (its ``data.yaml`` and
 segmentation labels): ``yolo`` reads it that way, each device its own box, as a third-party tool would.
 """
 
@@ -30,7 +30,8 @@ def detect_format(path: Path) -> str:
         return "coco"
     if path.is_dir() and (path / "manifest.json").is_file() and (path / "records").is_dir():
         return "synthua"
-    if (path.is_file() and path.suffix.lower() in (".yaml", ".yml")) or (path / "data.yaml").is_file():
+    if (path.is_file() and path.suffix.lower() in (".yaml", ".yml")) or (path / "data.yaml").is_file() \
+            or ((path / "images").is_dir() and (path / "labels").is_dir()):
         return "yolo"
     raise InputError(f"{shown(path)}: {'not found' if not path.exists() else 'no data.yaml, COCO .json or dataset manifest'}"
                      f"; expected an Ultralytics YOLO folder (data.yaml + images/ + labels/), a COCO instances .json "

@@ -9,6 +9,10 @@ device's own box. A person is a person whatever they use (COCO's convention, and
 find): every visible person gets a ``person`` box, a wheelchair user too, unless ``aid_users_as_person`` is off
 (for test sets that label a wheelchair user only as ``wheelchair``).
 
+Named conventions (:mod:`synthua_usd.model.box_conventions`, which says what each means) set both choices and the
+classes trained at once (:func:`targets_for`): ``synthua``, the default above, and ``wheelchair-sets``, the public
+wheelchair photo sets' (a wheelchair box covers the chair and its seated user, who has no ``person`` box).
+
 Boxes are the records' visible, pixel-edge boxes. A box lower than ``min_height_px`` (a person of 3 pixels far
 down the street) is kept as ``ignore``: never a training target, and neither required nor penalised when the
 split is scored (COCO's crowd rule).
@@ -26,12 +30,14 @@ from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.layout import SPLITS, Layout
+from synthua_usd.model.box_conventions import CONVENTIONS, DEFAULT_CONVENTION
 from synthua_usd.model.detection_limits import DEFAULT_MIN_HEIGHT_PX, MIN_HEIGHT_PX
 
 PERSON = "person"
 #: The classes trained by default: person and the eight mobility aids.
 DEFAULT_CLASSES = (PERSON,) + tuple(DEVICES)
 AID_BOXES = ("with_user", "device")
+_DEFAULT = CONVENTIONS[DEFAULT_CONVENTION]
 
 
 @dataclass(frozen=True)
@@ -39,12 +45,13 @@ class DetectionTargets:
     """What a detector is trained to find in a generated dataset.
 
     ``classes``: class names of the dataset's class map, things; ``aid_box``: ``with_user`` (a mobility aid's box
-    covers its user too) or ``device``; ``aid_users_as_person``: whether an aid user also gets a person box;
-    ``min_height_px``: boxes lower than this, pixels of the written image, are ``ignore``."""
+    covers its user too) or ``device``; ``aid_users_as_person``: whether an aid user also gets a person box (only
+    users of an aid among ``classes`` lose theirs); ``min_height_px``: boxes lower than this, pixels of the written
+    image, are ``ignore``. The defaults are those of :data:`DEFAULT_CONVENTION`."""
 
-    classes: tuple[str, ...] = DEFAULT_CLASSES
-    aid_box: str = "with_user"
-    aid_users_as_person: bool = True
+    classes: tuple[str, ...] = _DEFAULT.classes or DEFAULT_CLASSES
+    aid_box: str = _DEFAULT.aid_box
+    aid_users_as_person: bool = _DEFAULT.aid_users_as_person
     min_height_px: float = DEFAULT_MIN_HEIGHT_PX
 
     def __post_init__(self):
@@ -61,6 +68,37 @@ class DetectionTargets:
     @classmethod
     def from_document(cls, doc: dict) -> "DetectionTargets":
         return cls(tuple(doc["classes"]), doc["aid_box"], bool(doc["aid_users_as_person"]), float(doc["min_height_px"]))
+
+    @property
+    def convention(self) -> str | None:
+        """The name of the convention whose aid boxes and classes these are, or None."""
+        return next((name for name, c in CONVENTIONS.items() if (c.aid_box, c.aid_users_as_person,
+                                                                  c.classes or DEFAULT_CLASSES) ==
+                     (self.aid_box, self.aid_users_as_person, self.classes)), None)
+
+
+def targets_for(convention: str | None = None, classes: tuple[str, ...] | None = None, aid_box: str | None = None,
+                aid_users_as_person: bool | None = None,
+                min_height_px: float = DEFAULT_MIN_HEIGHT_PX) -> DetectionTargets:
+    """The targets of ``convention`` (None: :data:`DEFAULT_CONVENTION`, whose choices the options may change) with
+    the options given (None: the convention's). A named convention fixes ``aid_box`` and ``aid_users_as_person``:
+    another value for either raises :class:`InputError`; ``classes`` may narrow or widen what is trained."""
+    name = DEFAULT_CONVENTION if convention is None else convention
+    if name not in CONVENTIONS:
+        raise InputError(f"--convention: {name!r}; expected one of {', '.join(CONVENTIONS)}")
+    chosen = CONVENTIONS[name]
+    if convention is not None:
+        for option, given, fixed in (("--aid-box", aid_box, chosen.aid_box),
+                                     ("--aid-users-as-person", aid_users_as_person, chosen.aid_users_as_person)):
+            if given is not None and given != fixed:
+                shown_given = given if isinstance(given, str) else ("on" if given else "off")
+                shown_fixed = fixed if isinstance(fixed, str) else ("on" if fixed else "off")
+                raise InputError(f"{option} {shown_given}: --convention {name} sets it {shown_fixed}; expected the "
+                                 f"convention or the option, not both")
+    return DetectionTargets((chosen.classes or DEFAULT_CLASSES) if classes is None else tuple(classes),
+                            chosen.aid_box if aid_box is None else aid_box,
+                            chosen.aid_users_as_person if aid_users_as_person is None else aid_users_as_person,
+                            min_height_px)
 
 
 def _union(a: list, b: list) -> list:

@@ -20,6 +20,10 @@ Per image, from its display sRGB PNG (``images/{split}/{name}.png``, 8-bit, as `
   any bright image as edge); and a step edge in the outermost row or column reads as it would inside. Only a
   smooth ramp running into the frame reads there at half its slope.
 
+A photo of another set (:func:`photo_measures`, for ``synthua stats --compare``) is measured alike, on its values as
+stored: its first three channels (a grey image's one channel as all three, alpha ignored), 16-bit values scaled to
+the 8-bit range (/ 257).
+
 Per dataset and per split, over its images: count, mean, median and the 10th and 90th percentiles
 (:data:`PERCENTILES`; linear interpolation, NumPy's default). Each RGB is read once (OpenImageIO) and the
 arithmetic is float64 NumPy.
@@ -90,6 +94,23 @@ def _read_rgb8(index: DatasetIndex, img: ImageSummary) -> np.ndarray:
 def image_measures(index: DatasetIndex, img: ImageSummary) -> dict[str, float]:
     """RMS contrast and edge density of the RGB of ``img``."""
     y = luma(_read_rgb8(index, img))
+    return {"rms_contrast": rms_contrast(y), "edge_density": edge_density(y)}
+
+
+def photo_measures(path) -> dict[str, float]:
+    """RMS contrast and edge density of the image file at ``path`` (8- or 16-bit, grey or colour)."""
+    from synthua_usd.backends.images import read_image
+
+    try:
+        pixels, _ = read_image(path)
+    except OSError:
+        raise InputError(f"{shown(path)}: not an image OpenImageIO can read; expected a photo of the set") from None
+    values = pixels.astype(np.float64) / 257.0 if pixels.dtype == np.uint16 else pixels
+    if values.dtype != np.uint8 and pixels.dtype != np.uint16:
+        raise InputError(f"{shown(path)}: pixels of {pixels.dtype}; expected an 8- or 16-bit image")
+    if values.shape[2] < 3:
+        values = np.repeat(values[..., :1], 3, axis=2)
+    y = luma(values)
     return {"rms_contrast": rms_contrast(y), "edge_density": edge_density(y)}
 
 

@@ -213,3 +213,36 @@ def missed_boxes(panels: list[tuple[np.ndarray, tuple, tuple | None, str]], path
     if not panels:
         axes[0, 0].text(0.5, 0.5, "no false negatives", ha="center", va="center")
     return _save(fig, path)
+
+
+def distribution_comparison(samples: dict, rows: list[str], measures: list[str], labels: dict[str, str],
+                            statistics: dict, path: Path, log_x: tuple[str, ...] = ()) -> Path:
+    """Empirical distribution functions of two samples per panel (ours blue, real orange): one row per class name of
+    ``rows``, one column per measure of ``measures``; ``samples`` (measure, row) -> (ours, real) arrays (a panel
+    without samples is left blank), ``labels`` measure -> axis label, ``statistics`` (measure, row) -> the KS
+    statistic shown in the panel's title (the largest vertical gap between the two curves); measures in ``log_x`` on
+    a logarithmic axis (ratios)."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(len(rows), len(measures), figsize=(3.3 * len(measures), 2.6 * len(rows)), squeeze=False)
+    for r, name in enumerate(rows):
+        for c, measure in enumerate(measures):
+            ax = axes[r, c]
+            if (measure, name) not in samples:
+                ax.axis("off")
+                continue
+            for values, colour, side in zip(samples[measure, name], ("#4477aa", "#ee7733"), ("ours", "real")):
+                if len(values):
+                    x = np.sort(values)
+                    ax.step(x, np.arange(1, len(x) + 1) / len(x), where="post", color=colour,
+                            label=f"{side} ({len(x)})")
+            d = statistics.get((measure, name))
+            ax.set_title(f"{name}: D = {d:.2f}" if d is not None else f"{name}: no values", fontsize=9)
+            ax.set_xlabel(labels[measure], fontsize=8)
+            ax.set_ylim(0, 1.02)
+            if measure in log_x:
+                ax.set_xscale("log")
+            ax.tick_params(labelsize=7)
+            ax.legend(fontsize=7, loc="lower right")
+    fig.suptitle("Ours against the real set: empirical distribution functions (KS statistic D)")
+    fig.tight_layout()
+    return _save(fig, path)

@@ -9,6 +9,7 @@ elsewhere; it refers only to files inside the folder, by relative paths::
     REPORT_DIR/plots/{class_distribution,area_boxplot,cooccurrence,coverage_cdf,instances_per_image,
                       aid_area,aid_users}.png
     REPORT_DIR/gallery/{name}.png        RGB with the class colours laid over at 50 % (unlabelled left clear)
+    REPORT_DIR/real_comparison.csv  plots/real_comparison.png     with a real set to compare with (--compare)
 
 Everything is written into a staging folder and moved into place as a set (:func:`synthua_usd.core.atomic.output_set`).
 """
@@ -25,6 +26,8 @@ from synthua_usd.analytics import plots
 from synthua_usd.analytics.csv_text import csv_text
 from synthua_usd.analytics.dataset_index import DatasetIndex, ImageSummary, image_file
 from synthua_usd.analytics.image_contrast import EDGE_THRESHOLD, MEASURES, SOBEL_GAIN, SPREAD
+from synthua_usd.analytics.real_comparison import ALL, RealComparison
+from synthua_usd.analytics.real_comparison import MEASURES as COMPARED
 from synthua_usd.analytics.statistics import DatasetStatistics, mobility_aid_classes
 from synthua_usd.core.atomic import output_set, write_json_atomic, write_text_atomic
 from synthua_usd.model.photometry import REC709_LUMA
@@ -94,8 +97,9 @@ def _swatch(color) -> str:
 
 
 def write_report(index: DatasetIndex, stats: DatasetStatistics, out_dir: str | Path, samples: int = 8,
-                 seconds: float | None = None) -> ReportFiles:
-    """Write the report of ``stats`` (computed from ``index``) into ``out_dir`` as a set."""
+                 seconds: float | None = None, comparison: RealComparison | None = None) -> ReportFiles:
+    """Write the report of ``stats`` (computed from ``index``; with ``comparison``, the dataset against a real set)
+    into ``out_dir`` as a set."""
     cmap = index.class_map
     colors = {c.name: c.color for c in cmap.classes}
     classes = stats.classes
@@ -105,7 +109,11 @@ def write_report(index: DatasetIndex, stats: DatasetStatistics, out_dir: str | P
     pairs = [_read_pair(index, img) for img in chosen]   # before anything is written: a missing file stops here
     palette = cmap.palette()
     with output_set(out_dir) as stage:
-        write_json_atomic(stage / "statistics.json", stats.document())
+        document = stats.document()
+        if comparison is not None:
+            document["real_comparison"] = comparison.document()
+            write_text_atomic(stage / "real_comparison.csv", _csv([r.row() for r in comparison.rows]))
+        write_json_atomic(stage / "statistics.json", document)
         write_text_atomic(stage / "class_statistics.csv", _csv([c.csv_row() for c in classes]))
         co_rows = [{"class": n} | {m: int(stats.cooccurrence[i, j]) for j, m in enumerate(names)}
                    for i, n in enumerate(names)]
@@ -126,6 +134,11 @@ def write_report(index: DatasetIndex, stats: DatasetStatistics, out_dir: str | P
                         p / "aid_users.png")
         if s["diversity"]["randomised_images"]:
             plots.diversity(s["diversity"], p / "diversity.png")
+        if comparison is not None:
+            names = [ALL] + [r.class_name for r in comparison.rows if r.class_name != ALL and r.measure == COMPARED[0]]
+            plots.distribution_comparison(comparison.samples, names, list(COMPARED), _COMPARED_LABELS,
+                                          {(r.measure, r.class_name): r.ks_statistic for r in comparison.rows},
+                                          p / "real_comparison.png", log_x=("aspect_ratio",))
         (stage / "gallery").mkdir()
         from synthua_usd.backends.images import write_color_png
 
@@ -133,7 +146,7 @@ def write_report(index: DatasetIndex, stats: DatasetStatistics, out_dir: str | P
         for img, (rgb, ids) in zip(chosen, pairs):
             write_color_png(stage / "gallery" / f"{img.name}.png", overlay(rgb, ids, palette))
             shown_classes |= set(np.unique(ids).tolist())
-        page = _html(index, stats, chosen, sorted(shown_classes - {0}), seconds)
+        page = _html(index, stats, chosen, sorted(shown_classes - {0}), seconds, comparison)
         write_text_atomic(stage / "report.html", page)
     out_dir = Path(out_dir)
     return ReportFiles(out_dir=out_dir, html=out_dir / "report.html", gallery=tuple(i.name for i in chosen))
@@ -174,8 +187,48 @@ def _contrast_section(c: dict) -> list[str]:
     return out
 
 
+_COMPARED_LABELS = {"box_height_share": "box height / image height", "aspect_ratio": "box width / height",
+                    "boxes_per_image": "boxes per image", "rms_contrast": "RMS contrast", "edge_density": "edge density"}
+
+
+def _comparison_section(c: RealComparison) -> list[str]:
+    """The dataset against a real set: what was compared, a table of both sides and the KS statistic per measure
+    (the three largest in bold), and the figure of the distribution functions."""
+    e = html.escape
+    real, ours = c.about["real"], c.about["ours"]
+    largest = {(r.measure, r.class_name) for r in c.largest()}
+    head = "".join(f"<th>{q}</th>" for q in ("count", "median", "p10–p90"))
+    out = ["<h2>Against a real set</h2>",
+           f"<p>Real: {e(real['source'])} ({e(real['layout'])}, {e(str(real['split'] or 'whole'))}), "
+           f"{real['images']:,} images; ours: {ours['images']:,} images (QA-rejected left out), our boxes as a "
+           f"detector trains on them by the <code>{e(c.about['convention'])}</code> convention (boxes lower than "
+           f"{ours['min_height_px']:g} px left out: {ours['ignored_boxes_left_out']:,}). Classes matched "
+           f"<code>{e(c.about['mapping_options'])}</code>"
+           + (f"; not compared: {e(', '.join(real['classes_not_compared']))}" if real["classes_not_compared"] else "")
+           + ". Box height share = box height / image height, aspect ratio = width / height, per box; boxes per "
+           "image, RMS contrast and edge density per image (defined above). KS D is the two-sample "
+           "Kolmogorov–Smirnov statistic (scipy.stats.ks_2samp: the largest gap between the two distribution "
+           "functions, 0 the same, 1 apart), p its two-sided p-value; the three largest D in bold. File: "
+           '<a href="real_comparison.csv">real_comparison.csv</a>.</p>',
+           f'<table><tr><th rowspan="2">measure</th><th rowspan="2">class</th><th colspan="3">ours</th>'
+           f'<th colspan="3">real</th><th rowspan="2">KS D</th><th rowspan="2">p</th></tr><tr>{head}{head}</tr>']
+    for r in c.rows:
+        cells = "".join(f"<td>{side['count']:,}</td><td>{_fmt(side['median'], 3)}</td>"
+                        f"<td>{_fmt(side['p10'], 3)}–{_fmt(side['p90'], 3)}</td>" for side in (r.ours, r.real))
+        d = "–" if r.ks_statistic is None else f"{r.ks_statistic:.3f}"
+        if (r.measure, r.class_name) in largest:
+            d = f"<b>{d}</b>"
+        p = "–" if r.ks_p_value is None else f"{r.ks_p_value:.2g}"
+        out.append(f"<tr><td>{e(_COMPARED_LABELS[r.measure])}</td><td>{e(r.class_name)}</td>{cells}<td>{d}</td>"
+                   f"<td>{p}</td></tr>")
+    out.append('</table><figure><img src="plots/real_comparison.png" alt="distribution functions, ours and real">'
+               "<figcaption>ours (blue) and real (orange): the share of values at or below each x</figcaption>"
+               "</figure>")
+    return out
+
+
 def _html(index: DatasetIndex, stats: DatasetStatistics, chosen: list[ImageSummary], legend_ids: list[int],
-          seconds: float | None) -> str:
+          seconds: float | None, comparison: RealComparison | None = None) -> str:
     s = stats.summary
     e = html.escape
     cmap = index.class_map
@@ -226,6 +279,8 @@ def _html(index: DatasetIndex, stats: DatasetStatistics, chosen: list[ImageSumma
     out += [f"<tr><td>{e(k)}</td><td>{e(v)}</td></tr>" for k, v in summary_rows]
     out.append("</table>")
     out += _contrast_section(s["image_contrast"])
+    if comparison is not None:
+        out += _comparison_section(comparison)
     out.append("<h2>Gallery</h2><p>RGB with the class colours laid over at 50 %; unlabelled pixels left clear.</p>"
                '<div class="legend">')
     for cid in legend_ids:

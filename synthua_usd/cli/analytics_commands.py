@@ -9,8 +9,11 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK, say
+from synthua_usd.cli.options import InRange
 from synthua_usd.core.dataset_folders import check_outside_datasets
 from synthua_usd.core.errors import InputError
+from synthua_usd.model import detection_limits as L
+from synthua_usd.model.box_conventions import CONVENTIONS
 
 
 @click.command()
@@ -19,12 +22,32 @@ from synthua_usd.core.errors import InputError
               help="Report folder (created; files of an earlier report replaced as a set).")
 @click.option("--samples", type=click.IntRange(0, 64), default=8, show_default=True,
               help="Sample images in the report's gallery (aid users first, one condition after another).")
-def stats(dataset: Path, out_dir: Path, samples: int) -> int:
-    """The statistics of DATASET (written by `synthua generate`) as tables, plots and one HTML report.
+@click.option("--compare", "real", type=click.Path(path_type=Path),
+              help="A real detection set to set DATASET beside: an Ultralytics YOLO folder (data.yaml, or images/ "
+                   "and labels/; every split unless --compare-split), a COCO instances .json, or another generated "
+                   "dataset.")
+@click.option("--compare-split", type=click.Choice(["train", "val", "test"]),
+              help="With --compare: the one split of the real set to compare with [default: all of it].")
+@click.option("--map", "maps", multiple=True,
+              help="With --compare: REAL_CLASS=OUR_CLASS[,OUR_CLASS...], our classes that count as a class of the "
+                   "real set; repeat per class [default: same names, and wheelchair=manual_wheelchair,"
+                   "electric_wheelchair]. Classes no mapping names are not compared.")
+@click.option("--convention", type=click.Choice(list(CONVENTIONS)),
+              help="With --compare: the box convention our boxes are drawn by (see `synthua train --help`) "
+                   "[default: wheelchair-sets, the real wheelchair sets': a wheelchair's box covers its seated user, "
+                   "who has no person box].")
+@click.option("--min-height-px", type=InRange(L.MIN_HEIGHT_PX),
+              help=f"With --compare: our boxes lower than this (pixels) are left out, as training leaves them out "
+                   f"[default: {L.DEFAULT_MIN_HEIGHT_PX:g}].")
+def stats(dataset: Path, out_dir: Path, samples: int, real: Path | None, compare_split: str | None,
+          maps: tuple[str, ...], convention: str | None, min_height_px: float | None) -> int:
+    """The statistics of DATASET (written by `synthua generate`) as tables, plots and one HTML report; with
+    --compare, set beside a real detection set, measure by measure.
 
     \b
-    Example:
+    Examples:
       synthua stats out/dataset --out out/dataset_report     # then open out/dataset_report/report.html
+      synthua stats out/dataset --out out/report --compare ../shared/data/real_photos/wheelchair_dev
     \b
     Per class: objects (thing instances; stuff regions per image) and their share, imbalance ratio
     (most frequent / class), object area mean, median, standard deviation, maximum and IQR, pixel share.
@@ -36,20 +59,44 @@ def stats(dataset: Path, out_dir: Path, samples: int) -> int:
     the class maps of images sharing camera and time code and of the gallery's samples (their RGB again).
     QA-rejected images are left out.
     \b
+    --compare REAL: box height share (box height / image height), aspect ratio (width / height), boxes per
+    image (per matched class and over all), RMS contrast and edge density (per image) of ours and of the real
+    set side by side: count, median, p10, p90 of each, and the two-sample Kolmogorov-Smirnov statistic D (0:
+    the same distribution, 1: apart) with its p-value. Our boxes are those a detector trains on (QA-rejected
+    images and boxes under --min-height-px left out); our classes count as the real set's by --map.
+    \b
     Writes statistics.json, class_statistics.csv, cooccurrence.csv, plots/*.png, gallery/*.png and
-    report.html (self-contained: it refers only to files in the folder).
+    report.html (self-contained: it refers only to files in the folder); with --compare also
+    real_comparison.csv, plots/real_comparison.png, statistics.json's real_comparison and a section of the page.
     """
     from synthua_usd.analytics.dataset_index import load_index
     from synthua_usd.analytics.report import write_report
 
     check_outside_datasets(out_dir)  # before the work: write_report would refuse it at the end
+    if real is None:
+        given = [name for name, value in (("--compare-split", compare_split), ("--map", maps),
+                                          ("--convention", convention), ("--min-height-px", min_height_px))
+                 if value is not None and value != ()]
+        if given:
+            raise InputError(f"{given[0]}: given without --compare; expected --compare REAL_SET with it")
+    else:
+        from synthua_usd.analytics.class_mapping import parse_map_options
+
+        parse_map_options(maps)    # the syntax before anything is read
     from synthua_usd.analytics.statistics import compute
 
     t0 = time.perf_counter()
     index = load_index(dataset)
     result = compute(index)
+    comparison = None
+    if real is not None:
+        from synthua_usd.analytics.real_comparison import DEFAULT_COMPARE_CONVENTION, compare, read_real
+
+        convention = convention or DEFAULT_COMPARE_CONVENTION
+        comparison = compare(index, result.image_contrast, read_real(real, compare_split, convention), maps, convention,
+                             L.DEFAULT_MIN_HEIGHT_PX if min_height_px is None else min_height_px)
     seconds = time.perf_counter() - t0
-    files = write_report(index, result, out_dir, samples=samples, seconds=seconds)
+    files = write_report(index, result, out_dir, samples=samples, seconds=seconds, comparison=comparison)
     s = result.summary
     say(f"{s['images']} images ({s['rejected_images_left_out']} QA-rejected left out), {s['objects']} objects: "
                f"Gini {s['gini_pixel_area']:.4f}, entropy {s['shannon_entropy_bits']:.4f} bits (normalised "
@@ -58,8 +105,37 @@ def stats(dataset: Path, out_dir: Path, samples: int) -> int:
     c = s["image_contrast"]
     say("images: " + ", ".join(f"{label} median {c[k]['median']:.3f} (p10-p90 {c[k]['p10']:.3f}-{c[k]['p90']:.3f})"
                                for label, k in (("RMS contrast", "rms_contrast"), ("edge density", "edge_density"))))
+    if comparison is not None:
+        for line in comparison_lines(comparison):
+            say(line)
     say(f"statistics in {seconds:.2f} s, report in {time.perf_counter() - t0:.2f} s -> {files.html}")
     return EXIT_OK
+
+
+def comparison_lines(comparison) -> list[str]:
+    """The comparison with a real set as stdout shows it: what was compared, a table, the measures that differ
+    most."""
+    about, real = comparison.about, comparison.about["real"]
+    lines = [f"against {real['source']} ({real['layout']}, {real['split'] or 'whole'}: {real['images']} images) as "
+             f"{about['mapping_options']}, our boxes by the {about['convention']} convention"
+             + (f"; not compared: {', '.join(real['classes_not_compared'])}" if real["classes_not_compared"] else ""),
+             f"{'measure':17s} {'class':11s} {'ours: n':>8s} {'median (p10-p90)':>24s} {'real: n':>8s} "
+             f"{'median (p10-p90)':>24s} {'KS D':>6s} {'p':>8s}"]
+
+    def side(s):
+        if not s["count"]:
+            return f"{0:8d} {'-':>24s}"
+        return f"{s['count']:8d} {format(s['median'], '.3f') + ' (' + format(s['p10'], '.3f') + '-' + format(s['p90'], '.3f') + ')':>24s}"
+
+    for r in comparison.rows:
+        d = "-" if r.ks_statistic is None else f"{r.ks_statistic:.3f}"
+        p = "-" if r.ks_p_value is None else f"{r.ks_p_value:.2g}"
+        lines.append(f"{r.measure:17s} {r.class_name:11s} {side(r.ours)} {side(r.real)} {d:>6s} {p:>8s}")
+    largest = comparison.largest()
+    if largest:
+        lines.append("differs most: " + ", ".join(f"{r.measure} of {r.class_name} (D {r.ks_statistic:.2f})"
+                                                  for r in largest))
+    return lines
 
 
 @click.command("eval")

@@ -10,6 +10,7 @@ import click
 from synthua_usd.cli.common import EXIT_OK
 from synthua_usd.cli.options import InRange
 from synthua_usd.model import detection_limits as L
+from synthua_usd.model.box_conventions import CONVENTIONS, DEFAULT_CONVENTION
 
 _FORMAT = click.Choice(["auto", "yolo", "coco", "synthua"])
 _DEVICE = click.Choice(L.DEVICES)
@@ -36,14 +37,21 @@ _DEVICE = click.Choice(L.DEVICES)
                    "yolo11n.yaml); no weights are downloaded.")
 @click.option("--init", "init", type=click.Path(path_type=Path),
               help="Start from the weights of an earlier run folder (fine-tuning), instead of from scratch.")
+@click.option("--convention", type=click.Choice(list(CONVENTIONS)),
+              help="Box convention of a generated TRAIN_SET, named: " + "; ".join(
+                  f"{name}: {c.about}" for name, c in CONVENTIONS.items())
+                   + f" [default: {DEFAULT_CONVENTION}, whose choices --aid-box, --aid-users-as-person and --classes "
+                     f"may change; a named convention's --aid-box and --aid-users-as-person cannot be].")
 @click.option("--classes",
-              help="Classes to train, of a generated dataset's class map, comma-separated [default: person and the eight "
-                   "mobility aids: manual_wheelchair, electric_wheelchair, walker, crutch and the four canes].")
-@click.option("--aid-box", type=click.Choice(["with_user", "device"]), default="with_user", show_default=True,
+              help="Classes to train, of a generated dataset's class map, comma-separated [default: the convention's; "
+                   "synthua: person and the eight mobility aids, manual_wheelchair, electric_wheelchair, walker, "
+                   "crutch and the four canes].")
+@click.option("--aid-box", type=click.Choice(["with_user", "device"]),
               help="A mobility aid's box: with_user covers the aid and its user (what a real 'wheelchair' box "
-                   "covers); device the aid alone (as our COCO instances).")
-@click.option("--aid-users-as-person/--no-aid-users-as-person", default=True, show_default=True,
-              help="Whether a mobility-aid user is also a person box.")
+                   "covers); device the aid alone (as our COCO instances) [default: the convention's, with_user].")
+@click.option("--aid-users-as-person/--no-aid-users-as-person", default=None,
+              help="Whether a user of a trained mobility-aid class is also a person box [default: the convention's; "
+                   "synthua: yes, wheelchair-sets: no].")
 @click.option("--min-height-px", type=InRange(L.MIN_HEIGHT_PX), default=L.DEFAULT_MIN_HEIGHT_PX, show_default=True,
               help="Boxes lower than this (pixels of the generated image) are not trained on, nor scored.")
 @click.option("--format", "fmt", type=_FORMAT, default="auto", show_default=True,
@@ -54,8 +62,9 @@ _DEVICE = click.Choice(L.DEVICES)
 @click.option("--python", "python", type=click.Path(path_type=Path),
               help="Interpreter holding Ultralytics [default: $SYNTHUA_TRAIN_PYTHON, else .venv-train/bin/python].")
 def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, imgsz: int, batch: int, device: str,
-          seed: int, model: str, init: Path | None, classes: str | None, aid_box: str, aid_users_as_person: bool,
-          min_height_px: float, fmt: str, images_dir: Path | None, python: Path | None) -> int:
+          seed: int, model: str, init: Path | None, convention: str | None, classes: str | None, aid_box: str | None,
+          aid_users_as_person: bool | None, min_height_px: float, fmt: str, images_dir: Path | None,
+          python: Path | None) -> int:
     """Train an object detector (Ultralytics YOLO, from scratch) on TRAIN_SET within a bounded budget.
 
     \b
@@ -64,21 +73,23 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
       synthua train out/sim2real --minutes 30 --imgsz 320 --out out/runs/synthetic
       synthua evaluate-real out/runs/synthetic real_photos/ --out out/eval_real
       synthua train real_photos/ --init out/runs/synthetic --minutes 10 --out out/runs/finetuned
+      synthua train out/sim2real --convention wheelchair-sets --out out/runs/as_wheelchair_sets
     \b
     TRAIN_SET is a dataset `synthua generate` wrote (trained on its train split; boxes from its records: by
     default a wheelchair's box covers its user, as a real photo's 'wheelchair' box does, and a wheelchair user
-    is a person too), or an Ultralytics YOLO folder or COCO .json of real photos. Ultralytics runs in its own
-    environment, .venv-train (tools/setup_train.sh; AGPL-3.0); on a GPU when one is present. train.json
+    is a person too; --convention wheelchair-sets boxes them as the public wheelchair photo sets do, the
+    seated user inside the wheelchair's box and no person box), or an Ultralytics YOLO folder or COCO .json of
+    real photos (whose boxes are their own). Ultralytics runs in its own environment, .venv-train
+    (tools/setup_train.sh; AGPL-3.0); on a GPU when one is present. train.json
     records the set (its SHA-256, a generated dataset's id and config), classes, budget, seed, device and
     library versions.
     """
-    from synthua_usd.analytics.detection_targets import DEFAULT_CLASSES, DetectionTargets
+    from synthua_usd.analytics.detection_targets import targets_for
     from synthua_usd.pipeline.train import Budget, TrainRequest
     from synthua_usd.pipeline.train import train as run
 
-    chosen = tuple(c.strip() for c in classes.split(",") if c.strip()) if classes is not None else DEFAULT_CLASSES
-    targets = DetectionTargets(chosen, aid_box,
-                               aid_users_as_person, min_height_px)
+    chosen = tuple(c.strip() for c in classes.split(",") if c.strip()) if classes is not None else None
+    targets = targets_for(convention, chosen, aid_box, aid_users_as_person, min_height_px)
     budget = Budget(minutes=None if epochs is not None else minutes, epochs=epochs or 300, imgsz=imgsz, batch=batch)
     doc = run(TrainRequest(train_set, out_dir, budget, targets, model, init, fmt, images_dir, device, seed,
                            python=python))
@@ -113,11 +124,14 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
               show_default=True, help="Confidence of precision, recall and the false negatives (AP uses every score).")
 @click.option("--imgsz", type=InRange(L.IMGSZ), help="Prediction image size [default: the training's].")
 @click.option("--device", type=_DEVICE, default="auto", show_default=True, help="auto: CUDA when present, else CPU.")
+@click.option("--convention", type=click.Choice(list(CONVENTIONS)),
+              help="A generated TEST_SET's boxes drawn by this box convention (see `synthua train --help`), the "
+                   "model's classes kept [default: the one the model was trained with]; other sets keep their own.")
 @click.option("--python", "python", type=click.Path(path_type=Path),
               help="Interpreter holding Ultralytics [default: $SYNTHUA_TRAIN_PYTHON, else .venv-train/bin/python].")
 def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, ...], fmt: str, split: str | None,
                   images_dir: Path | None, confidence: float, imgsz: int | None, device: str,
-                  python: Path | None) -> int:
+                  convention: str | None, python: Path | None) -> int:
     """Score the detector of run folder MODEL (`synthua train`) on TEST_SET: real photos or a held-out split.
 
     \b
@@ -128,7 +142,8 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
       synthua evaluate-real out/runs/synthetic out/sim2real --split test --out out/eval_synthetic
     \b
     TEST_SET: an Ultralytics YOLO folder (data.yaml + images/ + labels/; box or polygon labels), a COCO
-    instances .json, or a generated dataset (scored on the boxes the model was trained with). Per mapped
+    instances .json, or a generated dataset (scored on the boxes the model was trained with, or those of
+    --convention, e.g. wheelchair-sets: the seated user inside the wheelchair's box, no person box). Per mapped
     class: AP50 and AP50-95 by pycocotools' COCOeval (bbox), precision and recall at --confidence (IoU 0.5),
     and a page of the worst false negatives (report.html, false_negatives.png). Test classes no --map names
     are not scored.
@@ -137,7 +152,7 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
     from synthua_usd.pipeline.evaluate_real import EvaluateRequest
 
     result = run(EvaluateRequest(model, test_set, out_dir, maps, fmt, split, images_dir, confidence,
-                                 imgsz=imgsz, device=device, python=python))
+                                 imgsz=imgsz, device=device, python=python, convention=convention))
     ev = result.evaluation
     click.echo(f"{ev.images} images ({result.document['test_set']['layout']}), mapping "
                f"{result.document['mapping_options']}: COCO AP {ev.stats['AP']:.4f}, AP50 {ev.stats['AP50']:.4f}")

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.backends import images, previews
+from synthua_usd.backends import camera_effects, images, previews
 from synthua_usd.core.atomic import atomic_path, write_json_atomic, write_text_atomic
 from synthua_usd.core.outputs import DEPTH_DEFINITION
 from synthua_usd.dataset import annotations, keypoints, qa, resample
@@ -35,6 +35,7 @@ from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.background import BackgroundWriter
+from synthua_usd.randomisation.effects import draw_image_effects
 
 #: The item that ends a shard: the worker finishes its pending write and returns that record.
 FLUSH = "flush"
@@ -241,6 +242,10 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     ignored = {entry["id"] for entry in instances if entry["ignore"]}
     panoptic_png, segments = annotations.panoptic(class_ids, instance_ids, snapshot.instances, class_map, ignored)
     display = frame.display()
+    effects = draw_image_effects(job.config.randomise, planned.seed, planned.camera_path, planned.time_code,
+                                 planned.condition)
+    if effects is not None:   # camera effects on the display image, before QA measures it; labels untouched
+        display = camera_effects.apply_effects(display, effects, frame.depth)
     measures = qa.measure(display, instances)
     verdict, reasons = qa.verdict(measures, job.config.qa)
 
@@ -296,7 +301,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
         qa=QAResult(verdict=verdict, reasons=list(reasons), measures=measures),
     )
     if randomised is not None:
-        record["randomisation"] = randomised.to_dict()
+        record["randomisation"] = randomised.to_dict() | ({} if effects is None else {"effects": effects.to_dict()})
     seconds["annotate"] += time.perf_counter() - t0
     return ImageBuffers(record, arrays, verdict == "rejected", seconds)
 

@@ -6,7 +6,8 @@ boxes an image; its classes are mapped to the test set's (:mod:`synthua_usd.anal
 scored by pycocotools (:mod:`synthua_usd.analytics.detection_metrics`); the report
 (:mod:`synthua_usd.analytics.detection_report`) is written as a set. A generated dataset as the test set is read
 with the box policy the model was trained with (its train.json), so a held-out synthetic split is scored on the
-boxes the model learnt.
+boxes the model learnt, or with ``convention`` (a named box convention,
+:mod:`synthua_usd.model.box_conventions`) in its place, the model's classes kept.
 """
 
 from __future__ import annotations
@@ -21,10 +22,12 @@ from synthua_usd.analytics.class_mapping import build_mapping, parse_map_options
 from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluation, evaluate_detections
 from synthua_usd.analytics.detection_report import write_detection_report
 from synthua_usd.analytics.detection_sources import detect_format, manifest_sha256, read_detection_set, set_id
-from synthua_usd.analytics.detection_targets import DetectionTargets
+from synthua_usd.analytics.detection_targets import DetectionTargets, targets_for
 from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import shown
 from synthua_usd.model import detection_limits as L
+from synthua_usd.model.box_conventions import CONVENTIONS
 from synthua_usd.pipeline.train import check_imgsz, run_weights
 
 #: Confidence below which predictions are dropped before scoring (COCO's AP ranks every detection).
@@ -37,7 +40,8 @@ MAX_DETECTIONS = 300
 class EvaluateRequest:
     """``model``: a run folder of `synthua train`; ``test_set`` in ``fmt`` (``split`` for YOLO and generated
     datasets, ``images_dir`` for COCO); ``maps``: ``--map`` values; ``confidence``: the one of precision, recall
-    and the false negatives; ``imgsz``: prediction size (default: the training's)."""
+    and the false negatives; ``imgsz``: prediction size (default: the training's); ``convention``: the box
+    convention a generated test set's boxes are drawn by (default: the model's training's)."""
 
     model: Path
     test_set: Path
@@ -52,8 +56,11 @@ class EvaluateRequest:
     device: str = "auto"
     threads: int | None = None
     python: Path | None = None
+    convention: str | None = None
 
     def __post_init__(self):
+        if self.convention is not None and self.convention not in CONVENTIONS:
+            raise InputError(f"--convention: {self.convention!r}; expected one of {', '.join(CONVENTIONS)}")
         for name, value in (("--confidence", self.confidence), ("--merge-iou", self.merge_iou)):
             if not L.CONFIDENCE.contains(value) or value >= 1.0:
                 raise InputError(f"{name}: {value:g}; expected a number in (0, 1)")
@@ -74,6 +81,11 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
     weights, about = run_weights(request.model)
     targets = DetectionTargets.from_document(about["targets"]) if about.get("targets") else DetectionTargets()
     fmt = detect_format(Path(request.test_set)) if request.fmt == "auto" else request.fmt
+    if request.convention is not None:
+        if fmt != "synthua":
+            raise InputError(f"--convention {request.convention}: {shown(request.test_set)} is read as a {fmt} set, whose "
+                             f"boxes are its own; expected a dataset `synthua generate` wrote, or no --convention")
+        targets = targets_for(request.convention, targets.classes, min_height_px=targets.min_height_px)
     split = request.split or ("test" if fmt == "synthua" else None)   # never a generated dataset's train split
     test = read_detection_set(request.test_set, fmt, split, request.images_dir, targets)
     model_classes = tuple(about["classes"])

@@ -2,7 +2,7 @@
 (``schemas/generate.schema.json``, ``$defs.randomise``) as checked, frozen plain data.
 
 Every range is ``(low, high)`` with ``low <= high`` (equal ends fix the value). Each part has ``enabled``
-(default true), so a part is switched off without deleting its ranges; a config without a ``randomise``
+(default true; ``district`` and ``effects`` default false), so a part is switched off without deleting its ranges; a config without a ``randomise``
 block (or with ``null``) randomises nothing and renders the scenario as composed, as before. The meaning of
 every field is documented once, in the schema's descriptions; the defaults are owned here and a test holds
 the schema's documentation to them.
@@ -235,9 +235,61 @@ class DistrictRandomisation:
         object.__setattr__(self, "seeds", seeds)
 
 
+#: Camera effects' kinds, in the order :func:`synthua_usd.backends.camera_effects.apply_effects` applies them.
+EFFECTS = ("defocus", "motion_blur", "vignetting", "exposure", "noise", "white_balance", "jpeg")
+
+
+@dataclass(frozen=True)
+class EffectsRandomisation:
+    """Camera effects applied to each image after rendering (its labels untouched), each with the probability
+    ``<effect>_probability`` per image, drawn from a stream of its own (off, or other ranges, move no scene draw):
+    defocus (a thin lens focused at ``focus_m``, log-uniform, blurring a point at infinity to a disc of radius
+    ``defocus_radius_width_share`` of the image width), linear motion blur (length ``motion_blur_length_width_share``
+    of the width, any direction), vignetting (``vignetting_corner_loss`` of the light lost at the corners, the cos⁴
+    law), exposure (``exposure_ev`` stops), sensor noise (shot noise of gain ``noise_shot_gain`` in linear units per
+    photo-electron, Gaussian read noise ``noise_read_sigma``), white balance (red and blue gains within
+    ``white_balance_gain``, green 1) and JPEG compression (quality within ``jpeg_quality``). Off by default: a config
+    that does not ask for it renders as before."""
+
+    enabled: bool = False
+    defocus_probability: float = 0.3
+    focus_m: Range = (1.5, 20.0)
+    defocus_radius_width_share: Range = (0.0005, 0.003)
+    motion_blur_probability: float = 0.3
+    motion_blur_length_width_share: Range = (0.002, 0.008)
+    vignetting_probability: float = 0.5
+    vignetting_corner_loss: Range = (0.1, 0.4)
+    exposure_probability: float = 1.0
+    exposure_ev: Range = (-0.3, 0.3)
+    noise_probability: float = 1.0
+    noise_shot_gain: Range = (0.0001, 0.002)
+    noise_read_sigma: Range = (0.0005, 0.004)
+    white_balance_probability: float = 1.0
+    white_balance_gain: Range = (0.9, 1.1)
+    jpeg_probability: float = 0.5
+    jpeg_quality: Range = (60, 95)
+
+    def __post_init__(self) -> None:
+        for effect in EFFECTS:
+            p = getattr(self, f"{effect}_probability")
+            if isinstance(p, bool) or not isinstance(p, (int, float)) or not (math.isfinite(p) and 0 <= p <= 1):
+                raise InputError(f"effects.{effect}_probability: {p!r}; expected a probability in [0, 1]")
+            object.__setattr__(self, f"{effect}_probability", float(p))
+        for name, lo, hi in (("focus_m", 0.1, 10_000.0), ("defocus_radius_width_share", 0.0, 0.05),
+                             ("motion_blur_length_width_share", 0.0, 0.1), ("vignetting_corner_loss", 0.0, 0.9),
+                             ("exposure_ev", -4.0, 4.0), ("noise_shot_gain", 0.0, 0.1), ("noise_read_sigma", 0.0, 0.1),
+                             ("white_balance_gain", 0.5, 2.0), ("jpeg_quality", 1.0, 100.0)):
+            object.__setattr__(self, name, _range(f"effects.{name}", getattr(self, name), lo, hi))
+        if not all(float(q).is_integer() for q in self.jpeg_quality):
+            raise InputError(f"effects.jpeg_quality: {[f'{q:g}' for q in self.jpeg_quality]}; expected two whole "
+                             f"numbers in [1, 100]")
+        object.__setattr__(self, "jpeg_quality", tuple(int(q) for q in self.jpeg_quality))
+
+
 _PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "hair": HairRandomisation,
           "looks": LooksRandomisation, "materials": MaterialRandomisation,
-          "light": LightRandomisation, "camera": CameraRandomisation, "district": DistrictRandomisation}
+          "light": LightRandomisation, "camera": CameraRandomisation, "district": DistrictRandomisation,
+          "effects": EffectsRandomisation}
 
 
 @dataclass(frozen=True)
@@ -254,6 +306,7 @@ class RandomisationConfig:
     light: LightRandomisation = field(default_factory=LightRandomisation)
     camera: CameraRandomisation = field(default_factory=CameraRandomisation)
     district: DistrictRandomisation = field(default_factory=DistrictRandomisation)
+    effects: EffectsRandomisation = field(default_factory=EffectsRandomisation)
 
     def __post_init__(self) -> None:
         if self.devices.enabled and not self.crowd.enabled:
@@ -289,9 +342,14 @@ class RandomisationConfig:
         return cls(seed=int(doc.get("seed", 0)), **parts)
 
     def to_document(self) -> dict:
-        """Every value explicit (as ``generate.json`` records it); ``from_document(to_document())`` is equal."""
+        """Every value explicit (as ``generate.json`` records it), but ``effects`` when it is the default (off,
+        default ranges), which is left out; ``from_document(to_document())`` is equal."""
         out: dict[str, Any] = {"seed": self.seed}
         for name in _PARTS:
+            if name == "effects" and self.effects == EffectsRandomisation():
+                # left out as it was before effects existed: a config that does not ask for them keeps its
+                # generate.json and job key (and with them resumption of datasets written before)
+                continue
             out[name] = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(getattr(self, name)).items()}
         return out
 

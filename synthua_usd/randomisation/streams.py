@@ -5,7 +5,8 @@ which worker renders the image, nor on what it rendered before) and one scope's 
 - ``district``: (seed) which district seed a scene's twin is;
 - ``scene``: (seed) the crowd's cast and looks, the devices, the twin's material variants;
 - ``view``: (seed, camera, time code) the camera's jitter, then where each person stands;
-- ``light``: (seed, camera, time code, condition) the sun, sky and exposure.
+- ``light``: (seed, camera, time code, condition) the sun, sky and exposure;
+- ``effects``: (seed, camera, time code, condition) the camera effects applied after rendering.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import zlib
 
 import numpy as np
 
-_SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4}
+_SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5}
 
 
 def _key(value) -> int:

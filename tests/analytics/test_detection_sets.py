@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from synthua_usd.analytics.detection_sets import Box, label_path, parse_yolo_labels, read_coco, read_yolo
+from synthua_usd.analytics.detection_sets import ALL_SPLITS, Box, label_path, parse_yolo_labels, read_coco, read_yolo
 from synthua_usd.core.errors import InputError
 
 
@@ -49,6 +49,37 @@ def test_yolo_names_as_mapping_and_val_when_no_test(tmp_path):
     (root / "data.yaml").write_text("val: images/test\nnames: {0: person, 1: wheelchair}\n")
     s = read_yolo(root / "data.yaml")
     assert s.split == "val" and s.names == ("person", "wheelchair") and len(s.images) == 2
+
+
+def test_all_splits_take_each_image_once(tmp_path):
+    root = yolo_folder(tmp_path / "set")
+    _image(root / "images" / "val" / "c.png", 40, 20)
+    (root / "data.yaml").write_text("train: images/test\nval: [images/val, images/test/a.jpg]\n"
+                                    "names: [person, wheelchair]\n")
+    s = read_yolo(root, ALL_SPLITS)
+    assert s.split == "train+val" and [im.path.name for im in s.images] == ["a.jpg", "b.png", "c.png"]
+    assert [im.id for im in s.images] == [1, 2, 3] and s.counts() == {"person": 1, "wheelchair": 1}
+
+
+def test_a_folder_without_data_yaml(tmp_path):
+    """Every image below images/ (or images/<split>); classes from classes.txt, else their indices; auto takes it as
+    YOLO."""
+    from synthua_usd.analytics.detection_sources import detect_format
+
+    root = yolo_folder(tmp_path / "set")
+    (root / "data.yaml").unlink()
+    _image(root / "images" / "val" / "c.png", 40, 20)
+    assert detect_format(root) == "yolo"
+    s = read_yolo(root)
+    assert s.names == ("0", "1") and len(s.images) == 3 and s.counts() == {"0": 1, "1": 1}
+    assert [im.path.name for im in read_yolo(root, "test").images] == ["a.jpg", "b.png"]
+    (root / "labels" / "classes.txt").write_text("person\nwheelchair\n")
+    assert read_yolo(root).counts() == {"person": 1, "wheelchair": 1}
+    with pytest.raises(InputError, match="images/train: not a folder"):
+        read_yolo(root, "train")
+    (root / "labels" / "classes.txt").write_text("person\nperson\n")
+    with pytest.raises(InputError, match="expected class names, one a line, each once"):
+        read_yolo(root)
 
 
 def test_yolo_split_as_list_file(tmp_path):

@@ -8,8 +8,10 @@ import json
 import pytest
 
 from synthua_usd.analytics.detection_sets import Box
-from synthua_usd.analytics.detection_targets import DEFAULT_CLASSES, DetectionTargets, image_boxes, read_generated
+from synthua_usd.analytics.detection_targets import (DEFAULT_CLASSES, DetectionTargets, image_boxes, read_generated,
+                                                     targets_for)
 from synthua_usd.core.errors import InputError
+from synthua_usd.model.box_conventions import CONVENTIONS, DEFAULT_CONVENTION
 
 CHAIR = "/W/A/ManualWheelchair"
 INSTANCES = [
@@ -38,6 +40,32 @@ def test_device_box_and_aid_users_not_persons():
     assert boxes == (Box("manual_wheelchair", 8, 10, 10, 9), Box("person", 30, 30, 1, 3))
     only_chairs = DetectionTargets(classes=("person", "manual_wheelchair"), aid_users_as_person=False)
     assert [b.label for b in image_boxes(INSTANCES, only_chairs)] == ["manual_wheelchair", "person", "person"]
+
+
+def test_the_wheelchair_sets_convention_boxes_the_seated_user_inside_the_chair():
+    """As lexra/wheelchair's README draws them: the chair's box is the union worked out above, its user has no person
+    box, and the cane user (on foot; canes are not among the convention's classes) stays a person."""
+    targets = targets_for("wheelchair-sets")
+    assert targets == DetectionTargets(("person", "manual_wheelchair", "electric_wheelchair"), "with_user", False)
+    assert targets.convention == "wheelchair-sets"
+    assert image_boxes(INSTANCES, targets) == (Box("manual_wheelchair", 8, 5, 10, 14),
+                                               Box("person", 30, 30, 1, 3, ignore=True), Box("person", 40, 2, 5, 15))
+
+
+def test_conventions_have_one_owner_and_refuse_contradicting_options():
+    assert DEFAULT_CONVENTION in CONVENTIONS and targets_for() == DetectionTargets()
+    assert DetectionTargets().convention == DEFAULT_CONVENTION
+    assert targets_for(None, aid_users_as_person=False) == DetectionTargets(aid_users_as_person=False)
+    assert targets_for(None, aid_users_as_person=False).convention is None
+    assert targets_for("wheelchair-sets", aid_users_as_person=False, aid_box="with_user") == targets_for("wheelchair-sets")
+    assert targets_for("wheelchair-sets", ("person", "manual_wheelchair")).classes == ("person", "manual_wheelchair")
+    for options, found in (({"aid_users_as_person": True}, "--aid-users-as-person on: --convention wheelchair-sets "
+                                                             "sets it off"),
+                           ({"aid_box": "device"}, "--aid-box device: --convention wheelchair-sets sets it with_user")):
+        with pytest.raises(InputError, match=found):
+            targets_for("wheelchair-sets", **options)
+    with pytest.raises(InputError, match="--convention: 'coco'; expected one of synthua, wheelchair-sets"):
+        targets_for("coco")
 
 
 def test_targets_refuse_bad_values():

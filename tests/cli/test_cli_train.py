@@ -35,3 +35,10 @@ def test_limits_hold_their_defaults():
     assert L.MINUTES.contains(L.DEFAULT_MINUTES) and L.IMGSZ.contains(L.DEFAULT_IMGSZ)
     assert L.DEFAULT_IMGSZ % 32 == 0 and L.BATCH.contains(L.DEFAULT_BATCH)
     assert L.MIN_HEIGHT_PX.contains(L.DEFAULT_MIN_HEIGHT_PX) and L.CONFIDENCE.contains(L.DEFAULT_CONFIDENCE)
+
+
+def test_a_convention_and_a_contradicting_option_are_refused(refuse):
+    refuse("train", "out", "--convention", "wheelchair-sets", "--aid-users-as-person", "--out", "run",
+           mentions=("--aid-users-as-person on", "--convention wheelchair-sets sets it off"))
+    refuse("train", "out", "--convention", "coco", "--out", "run", mentions=("--convention",))
+    refuse("evaluate-real", "run", "out", "--convention", "coco", "--out", "eval", mentions=("--convention",))

@@ -129,6 +129,23 @@ def test_evaluate_real_on_the_held_out_split_uses_the_trained_boxes(run, generat
     assert aps and all(0.0 <= v <= 1.0 for v in aps) and np.isfinite(aps).all()
 
 
+def test_evaluate_real_with_the_wheelchair_sets_convention(run, generated_random, tmp_path, capsys):
+    """The held-out split scored on the boxes of real wheelchair sets (the model's classes kept): no aid user is a
+    person box, so fewer person boxes than with the model's own convention; on a YOLO set --convention is refused."""
+    own, sets = tmp_path / "own", tmp_path / "sets"
+    assert main(["evaluate-real", str(run), str(generated_random), "--split", "val", "--out", str(own)]) == 0
+    assert main(["evaluate-real", str(run), str(generated_random), "--split", "val", "--convention",
+                 "wheelchair-sets", "--out", str(sets)]) == 0
+    a, b = (json.loads((p / "metrics.json").read_text())["test_set"] for p in (own, sets))
+    assert b["targets"]["aid_users_as_person"] is False and b["targets"]["classes"] == a["targets"]["classes"]
+    assert b["boxes"]["person"] < a["boxes"]["person"]
+    capsys.readouterr()
+    assert main(["evaluate-real", str(run), str(generated_random), "--format", "yolo", "--split", "val",
+                 "--convention", "wheelchair-sets", "--out", str(tmp_path / "yolo")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "is read as a yolo set, whose boxes are its own" in err[0]
+
+
 def test_fine_tuning_on_a_real_set_starts_from_the_run(run, generated_random, tmp_path):
     """A YOLO folder as the training set, from the synthetic run's weights: the classes are the set's own."""
     out = tmp_path / "tuned"
