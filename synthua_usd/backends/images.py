@@ -77,6 +77,12 @@ def write_color_png(path: Path, rgb8: np.ndarray) -> Path:
     return _write(path, rgb8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE})
 
 
+def write_rgba_png(path: Path, rgba8: np.ndarray) -> Path:
+    """(H, W, 4) uint8 sRGB colour with straight (not premultiplied) alpha, written as it is."""
+    return _write(path, rgba8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE},
+                  channel_names=["R", "G", "B", "A"])
+
+
 def write_color_jpeg(path: Path, rgb8: np.ndarray, quality: int = 95) -> Path:
     """(H, W, 3) uint8 sRGB values as a baseline JPEG of ``quality`` (1..100): MOTChallenge's frame format."""
     return _write(path, rgb8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE,

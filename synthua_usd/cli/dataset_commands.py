@@ -102,8 +102,21 @@ def verify(dataset: Path) -> int:
     not list, every planned image complete, every COCO annotation equal to its instance's pixels (a visible
     keypoint within 2 pixels of them), every panoptic segment equal to its PNG, Cityscapes and YOLO files
     consistent. Exit 1 on any problem, listed one per line; 2 when the manifest or generate.json is
-    malformed."""
+    malformed. A cut-out bank (synthua cutouts; its bank.json) is checked against its manifest and its own
+    masks instead."""
     from synthua_usd.pipeline.verify import MAX_LISTED, verify as run_verify
+
+    if (dataset / "bank.json").is_file():
+        from synthua_usd.pipeline.bank_check import check_bank
+
+        bank = check_bank(dataset)
+        for problem in bank.problems[:MAX_LISTED]:
+            say(f"problem: {problem}")
+        if len(bank.problems) > MAX_LISTED:
+            say(f"... and {len(bank.problems) - MAX_LISTED} more problems")
+        say(f"{dataset}: {bank.cutouts} cut-outs, {bank.files} files checked: "
+            f"{'ok' if bank.ok else f'{len(bank.problems)} problems'}")
+        return EXIT_OK if bank.ok else EXIT_FINDINGS
 
     result = run_verify(dataset, show_progress=sys.stderr.isatty())
     for problem in result.problems[:MAX_LISTED]:

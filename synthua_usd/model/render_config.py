@@ -93,3 +93,12 @@ def resolve_render(stage: Mapping[str, Any] | None = None, config: Mapping[str, 
     for source in (stage, config, options):
         values.update({key: value for key, value in (source or {}).items() if value is not None})
     return RenderConfig.from_dict(values)
+
+
+def takes_exactly(spp: int) -> bool:
+    """Whether Mitsuba's multi-jittered sampler (every RGB pass's) draws exactly ``spp`` samples (it draws an
+    r x c grid, ``r = isqrt(spp)``, ``c = ceil(spp / r)``): 1, 2, 3, 4, 6, 8, 9, 12, 15, 16, 20, ..."""
+    import math
+
+    r = math.isqrt(spp)
+    return r * -(-spp // r) == spp

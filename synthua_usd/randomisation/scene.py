@@ -276,8 +276,14 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
             groups += 1
         else:
             members.append(_member(rng, "pedestrian", config))
-    # one child stream for everyone's hair and one for their wear, spawned after the devices' (theirs stay as they
-    # were) whether or not they are used: no other draw of the scene moves
+    members, wardrobe = _styled(rng, config, members)
+    return density, aid_share, members, wardrobe
+
+
+def _styled(rng: np.random.Generator, config: RandomisationConfig,
+            members: list[CastMember]) -> tuple[tuple[CastMember, ...], Wardrobe | None]:
+    """``members`` with their hair (hair on) and their wear from a wardrobe drawn here (looks on; None without),
+    from one child stream of ``rng`` each, spawned whether or not they are used: no other draw moves."""
     hair_rng, wear_rng = rng.spawn(2)
     if config.hair.enabled:
         members = [replace(m, hair=draw_hair(hair_rng, m.body, config)) for m in members]
@@ -285,7 +291,27 @@ def draw_cast(rng: np.random.Generator, config: RandomisationConfig, walkable_ar
     if config.looks.enabled:  # people dress from the scene's wardrobe: its garments' colours replace their own
         wardrobe = draw_wardrobe(wear_rng, config.looks, config.crowd.clothing_jitter)
         members = [dressed(m, draw_wear(wear_rng, wardrobe), wardrobe) for m in members]
-    return density, aid_share, tuple(members), wardrobe
+    return tuple(members), wardrobe
+
+
+#: How an aid user of a cut-out comes: on its own, pushed by a companion (manual wheelchairs), or with 1-2
+#: companions walking beside it.
+UNIT_GROUPS = ("alone", "pushed", "accompanied")
+
+
+def draw_unit(rng: np.random.Generator, config: RandomisationConfig, aid: str | None,
+              group: str = "alone") -> tuple[tuple[CastMember, ...], Wardrobe | None]:
+    """The cast of one cut-out: a pedestrian (``aid`` None), or a user of ``aid`` (a class of
+    :data:`AID_CLASSES`) ``group`` (:data:`UNIT_GROUPS`; ``pushed`` only for a manual wheelchair), its companions
+    after it; each person drawn as a crowd's is (body, skin, clothes, device look, hair, wear)."""
+    if group not in UNIT_GROUPS or (aid is None and group != "alone") or (group == "pushed" and aid != "manual_wheelchair"):
+        raise ValueError(f"a cut-out of a {aid or 'pedestrian'} {group}: no such unit; expected a pedestrian alone, "
+                         f"any aid user alone or accompanied, or a manual wheelchair user pushed")
+    members = [_member(rng, "pedestrian" if aid is None else PROFILE_OF_AID[aid], config)]
+    if group != "alone":
+        _companions(rng.spawn(1)[0], config, members, 2, 1.0 if group == "pushed" else 0.0,
+                    1.0 if group == "accompanied" else 0.0, 0)
+    return _styled(rng, config, members)
 
 
 def dressed(member: CastMember, wear: Wear, wardrobe: Wardrobe) -> CastMember:

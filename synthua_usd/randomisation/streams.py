@@ -15,7 +15,7 @@ import zlib
 
 import numpy as np
 
-_SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5}
+_SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "cutout_group": 6, "cutout_view": 7}
 
 
 def _key(value) -> int:

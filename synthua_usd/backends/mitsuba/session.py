@@ -70,6 +70,17 @@ class RenderSession:
         """The loaded Mitsuba scene (None before the first render), e.g. to time raw ray casts against it."""
         return self._scene
 
+    @property
+    def lighting(self) -> weather_scene.Lighting | None:
+        """What the loaded scene's condition set (the sun's direction and irradiance, ...); None without one."""
+        return self._lighting if self._condition is not None else None
+
+    def denoiser(self) -> Denoiser:
+        """The session's denoiser (made once)."""
+        if self._denoiser is None:
+            self._denoiser = Denoiser()
+        return self._denoiser
+
     def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
         self._translation = translate(self.mi, snapshot, camera, self.config, condition)
         # optimize=False: Mitsuba would otherwise merge meshes and lose the identity labels depend on.
@@ -184,16 +195,16 @@ class RenderSession:
                 self._focus_lamps(hits, camera)
             # Mitsuba's perspective sensor cannot distort: a lens with distortion renders through its own sensor.
             sensor = distorted_sensor(self.mi, camera, self.config) if camera.distortion is not None else None
-            if self.config.denoise and self._denoiser is None:
+            if self.config.denoise and self._guides is None:
                 # The scalar variant needs the guides wrapped around the path tracer (see guide_integrator_dict).
                 wrapped = self.variant.startswith("scalar")
                 self._guides = self.mi.load_dict(guide_integrator_dict(self.config if wrapped else None))
-                self._denoiser = Denoiser()
+                self.denoiser()
             rgb_pass = render_rgb(self.mi, self._scene, self.config, show_progress, sensor=sensor, seed=seed,
-                                  guides=self._guides)
+                                  guides=self._guides if self.config.denoise else None)
             image = rgb_pass.rgb
             seconds["rgb"] = time.perf_counter() - t0
-            if self._denoiser is not None:
+            if self.config.denoise:
                 # Path-traced radiance only: fog and rain are added afterwards, noise-free, in image space.
                 t0 = time.perf_counter()
                 image, fireflies = self._denoiser.denoise_pass(image, rgb_pass.albedo, rgb_pass.normal)

@@ -18,7 +18,7 @@ from synthua_usd.backends.mitsuba.shape_tables import ShapeTables
 from synthua_usd.backends.mitsuba.weather_scene import LampMesh
 from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.model.conditions import Condition
-from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig, takes_exactly
 from synthua_usd.model.scene import Light, SceneSnapshot
 
 
@@ -121,13 +121,6 @@ SAMPLER = "multijitter"
 #: Mitsuba's multi-jittered sampler draws an r x c grid with r = isqrt(n), c = ceil(n / r) and rounds other
 #: counts up (5 -> 6); every pass asks for a count it takes as it is (:func:`pass_sample_counts`).
 MAX_SPP_PER_PASS = 16
-
-
-def takes_exactly(spp: int) -> bool:
-    """Whether the multi-jittered sampler draws exactly ``spp`` samples (``spp = r * ceil(spp / r)``,
-    ``r = isqrt(spp)``): 1, 2, 3, 4, 6, 8, 9, 12, 15, 16, 20, ..."""
-    r = math.isqrt(spp)
-    return r * -(-spp // r) == spp
 
 
 def pass_sample_counts(spp: int) -> list[int]:
