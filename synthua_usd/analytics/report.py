@@ -104,7 +104,7 @@ def write_report(index: DatasetIndex, stats: DatasetStatistics, out_dir: str | P
     chosen = gallery_images(index.images, samples)
     pairs = [_read_pair(index, img) for img in chosen]   # before anything is written: a missing file stops here
     palette = cmap.palette()
-    with output_set(out_dir) as stage:
+    with output_set(out_dir, inputs={"DATASET": index.root}) as stage:
         write_json_atomic(stage / "statistics.json", stats.document())
         write_text_atomic(stage / "class_statistics.csv", _csv([c.csv_row() for c in classes]))
         co_rows = [{"class": n} | {m: int(stats.cooccurrence[i, j]) for j, m in enumerate(names)}

@@ -166,7 +166,8 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
         from synthua_usd.pipeline.twin_import import IMPORT_WALKABLE
 
         crowd = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=frames, walkable=IMPORT_WALKABLE)
-    written, report = write_import(model, out_dir, cmap, report, crowd)
+    written, report = write_import(model, out_dir, cmap, report, crowd,
+                                   inputs={"INPUT": input_path, "--rules": rules, "--class-map": class_map})
     say(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
                f"{model.triangle_count()} triangles, classes {model.label_counts()}")
     for seg in model.report.get("segments", []):

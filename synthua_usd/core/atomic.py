@@ -25,6 +25,7 @@ from typing import Iterator
 
 from synthua_usd.core.dataset_folders import check_outside_datasets
 from synthua_usd.core.errors import OutputError, SynthuaError
+from synthua_usd.core.input_guard import Inputs, check_not_inputs
 
 
 @contextmanager
@@ -127,7 +128,7 @@ def write_json_atomic(path: str | Path, document, indent: int = 2) -> Path:
 
 
 @contextmanager
-def output_set(out_dir: str | Path, dataset_part: bool = False) -> Iterator[Path]:
+def output_set(out_dir: str | Path, dataset_part: bool = False, inputs: Inputs | None = None) -> Iterator[Path]:
     """Yield an empty staging folder beside ``out_dir``; write every output into it (subfolders allowed).
 
     On success, when ``out_dir`` does not exist the staging folder is renamed to it (one atomic step);
@@ -135,7 +136,9 @@ def output_set(out_dir: str | Path, dataset_part: bool = False) -> Iterator[Path
     does not hold are kept). Every target is checked before the first move, so a file that would land on
     a folder, or below a file, fails with nothing moved. On any error the staging folder is removed. An
     ``out_dir`` in a dataset folder is refused (:func:`synthua_usd.core.dataset_folders.check_outside_datasets`), unless
-    ``dataset_part``: ``synthua generate`` writing a part of its own dataset (a district's scenario).
+    ``dataset_part``: ``synthua generate`` writing a part of its own dataset (a district's scenario). A staged
+    file that would replace one of the command's ``inputs`` fails before anything is moved
+    (:func:`synthua_usd.core.input_guard.check_not_inputs`).
     """
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
@@ -152,17 +155,18 @@ def output_set(out_dir: str | Path, dataset_part: bool = False) -> Iterator[Path
     try:
         with named_as(staging, out_dir):
             yield staging
-            _move_into_place(staging, out_dir)
+            _move_into_place(staging, out_dir, inputs or {})
     finally:
         if staging.exists():
             shutil.rmtree(staging, ignore_errors=True)
 
 
-def _move_into_place(staging: Path, out_dir: Path) -> None:
+def _move_into_place(staging: Path, out_dir: Path, inputs: Inputs) -> None:
     if not out_dir.exists():
         os.rename(staging, out_dir)
         return
     files = sorted(p for p in staging.rglob("*") if not p.is_dir())
+    check_not_inputs((out_dir / src.relative_to(staging) for src in files), inputs)
     for src in files:
         target = out_dir / src.relative_to(staging)
         if target.is_dir() and not target.is_symlink():

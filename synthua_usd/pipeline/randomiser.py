@@ -267,6 +267,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
 
     from synthua_usd.core.atomic import output_set
     from synthua_usd.core.errors import InputError
+    from synthua_usd.core.input_guard import check_not_inputs
     from synthua_usd.dataset.config import GenerationConfig
     from synthua_usd.model.render_config import resolve_render
     from synthua_usd.usd.render_settings import render_defaults
@@ -275,6 +276,9 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     out = Path(request.out)
     if out.suffix.lower() not in USD_SUFFIXES[:3]:
         raise InputError(f"{out}: --out needs a USD layer name (.usda, .usdc or .usd); expected e.g. layer.usda")
+    inputs = {"SCENARIO": request.scenario, "--config": request.config_path, "--record": request.record_path,
+              "--class-map": request.class_map_path}
+    check_not_inputs([out], inputs)  # before anything is drawn; the layers beside it are checked with the set
     render: dict = {}
     if request.record_path is not None:
         document, seed, camera, time_code, condition, render = _from_record(Path(request.record_path))
@@ -319,7 +323,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     width, height = settings.width, settings.height
     randomiser = Randomiser(stage, config.randomise, class_map, (width, height))
     drawn = randomiser.apply(seed, camera, time_code, condition, district)
-    with output_set(out.parent) as staging:
+    with output_set(out.parent, inputs=inputs) as staging:
         randomiser.export(staging / out.name, anchor=out.parent)
         files = tuple(out.parent / p.name for p in sorted(staging.iterdir()))
     args = ("synthua", "render", str(scenario), "--layer", str(out), "--camera", camera,

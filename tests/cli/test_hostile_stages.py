@@ -330,7 +330,7 @@ def test_populate_refuses_nonsense(corpus, tmp_path, run_cli):
         code, _, err = run_cli("agents", "populate", SCENARIO, *args, "--out", tmp_path / "a.usdc")
         assert code == 2 and err.count("synthua: error:") == 1 and word in err, (args, err)
     code, _, err = run_cli("agents", "populate", corpus / "tiny.usda", "--out", corpus / "tiny.usda")
-    assert code == 2 and "input stage itself" in err
+    assert code == 2 and "is the input TWIN_OR_SCENARIO itself" in err
     assert not (tmp_path / "a.usdc").exists()
 
 
