@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK
-from synthua_usd.cli.options import InRange
+from synthua_usd.cli.options import InRange, seed_option
 from synthua_usd.model.ranges import Range
 
 
@@ -19,8 +19,7 @@ from synthua_usd.model.ranges import Range
 @click.option("--record", "record_path", type=click.Path(path_type=Path),
               help="Or an image record of a randomised dataset (DATASET/records/NAME.json): its seed, camera, time "
                    "code, condition and render size, and the dataset's config.")
-@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True,
-              help="The image's seed: images of one seed share a scene (crowd, looks, materials).")
+@seed_option(help="The image's seed: images of one seed share a scene (crowd, looks, materials).")
 @click.option("--camera", help="Camera prim path [default: the render settings' camera].")
 @click.option("--time-code", "--frame", "time_code", type=InRange(Range(-1e9, 1e9)),
               help="Time code of the image [default: the stage's start time code].")

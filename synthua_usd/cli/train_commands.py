@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK
-from synthua_usd.cli.options import InRange
+from synthua_usd.cli.options import InRange, seed_option
 from synthua_usd.model import detection_limits as L
 
 _FORMAT = click.Choice(["auto", "yolo", "coco", "synthua"])
@@ -29,8 +29,7 @@ _DEVICE = click.Choice(L.DEVICES)
 @click.option("--batch", type=InRange(L.BATCH), default=L.DEFAULT_BATCH, show_default=True, help="Images per step.")
 @click.option("--device", type=_DEVICE, default="auto", show_default=True,
               help="auto: CUDA when torch sees a GPU, else the CPU.")
-@click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True,
-              help="Ultralytics' seed (deterministic mode on).")
+@seed_option(help="Ultralytics' seed (deterministic mode on).")
 @click.option("--model", default=L.DEFAULT_MODEL, show_default=True,
               help="Architecture shipped inside the Ultralytics wheel, trained from scratch (e.g. yolo26s.yaml, "
                    "yolo11n.yaml); no weights are downloaded.")

@@ -18,6 +18,7 @@ from synthua_usd.core.errors import InputError, echo
 from synthua_usd.assets.hair import HAIR_STYLES
 from synthua_usd.assets.look_images import LOWER_FABRICS, SHOES, UPPER_FABRICS
 from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES
+from synthua_usd.model.ranges import SEED
 
 #: The mobility-aid classes a randomised crowd can use (the device classes of the agent profiles).
 AID_CLASSES = ("manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
@@ -230,8 +231,9 @@ class DistrictRandomisation:
 
     def __post_init__(self) -> None:
         seeds = tuple(int(s) for s in self.seeds)
-        if not seeds or any(s < 0 or s > 2**32 - 1 for s in seeds) or len(set(seeds)) != len(seeds):
-            raise InputError(f"district.seeds: {list(seeds)}; expected one or more distinct integers in 0..2^32-1")
+        if not seeds or not all(SEED.contains(s) for s in seeds) or len(set(seeds)) != len(seeds):
+            raise InputError(f"district.seeds: {list(seeds)}; expected one or more distinct integers, each "
+                             f"{str(SEED).removeprefix('an integer ')}")
         object.__setattr__(self, "seeds", seeds)
 
 
