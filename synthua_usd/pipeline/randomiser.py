@@ -211,7 +211,8 @@ class Randomiser:
 class RandomiseRequest:
     """One image's randomisation to write: of ``config_path``'s ``randomise`` block with ``seed``, ``camera``,
     ``time_code`` and ``condition`` (None: the stage's own lights), at the config's render size (else the
-    stage's); or, with ``record_path``, of that record of a dataset (its generate.json gives the config). When
+    stage's); or, with ``record_path``, of that record of a dataset (its generate.json gives the config; a record
+    fixes the seed, camera, time code and condition, so none of those, nor ``config_path``, may come with it). When
     the seed's scene is another district, the layers go over that district's scenario: the dataset's copy, or
     one written beside ``out`` (``<stem>.district_<d>/``); the render command printed names it."""
 
@@ -219,12 +220,25 @@ class RandomiseRequest:
     out: Path
     config_path: Path | None = None
     record_path: Path | None = None
-    seed: int = 0
+    seed: int | None = None
     camera: str | None = None
     time_code: float | None = None
     condition: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
+
+    def __post_init__(self) -> None:
+        from synthua_usd.core.errors import InputError
+
+        if self.record_path is None:
+            return
+        given = [option for option, value in (("--config", self.config_path), ("--seed", self.seed),
+                                              ("--camera", self.camera), ("--time-code", self.time_code),
+                                              ("--condition", self.condition)) if value is not None]
+        if given:
+            raise InputError(f"{given[0]}: given with --record {self.record_path}; expected one or the other (the "
+                             f"record fixes its image's seed, camera, time code and condition, and its dataset's "
+                             f"config)")
 
 
 @dataclass(frozen=True)
@@ -288,7 +302,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
             raise InputError("randomise: neither --config nor --record given; expected a generation config with a "
                              "randomise block, or an image record of a randomised dataset")
         config = GenerationConfig.load(request.config_path)
-        seed, camera, time_code, condition = request.seed, request.camera, request.time_code, request.condition
+        seed, camera, time_code, condition = request.seed or 0, request.camera, request.time_code, request.condition
     source = request.record_path or request.config_path
     if config.randomise is None:
         raise InputError(f"{source}: has no randomise block; expected a config that randomises scenes (see "
