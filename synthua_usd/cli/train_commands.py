@@ -130,7 +130,8 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
     instances .json, or a generated dataset (scored on the boxes the model was trained with). Per mapped
     class: AP50 and AP50-95 by pycocotools' COCOeval (bbox), precision and recall at --confidence (IoU 0.5),
     and a page of the worst false negatives (report.html, false_negatives.png). Test classes no --map names
-    are not scored.
+    are not scored. TEST_SET is read whole before the detector runs, or refused naming the file: every image
+    decoded, a COCO image's size its file's, every box on an image of the set and inside it.
     """
     from synthua_usd.pipeline.evaluate_real import evaluate_real as run
     from synthua_usd.pipeline.evaluate_real import EvaluateRequest

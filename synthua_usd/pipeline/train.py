@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from synthua_usd import __version__
-from synthua_usd.analytics.detection_sets import DetectionSet
+from synthua_usd.analytics.detection_sets import DetectionSet, MissingSplit
 from synthua_usd.analytics.detection_sources import manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
 from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
@@ -122,9 +122,9 @@ def _splits(request: TrainRequest) -> tuple[dict[str, DetectionSet], DetectionSe
                          f"train split; expected a set whose train split shows them")
     try:
         val = read("val")
-    except InputError as exc:  # no val split: Ultralytics validates the last epoch on the train split
+    except MissingSplit as exc:  # no val split: Ultralytics validates the last epoch on the train split
         log.warning("%s; Ultralytics validates on the train split instead", str(exc).split("; expected")[0])
-        val = train
+        val = train  # any other refusal of the val split (a class index out of range, a broken image) stands
     return {"train": train, "val": val}, train
 
 
