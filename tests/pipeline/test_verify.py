@@ -131,7 +131,7 @@ def test_a_record_that_is_not_a_record_is_a_problem(copy):
     (lambda r: r["qa"].update(verdict="maybe"), "qa.verdict"),
     (lambda r: r["instances"][0].update(bbox="everywhere"), "instances[0].bbox"),
     (lambda r: r["files"].pop("instance"), "files"),
-    (lambda r: r.update(surprise=1), "(document)"),
+    (lambda r: r.update(surprise=1), "surprise"),
 ])
 def test_a_hand_corrupted_record_is_a_problem_naming_its_field(copy, spoil, field):
     """Every record verify reads is validated against schemas/record.schema.json: a malformed one is one problem
