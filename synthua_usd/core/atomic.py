@@ -52,14 +52,18 @@ def renamed(exc: OSError, old: Path, new: Path, whole: bool = False) -> OSError:
     """``exc`` naming ``new`` wherever it named ``old`` or a path below it (``whole``: any path directly
     in the folder ``old`` is ``new`` itself, as mkstemp's random names are); ``exc`` itself when it names
     neither."""
+    # a library names the file as it made it: tempfile absolute where the folder was given relative
+    old_abs = Path(os.path.abspath(old))
+
     def mapped(name):
         if name is None:
             return None
         name = Path(os.fsdecode(name))
         if whole:
-            return new if name.parent == old else None
-        if name.is_relative_to(old):
-            return new / name.relative_to(old)
+            return new if name.parent in (old, old_abs) else None
+        for folder in (old, old_abs):
+            if name.is_relative_to(folder):
+                return new / name.relative_to(folder)
         return None
 
     first, second = mapped(exc.filename), mapped(getattr(exc, "filename2", None))
@@ -146,12 +150,14 @@ def output_set(out_dir: str | Path, dataset_part: bool = False, inputs: Inputs |
     if not dataset_part:
         check_outside_datasets(out_dir)
     parent = out_dir.parent
+    staging = parent / f".{out_dir.name[:64]}.partial-{secrets.token_hex(4)}"
     try:
         parent.mkdir(parents=True, exist_ok=True)
-        staging = parent / f".{out_dir.name[:64]}.partial-{secrets.token_hex(4)}"
         staging.mkdir()
     except FileExistsError:
         raise OutputError(f"{out_dir}: a parent of the output folder is a file; expected folders") from None
+    except OSError as exc:  # a read-only or full parent: the folder asked for, never the staging folder
+        raise renamed(exc, staging, out_dir) from None
     try:
         with named_as(staging, out_dir):
             yield staging
