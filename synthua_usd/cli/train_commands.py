@@ -66,7 +66,9 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
     \b
     TRAIN_SET is a dataset `synthua generate` wrote (trained on its train split; boxes from its records: by
     default a wheelchair's box covers its user, as a real photo's 'wheelchair' box does, and a wheelchair user
-    is a person too), or an Ultralytics YOLO folder or COCO .json of real photos. Ultralytics runs in its own
+    is a person too), or an Ultralytics YOLO folder or COCO .json of real photos. Its val split is what the last
+    epoch is validated on (the train split when the set has none); both are read whole, every image decoded, or
+    refused naming the file before training starts. Ultralytics runs in its own
     environment, .venv-train (tools/setup_train.sh; AGPL-3.0); on a GPU when one is present. train.json
     records the set (its SHA-256, a generated dataset's id and config), classes, budget, seed, device and
     library versions.
