@@ -336,10 +336,10 @@ def read_coco(json_path: str | Path, images_dir: str | Path | None = None) -> De
             if int(a["category_id"]) not in categories:
                 raise InputError(f"{where}: annotations[{n}].category_id: {a['category_id']}; expected an id of "
                                  f"categories")
-            image_id = a["image_id"]
-            if isinstance(image_id, bool) or not isinstance(image_id, int) or image_id not in sizes:
-                raise InputError(f"{where}: annotations[{n}].image_id: {echo(image_id)}; expected the id of one of "
-                                 f"its {len(sizes)} images (a box on no image would be scored as nothing)")
+            image_id = _whole_number(a["image_id"], f"{where}: annotations[{n}].image_id", 0)
+            if image_id not in sizes:
+                raise InputError(f"{where}: annotations[{n}].image_id: {image_id}; expected the id of one of its "
+                                 f"{len(sizes)} images (a box on no image would be scored as nothing)")
             width, height, path = sizes[image_id]
             if x < -EDGE_PX or y < -EDGE_PX or x + w > width + EDGE_PX or y + h > height + EDGE_PX:
                 raise InputError(f"{where}: annotations[{n}].bbox: {a['bbox']}; expected a box inside its image "

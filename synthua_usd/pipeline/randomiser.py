@@ -228,7 +228,7 @@ class RandomiseRequest:
     allow_external_assets: bool = False
 
     def __post_init__(self) -> None:
-        from synthua_usd.core.errors import InputError
+        from synthua_usd.core.errors import InputError, echo
 
         if self.record_path is None:
             return
@@ -236,7 +236,7 @@ class RandomiseRequest:
                                               ("--camera", self.camera), ("--time-code", self.time_code),
                                               ("--condition", self.condition)) if value is not None]
         if given:
-            raise InputError(f"{given[0]}: given with --record {self.record_path}; expected one or the other (the "
+            raise InputError(f"{given[0]}: given with --record {echo(self.record_path)}; expected one or the other (the "
                              f"record fixes its image's seed, camera, time code and condition, and its dataset's "
                              f"config)")
 
