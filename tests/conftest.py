@@ -162,6 +162,14 @@ def generated(tmp_path_factory) -> Path:
     return built_once(tmp_path_factory, "generated", generate_dataset)
 
 
+@pytest.fixture
+def generated_copy(generated, tmp_path) -> Path:
+    """A copy of the ``generated`` dataset, to damage."""
+    out = tmp_path / "dataset"
+    shutil.copytree(generated, out)
+    return out
+
+
 #: The test files that take longest (pytest-xdist workers on 2 cores, 2026-12-04), run first: with ``--dist loadfile
 #: --no-loadscope-reorder`` (``make test``) pytest-xdist hands out files in collection order, and a long one handed
 #: out last keeps one worker busy while the others idle. (Without ``--no-loadscope-reorder`` xdist reorders the

@@ -23,6 +23,11 @@ from synthua_usd.analytics.csv_text import csv_text
 from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluation, Miss
 from synthua_usd.analytics.detection_sets import DetectionSet
 from synthua_usd.core.atomic import output_set, write_json_atomic, write_text_atomic
+from synthua_usd.core.input_guard import Inputs
+
+#: Every file of the report (the module's docstring says what each is).
+REPORT_FILES = ("metrics.json", "per_class.csv", "false_negatives.csv", "false_negatives.png", "report.html",
+                "detections.json")
 
 #: False negatives shown in the figure.
 SHOWN_MISSES = 12
@@ -105,12 +110,12 @@ def _html(ev: DetectionEvaluation, about: dict, misses_shown: int) -> str:
 
 
 def write_detection_report(out_dir: str | Path, test: DetectionSet, ev: DetectionEvaluation,
-                           detections: list[Detection], about: dict) -> Path:
+                           detections: list[Detection], about: dict, inputs: Inputs | None = None) -> Path:
     """Write the report of ``ev`` (``detections`` as predicted, in the model's classes; ``about``: what was scored
-    with what, for metrics.json) into ``out_dir`` as a set."""
+    with what, for metrics.json) into ``out_dir`` as a set, none of its files one of the command's ``inputs``."""
     panels = _panels(test, ev.misses)   # reads images: a missing one fails before writing
     by_id = {im.id: im for im in test.images}
-    with output_set(out_dir) as stage:
+    with output_set(out_dir, inputs=inputs) as stage:
         document = about | ev.document() | {"false_negatives": len(ev.misses)}
         write_json_atomic(stage / "metrics.json", document)
         rows = [c.row() for c in ev.classes]

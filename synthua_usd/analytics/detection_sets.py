@@ -19,6 +19,13 @@ A :class:`DetectionSet` is plain data read from any of the layouts people keep d
 
 Boxes are in pixels of their image, pixel edges: (x, y) the top-left corner, w and h the size. ``ignore`` marks a
 box that evaluation neither requires nor penalises a detection on (COCO's ``iscrowd``).
+
+A set is read whole or refused by name, before a detector sees it: every image of a YOLO or COCO set is decoded to
+its last pixel (a truncated JPEG, a HEIC or a file that is no image is refused naming the file; the detector would
+fail on it with a message that does not, or score grey rows), a COCO image's ``width`` and ``height`` must be the
+file's, its ``file_name`` a path inside the images folder, every annotation's ``image_id`` an image of the file and
+its box inside that image (:data:`EDGE_PX` of slack, then clipped); a YOLO label path that is not a regular file is
+refused, never read as "no objects".
 """
 
 from __future__ import annotations
@@ -29,7 +36,7 @@ from pathlib import Path
 
 import yaml
 
-from synthua_usd.core.errors import InputError
+from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.input_files import MAX_DOCUMENT_BYTES, read_input_text, shown
 from synthua_usd.core.schemas import read_json
 
@@ -43,6 +50,13 @@ ALL_SPLITS = "all"
 MAX_IMAGES = 200_000
 #: Normalised coordinates may overshoot [0, 1] by this much (rounding of the tools that wrote them).
 TOLERANCE = 1e-3
+#: Pixels a COCO box may reach past its image's edge (rounding of the tools that wrote it); the box is clipped.
+EDGE_PX = 1.0
+
+
+class MissingSplit(InputError):
+    """The set has no such split (a YOLO data.yaml that names none, a generated dataset without images in it): the
+    one refusal ``synthua train`` answers by validating on the train split instead."""
 
 
 @dataclass(frozen=True)
@@ -94,15 +108,25 @@ class DetectionSet:
         return out
 
 
-def _image_size(path: Path) -> tuple[int, int]:
-    """(width, height) of an image stored upright. A photo whose EXIF orientation turns it would be read turned by
-    the detector (OpenCV applies it) and as stored here: refused rather than scored on boxes that do not fit."""
-    from synthua_usd.backends.images import image_size
+def checked_image_size(path: Path, whole: bool = True) -> tuple[int, int]:
+    """(width, height) of an image stored upright, decoded to its last pixel when ``whole`` (else from its header:
+    the images of a generated dataset, which ``synthua verify`` checks). A photo whose EXIF orientation turns it
+    would be read turned by the detector (OpenCV applies it) and as stored here: refused rather than scored on boxes
+    that do not fit."""
+    from synthua_usd.backends.images import decoded_image_size, image_size
 
+    if not path.is_file():
+        found = "file not found" if not path.exists() else "not a regular file"
+        raise InputError(f"{shown(path)}: {found}; expected an image of the set")
+    if path.suffix.lower() not in IMAGE_SUFFIXES:
+        raise InputError(f"{shown(path)}: the file name ends in '{echo(path.suffix)}'; expected an image the detector "
+                         f"reads ({', '.join(IMAGE_SUFFIXES)}; convert HEIC photos to JPEG first)")
     try:
-        width, height, orientation = image_size(path)
-    except OSError:
-        raise InputError(f"{shown(path)}: not an image OpenImageIO can read; expected an image of the set") from None
+        width, height, orientation = (decoded_image_size if whole else image_size)(path)
+    except OSError as exc:
+        reason = str(exc).split(": ", 1)[-1].splitlines()[0]
+        raise InputError(f"{shown(path)}: not an image OpenImageIO can read whole ({echo(reason, 160)}); expected an "
+                         f"undamaged image of the set") from None
     if orientation != 1:
         raise InputError(f"{shown(path)}: EXIF orientation {orientation}; expected images stored upright (orientation "
                          f"1): rotate them as stored first, e.g. with ImageMagick's mogrify -auto-orient")
@@ -225,12 +249,14 @@ def _set_images(paths: list[Path], names: tuple[str, ...], texts: list[str] | No
     """The images at ``paths`` with the boxes of their label files (``texts``: those files' text, when read)."""
     images = []
     for i, path in enumerate(paths, 1):
-        width, height = _image_size(path)
+        width, height = checked_image_size(path)
         labels = label_path(path)
         if texts is not None:
             text = texts[i - 1]
         else:
-            text = read_input_text(labels, MAX_DOCUMENT_BYTES, "a YOLO label file") if labels.is_file() else ""
+            # no label file: an image without objects; anything else at its path (a folder) is no such thing
+            present = labels.exists() or labels.is_symlink()
+            text = read_input_text(labels, MAX_DOCUMENT_BYTES, "a YOLO label file") if present else ""
         images.append(SetImage(i, path, width, height, parse_yolo_labels(text, names, width, height, shown(labels))))
     return tuple(images)
 
@@ -246,8 +272,8 @@ def read_yolo_folder(root: str | Path, split: str | None = None) -> DetectionSet
     paths = _split_images(root, str(folder), where)
     if not paths:
         raise InputError(f"{where}: no images; expected images in a format OpenImageIO reads ({', '.join(IMAGE_SUFFIXES)})")
-    texts = [read_input_text(label_path(p), MAX_DOCUMENT_BYTES, "a YOLO label file") if label_path(p).is_file() else ""
-             for p in paths]
+    texts = [read_input_text(label_path(p), MAX_DOCUMENT_BYTES, "a YOLO label file")
+             if label_path(p).exists() or label_path(p).is_symlink() else "" for p in paths]
     listed = next((c for c in (root / "classes.txt", root / "labels" / "classes.txt") if c.is_file()), None)
     if listed is not None:
         names = tuple(n.strip() for n in read_input_text(listed, MAX_DOCUMENT_BYTES, "a list of class names")
@@ -291,9 +317,9 @@ def read_yolo(data_yaml: str | Path, split: str | None = None) -> DetectionSet:
     else:
         wanted = [split] if split else [s for s in TEST_SPLITS if doc.get(s)][:1]
     if not wanted or not all(doc.get(s) for s in wanted):
-        raise InputError(f"{where}: {split or 'test/val'}: not in the file (splits: {', '.join(present) or 'none'}); "
-                         f"expected the split to score, e.g. --split "
-                         f"{next((s for s in ('test', 'val', 'train') if doc.get(s)), 'test')}")
+        raise MissingSplit(f"{where}: {split or 'test/val'}: not in the file (splits: {', '.join(present) or 'none'}); "
+                           f"expected the split to score, e.g. --split "
+                           f"{next((s for s in ('test', 'val', 'train') if doc.get(s)), 'test')}")
     paths: list[Path] = []
     for name in wanted:
         found = _split_images(base, doc[name], f"{where}: {name}")
@@ -308,9 +334,32 @@ def read_yolo(data_yaml: str | Path, split: str | None = None) -> DetectionSet:
 
 # --- COCO JSON ---------------------------------------------------------------------------------------------------
 
+def _whole_number(value, where: str, low: int) -> int:
+    """An integer JSON value of at least ``low`` (not a boolean, not 3.5), else :class:`InputError` at ``where``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not float(value).is_integer() \
+            or not math.isfinite(value) or value < low:
+        raise InputError(f"{where}: {echo(value)}; expected a whole number >= {low}")
+    return int(value)
+
+
+def _file_in(folder: Path, name, where: str) -> Path:
+    """``folder / name`` for a COCO ``file_name``: a relative path that stays inside ``folder`` (``../../etc/passwd``
+    and ``/etc/passwd`` are refused, as no image of the set)."""
+    from pathlib import PurePosixPath, PureWindowsPath
+
+    if not isinstance(name, str) or not name.strip():
+        raise InputError(f"{where}: {echo(name)}; expected the image's file name, relative to {shown(folder)}")
+    parts = PurePosixPath(name.replace("\\", "/")).parts
+    if PurePosixPath(name).is_absolute() or PureWindowsPath(name).is_absolute() or ".." in parts:
+        raise InputError(f"{where}: '{echo(name)}' leaves the images folder; expected a file name inside "
+                         f"{shown(folder)} (or name the images' folder with --images)")
+    return folder / name
+
+
 def read_coco(json_path: str | Path, images_dir: str | Path | None = None) -> DetectionSet:
     """The images and boxes of a COCO instances file; images looked up by ``file_name`` in ``images_dir``
-    (default: the file's folder)."""
+    (default: the file's folder). Read whole or refused (see the module's docstring): every image decoded and of
+    the size the file states, every annotation on an image of the file and inside it."""
     json_path = Path(json_path)
     where = shown(json_path)
     doc = read_json(json_path, "COCO instances (images, annotations, categories)")
@@ -321,6 +370,22 @@ def read_coco(json_path: str | Path, images_dir: str | Path | None = None) -> De
     try:
         categories = {int(c["id"]): str(c["name"]) for c in doc["categories"]}
         names = tuple(categories[k] for k in sorted(categories))
+        sizes: dict[int, tuple[int, int, Path]] = {}
+        for k, im in enumerate(doc["images"]):
+            image_id = _whole_number(im["id"], f"{where}: images[{k}].id", 0)
+            if image_id in sizes:
+                raise InputError(f"{where}: images[{k}].id: {image_id} twice; expected each image once")
+            width = _whole_number(im["width"], f"{where}: images[{k}].width", 1)
+            height = _whole_number(im["height"], f"{where}: images[{k}].height", 1)
+            path = _file_in(folder, im["file_name"], f"{where}: images[{k}].file_name")
+            if not path.is_file():
+                raise InputError(f"{where}: images[{k}]: {shown(path)}: file not found; expected the image in "
+                                 f"{shown(folder)} (or name its folder with --images)")
+            if checked_image_size(path) != (width, height):
+                found = "x".join(map(str, checked_image_size(path, whole=False)))
+                raise InputError(f"{shown(path)}: {found} pixels; expected the {width}x{height} that {where} "
+                                 f"images[{k}] states")
+            sizes[image_id] = (width, height, path)
         boxes: dict[int, list[Box]] = {}
         for n, a in enumerate(doc["annotations"]):
             x, y, w, h = (float(v) for v in a["bbox"])
@@ -330,15 +395,20 @@ def read_coco(json_path: str | Path, images_dir: str | Path | None = None) -> De
             if int(a["category_id"]) not in categories:
                 raise InputError(f"{where}: annotations[{n}].category_id: {a['category_id']}; expected an id of "
                                  f"categories")
-            boxes.setdefault(int(a["image_id"]), []).append(
-                Box(categories[int(a["category_id"])], x, y, w, h, bool(a.get("iscrowd", 0))))
-        images = []
-        for i, im in enumerate(sorted(doc["images"], key=lambda im: int(im["id"])), 1):
-            path = folder / str(im["file_name"])
-            if not path.is_file():
-                raise InputError(f"{where}: images: {shown(path)}: file not found; expected the image in "
-                                 f"{shown(folder)} (or name its folder with --images)")
-            images.append(SetImage(i, path, int(im["width"]), int(im["height"]), tuple(boxes.get(int(im["id"]), ()))))
+            image_id = _whole_number(a["image_id"], f"{where}: annotations[{n}].image_id", 0)
+            if image_id not in sizes:
+                raise InputError(f"{where}: annotations[{n}].image_id: {image_id}; expected the id of one of its "
+                                 f"{len(sizes)} images (a box on no image would be scored as nothing)")
+            width, height, path = sizes[image_id]
+            if x < -EDGE_PX or y < -EDGE_PX or x + w > width + EDGE_PX or y + h > height + EDGE_PX:
+                raise InputError(f"{where}: annotations[{n}].bbox: {a['bbox']}; expected a box inside its image "
+                                 f"{shown(path.name)} ({width}x{height} pixels)")
+            x0, y0 = min(max(x, 0.0), width), min(max(y, 0.0), height)
+            x1, y1 = min(max(x + w, 0.0), width), min(max(y + h, 0.0), height)
+            boxes.setdefault(image_id, []).append(
+                Box(categories[int(a["category_id"])], x0, y0, x1 - x0, y1 - y0, bool(a.get("iscrowd", 0))))
+        images = [SetImage(i, path, width, height, tuple(boxes.get(image_id, ())))
+                  for i, (image_id, (width, height, path)) in enumerate(sorted(sizes.items()), 1)]
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"{where}: {type(exc).__name__} {str(exc)[:80]}; expected COCO images (id, file_name, "
                          f"width, height), annotations (image_id, category_id, bbox) and categories (id, name)") from None

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from synthua_usd.analytics.dataset_index import load_class_map, manifest_images
-from synthua_usd.analytics.detection_sets import Box, DetectionSet, SetImage
+from synthua_usd.analytics.detection_sets import Box, DetectionSet, MissingSplit, SetImage, checked_image_size
 from synthua_usd.assets.devices import DEVICES
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
@@ -144,7 +144,7 @@ def read_generated(root, split: str | None, targets: DetectionTargets) -> Detect
     entries = sorted((e for e in manifest_images(layout.root) if str(e.get("qa", "accepted")) != "rejected"
                       and (split is None or e["split"] == split)), key=lambda e: int(e["id"]))
     if not entries:
-        raise InputError(f"{shown(layout.root)}: no images{f' in split {split}' if split else ''}; expected a "
+        raise MissingSplit(f"{shown(layout.root)}: no images{f' in split {split}' if split else ''}; expected a "
                          f"dataset with images in the split (see its manifest.json)")
     images = []
     for n, entry in enumerate(entries, 1):
@@ -157,5 +157,9 @@ def read_generated(root, split: str | None, targets: DetectionTargets) -> Detect
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"{shown(path)}: {type(exc).__name__} {exc}; expected an image record written by "
                              f"`synthua generate`") from None
-        images.append(SetImage(n, layout.path(Layout.rgb_png(image_split, name)), width, height, boxes))
+        image = layout.path(Layout.rgb_png(image_split, name))
+        if checked_image_size(image, whole=False) != (width, height):  # its header: `synthua verify` checks the rest
+            raise InputError(f"{shown(image)}: {'x'.join(map(str, checked_image_size(image, whole=False)))} pixels; "
+                             f"expected the {width}x{height} of its record {shown(path)}")
+        images.append(SetImage(n, image, width, height, boxes))
     return DetectionSet(tuple(targets.classes), tuple(images), "synthua", str(layout.root), split)

@@ -16,6 +16,10 @@ from synthua_usd.analytics import plots
 from synthua_usd.analytics.csv_text import csv_text
 from synthua_usd.analytics.evaluation import SemanticEvaluation
 from synthua_usd.core.atomic import output_set, write_json_atomic, write_text_atomic
+from synthua_usd.core.input_guard import Inputs
+
+#: Every file the report may hold (the module's docstring says what each is).
+EVALUATION_FILES = ("metrics.csv", "metrics.json", "confusion.csv", "confusion.png", "coco.json")
 
 
 def class_rows(ev: SemanticEvaluation) -> list[dict]:
@@ -31,8 +35,11 @@ def class_rows(ev: SemanticEvaluation) -> list[dict]:
     return rows
 
 
-def write_evaluation(out_dir: str | Path, semantic: SemanticEvaluation | None, coco: dict | None) -> Path:
-    with output_set(out_dir) as stage:
+def write_evaluation(out_dir: str | Path, semantic: SemanticEvaluation | None, coco: dict | None,
+                     inputs: Inputs | None = None) -> Path:
+    """Write the report of ``semantic`` and/or ``coco`` into ``out_dir`` as a set, none of its files one of the
+    command's ``inputs``."""
+    with output_set(out_dir, inputs=inputs) as stage:
         document: dict = {}
         if semantic is not None:
             rows = class_rows(semantic)

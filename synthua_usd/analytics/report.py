@@ -108,7 +108,7 @@ def write_report(index: DatasetIndex, stats: DatasetStatistics, out_dir: str | P
     chosen = gallery_images(index.images, samples)
     pairs = [_read_pair(index, img) for img in chosen]   # before anything is written: a missing file stops here
     palette = cmap.palette()
-    with output_set(out_dir) as stage:
+    with output_set(out_dir, inputs={"DATASET": index.root}) as stage:
         document = stats.document()
         if comparison is not None:
             document["real_comparison"] = comparison.document()

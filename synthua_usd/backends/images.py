@@ -116,6 +116,24 @@ def read_image(path: str | Path) -> tuple[np.ndarray, oiio.ImageSpec]:
     return np.asarray(pixels), spec
 
 
+def decoded_image_size(path: str | Path) -> tuple[int, int, int]:
+    """(width, height, orientation) of an image file whose every pixel decodes (:func:`image_size`'s values): the
+    whole image is read, so a truncated or damaged file fails here with OpenImageIO's words (a JPEG cut short
+    decodes with its missing rows grey and only a warning, "Premature end of JPEG file": that counts as damaged)."""
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise OSError(f"{path}: OpenImageIO cannot read it: {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        pixels = inp.read_image(0, 0, 0, -1, "uint8")
+        problem = inp.geterror()
+        if pixels is None or problem:
+            raise OSError(f"{path}: OpenImageIO cannot read its pixels: {problem or oiio.geterror() or 'no reason given'}")
+        return int(spec.width), int(spec.height), int(spec.get_int_attribute("Orientation", 1))
+    finally:
+        inp.close()
+
+
 def image_size(path: str | Path) -> tuple[int, int, int]:
     """(width, height, orientation) of an image file, from its header (no pixels are read): pixels as stored, and
     the EXIF orientation (1 = upright as stored; 2-8 a flip or turn a viewer applies, as OpenCV does on reading)."""

@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK, say
-from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
+from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange, seed_option
 from synthua_usd.model.ranges import Range
 
 # --- agents -----------------------------------------------------------------------------------------------
@@ -26,7 +26,7 @@ def agents() -> None:
               help="Fraction of agents using a mobility aid (wheelchairs, walker, crutches, canes).")
 @click.option("--time-codes", "--frames", "time_codes", type=click.IntRange(1, 10_000), default=48, show_default=True,
               help="Time codes to author, one sample each, from the stage's start time code (--frames is the same).")
-@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Seed: same seed, same bytes.")
+@seed_option(help="Seed: same seed, same bytes.")
 @click.option("--cell-m", type=InRange(Range(0.05, 10.0, "m")), default=0.5, show_default=True,
               help="Walkable grid cell size (metres, 0.05-10).")
 @click.option("--walk-on", default="sidewalk,crosswalk,curb_ramp,street_road", show_default=True,

@@ -163,13 +163,17 @@ def evaluate(gt_dir: Path, pred: Path, out_dir: Path, split: str | None) -> int:
     COCO mAP through pycocotools' COCOeval (segm and/or bbox), and AP per class.
     """
     from synthua_usd.analytics.evaluation import evaluate_coco, evaluate_semantic
-    from synthua_usd.analytics.evaluation_report import write_evaluation
+    from synthua_usd.analytics.evaluation_report import EVALUATION_FILES, write_evaluation
     from synthua_usd.core.input_files import shown
+    from synthua_usd.core.input_guard import check_not_inputs
 
-    check_outside_datasets(out_dir)  # before the work: write_evaluation would refuse it at the end
+    # before the work: write_evaluation would refuse either at the end
+    check_outside_datasets(out_dir)
+    inputs = {"--gt": gt_dir, "--pred": pred}
+    check_not_inputs([out_dir / name for name in EVALUATION_FILES], inputs)
     if pred.suffix.lower() == ".json":
         coco = evaluate_coco(gt_dir, pred, split)
-        write_evaluation(out_dir, None, coco)
+        write_evaluation(out_dir, None, coco, inputs)
         for iou_type, result in coco["iou_types"].items():
             st = result["stats"]
             say(f"{iou_type}: mAP {st['AP']:.4f}, AP50 {st['AP50']:.4f}, AP75 {st['AP75']:.4f} "
@@ -179,7 +183,7 @@ def evaluate(gt_dir: Path, pred: Path, out_dir: Path, split: str | None) -> int:
     if not pred.exists():
         raise InputError(f"{shown(pred)}: not found; expected a folder of predictions or a COCO results .json")
     ev = evaluate_semantic(gt_dir, pred, split)
-    write_evaluation(out_dir, ev, None)
+    write_evaluation(out_dir, ev, None, inputs)
     s = ev.summary
     say(f"{ev.images} images, {s['pixels']:,} pixels evaluated: pixel accuracy {s['pixel_accuracy']:.4f}, "
                f"mean IoU {s['mean_iou'] if s['mean_iou'] is None else format(s['mean_iou'], '.4f')} "

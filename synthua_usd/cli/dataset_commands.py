@@ -99,9 +99,11 @@ def generate(scenario: Path, config_path: Path, out_dir: Path, executor: str, wo
 @click.argument("dataset", type=click.Path(path_type=Path))
 def verify(dataset: Path) -> int:
     """Check DATASET against its manifest: every file present with its size and SHA-256 and no file it does
-    not list, every planned image complete, every COCO annotation equal to its instance's pixels (a visible
-    keypoint within 2 pixels of them), every panoptic segment equal to its PNG, Cityscapes and YOLO files
-    consistent. Exit 1 on any problem, listed one per line; 2 when the manifest or generate.json is
+    not list, every planned image complete, each image record against its own label PNGs (its class pixel
+    counts, instance ids, pixel counts, boxes and classes against class.png and instance.png; semantic.png
+    their colours), every COCO annotation equal to its instance's pixels (a visible keypoint within 2 pixels of
+    them), every panoptic segment equal to its PNG, Cityscapes and YOLO files consistent. Nothing is rendered
+    (replay does that). Exit 1 on any problem, listed one per line; 2 when the manifest or generate.json is
     malformed. A cut-out bank (synthua cutouts; its bank.json) is checked against its manifest and its own
     masks instead."""
     from synthua_usd.pipeline.verify import MAX_LISTED, verify as run_verify

@@ -49,9 +49,14 @@ class OneLineFormatter(logging.Formatter):
 
 
 def configure_logging(verbose: int) -> None:
+    """Log lines at warning level and above, info with ``-v``, debug with ``-vv``. The level is the handler's as well
+    as the root logger's: a library that lowers its own logger's level (trimesh's, while synthua collects the texture
+    images it could not load) still prints nothing below it."""
+    level = max(logging.WARNING - 10 * verbose, logging.DEBUG)
     handler = logging.StreamHandler()
     handler.setFormatter(OneLineFormatter())
-    logging.basicConfig(level=max(logging.WARNING - 10 * verbose, logging.DEBUG), handlers=[handler], force=True)
+    handler.setLevel(level)
+    logging.basicConfig(level=level, handlers=[handler], force=True)
     logging.captureWarnings(True)  # numpy's and others' warnings become log records, one line each
 
 

@@ -22,6 +22,7 @@ from synthua_usd.cli.cutout_commands import cutouts
 from synthua_usd.cli.common import parse_time_codes as _time_codes
 from synthua_usd.cli.dataset_commands import generate, replay, verify
 from synthua_usd.cli.failures import configure_logging, guarded
+from synthua_usd.cli.options import seed_option
 from synthua_usd.cli.randomise_commands import randomise
 from synthua_usd.cli.sheet_commands import contact_sheet
 from synthua_usd.cli.survey_commands import survey
@@ -177,7 +178,7 @@ def create_street(out_dir: Path) -> int:
 
 @create.command("district")
 @click.argument("out_dir", type=click.Path(path_type=Path))
-@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Layout and crowd seed.")
+@seed_option(help="Layout and crowd seed.")
 def create_district(out_dir: Path, seed: int) -> int:
     """Write the Largo da Ordem demo district as a full scenario into OUT_DIR: twin, semantics, a populated
     agents layer, cameras (CCTV, pedestrian and wheelchair eye level, UAV), camera rigs aimed at the crowd's
@@ -211,7 +212,7 @@ def create_district(out_dir: Path, seed: int) -> int:
               help=f"Image height in pixels [default: render settings, else {RenderConfig.height}].")
 @click.option("--spp", type=click.IntRange(1, MAX_SPP), help=f"RGB samples per pixel [default: render settings, else "
                                                           f"{RenderConfig.spp}]. Labels always use one ray per pixel centre.")
-@click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed of the RGB pass.")
+@seed_option(help="Sampler seed of the RGB pass.")
 @click.option("--denoise/--no-denoise", default=None,
               help="Denoise RGB: a firefly filter, then Intel Open Image Denoise guided by albedo and normal from the "
                    "same samples, before fog, rain and exposure (box pixel filter either way) [default: on; see the "

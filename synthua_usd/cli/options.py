@@ -10,7 +10,7 @@ from __future__ import annotations
 import click
 
 from synthua_usd.core.errors import echo
-from synthua_usd.model.ranges import Range
+from synthua_usd.model.ranges import SEED, Range
 
 
 class InRange(click.ParamType):
@@ -22,7 +22,7 @@ class InRange(click.ParamType):
 
     def get_metavar(self, param, ctx=None) -> str:  # click < 8.2 passes only param
         left = "(" if self.allowed.low_open else "["
-        return f"{left}{self.allowed.low:g}..{self.allowed.high:g}]"
+        return f"{left}{self.allowed.bound(self.allowed.low)}..{self.allowed.bound(self.allowed.high)}]"
 
     def convert(self, value, param, ctx):
         if isinstance(value, bool):
@@ -45,3 +45,9 @@ class InRange(click.ParamType):
 #: Crowd options shared by ``agents populate`` and ``twin import --populate`` (defaults: CrowdParams's).
 DENSITY = Range(0.0, 1e6, "persons/m²", low_open=True)
 AID_SHARE = Range(0.0, 1.0)
+
+
+def seed_option(help: str, default: int | None = 0):
+    """The ``--seed`` option of every command: an integer of :data:`synthua_usd.model.ranges.SEED`, the one seed
+    range (``synthua randomise`` prints ``synthua render --seed`` with a dataset image's seed)."""
+    return click.option("--seed", type=InRange(SEED), default=default, show_default=default is not None, help=help)

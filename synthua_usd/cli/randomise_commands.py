@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK
-from synthua_usd.cli.options import InRange
+from synthua_usd.cli.options import InRange, seed_option
 from synthua_usd.model.ranges import Range
 
 
@@ -18,9 +18,10 @@ from synthua_usd.model.ranges import Range
               help="Generation config whose randomise block draws the layers (schemas/generate.schema.json).")
 @click.option("--record", "record_path", type=click.Path(path_type=Path),
               help="Or an image record of a randomised dataset (DATASET/records/NAME.json): its seed, camera, time "
-                   "code, condition and render size, and the dataset's config.")
-@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True,
-              help="The image's seed: images of one seed share a scene (crowd, looks, materials).")
+                   "code, condition and render size, and the dataset's config (so --config, --seed, --camera, "
+                   "--time-code and --condition are refused with it).")
+@seed_option(help="The image's seed: images of one seed share a scene (crowd, looks, materials) [default: 0].",
+             default=None)
 @click.option("--camera", help="Camera prim path [default: the render settings' camera].")
 @click.option("--time-code", "--frame", "time_code", type=InRange(Range(-1e9, 1e9)),
               help="Time code of the image [default: the stage's start time code].")
@@ -31,7 +32,7 @@ from synthua_usd.model.ranges import Range
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--allow-external-assets", is_flag=True,
               help="Accept layers outside the stage's folder tree (refused by default).")
-def randomise(scenario: Path, config_path: Path | None, record_path: Path | None, seed: int, camera: str | None,
+def randomise(scenario: Path, config_path: Path | None, record_path: Path | None, seed: int | None, camera: str | None,
               time_code: float | None, condition: str | None, out: Path, class_map: Path | None,
               allow_external_assets: bool) -> int:
     """Write the randomisation layers of one image over SCENARIO.

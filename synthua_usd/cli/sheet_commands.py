@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK, say
+from synthua_usd.cli.options import seed_option
 
 
 @click.command("contact-sheet")
@@ -21,7 +22,7 @@ from synthua_usd.cli.common import EXIT_OK, say
 @click.option("--width", type=click.IntRange(16, 4096), default=320, show_default=True, help="Width of each cell image.")
 @click.option("--height", type=click.IntRange(16, 4096), default=240, show_default=True, help="Height of each cell image.")
 @click.option("--spp", type=click.IntRange(1, 65536), default=16, show_default=True, help="RGB samples per pixel.")
-@click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler and rain seed.")
+@seed_option(help="Sampler and rain seed.")
 @click.option("--variant", help="Mitsuba variant [default: best available].")
 @click.option("--class-map", type=click.Path(path_type=Path), help="Class map [default: bundled].")
 @click.option("--out", "out_path", type=click.Path(path_type=Path), required=True, help="The sheet to write (.png).")

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_OK
-from synthua_usd.cli.options import InRange
+from synthua_usd.cli.options import InRange, seed_option
 from synthua_usd.model import detection_limits as L
 from synthua_usd.model.box_conventions import CONVENTIONS, DEFAULT_CONVENTION
 
@@ -30,8 +30,7 @@ _DEVICE = click.Choice(L.DEVICES)
 @click.option("--batch", type=InRange(L.BATCH), default=L.DEFAULT_BATCH, show_default=True, help="Images per step.")
 @click.option("--device", type=_DEVICE, default="auto", show_default=True,
               help="auto: CUDA when torch sees a GPU, else the CPU.")
-@click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True,
-              help="Ultralytics' seed (deterministic mode on).")
+@seed_option(help="Ultralytics' seed (deterministic mode on).")
 @click.option("--model", default=L.DEFAULT_MODEL, show_default=True,
               help="Architecture shipped inside the Ultralytics wheel, trained from scratch (e.g. yolo26s.yaml, "
                    "yolo11n.yaml); no weights are downloaded.")
@@ -79,8 +78,10 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
     default a wheelchair's box covers its user, as a real photo's 'wheelchair' box does, and a wheelchair user
     is a person too; --convention wheelchair-sets boxes them as the public wheelchair photo sets do, the
     seated user inside the wheelchair's box and no person box), or an Ultralytics YOLO folder or COCO .json of
-    real photos (whose boxes are their own). Ultralytics runs in its own environment, .venv-train
-    (tools/setup_train.sh; AGPL-3.0); on a GPU when one is present. train.json
+    real photos (whose boxes are their own). Its val split is what the last epoch is validated on (the train
+    split when the set has none); both are read whole, every image decoded, or refused naming the file before
+    training starts. Ultralytics runs in its own environment, .venv-train (tools/setup_train.sh; AGPL-3.0); on a
+    GPU when one is present. train.json
     records the set (its SHA-256, a generated dataset's id and config), classes, budget, seed, device and
     library versions.
     """
@@ -146,7 +147,8 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
     --convention, e.g. wheelchair-sets: the seated user inside the wheelchair's box, no person box). Per mapped
     class: AP50 and AP50-95 by pycocotools' COCOeval (bbox), precision and recall at --confidence (IoU 0.5),
     and a page of the worst false negatives (report.html, false_negatives.png). Test classes no --map names
-    are not scored.
+    are not scored. TEST_SET is read whole before the detector runs, or refused naming the file: every image
+    decoded, a COCO image's size its file's, every box on an image of the set and inside it.
     """
     from synthua_usd.pipeline.evaluate_real import evaluate_real as run
     from synthua_usd.pipeline.evaluate_real import EvaluateRequest

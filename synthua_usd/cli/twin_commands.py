@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map, say
-from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange
+from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange, seed_option
 from synthua_usd.core.errors import echo
 from synthua_usd.importers import limits as importer_limits
 
@@ -166,7 +166,8 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
         from synthua_usd.pipeline.twin_import import IMPORT_WALKABLE
 
         crowd = CrowdParams(density_per_m2=density, aid_share=aid_share, time_codes=frames, walkable=IMPORT_WALKABLE)
-    written, report = write_import(model, out_dir, cmap, report, crowd)
+    written, report = write_import(model, out_dir, cmap, report, crowd,
+                                   inputs={"INPUT": input_path, "--rules": rules, "--class-map": class_map})
     say(f"imported {input_path} ({kind}) in {seconds:.1f} s: {len(model.objects)} objects, "
                f"{model.triangle_count()} triangles, classes {model.label_counts()}")
     for seg in model.report.get("segments", []):
@@ -196,7 +197,7 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
 
 
 @twin.command("demo")
-@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Layout seed.")
+@seed_option(help="Layout seed.")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder.")
 def twin_demo(seed: int, out_dir: Path) -> int:
     """Write the procedural Largo da Ordem demo district for SEED as a renderable scenario, without people.

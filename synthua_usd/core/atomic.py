@@ -25,6 +25,7 @@ from typing import Iterator
 
 from synthua_usd.core.dataset_folders import check_outside_datasets
 from synthua_usd.core.errors import OutputError, SynthuaError
+from synthua_usd.core.input_guard import Inputs, check_not_inputs
 
 
 @contextmanager
@@ -51,14 +52,18 @@ def renamed(exc: OSError, old: Path, new: Path, whole: bool = False) -> OSError:
     """``exc`` naming ``new`` wherever it named ``old`` or a path below it (``whole``: any path directly
     in the folder ``old`` is ``new`` itself, as mkstemp's random names are); ``exc`` itself when it names
     neither."""
+    # a library names the file as it made it: tempfile absolute where the folder was given relative
+    old_abs = Path(os.path.abspath(old))
+
     def mapped(name):
         if name is None:
             return None
         name = Path(os.fsdecode(name))
         if whole:
-            return new if name.parent == old else None
-        if name.is_relative_to(old):
-            return new / name.relative_to(old)
+            return new if name.parent in (old, old_abs) else None
+        for folder in (old, old_abs):
+            if name.is_relative_to(folder):
+                return new / name.relative_to(folder)
         return None
 
     first, second = mapped(exc.filename), mapped(getattr(exc, "filename2", None))
@@ -127,7 +132,7 @@ def write_json_atomic(path: str | Path, document, indent: int = 2) -> Path:
 
 
 @contextmanager
-def output_set(out_dir: str | Path, dataset_part: bool = False) -> Iterator[Path]:
+def output_set(out_dir: str | Path, dataset_part: bool = False, inputs: Inputs | None = None) -> Iterator[Path]:
     """Yield an empty staging folder beside ``out_dir``; write every output into it (subfolders allowed).
 
     On success, when ``out_dir`` does not exist the staging folder is renamed to it (one atomic step);
@@ -135,7 +140,9 @@ def output_set(out_dir: str | Path, dataset_part: bool = False) -> Iterator[Path
     does not hold are kept). Every target is checked before the first move, so a file that would land on
     a folder, or below a file, fails with nothing moved. On any error the staging folder is removed. An
     ``out_dir`` in a dataset folder is refused (:func:`synthua_usd.core.dataset_folders.check_outside_datasets`), unless
-    ``dataset_part``: ``synthua generate`` writing a part of its own dataset (a district's scenario).
+    ``dataset_part``: ``synthua generate`` writing a part of its own dataset (a district's scenario). A staged
+    file that would replace one of the command's ``inputs`` fails before anything is moved
+    (:func:`synthua_usd.core.input_guard.check_not_inputs`).
     """
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
@@ -143,26 +150,29 @@ def output_set(out_dir: str | Path, dataset_part: bool = False) -> Iterator[Path
     if not dataset_part:
         check_outside_datasets(out_dir)
     parent = out_dir.parent
+    staging = parent / f".{out_dir.name[:64]}.partial-{secrets.token_hex(4)}"
     try:
         parent.mkdir(parents=True, exist_ok=True)
-        staging = parent / f".{out_dir.name[:64]}.partial-{secrets.token_hex(4)}"
         staging.mkdir()
     except FileExistsError:
         raise OutputError(f"{out_dir}: a parent of the output folder is a file; expected folders") from None
+    except OSError as exc:  # a read-only or full parent: the folder asked for, never the staging folder
+        raise renamed(exc, staging, out_dir) from None
     try:
         with named_as(staging, out_dir):
             yield staging
-            _move_into_place(staging, out_dir)
+            _move_into_place(staging, out_dir, inputs or {})
     finally:
         if staging.exists():
             shutil.rmtree(staging, ignore_errors=True)
 
 
-def _move_into_place(staging: Path, out_dir: Path) -> None:
+def _move_into_place(staging: Path, out_dir: Path, inputs: Inputs) -> None:
     if not out_dir.exists():
         os.rename(staging, out_dir)
         return
     files = sorted(p for p in staging.rglob("*") if not p.is_dir())
+    check_not_inputs((out_dir / src.relative_to(staging) for src in files), inputs)
     for src in files:
         target = out_dir / src.relative_to(staging)
         if target.is_dir() and not target.is_symlink():

@@ -156,14 +156,57 @@ def schema_message(error: jsonschema.ValidationError) -> str:
     return message
 
 
+def unknown_key(where: str, key: str, valid) -> str:
+    """``<where>.<key>: not a key of <where>; expected <nearest>, the nearest valid key (valid: ...)``: a misspelt key
+    named with the key it most likely meant (difflib), or the valid keys when none is near."""
+    import difflib
+
+    valid = sorted(valid)
+    top = not where or where == "(document)"
+    field, parent = (echo(key, 60), "the document") if top else (f"{where}.{echo(key, 60)}", where)
+    near = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
+    listed = ", ".join(valid)
+    if near:
+        return f"{field}: not a key of {parent}; expected {near[0]}, the nearest valid key (valid: {listed})"
+    return f"{field}: not a key of {parent}; expected one of {listed}"
+
+
+def _specific(error: jsonschema.ValidationError) -> jsonschema.ValidationError:
+    """The violation that says what is wrong: inside a ``oneOf``/``anyOf`` (``randomise``: null or the block), the
+    branch's own (jsonschema's ``best_match``: a misspelt key of the block, not "is not valid under any of the
+    given schemas")."""
+    from jsonschema.exceptions import best_match
+
+    return best_match([error]) if error.context else error
+
+
+def _extra_key(error: jsonschema.ValidationError) -> str | None:
+    """:func:`unknown_key` for an ``additionalProperties`` violation of an object with listed properties."""
+    import re
+
+    schema, instance = error.schema, error.instance
+    if error.validator != "additionalProperties" or not isinstance(schema, dict) or not isinstance(instance, dict):
+        return None
+    known = schema.get("properties") or {}
+    patterns = list(schema.get("patternProperties") or {})
+    extra = [k for k in instance if k not in known and not any(re.search(p, k) for p in patterns)]
+    if not extra or not known:
+        return None
+    return unknown_key(json_pointer(error), extra[0], known)
+
+
 def schema_problem(document: Any, schema_name: str, definition: str | None = None) -> str | None:
-    """The first violation as ``<field>: <what was found>; expected ...`` (None when there is none)."""
+    """The first violation as ``<field>: <what was found>; expected ...`` (None when there is none); a misspelt key
+    as :func:`unknown_key` says it."""
     errors = schema_errors(document, schema_name, definition)
     if not errors:
         return None
-    first = errors[0]
+    first = _specific(errors[0])
     more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
     part = f"$defs/{definition} of " if definition is not None else ""
+    extra = _extra_key(first)
+    if extra is not None:
+        return f"{extra}{more}"
     return (f"{json_pointer(first)}: {schema_message(first)}; expected a document matching "
             f"{part}{schema_name}.schema.json{more}")
 

@@ -184,6 +184,8 @@ class SequenceCrowd:
 
 #: Most frames one sequence may have.
 MAX_SEQUENCE_FRAMES = 10_000
+#: Fewest: a track of one frame is no tracking sequence.
+MIN_SEQUENCE_FRAMES = 2
 
 
 @dataclass(frozen=True)
@@ -203,7 +205,8 @@ class SequencesConfig:
 
     @property
     def frames(self) -> int:
-        """Frames per sequence: ``duration_s * fps``, rounded, at least 1."""
+        """Frames per sequence: ``duration_s * fps``, rounded (a config is refused below
+        :data:`MIN_SEQUENCE_FRAMES`)."""
         return max(1, int(round(self.duration_s * self.fps)))
 
     def time_codes(self, start: float, time_codes_per_second: float) -> tuple[float, ...]:
@@ -379,6 +382,10 @@ class _Builder:
         if config.duration_s * config.fps > MAX_SEQUENCE_FRAMES:
             self.fail("sequences", f"duration_s x fps = {config.duration_s * config.fps:g} frames",
                       f"expected at most {MAX_SEQUENCE_FRAMES} frames a sequence")
+        if round(config.duration_s * config.fps) < MIN_SEQUENCE_FRAMES:
+            self.fail("sequences.duration_s", f"{config.duration_s:g} s at fps {config.fps:g} is "
+                      f"{config.duration_s * config.fps:g} frames", f"expected at least {MIN_SEQUENCE_FRAMES} frames a "
+                      f"sequence (a track needs two): a longer duration_s or a higher fps")
         return config
 
     def randomise(self, doc) -> RandomisationConfig | None:

@@ -6,8 +6,9 @@ optional ``min_height``; within the ranges of :mod:`synthua_usd.importers.limits
 and its source are in the report (``heights``). Coordinates are
 WGS84 lon/lat (RFC 7946) and are projected to a local transverse Mercator, or, when the file names a
 projected CRS in a legacy ``crs`` member, used as metres. A footprint must be a valid polygon (no
-self-intersections, holes inside their shell) of at least 0.01 m²: invalid footprints are refused with
-the reason and place, never silently repaired. Each building is one ``building`` instance with ``Walls``
+self-intersections, holes inside their shell) of at least 0.01 m², and have an area in the file's own coordinates
+too (a ring whose lon/lat positions lie on one line has none, though projecting it curves it into a sliver of some
+square metres): invalid footprints are refused with the reason and place, never silently repaired. Each building is one ``building`` instance with ``Walls``
 and ``Roof`` parts, in the palette's materials.
 """
 
@@ -78,8 +79,24 @@ def _rings(geometry, where: str) -> list[list[np.ndarray]]:
     return out
 
 
-def footprint_polygon(rings: list[np.ndarray], where: str):
-    """The shapely polygon of projected rings (metres), refused unless valid and of some area, each hole too."""
+#: A ring whose positions spread less than this share of their length across it, in the file's own coordinates,
+#: lies on one line (a real footprint, even a 0.1 m x 1 km sliver, spreads 1e-4; rounding of decimal degrees 1e-13).
+FLAT_RING = 1e-9
+
+
+def flat_ring(ring: np.ndarray) -> bool:
+    """Whether the positions of a ring (n, 2) of the file's own coordinates (lon/lat or projected) lie on one line
+    (or one point): its second singular value against its first."""
+    points = np.unique(np.asarray(ring, np.float64).reshape(-1, 2), axis=0)
+    if len(points) < 3:
+        return True
+    spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    return bool(spread[1] <= FLAT_RING * spread[0])
+
+
+def footprint_polygon(rings: list[np.ndarray], where: str, source: list[np.ndarray] | None = None):
+    """The shapely polygon of projected rings (metres), refused unless valid and of some area, each hole too;
+    ``source``, the same rings as the file gives them (lon/lat), must enclose an area too (:func:`flat_ring`)."""
     from shapely.geometry import Polygon
     from shapely.validation import explain_validity
 
@@ -101,6 +118,12 @@ def footprint_polygon(rings: list[np.ndarray], where: str):
         if area < MIN_FOOTPRINT_AREA_M2:  # a courtyard of no area: a digitising slip that cuts nothing
             raise InputError(f"{where}: ring {k} (a hole) has area {area:.3g} m²; expected holes of at least "
                              f"{MIN_FOOTPRINT_AREA_M2:g} m², or none")
+    for k, ring in enumerate(source or []):  # a line in lon/lat that projecting curved into a sliver
+        if flat_ring(ring):
+            what = "the footprint's ring" if k == 0 else f"ring {k} (a hole)"
+            raise InputError(f"{where}: {what} has area 0 in the file's coordinates (its positions lie on one line); "
+                             f"expected a footprint of at least {MIN_FOOTPRINT_AREA_M2:g} m² (a degenerate or "
+                             f"zero-area ring)")
     return poly
 
 
@@ -215,8 +238,8 @@ def import_footprints(path: str | Path, storey_height_m: float = DEFAULT_STOREY_
     check_projected(np.concatenate([r for polys in projected for rings in polys for r in rings]), where)
     footprints = []
     for (i, props, fw, polys, height), rings_m in zip(parsed, projected):
-        polygons = [footprint_polygon(rings, f"{fw}: polygon {k}" if len(rings_m) > 1 else fw)
-                    for k, rings in enumerate(rings_m)]
+        polygons = [footprint_polygon(rings, f"{fw}: polygon {k}" if len(rings_m) > 1 else fw, source)
+                    for k, (rings, source) in enumerate(zip(rings_m, polys))]
         footprints.append(Footprint(prim_name(props.get("name") or props.get("id") or f"Building_{i:04d}", "Building"),
                                     polygons, height, {"source_feature": i}, fw))
     return extruded_model(footprints, str(path), where, (float(origin[0]), float(origin[1]), 0.0), crs_text,

@@ -10,7 +10,8 @@ area (a way cut at the extract's edge, a broken multipolygon) are counted and na
 Heights come from the tags (:mod:`synthua_usd.importers.heights`); lon/lat (WGS84) is projected to a
 transverse Mercator centred on the extract (metres, stated in the report's ``crs``). A self-intersecting
 outline (which libosmium does not assemble: its own ring is taken) is repaired (shapely's ``make_valid``, its
-polygons kept) and reported, or refused with ``strict``.
+polygons kept) and reported, or refused with ``strict``; an outline whose lon/lat positions lie on one line has no
+area to repair and is skipped (reported), and an extract whose buildings all are skipped is refused.
 """
 
 from __future__ import annotations
@@ -23,7 +24,8 @@ import numpy as np
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.input_files import check_input_file, shown
 from synthua_usd.importers.crs import local_tmerc, lonlat_to
-from synthua_usd.importers.footprints import Footprint, check_projected, extruded_model, footprint_polygon
+from synthua_usd.importers.footprints import (Footprint, check_projected, extruded_model, flat_ring,
+                                               footprint_polygon)
 from synthua_usd.importers.heights import building_height
 from synthua_usd.importers.limits import (DEFAULT_HEIGHT, DEFAULT_HEIGHT_M, DEFAULT_STOREY_HEIGHT_M, MAX_OSM_BYTES,
                                           MIN_FOOTPRINT_AREA_M2, STOREY_HEIGHT)
@@ -90,20 +92,24 @@ def _ring(ring) -> np.ndarray:
     return np.array([(n.lon, n.lat) for n in ring], np.float64).reshape(-1, 2)
 
 
-def _polygons(rings_m: list[list[np.ndarray]], where: str, strict: bool) -> tuple[list, bool]:
-    """(valid shapely polygons, whether a repair was needed) of one area's projected polygons; an invalid
-    polygon is repaired by ``make_valid`` unless ``strict`` (then refused)."""
+def _polygons(rings_m: list[list[np.ndarray]], where: str, strict: bool,
+              lonlat: list[list[np.ndarray]]) -> tuple[list, bool]:
+    """(valid shapely polygons, whether a repair was needed) of one area's projected polygons (``lonlat``: the same
+    as the file gives them); an invalid polygon is repaired by ``make_valid`` unless ``strict`` (then refused), one
+    with no area in lon/lat (its positions on one line) is dropped."""
     from shapely import make_valid
     from shapely.geometry import Polygon
 
     out, repaired = [], False
-    for k, rings in enumerate(rings_m):
+    for k, (rings, source) in enumerate(zip(rings_m, lonlat)):
         pw = f"{where}: polygon {k}" if len(rings_m) > 1 else where
         try:
-            out.append(footprint_polygon(rings, pw))
+            out.append(footprint_polygon(rings, pw, source))
         except InputError:
             if strict:
                 raise
+            if flat_ring(source[0]):  # nothing to repair: projecting only curved a line into a sliver
+                continue
             repaired = True
             fixed = make_valid(Polygon(rings[0], rings[1:])) if len(rings[0]) >= 4 else Polygon()
             pieces = getattr(fixed, "geoms", [fixed])
@@ -138,13 +144,17 @@ def import_osm(path: str | Path, storey_height_m: float = DEFAULT_STOREY_HEIGHT_
     built, repaired, skipped = [], [], []
     for area, rings_m in zip(areas, projected):
         bw = f"{where}: {area.osm_id}"
-        polygons, fixed = _polygons(rings_m, bw, strict)
+        polygons, fixed = _polygons(rings_m, bw, strict, area.polygons)
         if fixed:
             repaired.append(area.osm_id)
         if not polygons:
             skipped.append(area.osm_id)
             continue
         built.append((area, bw, polygons))
+    if not built:
+        raise InputError(f"{where}: none of its {len(areas)} building areas has an outline of at least "
+                         f"{MIN_FOOTPRINT_AREA_M2:g} m² (e.g. {', '.join(skipped[:3])}: zero area, or none left after "
+                         f"repair); expected an extract with buildings")
     outlines = _outlines_with_parts(built)
     footprints = [Footprint(prim_name(area.tags.get("name") or area.osm_id.replace("/", "_"), "Building"), polygons,
                             building_height(area.tags, bw, storey_height_m, default_height_m, "tag ", strict),

@@ -33,10 +33,14 @@ class Range:
         if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low <= self.high):
             raise ValueError(f"a range needs finite low <= high, but was [{self.low}, {self.high}]")
 
+    def bound(self, value: float) -> str:
+        """An end of the range as messages show it: integers whole (4294967295, not 4.29497e+09), else %g."""
+        return str(int(value)) if self.integer else f"{value:g}"
+
     def __str__(self) -> str:
         kind = "an integer" if self.integer else "a number"
         left = "(" if self.low_open else "["
-        return f"{kind} in {left}{self.low:g}, {self.high:g}]" + (f" {self.unit}" if self.unit else "")
+        return f"{kind} in {left}{self.bound(self.low)}, {self.bound(self.high)}]" + (f" {self.unit}" if self.unit else "")
 
     def contains(self, value: float) -> bool:
         """Finite and inside (NaN, infinities and non-numbers never are)."""
@@ -69,6 +73,13 @@ def _show(value) -> str:
         return f"'{echo(value)}'"
     return {list: "an array", dict: "an object"}.get(type(value), type(value).__name__)
 
+
+#: Every seed synthua takes, the one range of every command's --seed and every seed of a config
+#: (``schemas/generate.schema.json`` states the same maximum; a test holds it to this): an unsigned 32-bit integer,
+#: what NumPy's legacy seeding (Ultralytics') takes. ``synthua randomise`` prints ``synthua render --seed`` with a
+#: dataset image's seed, so the two must accept the same seeds; Mitsuba's 32-bit sampler seeds are derived from it
+#: (:func:`synthua_usd.model.render_config.sampler_seed`).
+SEED = Range(0, 2**32 - 1, integer=True)
 
 #: Projected coordinates (metres) of any input (CityJSON, GeoJSON with a CRS, meshes, point clouds, GCPs):
 #: UTM northings reach 1e7, so 1e8 leaves room and keeps squares and sums far from overflow.

@@ -8,10 +8,21 @@ from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 from synthua_usd.core.errors import InputError
+from synthua_usd.model.ranges import SEED
 
 PIXEL_FILTERS = ("gaussian", "box")
 MAX_SIDE = 16384
 MAX_SPP = 65536
+#: The odd multiplier that spreads a render seed over Mitsuba's 32-bit sampler seeds (one per RGB pass).
+_PASS_STRIDE = 100_003
+
+
+def sampler_seed(seed: int, render_pass: int) -> int:
+    """Mitsuba's sampler seed of RGB pass ``render_pass`` of a render seeded ``seed`` (any seed of
+    :data:`synthua_usd.model.ranges.SEED`): ``seed * 100003 + render_pass`` modulo 2^32, as Mitsuba takes 32-bit
+    seeds. Below 42,949 the modulo changes nothing (the seeds every earlier dataset was rendered with); the odd
+    multiplier maps distinct seeds to distinct first passes."""
+    return (int(seed) * _PASS_STRIDE + int(render_pass)) % 2**32
 
 
 @dataclass(frozen=True)
@@ -65,8 +76,8 @@ class RenderConfig:
             raise InputError(f"pixel_filter should be one of {', '.join(PIXEL_FILTERS)}, but was {self.pixel_filter!r}")
         if not isinstance(self.denoise, bool):
             raise InputError(f"denoise should be true or false, but was {self.denoise!r}")
-        if not isinstance(self.seed, int) or self.seed < 0:
-            raise InputError(f"seed should be an integer >= 0, but was {self.seed!r}")
+        if not isinstance(self.seed, int) or not SEED.contains(self.seed):
+            raise InputError(f"seed: {self.seed!r}; expected {SEED}")
 
     @classmethod
     def from_dict(cls, data: dict) -> "RenderConfig":

@@ -31,6 +31,7 @@ from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.core import json_text
 from synthua_usd.core.atomic import atomic_path
 from synthua_usd.core.errors import InputError, StageError, echo
+from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.core.resources import check_frame_memory
 from synthua_usd.core.schemas import validate_document
 from synthua_usd.geometry.placement import (DEFAULT_DISTANCE_M, Placement, Terrain, dashcam_candidates, fixed_candidates,
@@ -170,8 +171,8 @@ def default_time_codes(start: float, end: float, n: int = DEFAULT_REPORT_TIME_CO
 
 def _check_request(request: RigRequest) -> None:
     out = check_layer_path(request.out_path, "the cameras layer")
-    if out.exists() and out.resolve() == Path(request.stage_path).resolve():
-        raise InputError(f"{echo(out)}: --out is the input stage itself; expected a new layer file")
+    check_not_inputs([out, request.report_path], {"SCENARIO": request.stage_path, "--layer": request.layers,
+                                                  "--class-map": request.class_map_path})
     if not request.rigs:
         raise InputError("no --rig given; expected at least one (e.g. --rig cctv:aim=aid_user)")
     if not (isinstance(request.min_target_px, int) and request.min_target_px >= 0):

@@ -22,6 +22,7 @@ from synthua_usd.backends.images import linear_to_display
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.backends.mitsuba.weather_scene import scene_key
 from synthua_usd.core.errors import InputError, StageError
+from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.core.resources import check_frame_memory
 from synthua_usd.model.conditions import display_order
 from synthua_usd.model.render_config import RenderConfig
@@ -74,6 +75,7 @@ def make_contact_sheet(request: SheetRequest, show_progress: bool = False) -> Sh
     """Check every input, render every cell, compose and write the sheet (one PNG, written atomically)."""
     if request.out_path.suffix.lower() != ".png":
         raise InputError(f"{request.out_path}: the contact sheet is a PNG; expected a file name ending in .png")
+    check_not_inputs([request.out_path], {"SCENARIO": request.stage_path, "--class-map": request.class_map_path})
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
     stage = open_stage(request.stage_path, request.allow_external_assets)
     time_code = stage.GetStartTimeCode() if request.time_code is None else request.time_code

@@ -20,12 +20,13 @@ from pathlib import Path
 from synthua_usd import __version__
 from synthua_usd.analytics.class_mapping import build_mapping, parse_map_options
 from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluation, evaluate_detections
-from synthua_usd.analytics.detection_report import write_detection_report
+from synthua_usd.analytics.detection_report import REPORT_FILES, write_detection_report
 from synthua_usd.analytics.detection_sources import detect_format, manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets, targets_for
 from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
+from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.model import detection_limits as L
 from synthua_usd.model.box_conventions import CONVENTIONS
 from synthua_usd.pipeline.train import check_imgsz, run_weights
@@ -78,6 +79,8 @@ class EvaluateResult:
 
 def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
     """Predict, score and write the report; see the module's docstring."""
+    inputs = {"MODEL": request.model, "TEST_SET": request.test_set, "--images": request.images_dir}
+    check_not_inputs([Path(request.out_dir) / name for name in REPORT_FILES], inputs)
     weights, about = run_weights(request.model)
     targets = DetectionTargets.from_document(about["targets"]) if about.get("targets") else DetectionTargets()
     fmt = detect_format(Path(request.test_set)) if request.fmt == "auto" else request.fmt
@@ -124,5 +127,5 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
                        "merge_iou": request.merge_iou},
         "versions": result["versions"], "downloaded": result["downloaded"],
     }
-    write_detection_report(request.out_dir, test, evaluation, detections, document)
+    write_detection_report(request.out_dir, test, evaluation, detections, document, inputs)
     return EvaluateResult(evaluation, document | evaluation.document(), Path(request.out_dir))

@@ -155,7 +155,8 @@ def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     want_rgb = any(o.var == "rgb" for o in outputs)
     keep = request.keep_buffers if request.keep_buffers is not None else single
     # Frame N's files are written on a background thread while frame N+1 renders; at most one frame waits.
-    with output_set(request.out_dir) as staging, BackgroundWriter(max_pending=1) as writer:
+    inputs = {"SCENARIO": request.stage_path, "--layer": request.layers, "--class-map": request.class_map_path}
+    with output_set(request.out_dir, inputs=inputs) as staging, BackgroundWriter(max_pending=1) as writer:
         bar = tqdm(frames, unit="frame", desc="render", disable=not show_progress or single)
         for cam_path, tc in bar:
             snapshot = reader.snapshot(tc)

@@ -33,6 +33,7 @@ from synthua_usd import __version__
 from synthua_usd.composition.scenario import ROOT_FILE
 from synthua_usd.core.atomic import write_json_atomic, write_text_atomic
 from synthua_usd.core.errors import InputError, OutputError, StageError
+from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.core.resources import check_frame_memory
 from synthua_usd.dataset import coverage, sampling
 from synthua_usd.dataset.config import GenerationConfig
@@ -172,6 +173,9 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
         from synthua_usd.pipeline.ray_executor import check_reachable
 
         check_reachable(request.address)
+    # the dataset folder is generate's own: an input inside it could be replaced (district scenes, generate.json)
+    check_not_inputs([request.out_dir], {"SCENARIO": request.scenario, "--config": request.config_path,
+                                         "--class-map": request.class_map_path}, whole_folder=True)
     config = GenerationConfig.load(request.config_path)
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
     stage, pool, cameras, render, stack = _stage_facts(request, config, class_map)

@@ -11,6 +11,7 @@ import numpy as np
 from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
 from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.usd.agents_writer import AGENTS_ROOT, build_agents_layer
 from synthua_usd.usd.authoring import check_layer_path, save_layer_atomic
@@ -35,8 +36,7 @@ def populate(request: PopulateRequest) -> tuple[Crowd, Path, float]:
     the layer written and the seconds it took."""
     t0 = time.perf_counter()
     out = check_layer_path(request.out_path, "the agents layer")
-    if out.exists() and out.resolve() == Path(request.stage_path).resolve():
-        raise InputError(f"{out}: --out is the input stage itself; expected a new layer file beside it")
+    check_not_inputs([out], {"TWIN_OR_SCENARIO": request.stage_path, "--class-map": request.class_map_path})
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
     unknown = [c for c in request.params.walkable if class_map.resolve(c) is None]
     if unknown:

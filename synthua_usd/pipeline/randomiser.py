@@ -211,7 +211,8 @@ class Randomiser:
 class RandomiseRequest:
     """One image's randomisation to write: of ``config_path``'s ``randomise`` block with ``seed``, ``camera``,
     ``time_code`` and ``condition`` (None: the stage's own lights), at the config's render size (else the
-    stage's); or, with ``record_path``, of that record of a dataset (its generate.json gives the config). When
+    stage's); or, with ``record_path``, of that record of a dataset (its generate.json gives the config; a record
+    fixes the seed, camera, time code and condition, so none of those, nor ``config_path``, may come with it). When
     the seed's scene is another district, the layers go over that district's scenario: the dataset's copy, or
     one written beside ``out`` (``<stem>.district_<d>/``); the render command printed names it."""
 
@@ -219,12 +220,25 @@ class RandomiseRequest:
     out: Path
     config_path: Path | None = None
     record_path: Path | None = None
-    seed: int = 0
+    seed: int | None = None
     camera: str | None = None
     time_code: float | None = None
     condition: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
+
+    def __post_init__(self) -> None:
+        from synthua_usd.core.errors import InputError, echo
+
+        if self.record_path is None:
+            return
+        given = [option for option, value in (("--config", self.config_path), ("--seed", self.seed),
+                                              ("--camera", self.camera), ("--time-code", self.time_code),
+                                              ("--condition", self.condition)) if value is not None]
+        if given:
+            raise InputError(f"{given[0]}: given with --record {echo(self.record_path)}; expected one or the other (the "
+                             f"record fixes its image's seed, camera, time code and condition, and its dataset's "
+                             f"config)")
 
 
 @dataclass(frozen=True)
@@ -267,6 +281,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
 
     from synthua_usd.core.atomic import output_set
     from synthua_usd.core.errors import InputError
+    from synthua_usd.core.input_guard import check_not_inputs
     from synthua_usd.dataset.config import GenerationConfig
     from synthua_usd.model.render_config import resolve_render
     from synthua_usd.usd.render_settings import render_defaults
@@ -275,6 +290,9 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     out = Path(request.out)
     if out.suffix.lower() not in USD_SUFFIXES[:3]:
         raise InputError(f"{out}: --out needs a USD layer name (.usda, .usdc or .usd); expected e.g. layer.usda")
+    inputs = {"SCENARIO": request.scenario, "--config": request.config_path, "--record": request.record_path,
+              "--class-map": request.class_map_path}
+    check_not_inputs([out], inputs)  # before anything is drawn; the layers beside it are checked with the set
     render: dict = {}
     if request.record_path is not None:
         document, seed, camera, time_code, condition, render = _from_record(Path(request.record_path))
@@ -284,7 +302,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
             raise InputError("randomise: neither --config nor --record given; expected a generation config with a "
                              "randomise block, or an image record of a randomised dataset")
         config = GenerationConfig.load(request.config_path)
-        seed, camera, time_code, condition = request.seed, request.camera, request.time_code, request.condition
+        seed, camera, time_code, condition = request.seed or 0, request.camera, request.time_code, request.condition
     source = request.record_path or request.config_path
     if config.randomise is None:
         raise InputError(f"{source}: has no randomise block; expected a config that randomises scenes (see "
@@ -319,7 +337,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     width, height = settings.width, settings.height
     randomiser = Randomiser(stage, config.randomise, class_map, (width, height))
     drawn = randomiser.apply(seed, camera, time_code, condition, district)
-    with output_set(out.parent) as staging:
+    with output_set(out.parent, inputs=inputs) as staging:
         randomiser.export(staging / out.name, anchor=out.parent)
         files = tuple(out.parent / p.name for p in sorted(staging.iterdir()))
     args = ("synthua", "render", str(scenario), "--layer", str(out), "--camera", camera,

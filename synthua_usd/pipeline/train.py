@@ -31,19 +31,22 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from synthua_usd import __version__
-from synthua_usd.analytics.detection_sets import DetectionSet
+from synthua_usd.analytics.detection_sets import DetectionSet, MissingSplit
 from synthua_usd.analytics.detection_sources import manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
 from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
 from synthua_usd.core.atomic import output_set, write_json_atomic
 from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.schemas import read_json
 from synthua_usd.model import detection_limits as L
 
 log = logging.getLogger(__name__)
 
+#: The files of a run folder (the module's docstring says what each is).
+RUN_FILES = ("weights.pt", "train.json", "results.csv", "train.log")
 
 
 def check_imgsz(imgsz: int) -> int:
@@ -119,9 +122,9 @@ def _splits(request: TrainRequest) -> tuple[dict[str, DetectionSet], DetectionSe
                          f"train split; expected a set whose train split shows them")
     try:
         val = read("val")
-    except InputError as exc:  # no val split: Ultralytics validates the last epoch on the train split
+    except MissingSplit as exc:  # no val split: Ultralytics validates the last epoch on the train split
         log.warning("%s; Ultralytics validates on the train split instead", str(exc).split("; expected")[0])
-        val = train
+        val = train  # any other refusal of the val split (a class index out of range, a broken image) stands
     return {"train": train, "val": val}, train
 
 
@@ -141,12 +144,14 @@ def train(request: TrainRequest) -> dict:
     """Train, write the run folder (see the module's docstring) and return its train.json document."""
     if request.device not in L.DEVICES:
         raise InputError(f"--device: {request.device!r}; expected one of {', '.join(L.DEVICES)}")
+    inputs = {"TRAIN_SET": request.train_set, "--init": request.init, "--images": request.images_dir}
+    check_not_inputs([Path(request.out_dir) / name for name in RUN_FILES], inputs)  # before the training
     splits, train_set = _splits(request)
     init_weights, init_about = run_weights(request.init) if request.init is not None else (None, None)
     python = find_detector_python(request.python)
     threads = request.threads or len(os.sched_getaffinity(0))
     names = train_set.names
-    with output_set(request.out_dir) as stage, tempfile.TemporaryDirectory(prefix="synthua-train-") as scratch:
+    with output_set(request.out_dir, inputs=inputs) as stage, tempfile.TemporaryDirectory(prefix="synthua-train-") as scratch:
         data_yaml = write_yolo_boxes(Path(scratch) / "data", splits, names)
         b = request.budget
         job = {"action": "train", "data": str(data_yaml), "model": str(init_weights.resolve()) if init_weights else request.model,

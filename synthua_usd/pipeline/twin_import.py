@@ -18,6 +18,7 @@ from synthua_usd.agents.crowd import Crowd, CrowdParams, populate_crowd
 from synthua_usd.composition.scenario import CAMERAS_ROOT, ROOT_FILE, ScenarioSpec, StageMetadata
 from synthua_usd.core.atomic import output_set, write_json_atomic
 from synthua_usd.core.findings import Finding, Severity
+from synthua_usd.core.input_guard import Inputs
 from synthua_usd.geometry.framing import Framing, automatic_cameras
 from synthua_usd.geometry.ground import ground_object
 from synthua_usd.model.materials import subset
@@ -97,13 +98,13 @@ def labelled_shares(scenario: Path, class_map: ClassMap, cameras: list[str]) -> 
 
 
 def write_import(model: TwinModel, out_dir: str | Path, class_map: ClassMap, report: dict,
-                 crowd: CrowdParams | None = None) -> tuple[list[Path], dict]:
+                 crowd: CrowdParams | None = None, inputs: Inputs | None = None) -> tuple[list[Path], dict]:
     """Write the scenario of ``model`` (with ``crowd`` people when given) and ``report`` (completed with the
     ground, the cameras' framing and label-pass shares, the population, and their findings) into
-    ``out_dir``; returns the final paths and the report."""
+    ``out_dir``, none of the files one of the command's ``inputs``; returns the final paths and the report."""
     out_dir = Path(out_dir)
     spec, framing = import_scenario(model, crowd)
-    with output_set(out_dir) as staging:
+    with output_set(out_dir, inputs=inputs) as staging:
         written = write_scenario(spec, staging, class_map)
         shares = labelled_shares(staging / ROOT_FILE, class_map, [c.name for c in spec.cameras])
         findings = list(report.get("findings", []))

@@ -2,10 +2,14 @@
 
 :func:`verify` checks, without trusting any file more than another: the manifest (against its schema)
 and the plan (every planned image has a record), every file's size and SHA-256 against the manifest, that
-the folder holds no file the manifest does not list, and cross-file consistency: every COCO annotation's
+the folder holds no file the manifest does not list, and cross-file consistency: each record against its own
+label PNGs (the files its ``files`` names: its ``class_pixel_counts`` are ``class.png``'s, its instances are the
+ids of ``instance.png`` with their pixel counts, boxes and, in ``class.png``, their class; ``semantic.png`` is
+``class.png`` in the class map's colours), so that label PNGs swapped between images (checksums rewritten to
+match) or a record naming a class its PNGs do not hold fail without rendering; every COCO annotation's
 mask is its instance's pixels in ``instance.png`` (area and box included) and every visible thing instance
 has one; the person keypoints file is the person part of the instances file; every panoptic segment matches its PNG exactly; the Cityscapes label ids are the class map's ids of
-``class.png``; YOLO has one line per annotated instance. A record or an annotation document that is not
+``class.png``, its instance ids and colours what its writer makes of ``instance.png``, ``class.png`` and the record; YOLO has one line per annotated instance. A record or an annotation document that is not
 what generate writes (a record: one that does not validate against ``schemas/record.schema.json``) is a
 problem of the dataset, never a crash.
 
@@ -25,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.core.atomic import named_as
-from synthua_usd.core.errors import InputError, OutputError, echo
+from synthua_usd.core.errors import InputError, OutputError, SynthuaError, echo
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.schemas import read_json, type_name
 from synthua_usd.dataset.annotations import rle_problem
@@ -132,10 +136,11 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
     from synthua_usd.model.taxonomy import ClassMap
 
     try:
-        yolo_classes = class_index(ClassMap.load(root / Layout.CLASS_MAP))
+        class_map = ClassMap.load(root / Layout.CLASS_MAP)
+        yolo_classes = class_index(class_map)
     except InputError as exc:
         result.add(f"{Layout.CLASS_MAP}: {exc}")
-        yolo_classes = {}
+        class_map, yolo_classes = None, {}
     records = []
     for img in manifest["images"]:
         relative = Layout.record(img["name"])
@@ -189,7 +194,7 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
             continue  # a damaged file is reported already; its image is not read
         try:
             _check_image(layout, record, coco_by_image.get(record["id"], []), panoptic_by_image.get(record["id"]),
-                         yolo_classes, result, min_px)
+                         yolo_classes, result, min_px, class_map)
         except Exception as exc:  # noqa: BLE001 - whatever a broken file raises, it is a problem of the dataset
             result.add(f"image {record['id']} ({record['name']}): cannot be checked: {type(exc).__name__}: "
                        f"{echo(exc)}")
@@ -299,15 +304,18 @@ def _read(layout: Layout, relative: str) -> np.ndarray:
 
 
 def _check_image(layout: Layout, record: ImageRecord, coco_annotations: list[dict], panoptic_annotation: dict | None,
-                 yolo_classes: dict[int, int], result: Verification, min_px: int = 0) -> None:
-    """The image's annotations against its label maps; an instance with fewer than ``min_px`` pixels in
-    ``instance.png`` must be an ignore region (COCO iscrowd 1, no YOLO line) and every other one must not."""
+                 yolo_classes: dict[int, int], result: Verification, min_px: int = 0, class_map=None) -> None:
+    """The record and the image's annotations against its label maps (each PNG read once); an instance with fewer
+    than ``min_px`` pixels in ``instance.png`` must be an ignore region (COCO iscrowd 1, no YOLO line) and every
+    other one must not."""
     from pycocotools import mask as mask_utils
 
     where = f"image {record['id']} ({record['name']})"
     files = record["files"]
     instance_ids = _read(layout, files["instance"])[..., 0]
     class_ids = _read(layout, files["class"])[..., 0]
+    if class_map is not None:
+        _check_record_labels(layout, where, record, instance_ids, class_ids, class_map, result)
     things = {i["id"]: i for i in record["instances"] if i["isthing"]}
     seen = set()
     for ann in coco_annotations:
@@ -352,6 +360,8 @@ def _check_image(layout: Layout, record: ImageRecord, coco_annotations: list[dic
                        f"e.g. {diff}")
     if "cs_labelIds" in files and not np.array_equal(_read(layout, files["cs_labelIds"])[..., 0], class_ids):
         result.add(f"{where}: {files['cs_labelIds']} differs from {files['class']}")
+    if class_map is not None and {"cs_instanceIds", "cs_color"} & set(files):
+        _check_cityscapes(layout, where, record, instance_ids, class_ids, class_map, result)
     if "yolo_label" in files:
         lines = [ln for ln in layout.path(files["yolo_label"]).read_text(encoding="utf-8").splitlines() if ln.strip()]
         pixels = np.bincount(instance_ids.reshape(-1).astype(np.int64))
@@ -360,6 +370,106 @@ def _check_image(layout: Layout, record: ImageRecord, coco_annotations: list[dic
         if len(lines) != expected:
             result.add(f"{where}: {files['yolo_label']} has {len(lines)} lines; the image has {expected} instances "
                        f"of YOLO classes with at least min_instance_px = {min_px} pixels")
+
+
+#: Disagreements of one record with its label PNGs listed in full; the rest are counted in one line.
+RECORD_DISAGREEMENTS = 4
+
+
+def _check_record_labels(layout: Layout, where: str, record: ImageRecord, instance_ids: np.ndarray,
+                         class_ids: np.ndarray, class_map, result: Verification) -> None:
+    """The record against its own label PNGs, without rendering: ``class_pixel_counts`` against ``class.png``;
+    every instance's id, pixel count and box against ``instance.png`` and its class against ``class.png`` under its
+    pixels (no id of ``instance.png`` missing from the record); ``semantic.png`` (when the record lists it) against
+    ``class.png`` in the class map's colours. ``instance_ids``, ``class_ids``: (H, W) as read."""
+    files = record["files"]
+    found: list[str] = []
+    if instance_ids.shape != class_ids.shape or instance_ids.shape != (record["height"], record["width"]):
+        result.add(f"{where}: {files['instance']} is {instance_ids.shape[1]}x{instance_ids.shape[0]} and "
+                   f"{files['class']} {class_ids.shape[1]}x{class_ids.shape[0]}; the record says "
+                   f"{record['width']}x{record['height']}")
+        return
+    name_of = {c.id: c.name for c in class_map.classes}
+    counts = np.bincount(class_ids.reshape(-1).astype(np.int64), minlength=256)
+    in_png = {name_of.get(k, f"class id {k}"): int(n) for k, n in enumerate(counts) if n}
+    said = {str(k): int(v) for k, v in record["class_pixel_counts"].items()}
+    for name in sorted(set(in_png) | set(said)):
+        if in_png.get(name, 0) != said.get(name, 0):
+            found.append(f"class_pixel_counts {name} is {said.get(name, 0)}, {files['class']} has "
+                         f"{in_png.get(name, 0)} pixels of it")
+    # one pass over the pixels: every (instance id, class id) pair, its pixel count and its box
+    ids = instance_ids.reshape(-1).astype(np.int64)
+    pairs, pixels = np.unique(ids * 256 + class_ids.reshape(-1).astype(np.int64), return_counts=True)
+    top = int(ids.max()) + 1
+    height, width = instance_ids.shape
+    xs, ys = np.tile(np.arange(width), height), np.repeat(np.arange(height), width)
+    lo_x, lo_y = np.full(top, width), np.full(top, height)
+    hi_x, hi_y = np.full(top, -1), np.full(top, -1)
+    np.minimum.at(lo_x, ids, xs)
+    np.minimum.at(lo_y, ids, ys)
+    np.maximum.at(hi_x, ids, xs)
+    np.maximum.at(hi_y, ids, ys)
+    classes_of: dict[int, dict[int, int]] = {}
+    for pair, n in zip(pairs.tolist(), pixels.tolist()):
+        classes_of.setdefault(pair // 256, {})[pair % 256] = n
+    listed = set()
+    for inst in record["instances"]:
+        iid, area = int(inst["id"]), int(inst["area"])
+        listed.add(iid)
+        held = classes_of.get(iid, {}) if iid > 0 else {}
+        if sum(held.values()) != area:
+            found.append(f"instance {iid} ({inst['class_name']}) has {area} pixels in the record, "
+                         f"{sum(held.values())} in {files['instance']}")
+            continue
+        if not area:
+            continue
+        expected = class_map.resolve(str(inst["class_name"]))
+        if expected is None or expected.id != int(inst["category_id"]) or set(held) != {expected.id}:
+            shown = ", ".join(f"{name_of.get(c, f'class id {c}')} ({n} px)" for c, n in sorted(held.items()))
+            found.append(f"instance {iid} is {inst['class_name']} (category {inst['category_id']}) in the record, "
+                         f"{shown} in {files['class']}")
+        box = [int(lo_x[iid]), int(lo_y[iid]), int(hi_x[iid] - lo_x[iid] + 1), int(hi_y[iid] - lo_y[iid] + 1)]
+        if [float(v) for v in inst["bbox"]] != [float(v) for v in box]:
+            found.append(f"instance {iid} ({inst['class_name']}) has bbox {inst['bbox']} in the record, {box} in "
+                         f"{files['instance']}")
+    unlisted = sorted(i for i in classes_of if i and i not in listed)
+    if unlisted:
+        found.append(f"{files['instance']} holds instance ids {unlisted[:8]} the record does not list")
+    if "semantic" in files:
+        semantic = _read(layout, files["semantic"])[..., :3]
+        if semantic.shape != (*class_ids.shape, 3) or not np.array_equal(semantic, class_map.palette()[class_ids]):
+            found.append(f"{files['semantic']} is not {files['class']} in the class map's colours")
+    for line in found[:RECORD_DISAGREEMENTS]:
+        result.add(f"{where}: its record and its label PNGs disagree: {line}")
+    if len(found) > RECORD_DISAGREEMENTS:
+        result.add(f"{where}: ... and {len(found) - RECORD_DISAGREEMENTS} more disagreements of its record with "
+                   f"its label PNGs")
+
+
+def _check_cityscapes(layout: Layout, where: str, record: ImageRecord, instance_ids: np.ndarray,
+                      class_ids: np.ndarray, class_map, result: Verification) -> None:
+    """``cs_instanceIds`` and ``cs_color`` are what the Cityscapes writer makes of ``instance.png``, ``class.png``
+    and the record's instances (their classes and ignore flags)."""
+    from synthua_usd.dataset.formats.cityscapes import cityscapes_arrays
+    from synthua_usd.model.scene import Instance
+
+    files = record["files"]
+    instances = [Instance(int(i["id"]), str(i["prim_path"]), int(i["category_id"]), str(i["class_name"]),
+                          bool(i["isthing"])) for i in record["instances"]]
+    ignored = {int(i["id"]) for i in record["instances"] if i.get("ignore")}
+    try:
+        _, expected_ids, expected_color = cityscapes_arrays(class_ids.astype(np.uint8), instance_ids.astype(np.uint16),
+                                                            instances, class_map, ignored)
+    except SynthuaError as exc:
+        result.add(f"{where}: its record and its label PNGs disagree: {echo(exc)}")
+        return
+    for key, expected in (("cs_instanceIds", expected_ids), ("cs_color", expected_color)):
+        if key in files:
+            found = _read(layout, files[key])
+            found = found[..., 0] if expected.ndim == 2 else found[..., :3]
+            if found.shape != expected.shape or not np.array_equal(found, expected):
+                result.add(f"{where}: {files[key]} is not what {files['instance']}, {files['class']} and the record "
+                           f"make (Cityscapes {key[3:]})")
 
 
 def _check_keypoints(where: str, ann: dict, truth: np.ndarray, result: Verification) -> None:

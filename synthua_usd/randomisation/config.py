@@ -15,9 +15,11 @@ from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
 from synthua_usd.core.errors import InputError, echo
+from synthua_usd.core.schemas import unknown_key
 from synthua_usd.assets.hair import HAIR_STYLES
 from synthua_usd.assets.look_images import LOWER_FABRICS, SHOES, UPPER_FABRICS
 from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES
+from synthua_usd.model.ranges import SEED
 
 #: The mobility-aid classes a randomised crowd can use (the device classes of the agent profiles).
 AID_CLASSES = ("manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
@@ -32,6 +34,9 @@ Range = tuple[float, float]
 #: Densest randomised crowd, persons/m² of walkable area: placing a crowd anew for every view keeps people
 #: apart by rejection, which stays reliable up to about this (free walking ends near 0.7/m²).
 MAX_DENSITY_PER_M2 = 0.3
+#: Least share of the image's height an aid user placed in view may span (0.005: about 2 pixels of a 480-pixel
+#: image); below it "in view" means nothing a detector or a label could use.
+MIN_VIEW_HEIGHT_SHARE = 0.005
 
 
 def _range(name: str, value, lo: float | None = None, hi: float | None = None) -> Range:
@@ -80,6 +85,11 @@ class CrowdRandomisation:
             raise InputError(f"crowd.aid_users_in_view: {list(users)}; expected two whole numbers")
         object.__setattr__(self, "aid_users_in_view", (int(users[0]), int(users[1])))
         object.__setattr__(self, "view_height_share", _range("crowd.view_height_share", self.view_height_share, 0.0, 10.0))
+        if self.view_height_share[0] < MIN_VIEW_HEIGHT_SHARE:
+            # a share of 0 asks for aid users of no height in the image: placed out of view, silently
+            raise InputError(f"crowd.view_height_share: [{self.view_height_share[0]:g}, {self.view_height_share[1]:g}]; "
+                             f"expected a low end of at least {MIN_VIEW_HEIGHT_SHARE:g} (a share of the image's "
+                             f"height an aid user in view spans)")
         aids = tuple(self.aids)
         unknown = [a for a in aids if a not in AID_CLASSES]
         if unknown or not aids:
@@ -230,8 +240,9 @@ class DistrictRandomisation:
 
     def __post_init__(self) -> None:
         seeds = tuple(int(s) for s in self.seeds)
-        if not seeds or any(s < 0 or s > 2**32 - 1 for s in seeds) or len(set(seeds)) != len(seeds):
-            raise InputError(f"district.seeds: {list(seeds)}; expected one or more distinct integers in 0..2^32-1")
+        if not seeds or not all(SEED.contains(s) for s in seeds) or len(set(seeds)) != len(seeds):
+            raise InputError(f"district.seeds: {list(seeds)}; expected one or more distinct integers, each "
+                             f"{str(SEED).removeprefix('an integer ')}")
         object.__setattr__(self, "seeds", seeds)
 
 
@@ -331,7 +342,7 @@ class RandomisationConfig:
             known = {f.name for f in fields(kind)}
             unknown = sorted(set(values) - known)
             if unknown:
-                raise InputError(f"{source}.{name}: unknown keys {unknown}; expected among {sorted(known)}")
+                raise InputError(unknown_key(f"{source}.{name}", unknown[0], known))
             for key, value in values.items():
                 if isinstance(value, list):
                     values[key] = tuple(value)

@@ -9,6 +9,7 @@ from pathlib import Path
 from pxr import Sdf, UsdGeom
 
 from synthua_usd.core.errors import InputError, StageError, echo
+from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.usd.authoring import check_layer_path, save_layer_atomic
 from synthua_usd.usd.stage_io import open_layer
 
@@ -31,6 +32,7 @@ def compose_layers(out_path: str | Path, layer_paths: list[str | Path], doc: str
     out_path = check_layer_path(out_path, "the scenario root")
     if not layer_paths:
         raise StageError(f"{out_path}: no layers to compose; give at least one layer file")
+    check_not_inputs([out_path], {"LAYERS": layer_paths})  # a scenario cannot sublayer itself
     layers = [(Path(p), open_layer(p)) for p in layer_paths]
     if not allow_external_assets:
         folder = out_path.resolve().parent
@@ -39,8 +41,6 @@ def compose_layers(out_path: str | Path, layer_paths: list[str | Path], doc: str
                 raise InputError(f"{echo(p)}: outside the scenario's folder {echo(folder)}, so validate, render and "
                                  f"generate would refuse {echo(out_path)}; expected layers in that folder tree (write "
                                  f"the scenario beside them, or pass --allow-external-assets to compose it anyway)")
-    if any(p.resolve() == out_path.resolve() for p, _ in layers):
-        raise StageError(f"{out_path}: the scenario cannot sublayer itself")
     root = Sdf.Layer.CreateAnonymous(".usda")
     for key in _AGREE:
         values = {(str(p), layer.pseudoRoot.GetInfo(key)) for p, layer in layers if layer.pseudoRoot.HasInfo(key)}

@@ -20,6 +20,11 @@ from synthua_usd.model.taxonomy import ClassMap
 #: Plausible physical lens values; outside them the authored numbers are probably in the wrong unit.
 FOCAL_RANGE_MM = (1.0, 2000.0)
 APERTURE_RANGE_MM = (1.0, 100.0)
+#: Plausible field of view across the wider side of the authored filmback (a rectilinear lens: from a CCTV dome's zoom
+#: at its longest, about 2.3 degrees, to the widest ultra-wides, about 135). Each value can look plausible alone
+#: while the three mix units: focalLength 20 (a 20 mm lens typed in millimetres) over a 0.36 filmback is 2000 mm
+#: over 36 mm, 1 degree; 0.02 (typed in metres) is 2 mm, 167 degrees.
+FOV_RANGE_DEG = (2.0, 150.0)
 #: Lens distortion lives on the camera prim as custom attributes: ``synthua:distortion:model`` (token,
 #: ``brown_conrady``) and one double per coefficient (``synthua:distortion:k1`` ... ``:p2``).
 DISTORTION_PREFIX = "synthua:distortion:"
@@ -119,6 +124,20 @@ def camera_findings(prim: Usd.Prim, t: Usd.TimeCode, meters_per_unit: float, rul
                 out.append(Finding(rule, path, f"{attr} is not authored: USD's fallback {value:g} is {mm:g} mm here, "
                                                f"outside the plausible {lo:g}-{hi:g} mm; author the lens in tenths of a "
                                                f"scene unit ({unit:g} mm here)", Severity.WARNING))
+    lens = {a: prim.GetAttribute(a).Get(t) for a in ("focalLength", "horizontalAperture", "verticalAperture")}
+    if all(v is not None and math.isfinite(v) and v > 0 for v in lens.values()):
+        wide = max(("horizontalAperture", "verticalAperture"), key=lambda a: lens[a])  # the view across its wider side
+        focal_mm, aperture_mm = lens["focalLength"] * unit, lens[wide] * unit
+        fov = math.degrees(2 * math.atan(lens[wide] / (2 * lens["focalLength"])))
+        plausible = FOCAL_RANGE_MM[0] <= focal_mm <= FOCAL_RANGE_MM[1] and \
+            APERTURE_RANGE_MM[0] <= aperture_mm <= APERTURE_RANGE_MM[1]
+        if plausible and not FOV_RANGE_DEG[0] <= fov <= FOV_RANGE_DEG[1]:  # each value alone is reported above
+            out.append(Finding(rule, path, f"focalLength = {lens['focalLength']:g} over {wide} = {lens[wide]:g} "
+                                           f"({focal_mm:g} mm over {aperture_mm:g} mm) is a field of view of {fov:.3g} "
+                                           f"degrees, outside the plausible {FOV_RANGE_DEG[0]:g}-{FOV_RANGE_DEG[1]:g}; "
+                                           f"expected the three lens values in one unit, tenths of a scene unit "
+                                           f"({unit:g} mm here): a 20 mm lens over a 36 mm filmback is "
+                                           f"{20 / unit:g} over {36 / unit:g}"))
     for attr in ("horizontalApertureOffset", "verticalApertureOffset"):
         offset = prim.GetAttribute(attr).Get(t)
         if offset:

@@ -85,6 +85,9 @@ BROKEN_STAGES: dict[str, tuple[str | bytes, tuple[str, ...]]] = {
     "lens in millimetres on a metre stage": (_variant("focalLength = 0.2", "focalLength = 24").replace(
         "horizontalAperture = 0.36", "horizontalAperture = 36").replace("verticalAperture = 0.24", "verticalAperture = 24"),
         (CAM, "tenths of a scene unit")),
+    # each value alone looks plausible, so validate called them clean: 2000 mm over 36 mm, 2 mm over 36 mm
+    "focal length alone in millimetres": (_variant("focalLength = 0.2", "focalLength = 20"), (CAM, "field of view")),
+    "focal length alone in metres": (_variant("focalLength = 0.2", "focalLength = 0.02"), (CAM, "field of view")),
 }
 
 #: Cases `validate stage` reports as findings (exit 1) rather than refusing to read (exit 2).
@@ -95,7 +98,8 @@ FINDINGS = {"NaN points": "mesh-topology", "face counts do not match": "mesh-top
             "camera focal length 0": "camera-lens", "orthographic camera": "camera-lens",
             "label not in the class map": "label-in-class-map", "two labels": "gprim-has-one-class",
             "no geometry": "renderable", "NaN translate": "finite-values", "NaN cube size": "gprim-shape",
-            "negative sphere radius": "gprim-shape", "lens in millimetres on a metre stage": "camera-lens"}
+            "negative sphere radius": "gprim-shape", "lens in millimetres on a metre stage": "camera-lens",
+            "focal length alone in millimetres": "camera-lens", "focal length alone in metres": "camera-lens"}
 
 
 @pytest.fixture(scope="module")
@@ -330,7 +334,7 @@ def test_populate_refuses_nonsense(corpus, tmp_path, run_cli):
         code, _, err = run_cli("agents", "populate", SCENARIO, *args, "--out", tmp_path / "a.usdc")
         assert code == 2 and err.count("synthua: error:") == 1 and word in err, (args, err)
     code, _, err = run_cli("agents", "populate", corpus / "tiny.usda", "--out", corpus / "tiny.usda")
-    assert code == 2 and "input stage itself" in err
+    assert code == 2 and "is the input TWIN_OR_SCENARIO itself" in err
     assert not (tmp_path / "a.usdc").exists()
 
 

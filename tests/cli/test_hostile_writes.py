@@ -71,3 +71,25 @@ def test_an_output_folder_that_cannot_take_the_files_is_named_not_the_staging_fo
         message = assert_refused(result, str(disk))
         assert ".partial" not in message, message
         assert sorted(os.listdir(tmp_path)) == ["mnt"]
+
+
+#: name -> arguments writing ``out`` (relative to the current folder) inside a read-only folder.
+READ_ONLY_WRITERS = {
+    "compose": lambda out: ["compose", f"{out}.usda", TINY, "--allow-external-assets"],
+    "agents populate": lambda out: ["agents", "populate", TINY.parent / "tiny_street_lamps.usda", "--walk-on", "road",
+                                    "--out", f"{out}.usdc"],
+    "render": lambda out: ["render", TINY, "--camera", "/World/Cam", "--width", "8", "--height", "6", "--spp", "1",
+                           "--out", out],
+    "twin import": lambda out: ["twin", "import", "mesh", OBJ, "--rules", RULES, "--out", out],
+}
+
+
+@pytest.mark.parametrize("name", sorted(READ_ONLY_WRITERS))
+def test_a_read_only_folder_names_the_output_not_a_temporary_file(name, tmp_path):
+    """compose into a folder it may not write named '/tmp/.../mnt/.root.6dkhxtu7.usda' (tempfile gives its own
+    names absolute; the output was asked for relative), render its staging folder 'mnt/.out.partial-...'."""
+    with small_disk(tmp_path, "size=64k,ro"):
+        args = READ_ONLY_WRITERS[name]("mnt/out")
+        result = run_synthua(*args, cwd=tmp_path)
+        message = assert_refused(result, "mnt/out", "read-only file system")
+        assert ".partial" not in message and "/." not in message and "mnt/." not in message, message

@@ -1,6 +1,8 @@
-"""Hostile GeoJSON for ``synthua twin import footprints``."""
+"""Hostile GeoJSON for ``synthua twin import footprints``, and building outlines of no area in OpenStreetMap extracts."""
 
 from __future__ import annotations
+
+import json
 
 import pytest
 
@@ -88,3 +90,50 @@ def test_hostile_geojson(refuse, workdir, case):
     path = write(workdir / "blocks.geojson", spoil(doc(GEOJSON)))
     refuse("twin", "import", "footprints", path, "--out", workdir / "out", "--strict",
            mentions=("blocks.geojson", *words))
+
+
+#: Positions on one line of latitude 2 km long: no area in lon/lat, as GeoJSON's straight lines between positions
+#: have none; projected to metres the parallel curves, and the ring became a sliver of some 30 m² that was imported.
+LONG_LINE = [[-49.30, -25.4270], [-49.29, -25.4270], [-49.28, -25.4270], [-49.30, -25.4270]]
+DIAGONAL_LINE = [[-49.30, -25.43], [-49.29, -25.42], [-49.28, -25.41], [-49.30, -25.43]]
+
+
+@pytest.mark.parametrize("ring", [LONG_LINE, DIAGONAL_LINE])
+@pytest.mark.parametrize("strict", [[], ["--strict"]])
+def test_a_ring_of_no_area_in_lon_lat_is_refused(refuse, workdir, ring, strict):
+    path = write(workdir / "blocks.geojson", _feature(doc(GEOJSON), coordinates=[ring]))
+    refuse("twin", "import", "footprints", path, "--out", workdir / "out", *strict,
+           mentions=("blocks.geojson", "features[0]", "area 0 in the file's coordinates"))
+
+
+def _osm(path, rings: list) -> str:
+    """An OpenStreetMap extract of one building way per ring of (lon, lat) positions (closed here)."""
+    import osmium
+    from osmium.osm.mutable import Node, Way
+
+    writer = osmium.SimpleWriter(str(path))
+    node = 0
+    for k, ring in enumerate(rings):
+        ids = []
+        for lon, lat in ring[:-1]:
+            node += 1
+            writer.add_node(Node(id=node, location=(lon, lat)))
+            ids.append(node)
+        writer.add_way(Way(id=100 + k, nodes=ids + ids[:1], tags={"building": "yes", "height": "9"}))
+    writer.close()
+    return path
+
+
+@pytest.mark.parametrize("ring", [LINE, LONG_LINE])
+def test_an_osm_extract_whose_only_building_has_no_area_is_refused(refuse, workdir, ring):
+    """ValueError in geometry/ground.py: the building was skipped, and the ground was made of nothing."""
+    path = _osm(workdir / "zero_area.osm", [ring])
+    refuse("twin", "import", "osm", path, "--out", workdir / "out", mentions=("zero_area.osm", "way/100", "0.01 m²"))
+
+
+def test_an_osm_building_of_no_area_beside_others_is_skipped_and_reported(run_cli, tmp_path):
+    path = _osm(tmp_path / "city.osm", [LONG_LINE, SQUARE])
+    code, out, err = run_cli("twin", "import", "osm", path, "--out", tmp_path / "out")
+    assert code == 0, err
+    report = json.loads((tmp_path / "out" / "import_report.json").read_text())
+    assert report["buildings"] == 1 and report["osm"]["skipped_ids"] == ["way/100"], report["osm"]

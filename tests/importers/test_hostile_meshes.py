@@ -168,3 +168,17 @@ def test_hostile_pointcloud(refuse, workdir, case):
     name, make = POINTCLOUD_CASES[case]
     path = write(workdir / name, make(np.random.default_rng(7)))
     refuse("twin", "import", "pointcloud", path, "--out", workdir / "out", mentions=(name,))
+
+
+@pytest.mark.parametrize("verbose, shown", [([], ()), (["-v"], ("info",)), (["-vv"], ("info", "debug"))])
+def test_mesh_import_prints_trimesh_notes_only_when_asked(run_cli, tmp_path, verbose, shown):
+    """trimesh's "triangulating faces" (info) and "`trimesh.load(force='scene')` is a compatibility wrapper" (debug)
+    were printed without -v, even on success: synthua lowered trimesh's logger to collect its notes of textures it
+    could not load, and the root handler printed whatever reached it."""
+    from importers.hostile_corpus import mesh_input
+
+    code, _, err = run_cli(*verbose, "twin", "import", "mesh", mesh_input(tmp_path), "--rules", RULES, "--out",
+                           tmp_path / "out")
+    assert code == 0, err
+    levels = {line.split(":")[1].strip() for line in err.splitlines() if line.startswith("synthua: ")}
+    assert levels - {"warning"} == set(shown), err

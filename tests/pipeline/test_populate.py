@@ -78,7 +78,7 @@ def test_populate_returns_the_crowd_and_writes_a_binary_layer(tmp_path):
 
 @pytest.mark.parametrize("out,text", [
     ("agents.txt", "the agents layer needs a USD file name (.usda text, .usdc binary or .usd)"),
-    (SCENARIO, "--out is the input stage itself; expected a new layer file beside it"),
+    (SCENARIO, "is the input TWIN_OR_SCENARIO itself"),
 ])
 def test_populate_refuses_bad_output_paths(tmp_path, out, text):
     before = SCENARIO.read_bytes()

@@ -14,13 +14,6 @@ import pytest
 from synthua_usd.pipeline.verify import verify
 
 
-@pytest.fixture
-def copy(generated, tmp_path) -> Path:
-    out = tmp_path / "copy"
-    shutil.copytree(generated, out)
-    return out
-
-
 def _names(root: Path) -> list[str]:
     return [img["name"] for img in json.loads((root / "manifest.json").read_text())["images"]]
 
@@ -35,31 +28,31 @@ def _rewrite_with_checksum(root: Path, relative: str, content: bytes) -> None:
     (root / "manifest.json").write_text(json.dumps(manifest))
 
 
-def test_replay_compares_the_re_render_with_the_files_on_disk(copy, run_cli):
+def test_replay_compares_the_re_render_with_the_files_on_disk(generated_copy, run_cli):
     """class.png overwritten after generation (its record's checksums unchanged): replay says which file differs."""
-    first, second = _names(copy)[:2]
+    first, second = _names(generated_copy)[:2]
     target = f"frames/{second}/class.png"
-    shutil.copyfile(copy / "frames" / first / "class.png", copy / target)
-    image_id = json.loads((copy / "records" / f"{second}.json").read_text())["id"]
-    code, out, err = run_cli("replay", copy, str(image_id))
+    shutil.copyfile(generated_copy / "frames" / first / "class.png", generated_copy / target)
+    image_id = json.loads((generated_copy / "records" / f"{second}.json").read_text())["id"]
+    code, out, err = run_cli("replay", generated_copy, str(image_id))
     assert code == 1, out + err
     assert f"differs: {target}" in out.splitlines() and "byte-identical" not in out, out
 
 
-def test_replay_of_an_image_whose_file_is_missing_says_so(copy, run_cli):
-    name = _names(copy)[1]
-    (copy / "frames" / name / "instance.png").unlink()
-    image_id = json.loads((copy / "records" / f"{name}.json").read_text())["id"]
-    code, out, _ = run_cli("replay", copy, str(image_id))
+def test_replay_of_an_image_whose_file_is_missing_says_so(generated_copy, run_cli):
+    name = _names(generated_copy)[1]
+    (generated_copy / "frames" / name / "instance.png").unlink()
+    image_id = json.loads((generated_copy / "records" / f"{name}.json").read_text())["id"]
+    code, out, _ = run_cli("replay", generated_copy, str(image_id))
     assert code == 1 and f"differs: frames/{name}/instance.png" in out, out
 
 
-def test_verify_reports_files_the_manifest_does_not_list(copy, run_cli):
-    (copy / "notes.txt").write_text("mine")
-    (copy / "frames" / "x").mkdir()
-    (copy / "frames" / "x" / ".hidden").write_text("")
-    (copy / "link.png").symlink_to(copy / "manifest.json")
-    code, out, _ = run_cli("verify", copy)
+def test_verify_reports_files_the_manifest_does_not_list(generated_copy, run_cli):
+    (generated_copy / "notes.txt").write_text("mine")
+    (generated_copy / "frames" / "x").mkdir()
+    (generated_copy / "frames" / "x" / ".hidden").write_text("")
+    (generated_copy / "link.png").symlink_to(generated_copy / "manifest.json")
+    code, out, _ = run_cli("verify", generated_copy)
     assert code == 1
     problems = [line for line in out.splitlines() if line.startswith("problem:")]
     for rel in ("notes.txt", "frames/x/.hidden", "link.png"):
@@ -74,11 +67,11 @@ def test_verify_reports_files_the_manifest_does_not_list(copy, run_cli):
     (lambda m: [m], ("manifest.json",)),
     (lambda m: "[" * 100_000 + "]" * 100_000, ("manifest.json", "nested")),
 ])
-def test_a_malformed_manifest_is_one_line_naming_it(copy, spoil, mentions, run_cli):
-    manifest = json.loads((copy / "manifest.json").read_text())
+def test_a_malformed_manifest_is_one_line_naming_it(generated_copy, spoil, mentions, run_cli):
+    manifest = json.loads((generated_copy / "manifest.json").read_text())
     spoiled = spoil(manifest)
-    (copy / "manifest.json").write_text(spoiled if isinstance(spoiled, str) else json.dumps(spoiled))
-    for command in (["verify", copy], ["stats", copy, "--out", copy.parent / "report"]):
+    (generated_copy / "manifest.json").write_text(spoiled if isinstance(spoiled, str) else json.dumps(spoiled))
+    for command in (["verify", generated_copy], ["stats", generated_copy, "--out", generated_copy.parent / "report"]):
         code, _, err = run_cli(*command)
         lines = err.strip().splitlines()
         assert code == 2 and len(lines) == 1 and lines[0].startswith("synthua: error: "), err
@@ -86,10 +79,10 @@ def test_a_malformed_manifest_is_one_line_naming_it(copy, spoil, mentions, run_c
 
 
 @pytest.mark.parametrize("plan", [{"a": 1}, [{"id": "one"}], [{"id": 1, "bogus": 2}]])
-def test_a_malformed_generate_json_is_one_line_naming_it(copy, plan, run_cli):
-    job = json.loads((copy / "generate.json").read_text())
-    (copy / "generate.json").write_text(json.dumps(job | {"plan": plan}))
-    commands = [["replay", copy, "1"]] + ([["verify", copy]] if not isinstance(plan, list) or
+def test_a_malformed_generate_json_is_one_line_naming_it(generated_copy, plan, run_cli):
+    job = json.loads((generated_copy / "generate.json").read_text())
+    (generated_copy / "generate.json").write_text(json.dumps(job | {"plan": plan}))
+    commands = [["replay", generated_copy, "1"]] + ([["verify", generated_copy]] if not isinstance(plan, list) or
                                          not isinstance(plan[0]["id"], int) else [])
     for command in commands:
         code, _, err = run_cli(*command)
@@ -102,28 +95,28 @@ def test_a_malformed_generate_json_is_one_line_naming_it(copy, plan, run_cli):
     lambda doc: doc | {"images": "all"},
     lambda doc: [doc],
 ])
-def test_a_malformed_coco_document_is_a_problem_not_a_crash(copy, spoil):
+def test_a_malformed_coco_document_is_a_problem_not_a_crash(generated_copy, spoil):
     relative = "annotations/instances_train.json"
-    doc = json.loads((copy / relative).read_text())
-    _rewrite_with_checksum(copy, relative, json.dumps(spoil(doc)).encode())
-    result = verify(copy)
+    doc = json.loads((generated_copy / relative).read_text())
+    _rewrite_with_checksum(generated_copy, relative, json.dumps(spoil(doc)).encode())
+    result = verify(generated_copy)
     assert any(relative in p and "not a COCO instances document" in p for p in result.problems), result.problems
 
 
 @pytest.mark.parametrize("counts", ["!!garbage!!", "o", "PPYo0"])
-def test_garbage_rle_in_the_dataset_is_a_problem_before_pycocotools_reads_it(copy, counts):
+def test_garbage_rle_in_the_dataset_is_a_problem_before_pycocotools_reads_it(generated_copy, counts):
     relative = "annotations/instances_train.json"
-    doc = json.loads((copy / relative).read_text())
+    doc = json.loads((generated_copy / relative).read_text())
     doc["annotations"][0]["segmentation"]["counts"] = counts
-    _rewrite_with_checksum(copy, relative, json.dumps(doc).encode())
-    result = verify(copy)
+    _rewrite_with_checksum(generated_copy, relative, json.dumps(doc).encode())
+    result = verify(generated_copy)
     assert any("segmentation: counts" in p for p in result.problems), result.problems
 
 
-def test_a_record_that_is_not_a_record_is_a_problem(copy):
-    name = _names(copy)[0]
-    _rewrite_with_checksum(copy, f"records/{name}.json", json.dumps({"id": "x"}).encode())
-    result = verify(copy)
+def test_a_record_that_is_not_a_record_is_a_problem(generated_copy):
+    name = _names(generated_copy)[0]
+    _rewrite_with_checksum(generated_copy, f"records/{name}.json", json.dumps({"id": "x"}).encode())
+    result = verify(generated_copy)
     assert any(f"records/{name}.json: not an image record" in p for p in result.problems), result.problems
 
 
@@ -131,16 +124,16 @@ def test_a_record_that_is_not_a_record_is_a_problem(copy):
     (lambda r: r["qa"].update(verdict="maybe"), "qa.verdict"),
     (lambda r: r["instances"][0].update(bbox="everywhere"), "instances[0].bbox"),
     (lambda r: r["files"].pop("instance"), "files"),
-    (lambda r: r.update(surprise=1), "(document)"),
+    (lambda r: r.update(surprise=1), "surprise"),
 ])
-def test_a_hand_corrupted_record_is_a_problem_naming_its_field(copy, spoil, field):
+def test_a_hand_corrupted_record_is_a_problem_naming_its_field(generated_copy, spoil, field):
     """Every record verify reads is validated against schemas/record.schema.json: a malformed one is one problem
     naming the record and the field (its checksum made to agree, so only the validation can notice)."""
-    name = _names(copy)[0]
+    name = _names(generated_copy)[0]
     relative = f"records/{name}.json"
-    record = json.loads((copy / relative).read_text())
+    record = json.loads((generated_copy / relative).read_text())
     spoil(record)
-    _rewrite_with_checksum(copy, relative, json.dumps(record).encode())
-    result = verify(copy)
+    _rewrite_with_checksum(generated_copy, relative, json.dumps(record).encode())
+    result = verify(generated_copy)
     assert [p for p in result.problems if p.startswith(f"{relative}: not an image record: {field}: ")], result.problems
-    assert result.images == len(_names(copy)) - 1
+    assert result.images == len(_names(generated_copy)) - 1

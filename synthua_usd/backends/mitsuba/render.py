@@ -16,7 +16,7 @@ from synthua_usd.backends.exposure import Exposure
 from synthua_usd.backends.mitsuba.translate import pass_sample_counts
 from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.model.conditions import Condition
-from synthua_usd.model.render_config import RenderConfig
+from synthua_usd.model.render_config import RenderConfig, sampler_seed
 from synthua_usd.model.scene import SceneSnapshot
 
 
@@ -78,7 +78,7 @@ def render_rgb(mi, scene, config: RenderConfig, show_progress: bool = False, sen
     total = np.zeros((config.height, config.width, 3 if guides is None else 9), np.float64)
     with tqdm(total=config.spp, unit="spp", desc="rgb", disable=not show_progress, leave=False) as bar:
         for k, spp in enumerate(counts):
-            pass_seed = seed * 100_003 + k
+            pass_seed = sampler_seed(seed, k)
             which = 0 if sensor is None else sensor  # the scene's own sensor, or the given one
             aux = None if guides is None else np.asarray(mi.render(scene, spp=spp, seed=pass_seed, sensor=which,
                                                                    integrator=guides), np.float64)
