@@ -6,6 +6,8 @@ Usage:
          [--images K] [--workers W] [--variant llvm_ad_rgb] [--out DIR] [--keep] [--no-progress]
   python tools/bench_generate.py --memory N [--scenario stages/scenario.usda] [--width 160 --height 120]
          [--workers W] [--out DIR] [--keep]
+  python tools/bench_generate.py --base REV [--rounds R] --config configs/sim2real.json --images 48 --seeds 4
+         --width 640 --height 480 --spp 8 --workers 2
 
 Default mode: runs ``generate`` on a scenario with a generation config (a temporary copy whose ``images`` is
 ``--images K``, when given, with explicit per-condition / per-rig-type quota counts scaled down by the same
@@ -20,6 +22,13 @@ WIDTHxHEIGHT at 1 spp, time codes 1:48:1, as many seeds as N needs, quotas relax
 QA flagging only, so that no rejected image is replaced by images of a later round)
 and prints, per worker, its memory after 10 %, 50 % and 100 % of the images and the growth from 10 % to
 100 %, which must stay near zero.
+
+``--base REV``: the same job run with the code of git revision REV (a temporary worktree, through ``PYTHONPATH``,
+with its own schemas) and with this tree, one after the other, ``--rounds`` times alternating, each run in a fresh
+process with an empty Dr.Jit kernel cache (a fresh ``HOME``: a first run's compile costs count); prints each run's
+images/min, wall and CPU seconds, the ratios (this tree against REV) and whether the two datasets are the same
+bytes (sha256 of every file; ``generate.json``'s recorded scenario path aside). ``--width``, ``--height``, ``--spp``
+and ``--seeds K`` (seeds 0..K-1) override the config's render size, samples and seeds in every mode.
 
 Memory is given two ways: the peak each worker reports with its results (``GenerateSummary.peak_rss_mib``
 and ``rss_trace``: its ``VmHWM`` on Linux), and each worker's ``/proc/PID/status`` read from here after
@@ -74,7 +83,6 @@ class Probe:
     def install(self) -> None:
         from synthua_usd.pipeline import executors
         from synthua_usd.pipeline import generate as gen
-        from synthua_usd.pipeline import view_scores
         from synthua_usd.pipeline.worker_protocol import ExecutorConfig
 
         probe = self
@@ -117,7 +125,12 @@ class Probe:
                 probe.capacity += (time.perf_counter() - t0) * len(seen)
 
         executors.run_shards = timed("render", run_shards_probed)  # generate() imports it at call time
-        view_scores.score_views = timed("plan", view_scores.score_views)
+        try:  # the view scores' module; a --base revision before it scored in generate itself
+            from synthua_usd.pipeline import view_scores
+        except ImportError:
+            gen.score_views = timed("plan", gen.score_views)
+        else:
+            view_scores.score_views = timed("plan", view_scores.score_views)
         gen.assemble = timed("assemble", gen.assemble)
 
 
@@ -131,9 +144,19 @@ def scaled_counts(counts: dict, factor: float) -> dict:
     return out
 
 
-def district_config(base: Path, images: int | None) -> tuple[dict, list[str]]:
+def district_config(base: Path, images: int | None, width: int | None = None, height: int | None = None,
+                    spp: int | None = None, seeds: int | None = None) -> tuple[dict, list[str]]:
     doc = json.loads(base.read_text(encoding="utf-8"))
     notes = []
+    render = dict(doc.get("render") or {})
+    for key, value in (("width", width), ("height", height), ("spp", spp)):
+        if value is not None and render.get(key) != value:
+            render[key] = value
+            notes.append(f"render.{key} {value}")
+    doc["render"] = render
+    if seeds is not None:
+        doc["seeds"] = list(range(seeds))
+        notes.append(f"seeds 0..{seeds - 1}")
     if images is not None and images != doc["images"]:
         factor = images / doc["images"]
         notes.append(f"images {doc['images']} -> {images}")
@@ -180,6 +203,88 @@ def fmt(x, unit="", nd=1) -> str:
     return "-" if x is None else f"{x:.{nd}f}{unit}"
 
 
+def use_tree_schemas(tree: Path) -> None:
+    """Make ``synthua_usd.schema_files`` (which an editable install maps to the installed checkout's schemas) the
+    schemas of ``tree``, whose package ``PYTHONPATH`` puts first: a revision's code with its own schemas."""
+    import importlib.util
+
+    class TreeSchemas:
+        @classmethod
+        def find_spec(cls, fullname, path=None, target=None):
+            if fullname != "synthua_usd.schema_files":
+                return None
+            return importlib.util.spec_from_file_location(fullname, str(Path(tree) / "schemas" / "__init__.py"))
+
+    sys.meta_path.insert(0, TreeSchemas)
+
+
+def tree_digests(folder: Path) -> dict[str, str]:
+    """sha256 of every file below ``folder`` by relative path (``generate.json`` names the scenario's absolute
+    path, which is the same here: it is compared too)."""
+    import hashlib
+
+    return {p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def compare(args) -> int:
+    """``--base REV``: REV's code and this tree's, side by side (see the module's docstring)."""
+    import subprocess
+
+    work = Path(tempfile.mkdtemp(prefix="bench_generate_base_"))
+    base_tree = work / "base"
+    subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(base_tree), args.base], check=True,
+                   capture_output=True)
+    # both runs read the same scenario and config files (absolute paths: generate.json records the scenario's)
+    memory = args.memory is not None
+    scenario = (args.scenario or REPO / "stages" / ("scenario.usda" if memory else "district/scenario.usda")).resolve()
+    config = (args.config or REPO / "configs" / ("demo.json" if memory else "district.json")).resolve()
+    passed = ["--scenario", str(scenario), "--config", str(config)]
+    for flag, value in (("--images", args.images), ("--memory", args.memory), ("--width", args.width),
+                        ("--height", args.height), ("--spp", args.spp), ("--seeds", args.seeds),
+                        ("--workers", args.workers), ("--variant", args.variant)):
+        if value is not None:
+            passed += [flag, str(value)]
+    runs: list[tuple[str, int, dict]] = []
+    try:
+        for r in range(args.rounds):
+            for name, tree in (("base", base_tree), ("this", REPO)) if r % 2 == 0 else (("this", REPO), ("base", base_tree)):
+                out, measures = work / f"{name}_{r}", work / f"{name}_{r}.json"
+                home = work / f"home_{name}_{r}"  # an empty Dr.Jit kernel cache
+                home.mkdir()
+                env = {**os.environ, "PYTHONPATH": str(tree), "HOME": str(home)}
+                print(f"round {r + 1}: {name} ({args.base if name == 'base' else 'this tree'})", flush=True)
+                subprocess.run([sys.executable, str(Path(__file__).resolve()), *passed, "--no-progress", "--keep",
+                                "--out", str(out), "--json", str(measures), "--tree", str(tree)],
+                               env=env, cwd=str(tree), check=True)
+                runs.append((name, r, json.loads(measures.read_text(encoding="utf-8"))))
+        first = {name: tree_digests(work / f"{name}_0") for name in ("base", "this")}
+        differ = sorted(p for p in first["base"].keys() | first["this"].keys()
+                        if first["base"].get(p) != first["this"].get(p))
+        print(f"\n{'run':14} {'images':>7} {'wall s':>8} {'CPU s':>8} {'images/min':>11} {'plan s':>8}")
+        for name, r, m in runs:
+            print(f"{name + ' ' + str(r + 1):14} {m['rendered']:7d} {m['wall_s']:8.1f} {m['cpu_s']:8.1f} "
+                  f"{m['images_per_min']:11.2f} {m['plan_s']:8.1f}")
+        mean = {name: {k: np.mean([m[k] for n, _, m in runs if n == name]) for k in ("wall_s", "cpu_s", "images_per_min")}
+                for name in ("base", "this")}
+        print(f"this tree against {args.base}: images/min x{mean['this']['images_per_min'] / mean['base']['images_per_min']:.2f}, "
+              f"wall x{mean['this']['wall_s'] / mean['base']['wall_s']:.2f}, CPU x{mean['this']['cpu_s'] / mean['base']['cpu_s']:.2f}")
+        verdict = (f"the same bytes, all {len(first['this'])} files" if not differ
+                   else f"{len(differ)} of {len(first['this'])} files differ: {', '.join(differ[:8])}")
+        print(f"datasets (first round): {verdict}")
+        if args.json is not None:
+            args.json.write_text(json.dumps({"base": args.base, "runs": [{"code": n, "round": r, **m} for n, r, m in runs],
+                                             "same_bytes": not differ, "differ": differ}, indent=1) + "\n",
+                                 encoding="utf-8")
+    finally:
+        subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(base_tree)], capture_output=True)
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+        else:
+            print(f"kept: {work}")
+    return 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -191,8 +296,15 @@ def main() -> int:
     parser.add_argument("--images", type=int, default=None, help="override the config's image count")
     parser.add_argument("--memory", type=int, metavar="N", default=None,
                         help="memory mode: N small images of the demo street")
-    parser.add_argument("--width", type=int, default=160, help="render width in --memory mode")
-    parser.add_argument("--height", type=int, default=120, help="render height in --memory mode")
+    parser.add_argument("--width", type=int, default=None, help="render width [default: the config's; 160 in --memory mode]")
+    parser.add_argument("--height", type=int, default=None, help="render height [default: the config's; 120 in --memory]")
+    parser.add_argument("--spp", type=int, default=None, help="samples per pixel [default: the config's]")
+    parser.add_argument("--seeds", type=int, default=None, help="seeds 0..K-1 [default: the config's]")
+    parser.add_argument("--base", default=None, metavar="REV",
+                        help="compare with the code of git revision REV, side by side (see above)")
+    parser.add_argument("--rounds", type=int, default=1, help="with --base: runs of each, alternating")
+    parser.add_argument("--json", type=Path, default=None, help="write the run's measures to this JSON file")
+    parser.add_argument("--tree", type=Path, default=None, help=argparse.SUPPRESS)  # a --base run's code
     parser.add_argument("--workers", type=int, default=None, help="[default: the config's, else generate's]")
     parser.add_argument("--variant", default=None)
     parser.add_argument("--out", type=Path, default=None,
@@ -201,13 +313,17 @@ def main() -> int:
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args()
 
+    if args.base is not None:
+        return compare(args)
+    if args.tree is not None:
+        use_tree_schemas(args.tree)
     memory = args.memory is not None
     scenario = args.scenario or REPO / "stages" / ("scenario.usda" if memory else "district/scenario.usda")
     base = args.config or REPO / "configs" / ("demo.json" if memory else "district.json")
     if memory:
-        doc, notes = memory_config(base, scenario, args.memory, args.width, args.height)
+        doc, notes = memory_config(base, scenario, args.memory, args.width or 160, args.height or 120)
     else:
-        doc, notes = district_config(base, args.images)
+        doc, notes = district_config(base, args.images, args.width, args.height, args.spp, args.seeds)
 
     from synthua_usd.pipeline.generate import GenerateRequest, generate
 
@@ -260,6 +376,14 @@ def main() -> int:
     render_wall = phases["render (workers)"] or float("nan")
     print(f"images/min: {60 * summary.rendered / wall:.2f} rendered end to end ({60 * kept / wall:.2f} kept, i.e. "
           f"not rejected), {60 * summary.rendered / render_wall:.2f} rendered over the render phase")
+
+    if args.json is not None:
+        cpu = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+        args.json.write_text(json.dumps({
+            "images": images, "rendered": summary.rendered, "wall_s": wall, "plan_s": phases["plan (score views)"],
+            "render_s": phases["render (workers)"], "cpu_s": sum(r.ru_utime + r.ru_stime for r in cpu),
+            "images_per_min": 60 * summary.rendered / wall, "worker_seconds": summary.seconds,
+            "peak_rss_mib": summary.peak_rss_mib}, indent=1) + "\n", encoding="utf-8")
 
     s = summary.seconds
     total = sum(s.values()) or 1.0

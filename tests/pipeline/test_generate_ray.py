@@ -25,3 +25,15 @@ def test_unreachable_ray_head_is_refused_before_anything_is_written(tmp_path):
                          "--address", "127.0.0.1:9")
     assert_refused(result, "--address", "127.0.0.1:9")
     assert result.seconds < 30 and not out.exists()
+
+
+@pytest.mark.slow
+def test_a_randomised_job_on_two_ray_workers_gives_the_local_pools_bytes(generated_random, tmp_path):
+    """Issue 39: the randomised street job (its view scores and its images) on a Ray instance of two worker actors
+    writes what the local pool wrote, file for file."""
+    pytest.importorskip("ray")
+    from conftest import RANDOM_CONFIG
+
+    out = tmp_path / "ray"
+    generate_dataset(out, config=RANDOM_CONFIG, executor="ray", workers=2)
+    assert tree_bytes(out) == tree_bytes(generated_random)
