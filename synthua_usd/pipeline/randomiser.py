@@ -31,6 +31,7 @@ from synthua_usd.core.errors import StageError
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.districts import district_of
 from synthua_usd.randomisation.config import RandomisationConfig
+from synthua_usd.randomisation.framing import draw_framing
 from synthua_usd.randomisation.light import LightDraw, draw_light
 from synthua_usd.randomisation.scene import SceneDraw, draw_scene
 from synthua_usd.randomisation.streams import stream
@@ -179,6 +180,14 @@ class Randomiser:
         placements = ()
         if self.config.crowd.enabled and scene.cast:
             placements = place_cast(rng, scene.cast, self.area, camera, self.size, self.config.crowd)
+        framing = None
+        if (self.config.framing.enabled and placements and self.area is not None
+                and camera_rig_type(self.base, camera_path) in self.config.framing.rig_types):
+            framing = draw_framing(stream(self.config.seed, seed, "framing", camera_path, time_code),
+                                   self.config.framing, scene.cast, placements, self.area, camera, self.size,
+                                   self.bodies.bank)
+            if framing is not None:
+                camera = framing.camera(base_camera)
         light = randomised = None
         if condition is not None:
             base_condition = read_condition(self.base, condition)
@@ -186,7 +195,7 @@ class Randomiser:
                                base_condition, self.config.light)
             randomised = light.condition(base_condition)
         override = None
-        if jitter is not None or (light is not None and light.exposure_ev):
+        if jitter is not None or framing is not None or (light is not None and light.exposure_ev):
             override = camera_override(self.base, camera_path, time_code, camera.camera_to_world,
                                        camera.focal_length_mm, base_camera.focal_length_mm,
                                        light.exposure_ev if light is not None else 0.0)
@@ -196,7 +205,7 @@ class Randomiser:
         digest = hashlib.sha256(fresh.ExportToString().encode("utf-8")).hexdigest()
         fresh.subLayerPaths.append(self.scene_layer.identifier)
         self.view_layer.TransferContent(fresh)
-        return ImageRandomisation(self.config.seed, scene, ViewDraw(jitter, placements), light, digest)
+        return ImageRandomisation(self.config.seed, scene, ViewDraw(jitter, placements, framing), light, digest)
 
     def export(self, out: Path, anchor: Path | None = None) -> tuple[Path, Path, Path]:
         """Write the current image's layers: ``out`` (the view layer), ``<stem>.scene.usda`` and

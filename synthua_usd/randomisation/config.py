@@ -297,10 +297,47 @@ class EffectsRandomisation:
         object.__setattr__(self, "jpeg_quality", tuple(int(q) for q in self.jpeg_quality))
 
 
+@dataclass(frozen=True)
+class FramingRandomisation:
+    """Views framed as photographers frame aid users, as well as the rigs' own: a share ``share`` of the views of
+    cameras of ``rig_types`` is taken from ``distance_m`` of one of the aid users placed in view (on the ground),
+    at an eye height (``eye_height_m``, or ``seated_height_m`` for the share ``seated_share``: a seated
+    photographer, a wheelchair user's eye), aimed at the user, its focal length such that the user fills
+    ``height_share`` of the frame height; from a stream of its own. Off by default: a config that does not ask for
+    it renders as before."""
+
+    enabled: bool = False
+    share: float = 0.6
+    rig_types: tuple[str, ...] = ("pedestrian_eye", "wheelchair_eye")
+    distance_m: Range = (1.5, 8.0)
+    eye_height_m: Range = (1.45, 1.75)
+    seated_height_m: Range = (1.0, 1.3)
+    seated_share: float = 0.3
+    height_share: Range = (0.2, 0.9)
+
+    def __post_init__(self) -> None:
+        from synthua_usd.composition.rigs import RIG_TYPES
+
+        for name in ("share", "seated_share"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
+                raise InputError(f"framing.{name}: {value!r}; expected a share in [0, 1]")
+        unknown = [r for r in self.rig_types if r not in RIG_TYPES]
+        if unknown or not self.rig_types:
+            raise InputError(f"framing.rig_types: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
+                             f"{', '.join(sorted(RIG_TYPES))}")
+        for name, lo, hi in (("distance_m", 0.5, 50.0), ("eye_height_m", 0.3, 3.0), ("seated_height_m", 0.3, 3.0),
+                             ("height_share", 0.02, 1.0)):
+            object.__setattr__(self, name, _range(f"framing.{name}", getattr(self, name), lo, hi))
+
+
 _PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "hair": HairRandomisation,
           "looks": LooksRandomisation, "materials": MaterialRandomisation,
           "light": LightRandomisation, "camera": CameraRandomisation, "district": DistrictRandomisation,
-          "effects": EffectsRandomisation}
+          "effects": EffectsRandomisation, "framing": FramingRandomisation}
+#: Parts that came after datasets were made: left out of a config's document while they are their default (off),
+#: so that a config that does not ask for them keeps its generate.json and job key.
+_LATER_PARTS = {"effects": EffectsRandomisation, "framing": FramingRandomisation}
 
 
 @dataclass(frozen=True)
@@ -318,6 +355,7 @@ class RandomisationConfig:
     camera: CameraRandomisation = field(default_factory=CameraRandomisation)
     district: DistrictRandomisation = field(default_factory=DistrictRandomisation)
     effects: EffectsRandomisation = field(default_factory=EffectsRandomisation)
+    framing: FramingRandomisation = field(default_factory=FramingRandomisation)
 
     def __post_init__(self) -> None:
         if self.devices.enabled and not self.crowd.enabled:
@@ -353,13 +391,13 @@ class RandomisationConfig:
         return cls(seed=int(doc.get("seed", 0)), **parts)
 
     def to_document(self) -> dict:
-        """Every value explicit (as ``generate.json`` records it), but ``effects`` when it is the default (off,
-        default ranges), which is left out; ``from_document(to_document())`` is equal."""
+        """Every value explicit (as ``generate.json`` records it), but the parts of :data:`_LATER_PARTS` that are
+        their default (off, default ranges), which are left out; ``from_document(to_document())`` is equal."""
         out: dict[str, Any] = {"seed": self.seed}
         for name in _PARTS:
-            if name == "effects" and self.effects == EffectsRandomisation():
-                # left out as it was before effects existed: a config that does not ask for them keeps its
-                # generate.json and job key (and with them resumption of datasets written before)
+            if name in _LATER_PARTS and getattr(self, name) == _LATER_PARTS[name]():
+                # left out as before the part existed: a config that does not ask for it keeps its generate.json
+                # and job key (and with them resumption of datasets written before)
                 continue
             out[name] = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(getattr(self, name)).items()}
         return out

@@ -15,7 +15,8 @@ import zlib
 
 import numpy as np
 
-_SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "cutout_group": 6, "cutout_view": 7}
+_SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "cutout_group": 6, "cutout_view": 7,
+           "framing": 8}
 
 
 def _key(value) -> int:

@@ -199,13 +199,19 @@ class CameraJitter:
 
 @dataclass(frozen=True)
 class ViewDraw:
-    """Everything one view drew: the camera (None when not randomised) and one placement per cast member."""
+    """Everything one view drew: the camera (None when not randomised), one placement per cast member, and the
+    framing that moved the camera to an aid user (None: the rig's view; :mod:`synthua_usd.randomisation.framing`)."""
 
     camera: CameraJitter | None
     placements: tuple[Placement, ...]
+    framing: object = None
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        out = {"camera": None if self.camera is None else asdict(self.camera),
+               "placements": [asdict(p) for p in self.placements]}
+        if self.framing is not None:  # absent, not null, where the part is off: records as before it existed
+            out["framing"] = self.framing.to_dict()
+        return out
 
 
 def _rotation(axis: np.ndarray, degrees: float) -> np.ndarray:
