@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
@@ -187,3 +187,18 @@ def display_order(names) -> list[str]:
     snow), then any others sorted: the order of listings and contact sheets."""
     rank = {c.name: k for k, c in enumerate(SHIPPED)}
     return sorted(names, key=lambda n: (rank.get(n, len(rank)), n))
+
+
+def indoors(condition: Condition) -> Condition:
+    """``condition`` as it is inside a closed room (the procedural indoor settings, :mod:`synthua_usd.demo.settings`),
+    under the same name: no outdoor weather (fog, rain, wet ground, snow), no window lit from inside (a window seen
+    from the room shows what is beyond it, not a lamp), and no sky: the room's doors are shut and its windows glazed
+    (opaque panes), so neither the sun nor the sky lights anything inside, and they are put out (the sun below the
+    horizon, a black night sky) so that a renderer spends its light samples on the room's own lights, which are on
+    under every condition (:mod:`synthua_usd.model.lamps`, role ``ceiling``). Measured before they were put out:
+    with the sun up, a renderer sampling the sun and sky by their outdoor illuminance left 78 % of a room's pixels
+    black at 4 spp."""
+    return replace(condition, description=f"{condition.description} (indoors: lit by the room's lights; no sky, fog, "
+                                          f"rain, wet ground or snow)",
+                   sun_elevation_deg=-90.0, night_sky_luminance_cd_m2=0.0, fog_visibility_m=math.inf, fog_top_m=0.0,
+                   rain_rate_mm_per_h=0.0, ground_wetness=0.0, snow_cover=0.0, lit_window_fraction=0.0)

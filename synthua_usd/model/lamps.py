@@ -9,8 +9,10 @@ labels, never change.
 
 Photometry (sources, rounded): a residential LED street luminaire gives 3 000–8 000 lm (5 000 lm here);
 a halogen low-beam headlamp puts out about 1 000 lm; a tail lamp 4–17 cd (UN ECE R7), about 30 lm into its
-hemisphere; a window lit from inside is seen at 10–50 cd/m² at night (20 cd/m² here). Colours: 3 000 K
-street LEDs, 2 700 K interiors, 4 000 K headlamps, red tail lamps.
+hemisphere; a window lit from inside is seen at 10–50 cd/m² at night (20 cd/m² here); a 60 x 60 cm LED ceiling
+panel of offices, shops and clinics gives 3 000–4 000 lm (3 000 lm here: one a 6–8 m² of floor gives the
+300–500 lx that EN 12464-1 asks of such rooms). Colours: 3 000 K street LEDs, 2 700 K interiors, 4 000 K
+headlamps and ceiling panels, red tail lamps.
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ class LampKind:
     ``flux_lm`` is the luminous flux of one lamp *instance* (the labelled object), spread evenly over the
     area of its meshes of this role, which then glow at L = Φ / (π A) cd/m² (a Lambertian emitter); when
     it is 0, every mesh of the role glows at ``luminance_cd_m2``. ``color`` is linear Rec.709 with unit
-    luminance. ``switch`` names the :class:`~synthua_usd.model.conditions.Condition` field that turns it on.
+    luminance. ``switch`` names the :class:`~synthua_usd.model.conditions.Condition` field that turns it on;
+    empty, the lamp is always on (a room's ceiling lights, whatever the weather outside).
     """
 
     role: str
@@ -50,6 +53,7 @@ KINDS: dict[str, LampKind] = {k.role: k for k in (
     LampKind("window", CCT_2700K, "lit_window_fraction", luminance_cd_m2=20.0),
     LampKind("headlamp", CCT_4000K, "vehicle_lamps_on", flux_lm=2000.0),  # two lamps of ~1 000 lm
     LampKind("taillamp", REC709_RED, "vehicle_lamps_on", flux_lm=60.0),  # two lamps of ~30 lm
+    LampKind("ceiling", CCT_4000K, "", flux_lm=3000.0),  # a room's lights: on under every condition
 )}
 
 #: The lamp role of meshes of a class that carry no ``synthua:lamp`` of their own.
@@ -69,6 +73,8 @@ def window_is_lit(instance_path: str, fraction: float) -> bool:
 
 def is_on(kind: LampKind, condition, instance_path: str) -> bool:
     """Whether lamps of ``kind`` on the instance ``instance_path`` shine under ``condition``."""
+    if not kind.switch:
+        return True
     value = getattr(condition, kind.switch)
     if isinstance(value, bool):
         return value
