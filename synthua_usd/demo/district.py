@@ -22,11 +22,12 @@ from synthua_usd.assets import buildings, devices, market, nature, place, street
 from synthua_usd.composition.rigs import AimedRigs, RigSpec
 from synthua_usd.composition.scenario import ScenarioSpec, StageMetadata
 from synthua_usd.demo.district_textures import add_textures
+from synthua_usd.demo.twin_builder import TwinBuilder
 from synthua_usd.model import meshes as geo
 from synthua_usd.model.cameras import CameraSpec
 from synthua_usd.model.materials import WALL_COLOURS, subset
 from synthua_usd.model.taxonomy import ClassMap
-from synthua_usd.model.twin import TwinModel, TwinObject, TwinPart
+from synthua_usd.model.twin import TwinModel, TwinPart
 
 ROAD_Y = (-45.0, -37.0)
 ROAD_SIDEWALK_S = (-49.5, -45.0)
@@ -85,28 +86,7 @@ def _ramp_along_x(x_low, x_high, y0, y1, z_low, z_high, z_base) -> geo.Mesh:
     return pts[:, [1, 0, 2]], tris[:, ::-1]
 
 
-class _Builder:
-    """Collects objects in order; names are made unique per folder."""
-
-    def __init__(self) -> None:
-        self.objects: list[TwinObject] = []
-        self._counts: dict[str, int] = {}
-
-    def add(self, folder: str, stem: str, label: str, pieces: list[TwinPart], **attributes) -> str:
-        n = self._counts.get(f"{folder}/{stem}", 0)
-        self._counts[f"{folder}/{stem}"] = n + 1
-        path = f"{folder}/{stem}_{n:03d}"
-        parts, seen = [], set()
-        for i, p in enumerate(pieces):
-            name = f"{p.name}_{i}" if p.name in seen else p.name  # repeated part names get their index
-            seen.add(p.name)
-            parts.append(p if name == p.name else TwinPart(name, p.points, p.triangles, p.material, uvs=p.uvs))
-        parts = tuple(parts)
-        self.objects.append(TwinObject(path, label, parts, attributes))
-        return path
-
-
-def _sidewalk_x_strip(x0, x1, y_kerb, y_back, gaps: list[float], z_of=None) -> list[TwinPart]:
+def sidewalk_x_strip(x0, x1, y_kerb, y_back, gaps: list[float], z_of=None) -> list[TwinPart]:
     """A sidewalk along x whose kerb faces the road at ``y_kerb``; curb-ramp gaps centred at ``gaps``.
     Returns slab and kerb pieces (the kerb is 20 cm of granite along the road edge)."""
     sgn = 1.0 if y_back > y_kerb else -1.0
@@ -133,7 +113,7 @@ def build_district(seed: int = 0, textures: bool = True) -> TwinModel:
     """The district for ``seed`` as a :class:`TwinModel` (local metres, origin at the layout's centre), with
     its procedural textures (:mod:`synthua_usd.demo.district_textures`) unless ``textures`` is False."""
     rng = np.random.default_rng(seed)
-    b = _Builder()
+    b = TwinBuilder()
     _streets(b)
     _buildings(b, rng)
     _furniture(b, rng)
@@ -146,7 +126,7 @@ def build_district(seed: int = 0, textures: bool = True) -> TwinModel:
     return add_textures(model, seed) if textures else model
 
 
-def _streets(b: _Builder) -> None:
+def _streets(b: TwinBuilder) -> None:
     L = HALF_X
     # Open ground under everything, 2 cm below the road so that no two surfaces are coplanar: for the same
     # reason it reaches 1 m past the road's ends and further down than any bed or slab (their end and
@@ -154,11 +134,11 @@ def _streets(b: _Builder) -> None:
     b.add("Nature", "Ground", "grass", [TwinPart.of("Surface", geo.box((-L - 1.0, -50.0, -1.0), (L + 1.0, 50.0, -0.02)), "Grass")])
     b.add("Streets", "AsphaltRoad", "road", [TwinPart.of("Surface", geo.box((-L, ROAD_Y[0], -0.3), (L, ROAD_Y[1], 0.0)), "Asphalt")])
     # Road sidewalks, with curb ramps at the crosswalks; the north one stops at the cobbled street.
-    b.add("Sidewalks", "RoadSouth", "sidewalk", _sidewalk_x_strip(-L, L, ROAD_Y[0], ROAD_SIDEWALK_S[0], list(CROSSWALK_XS)))
+    b.add("Sidewalks", "RoadSouth", "sidewalk", sidewalk_x_strip(-L, L, ROAD_Y[0], ROAD_SIDEWALK_S[0], list(CROSSWALK_XS)))
     for side, (x0, x1) in (("RoadNorthWest", (-L, STREET_X[0] - STREET_SIDEWALK_W)),
                            ("RoadNorthEast", (STREET_X[1] + STREET_SIDEWALK_W, L))):
         gaps = [g for g in CROSSWALK_XS if x0 < g < x1]
-        b.add("Sidewalks", side, "sidewalk", _sidewalk_x_strip(x0, x1, ROAD_Y[1], ROAD_SIDEWALK_N[1], gaps))
+        b.add("Sidewalks", side, "sidewalk", sidewalk_x_strip(x0, x1, ROAD_Y[1], ROAD_SIDEWALK_N[1], gaps))
     for x in CROSSWALK_XS:
         for y_kerb, sgn in ((ROAD_Y[0], -1.0), (ROAD_Y[1], 1.0)):
             ya, yb = sorted((y_kerb, y_kerb + sgn * RAMP_LEN))
@@ -226,7 +206,7 @@ def _streets(b: _Builder) -> None:
         b.add("Covers", "Manhole", "cover", cover)
 
 
-def _buildings(b: _Builder, rng: np.random.Generator) -> None:
+def _buildings(b: TwinBuilder, rng: np.random.Generator) -> None:
     def house(folder, at, heading, width, depth, storeys, mural, foundation, ground_z=None):
         """``ground_z(y)``: height of a sloping sidewalk in front of the house; its doors stand on it."""
         wall = f"Wall{int(rng.integers(len(WALL_COLOURS)))}"
@@ -238,11 +218,11 @@ def _buildings(b: _Builder, rng: np.random.Generator) -> None:
                 pts = np.concatenate([p.points for p in door])
                 lift = max(ground_z(y) for y in pts[:, 1]) - pts[:, 2].min()
                 door = [p.moved(p.points + (0.0, 0.0, lift)) for p in door]
-            b.objects.append(_sub(stem, "Door", k, "door", door))
+            b.sub(stem, "Door", k, "door", door)
         for k, window in enumerate(parts.windows):
-            b.objects.append(_sub(stem, "Window", k, "window", place(window, at, heading)))
+            b.sub(stem, "Window", k, "window", place(window, at, heading))
         for k, mural_p in enumerate(parts.murals):
-            b.objects.append(_sub(stem, "Mural", k, "mural", place(mural_p, at, heading)))
+            b.sub(stem, "Mural", k, "mural", place(mural_p, at, heading))
 
     depth = 11.0
     # Along the cobbled street, stepping up with the slope; fronts on the sidewalks' back edge.
@@ -282,19 +262,12 @@ def _buildings(b: _Builder, rng: np.random.Generator) -> None:
     at, heading = (0.0, PLAZA_Y[1] + 7.0, PLAZA_Z + PAVER_H), -90.0
     stem = b.add("Buildings", "Church", "building", place(parts.structure, at, heading), name="Igreja da Ordem")
     for k, door in enumerate(parts.doors):
-        b.objects.append(_sub(stem, "Door", k, "door", place(door, at, heading)))
+        b.sub(stem, "Door", k, "door", place(door, at, heading))
     for k, window in enumerate(parts.windows):
-        b.objects.append(_sub(stem, "Window", k, "window", place(window, at, heading)))
+        b.sub(stem, "Window", k, "window", place(window, at, heading))
 
 
-def _sub(stem: str, kind: str, k: int, label: str, pieces: list[TwinPart]) -> TwinObject:
-    """A door, window or mural of a building: its own instance beside the building's structure."""
-    folder, name = stem.rsplit("/", 1)
-    return TwinObject(f"{folder}/{name}_{kind}_{k:02d}", label,
-                      tuple(pieces))
-
-
-def _furniture(b: _Builder, rng: np.random.Generator) -> None:
+def _furniture(b: TwinBuilder, rng: np.random.Generator) -> None:
     pz = PLAZA_Z + PAVER_H
     # Lanterns along the cobbled street's sidewalks and round the largo; arm lights along the road.
     for x, heading in ((STREET_X[0] - 0.6, 0.0), (STREET_X[1] + 0.6, 180.0)):
@@ -326,7 +299,7 @@ def _furniture(b: _Builder, rng: np.random.Generator) -> None:
     b.add("Furniture", "BikeRack", "furniture", place(street.bike_rack(), (36.0, PLAZA_Y[0] + 6.0, pz)))
 
 
-def _market(b: _Builder, rng: np.random.Generator) -> None:
+def _market(b: TwinBuilder, rng: np.random.Generator) -> None:
     pz = PLAZA_Z + PAVER_H
     canvases = ["CanvasWhite", "CanvasRed", "CanvasBlue", "CanvasYellow"]
     for y, heading in ((13.0, 90.0), (24.0, -90.0)):
@@ -347,7 +320,7 @@ def _market(b: _Builder, rng: np.random.Generator) -> None:
             b.add("Market", "Umbrella", "umbrella", place(market.umbrella(canvas=canvases[k % 4], foot_m=market.TABLE_TOP_M), (x, y, pz)))
 
 
-def _vehicles(b: _Builder, rng: np.random.Generator) -> None:
+def _vehicles(b: TwinBuilder, rng: np.random.Generator) -> None:
     lane = ROAD_Y[0] + 1.3
     for x_from, x_to in ((-70.0, -36.0), (-24.0, 24.0), (36.0, 55.0)):
         x = x_from
@@ -365,7 +338,7 @@ def _vehicles(b: _Builder, rng: np.random.Generator) -> None:
         b.add("Vehicles", "Bicycle", "bicycle", place(vehicles.bicycle(), (36.0 + 0.3, PLAZA_Y[0] + 4.9 + 0.75 * k, PLAZA_Z + PAVER_H), 0.0))
 
 
-def _nature(b: _Builder, rng: np.random.Generator) -> None:
+def _nature(b: TwinBuilder, rng: np.random.Generator) -> None:
     pz = PLAZA_Z + PAVER_H
     for x, y in [(-38.0, 9.0), (-38.0, 30.0), (38.0, 30.0), (-14.0, 30.0), (14.0, 30.0)]:
         b.add("Nature", "GrassBed", "grass", place(nature.grass_bed(4.0, 4.0), (x, y, pz)))
@@ -388,7 +361,7 @@ def _nature(b: _Builder, rng: np.random.Generator) -> None:
             b.add("Animals", "Pigeon", "animal", place(nature.pigeon(), (x, y, pz), float(rng.uniform(0, 360))))
 
 
-def _mobility_aids(b: _Builder) -> None:
+def _mobility_aids(b: TwinBuilder) -> None:
     """Devices standing unattended so that every class appears in the twin; the agents layer brings
     devices in use, with their users."""
     pz = PLAZA_Z + PAVER_H
