@@ -50,7 +50,9 @@ def visibility(uv: np.ndarray, z: np.ndarray, instance_id: int, instance_ids: np
         inside = (np.isfinite(uv).all(axis=1) & (z >= near_m) & (uv[:, 0] >= 0) & (uv[:, 0] < width)
                   & (uv[:, 1] >= 0) & (uv[:, 1] < height))
     for k in np.flatnonzero(inside):
-        col, row = int(uv[k, 0]), int(uv[k, 1])
+        # the pixel of the coordinates as written (rounded to 0.01 px, :func:`coco_keypoints`): 72.996 is written
+        # 73.0, and a reader checks the window round pixel 73, not 72
+        col, row = int(round(float(uv[k, 0]), 2)), int(round(float(uv[k, 1]), 2))
         rows = slice(max(0, row - WINDOW_PX), row + WINDOW_PX + 1)
         cols = slice(max(0, col - WINDOW_PX), col + WINDOW_PX + 1)
         hit = (instance_ids[rows, cols] == instance_id) & (z_depth[rows, cols] >= z[k] - DEPTH_TOLERANCE_M)
