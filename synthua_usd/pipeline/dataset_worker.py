@@ -58,7 +58,8 @@ class WorkerJob:
     layer_stack: str = ""
     #: Class id -> YOLO class index (:func:`synthua_usd.dataset.formats.yolo.class_index`).
     yolo_classes: dict = field(default_factory=dict)
-    #: With randomised districts: district seed -> the scenario of that district in the dataset.
+    #: With randomised districts or settings: scene key -> its scenario in the dataset
+    #: (:mod:`synthua_usd.pipeline.scenes`).
     scenes: dict = field(default_factory=dict)
 
 
@@ -72,8 +73,8 @@ class WorkerState:
     conditions: dict = field(default_factory=dict)
     #: Gives each image its randomisation layers (None when the config randomises nothing).
     randomiser: object = None
-    #: The district seed whose scenario ``stage`` is (None: the job's scenario).
-    district: int | None = None
+    #: The scene key whose scenario ``stage`` is (None: the job's scenario).
+    scene: object = None
     #: Writes the previous image (its files, then its record) while the next one renders.
     writer: BackgroundWriter = field(default_factory=BackgroundWriter)
     seconds: dict = field(default_factory=lambda: {"render": 0.0, "annotate": 0.0, "write": 0.0})
@@ -100,17 +101,17 @@ def init_worker(job: WorkerJob) -> WorkerState:
     return state
 
 
-def _open(state: WorkerState, scenario: str, district: int | None) -> None:
-    """Make ``scenario`` (the job's, or a district's of the dataset) the stage the worker renders."""
+def _open(state: WorkerState, scenario: str, scene) -> None:
+    """Make ``scenario`` (the job's, or a scene's of the dataset) the stage the worker renders."""
     from synthua_usd.usd.reader import StageReader
     from synthua_usd.usd.stage_io import open_stage
 
     job = state.job
     if state.randomiser is not None:
         state.randomiser.close()
-    # a district's scenario is the dataset's own copy, checked when it was written
-    stage = open_stage(scenario, job.allow_external_assets or district is not None)
-    state.stage, state.reader, state.district, state.conditions = stage, StageReader(stage, state.class_map), district, {}
+    # a scene's scenario is the dataset's own, checked when it was written
+    stage = open_stage(scenario, job.allow_external_assets or scene is not None)
+    state.stage, state.reader, state.scene, state.conditions = stage, StageReader(stage, state.class_map), scene, {}
     state.randomiser = None
     if job.config.randomise is not None:
         from synthua_usd.pipeline.randomiser import Randomiser
@@ -177,12 +178,12 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
     t0 = time.perf_counter()
     randomised = None
     if state.randomiser is not None:
-        from synthua_usd.pipeline.districts import district_of
+        from synthua_usd.pipeline.scenes import scene_of
 
-        district = district_of(job.config.randomise, seed)
-        if district != state.district:
-            _open(state, job.scenes[district] if district is not None else job.scenario, district)
-        randomised = state.randomiser.apply(seed, camera_path, time_code, condition_name, district)
+        scene = scene_of(job.config.randomise, seed)
+        if scene != state.scene:
+            _open(state, job.scenes[scene] if scene is not None else job.scenario, scene)
+        randomised = state.randomiser.apply(seed, camera_path, time_code, condition_name, scene)
     t_randomise = time.perf_counter() - t0
     snapshot = state.reader.snapshot(time_code)
     camera = read_camera(state.stage, camera_path, time_code)

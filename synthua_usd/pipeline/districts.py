@@ -1,7 +1,8 @@
 """Randomised scenes over several procedural districts: the scenario of each district seed a dataset draws.
 
 A dataset whose config sets ``randomise.district`` renders each seed's scene in the Largo da Ordem district
-of one of its district seeds (:func:`district_of`, drawn from the seed's ``district`` stream). Each district is
+of one of its district seeds (:func:`district_of`, drawn from the seed's ``district`` stream; which scenario a
+scene is in is :func:`synthua_usd.pipeline.scenes.scene_of`'s to say). Each district is
 written once into the dataset as a complete, self-contained scenario, ``scenes/district_<d>/``: the district's
 twin and semantics layers with their textures (``synthua create district --seed d`` would write the same bytes),
 copies of the scenario's own thin layers (render settings, environment, cameras, rigs), and a
@@ -24,8 +25,6 @@ from synthua_usd.usd.stage_io import open_layer
 
 #: What the demo district's twin layer says it is (``customLayerData`` ``synthua:source``).
 DISTRICT_SOURCE = "largo-da-ordem demo district"
-#: Where a dataset keeps its districts, relative to the dataset folder.
-SCENES_FOLDER = "scenes"
 
 
 def district_of(config: RandomisationConfig, seed: int) -> int | None:
@@ -34,11 +33,6 @@ def district_of(config: RandomisationConfig, seed: int) -> int | None:
         return None
     seeds = config.district.seeds
     return int(seeds[int(stream(config.seed, seed, "district").integers(len(seeds)))])
-
-
-def scene_folder(seed: int) -> str:
-    """``scenes/district_<seed>`` (relative to the dataset folder)."""
-    return f"{SCENES_FOLDER}/district_{seed}"
 
 
 def check_district_scenario(scenario: Path) -> list[str]:
@@ -104,13 +98,3 @@ def _copy_thin_layer(source: Path, target: Path) -> None:
         raise InputError(f"{source}: sublayers or references other files; expected the thin layers of a scenario "
                          f"written by synthua create district")
     shutil.copyfile(source, target)
-
-
-def clear_partial_scenes(dataset: Path) -> None:
-    """Remove the staging folders a killed run left in ``scenes/`` (their districts are written again)."""
-    folder = Path(dataset) / SCENES_FOLDER
-    if folder.is_dir():
-        for path in folder.iterdir():
-            if path.name.startswith(".") and path.is_dir():
-                shutil.rmtree(path, ignore_errors=True)
-

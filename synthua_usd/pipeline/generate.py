@@ -30,7 +30,6 @@ from typing import Callable
 
 
 from synthua_usd import __version__
-from synthua_usd.composition.scenario import ROOT_FILE
 from synthua_usd.core.atomic import write_json_atomic, write_text_atomic
 from synthua_usd.core.errors import InputError, OutputError, StageError
 from synthua_usd.core.input_guard import check_not_inputs
@@ -138,23 +137,16 @@ def _stage_facts(request: GenerateRequest, config: GenerationConfig, class_map: 
 
 
 def write_scenes(request: GenerateRequest, config: GenerationConfig, pool, class_map: ClassMap,
-                 out: Path) -> dict[int, Path]:
-    """With randomised districts: every district the pool's seeds draw, written into the dataset's ``scenes/``
-    (kept from an earlier run of the job); district seed -> its scenario. Empty otherwise."""
-    from synthua_usd.pipeline.districts import (check_district_scenario, clear_partial_scenes, district_of,
-                                                scene_folder, write_district_scene)
+                 out: Path) -> dict:
+    """With randomised districts or settings: every scenario the pool's seeds draw, written into the dataset's
+    ``scenes/`` (kept from an earlier run of the job); scene key -> its scenario
+    (:mod:`synthua_usd.pipeline.scenes`). Empty otherwise."""
+    from synthua_usd.pipeline.scenes import write_dataset_scenes
 
-    randomise = config.randomise
-    if randomise is None or not randomise.district.enabled:
-        return {}
     try:
-        check_district_scenario(request.scenario)
+        return write_dataset_scenes(request.scenario, config.randomise, sorted({c.seed for c in pool}), class_map, out)
     except InputError as exc:
         raise InputError(f"{request.config_path}: {exc}") from None
-    clear_partial_scenes(out)
-    districts = sorted({district_of(randomise, c.seed) for c in pool})
-    return {d: write_district_scene(request.scenario, d, out / scene_folder(d), class_map, dataset_part=True)
-            for d in districts}
 
 
 def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateSummary:
@@ -336,12 +328,9 @@ def worker_job_from_document(document: dict, out_dir: Path, scenario: Path | Non
     render = RenderConfig.from_dict(document["render"])
     cameras = [tuple(c) for c in document["cameras"]]
     size = config.output_size(render.width, render.height)
-    from synthua_usd.pipeline.districts import scene_folder
+    from synthua_usd.pipeline.scenes import scene_paths
 
-    scenes = {}
-    if config.randomise is not None and config.randomise.district.enabled:
-        scenes = {d: str((Path(dataset or out_dir) / scene_folder(d) / ROOT_FILE).resolve())
-                  for d in config.randomise.district.seeds}
+    scenes = scene_paths(config.randomise, config.seeds, Path(dataset or out_dir))
     return WorkerJob(scenario=str(Path(scenario).resolve()) if scenario is not None else document["scenario"],
                      out_dir=str(Path(out_dir).resolve()), render=render, config=config,
                      class_map_document=key["class_map"],
@@ -365,11 +354,11 @@ def _render_all(todo, done: dict, job: WorkerJob, request: GenerateRequest, work
     # first (wetness and a sun below the horizon mean a reload), then camera and time code; with randomisation
     # the district and the seed come first (each seed is a scene of its own, loaded once)
     if job.config.randomise is not None:
-        from synthua_usd.pipeline.districts import district_of
+        from synthua_usd.pipeline.scenes import scene_of, scene_order
 
         def order(p):
-            district = district_of(job.config.randomise, p.seed)
-            return (-1 if district is None else district, p.seed, p.condition or "", p.camera_path, p.time_code, p.id)
+            return (scene_order(scene_of(job.config.randomise, p.seed)), p.seed, p.condition or "", p.camera_path,
+                    p.time_code, p.id)
 
         def scene(p):  # each seed is a scene of its own
             return order(p)[:2]
@@ -416,7 +405,7 @@ def _read_job(out: Path) -> dict | None:
     if not path.exists():
         if out.exists() and not out.is_dir():
             raise OutputError(f"{out}: is a file; expected a dataset folder or a path that does not exist")
-        from synthua_usd.pipeline.districts import SCENES_FOLDER
+        from synthua_usd.pipeline.scenes import SCENES_FOLDER
 
         # a run killed before its plan was written may have left the districts it writes first
         if out.is_dir() and any(not p.name.startswith(".") and p.name != SCENES_FOLDER for p in out.iterdir()):
@@ -497,7 +486,7 @@ def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, co
                + [file_entry(root, Layout.record(r["name"]))]} for r in records]
     dataset_files = [file_entry(root, p.relative_to(root).as_posix()) for p in written]
     dataset_files.append(file_entry(root, Layout.CONFIG))
-    from synthua_usd.pipeline.districts import SCENES_FOLDER
+    from synthua_usd.pipeline.scenes import SCENES_FOLDER
 
     dataset_files += [file_entry(root, p.relative_to(root).as_posix()) for p in sorted((root / SCENES_FOLDER).rglob("*"))
                       if p.is_file()] if (root / SCENES_FOLDER).is_dir() else []

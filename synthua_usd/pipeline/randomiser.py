@@ -12,7 +12,8 @@ is read and loaded afresh.
 
 What a draw needs of the scenario itself (the twin's walkable surfaces and materials, the cameras, the
 conditions) is read from a second composition of the same root layer with an empty session layer, so it never
-sees an earlier image's randomisation.
+sees an earlier image's randomisation. The scenario a scene is in (the dataset's, a district's, a setting's: :mod:`synthua_usd.pipeline.scenes`) is the
+caller's to open; the randomiser records it.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from synthua_usd.assets.postures import shared_body_parts
 from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.core.errors import StageError
 from synthua_usd.model.taxonomy import ClassMap
-from synthua_usd.pipeline.districts import district_of
+from synthua_usd.pipeline.scenes import SceneKey, scene_of
 from synthua_usd.randomisation.config import RandomisationConfig
 from synthua_usd.randomisation.framing import draw_framing
 from synthua_usd.randomisation.light import LightDraw, draw_light
@@ -49,18 +50,24 @@ log = logging.getLogger(__name__)
 @dataclass(frozen=True)
 class ImageRandomisation:
     """What one image drew: the randomisation seed, its scene, its view, its light (None without a condition),
-    and the SHA-256 of its view layer as authored (the same draws author the same bytes)."""
+    and the SHA-256 of its view layer as authored (the same draws author the same bytes); with the ``settings``
+    part on, the scene's ``setting`` (None in the district; absent from the record with the part off)."""
 
     seed: int
     scene: SceneDraw
     view: ViewDraw
     light: LightDraw | None
     view_layer_digest: str
+    settings_on: bool = False
+    setting: object = None
 
     def to_dict(self) -> dict:
-        return {"seed": self.seed, "scene_seed": self.scene.scene_seed, "district_seed": self.scene.district_seed,
-                "view_layer_sha256": self.view_layer_digest, "scene": self.scene.to_dict(),
-                "view": self.view.to_dict(), "light": None if self.light is None else self.light.to_dict()}
+        out = {"seed": self.seed, "scene_seed": self.scene.scene_seed, "district_seed": self.scene.district_seed,
+               "view_layer_sha256": self.view_layer_digest, "scene": self.scene.to_dict(),
+               "view": self.view.to_dict(), "light": None if self.light is None else self.light.to_dict()}
+        if self.settings_on:  # absent, not null, where the part is off: records as before it existed
+            out["setting"] = None if self.setting is None else self.setting.to_dict()
+        return out
 
 
 def _metadata(stage: Usd.Stage) -> StageMetadata:
@@ -135,14 +142,15 @@ class Randomiser:
         if self.view_layer.identifier in session.subLayerPaths:
             session.subLayerPaths.remove(self.view_layer.identifier)
 
-    def scene(self, seed: int, district_seed: int | None = None) -> SceneDraw:
-        """Make the scene of ``seed`` the stage's (drawn and authored once per seed in a row)."""
+    def scene(self, seed: int, key: SceneKey | None = None) -> SceneDraw:
+        """Make the scene of ``seed`` the stage's (drawn and authored once per seed in a row); ``key`` the scenario
+        the stage is (:func:`synthua_usd.pipeline.scenes.scene_of`; None: the dataset's own), recorded."""
         if self._scene is not None and self._scene.scene_seed == seed:
             return self._scene
         rng = stream(self.config.seed, seed, "scene")
         draw = draw_scene(rng, self.config, seed, walkable_area_m2=self.area.area_m2() if self.area else 0.0,
                           seats=list(self.area.seats) if self.area else [], objects=self.objects,
-                          district_seed=district_seed)
+                          district_seed=None if key is None else key.district_seed)
         prototypes, scene, cast = scene_layers(draw, self.meta, self.class_map.taxonomy, self.bodies, self.materials,
                                                self.bound, deactivate_agents=self.has_agents and self.config.crowd.enabled)
         with Sdf.ChangeBlock():  # both at once: the stage never composes the old instances over new prototypes
@@ -163,11 +171,11 @@ class Randomiser:
         return draw
 
     def apply(self, seed: int, camera_path: str, time_code: float, condition: str | None,
-              district_seed: int | None = None) -> ImageRandomisation:
+              key: SceneKey | None = None) -> ImageRandomisation:
         """Give the stage the randomisation of the image (``seed``, ``camera_path``, ``time_code``, ``condition``
-        name or None for the stage's own lights; ``district_seed`` the district the stage is, recorded) and
-        return what it drew."""
-        scene = self.scene(seed, district_seed)
+        name or None for the stage's own lights; ``key`` the scenario the stage is, recorded) and return what it
+        drew."""
+        scene = self.scene(seed, key)
         cast = self._cast
         base_camera = read_camera(self.base, camera_path, time_code)
         rng = stream(self.config.seed, seed, "view", camera_path, time_code)
@@ -205,7 +213,8 @@ class Randomiser:
         digest = hashlib.sha256(fresh.ExportToString().encode("utf-8")).hexdigest()
         fresh.subLayerPaths.append(self.scene_layer.identifier)
         self.view_layer.TransferContent(fresh)
-        return ImageRandomisation(self.config.seed, scene, ViewDraw(jitter, placements, framing), light, digest)
+        return ImageRandomisation(self.config.seed, scene, ViewDraw(jitter, placements, framing), light, digest,
+                                  self.config.settings.enabled, None if key is None else key.setting)
 
     def export(self, out: Path, anchor: Path | None = None) -> tuple[Path, Path, Path]:
         """Write the current image's layers: ``out`` (the view layer), ``<stem>.scene.usda`` and
@@ -222,8 +231,9 @@ class RandomiseRequest:
     ``time_code`` and ``condition`` (None: the stage's own lights), at the config's render size (else the
     stage's); or, with ``record_path``, of that record of a dataset (its generate.json gives the config; a record
     fixes the seed, camera, time code and condition, so none of those, nor ``config_path``, may come with it). When
-    the seed's scene is another district, the layers go over that district's scenario: the dataset's copy, or
-    one written beside ``out`` (``<stem>.district_<d>/``); the render command printed names it."""
+    the seed's scene is in another scenario (a district, a setting: :mod:`synthua_usd.pipeline.scenes`), the layers
+    go over that scenario: the dataset's copy, or one written beside ``out`` (``<stem>.district_<d>/``,
+    ``<stem>.<kind>_<variant>/``); the render command printed names it."""
 
     scenario: Path
     out: Path
@@ -317,19 +327,21 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
         raise InputError(f"{source}: has no randomise block; expected a config that randomises scenes (see "
                          f"schemas/generate.schema.json, randomise)")
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
-    scenario, district = Path(request.scenario), district_of(config.randomise, seed)
-    if district is not None:
-        # the seed's scene lies in another district: the dataset's copy of it, or one written beside --out
-        from synthua_usd.pipeline.districts import check_district_scenario, scene_folder, write_district_scene
+    scenario, key = Path(request.scenario), scene_of(config.randomise, seed)
+    if key is not None:
+        # the seed's scene lies in another scenario: the dataset's copy of it, or one written beside --out
+        from synthua_usd.pipeline.scenes import write_scene
 
-        check_district_scenario(scenario)
+        if config.randomise.district.enabled:
+            from synthua_usd.pipeline.districts import check_district_scenario
+
+            check_district_scenario(scenario)
         dataset = Path(request.record_path).resolve().parent.parent if request.record_path is not None else None
-        if dataset is not None and (dataset / scene_folder(district) / "scenario.usda").is_file():
-            scenario = dataset / scene_folder(district) / "scenario.usda"
+        if dataset is not None and (dataset / key.folder / "scenario.usda").is_file():
+            scenario = dataset / key.folder / "scenario.usda"
         else:
-            scenario = write_district_scene(scenario, district, out.parent / f"{out.stem}.district_{district}",
-                                            class_map)
-    stage = open_stage(scenario, request.allow_external_assets or district is not None)
+            scenario = write_scene(scenario, key, out.parent / f"{out.stem}.{key.name}", class_map)
+    stage = open_stage(scenario, request.allow_external_assets or key is not None)
     defaults = render_defaults(stage)
     if camera is None:
         camera = defaults.camera_path
@@ -345,7 +357,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
                               | ({"denoise": render["denoise"] is not None} if "denoise" in render else {}))
     width, height = settings.width, settings.height
     randomiser = Randomiser(stage, config.randomise, class_map, (width, height))
-    drawn = randomiser.apply(seed, camera, time_code, condition, district)
+    drawn = randomiser.apply(seed, camera, time_code, condition, key)
     with output_set(out.parent, inputs=inputs) as staging:
         randomiser.export(staging / out.name, anchor=out.parent)
         files = tuple(out.parent / p.name for p in sorted(staging.iterdir()))

@@ -21,7 +21,7 @@ from synthua_usd.dataset.annotations import relation_entries
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.taxonomy import ClassMap
 
-#: (district seed or None, seed or None, time code, camera path): one view of the pool.
+#: (scene key or None, seed or None, time code, camera path): one view of the pool.
 View = tuple
 #: Views a worker scores before it takes the next shard (a seed's views stay together where they fit).
 SHARD_VIEWS = 16
@@ -30,7 +30,7 @@ SHARD_VIEWS = 16
 @dataclass(frozen=True)
 class ScoreJob:
     """What a scorer needs, as plain picklable data (sent to worker processes and Ray actors). ``scenes``: with
-    randomised districts, district seed -> the district's scenario in the dataset."""
+    randomised districts or settings, scene key -> its scenario in the dataset (:mod:`synthua_usd.pipeline.scenes`)."""
 
     scenario: str
     render: RenderConfig
@@ -68,7 +68,7 @@ class ViewScorer:
             if self._stage is None:
                 self._stage = open_stage(self.job.scenario, self.job.allow_external_assets)
             stage = self._stage
-        else:  # the dataset's own copy of the district, checked when it was written
+        else:  # the dataset's own scenario of the scene, checked when it was written
             stage = open_stage(self.job.scenes[district], allow_external_assets=True)
         self.reader = StageReader(stage, self.class_map)
         self.randomiser = None
@@ -108,13 +108,13 @@ class ViewScorer:
 
 def pool_views(pool, randomise, scenes: dict) -> list[View]:
     """The distinct views of the candidate ``pool``, in scoring order: without randomisation one per (time code,
-    camera); with it one per (seed, camera, time code), grouped by district and seed."""
-    from synthua_usd.pipeline.districts import district_of
+    camera); with it one per (seed, camera, time code), grouped by scene and seed."""
+    from synthua_usd.pipeline.scenes import scene_of
 
     if randomise is None:
         return [(None, None, tc, path) for tc, path in sorted(dict.fromkeys((c.time_code, c.camera_path)
                                                                              for c in pool))]
-    return sorted(dict.fromkeys((district_of(randomise, c.seed) if scenes else None, c.seed, c.time_code,
+    return sorted(dict.fromkeys((scene_of(randomise, c.seed) if scenes else None, c.seed, c.time_code,
                                  c.camera_path) for c in pool), key=lambda v: (v[0] is not None, v))
 
 

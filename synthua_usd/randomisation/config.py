@@ -2,8 +2,9 @@
 (``schemas/generate.schema.json``, ``$defs.randomise``) as checked, frozen plain data.
 
 Every range is ``(low, high)`` with ``low <= high`` (equal ends fix the value). Each part has ``enabled``
-(default true; ``district`` and ``effects`` default false), so a part is switched off without deleting its ranges; a config without a ``randomise``
-block (or with ``null``) randomises nothing and renders the scenario as composed, as before. The meaning of
+(default true; ``district``, ``effects``, ``framing`` and ``settings`` default false; the last is defined in
+:mod:`synthua_usd.randomisation.settings`), so a part is switched off without deleting its ranges; a config without a ``randomise`` block (or with ``null``)
+randomises nothing and renders the scenario as composed, as before. The meaning of
 every field is documented once, in the schema's descriptions; the defaults are owned here and a test holds
 the schema's documentation to them.
 """
@@ -20,6 +21,7 @@ from synthua_usd.assets.hair import HAIR_STYLES
 from synthua_usd.assets.look_images import LOWER_FABRICS, SHOES, UPPER_FABRICS
 from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES
 from synthua_usd.model.ranges import SEED
+from synthua_usd.randomisation.settings import SettingsRandomisation
 
 #: The mobility-aid classes a randomised crowd can use (the device classes of the agent profiles).
 AID_CLASSES = ("manual_wheelchair", "electric_wheelchair", "walker", "crutch", "smart_cane", "wooden_cane",
@@ -39,8 +41,9 @@ MAX_DENSITY_PER_M2 = 0.3
 MIN_VIEW_HEIGHT_SHARE = 0.005
 
 
-def _range(name: str, value, lo: float | None = None, hi: float | None = None) -> Range:
-    """``value`` (two numbers, low <= high) as a tuple, within [lo, hi] when given."""
+def low_high(name: str, value, lo: float | None = None, hi: float | None = None) -> Range:
+    """``value`` (two numbers, low <= high) as a tuple, within [lo, hi] when given; an :class:`InputError` naming
+    ``name`` otherwise (every part's ranges are checked by it)."""
     try:
         a, b = (float(v) for v in value)
     except (TypeError, ValueError):
@@ -50,6 +53,20 @@ def _range(name: str, value, lo: float | None = None, hi: float | None = None) -
     if (lo is not None and a < lo) or (hi is not None and b > hi):
         raise InputError(f"{name}: [{a:g}, {b:g}]; expected a range within [{lo:g}, {hi:g}]")
     return a, b
+
+
+_range = low_high  # the name other modules of the package import it by
+
+
+def names_among(name: str, values, known) -> tuple[str, ...]:
+    """``values`` as a tuple of distinct names, each one of ``known``; an :class:`InputError` naming ``name``
+    (the field) lists what is expected otherwise."""
+    values = tuple(values)
+    unknown = [v for v in values if v not in known]
+    if unknown or not values or len(set(values)) != len(values):
+        raise InputError(f"{name}: {', '.join(map(echo, unknown or values)) or 'none'}; expected one or more distinct "
+                         f"of {', '.join(known)}")
+    return values
 
 
 @dataclass(frozen=True)
@@ -73,18 +90,18 @@ class CrowdRandomisation:
     clothing_jitter: float = 0.15
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "density_per_m2", _range("crowd.density_per_m2", self.density_per_m2, 0.0,
+        object.__setattr__(self, "density_per_m2", low_high("crowd.density_per_m2", self.density_per_m2, 0.0,
                                                                   MAX_DENSITY_PER_M2))
         if self.density_per_m2[0] <= 0:
             raise InputError(f"crowd.density_per_m2: [{self.density_per_m2[0]:g}, {self.density_per_m2[1]:g}]; "
                              f"expected a low end > 0 persons/m²")
         for name in ("aid_share", "seated_share", "group_share", "pushed_share", "accompanied_share"):
-            object.__setattr__(self, name, _range(f"crowd.{name}", getattr(self, name), 0.0, 1.0))
-        users = _range("crowd.aid_users_in_view", self.aid_users_in_view, 0, 50)
+            object.__setattr__(self, name, low_high(f"crowd.{name}", getattr(self, name), 0.0, 1.0))
+        users = low_high("crowd.aid_users_in_view", self.aid_users_in_view, 0, 50)
         if not all(float(v).is_integer() for v in users):
             raise InputError(f"crowd.aid_users_in_view: {list(users)}; expected two whole numbers")
         object.__setattr__(self, "aid_users_in_view", (int(users[0]), int(users[1])))
-        object.__setattr__(self, "view_height_share", _range("crowd.view_height_share", self.view_height_share, 0.0, 10.0))
+        object.__setattr__(self, "view_height_share", low_high("crowd.view_height_share", self.view_height_share, 0.0, 10.0))
         if self.view_height_share[0] < MIN_VIEW_HEIGHT_SHARE:
             # a share of 0 asks for aid users of no height in the image: placed out of view, silently
             raise InputError(f"crowd.view_height_share: [{self.view_height_share[0]:g}, {self.view_height_share[1]:g}]; "
@@ -204,9 +221,9 @@ class LightRandomisation:
                              f"(beyond the polar circles the sun may not rise or set)")
         if not (math.isfinite(self.sun_band_deg) and 0 <= self.sun_band_deg <= 90):
             raise InputError(f"light.sun_band_deg: {self.sun_band_deg!r}; expected degrees in [0, 90]")
-        object.__setattr__(self, "turbidity_offset", _range("light.turbidity_offset", self.turbidity_offset, -9.0, 9.0))
-        object.__setattr__(self, "exposure_ev", _range("light.exposure_ev", self.exposure_ev, -4.0, 4.0))
-        object.__setattr__(self, "night_sky_factor", _range("light.night_sky_factor", self.night_sky_factor, 0.01, 100.0))
+        object.__setattr__(self, "turbidity_offset", low_high("light.turbidity_offset", self.turbidity_offset, -9.0, 9.0))
+        object.__setattr__(self, "exposure_ev", low_high("light.exposure_ev", self.exposure_ev, -4.0, 4.0))
+        object.__setattr__(self, "night_sky_factor", low_high("light.night_sky_factor", self.night_sky_factor, 0.01, 100.0))
 
 
 @dataclass(frozen=True)
@@ -227,7 +244,7 @@ class CameraRandomisation:
             if not (math.isfinite(value) and 0 <= value <= hi):
                 raise InputError(f"camera.{name}: {value!r}; expected a number in [0, {hi:g}]")
         object.__setattr__(self, "focal_length_factor",
-                           _range("camera.focal_length_factor", self.focal_length_factor, 0.25, 4.0))
+                           low_high("camera.focal_length_factor", self.focal_length_factor, 0.25, 4.0))
 
 
 @dataclass(frozen=True)
@@ -290,7 +307,7 @@ class EffectsRandomisation:
                              ("motion_blur_length_width_share", 0.0, 0.1), ("vignetting_corner_loss", 0.0, 0.9),
                              ("exposure_ev", -4.0, 4.0), ("noise_shot_gain", 0.0, 0.1), ("noise_read_sigma", 0.0, 0.1),
                              ("white_balance_gain", 0.5, 2.0), ("jpeg_quality", 1.0, 100.0)):
-            object.__setattr__(self, name, _range(f"effects.{name}", getattr(self, name), lo, hi))
+            object.__setattr__(self, name, low_high(f"effects.{name}", getattr(self, name), lo, hi))
         if not all(float(q).is_integer() for q in self.jpeg_quality):
             raise InputError(f"effects.jpeg_quality: {[f'{q:g}' for q in self.jpeg_quality]}; expected two whole "
                              f"numbers in [1, 100]")
@@ -328,16 +345,16 @@ class FramingRandomisation:
                              f"{', '.join(sorted(RIG_TYPES))}")
         for name, lo, hi in (("distance_m", 0.5, 50.0), ("eye_height_m", 0.3, 3.0), ("seated_height_m", 0.3, 3.0),
                              ("height_share", 0.02, 1.0)):
-            object.__setattr__(self, name, _range(f"framing.{name}", getattr(self, name), lo, hi))
+            object.__setattr__(self, name, low_high(f"framing.{name}", getattr(self, name), lo, hi))
 
 
 _PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "hair": HairRandomisation,
           "looks": LooksRandomisation, "materials": MaterialRandomisation,
           "light": LightRandomisation, "camera": CameraRandomisation, "district": DistrictRandomisation,
-          "effects": EffectsRandomisation, "framing": FramingRandomisation}
+          "effects": EffectsRandomisation, "framing": FramingRandomisation, "settings": SettingsRandomisation}
 #: Parts that came after datasets were made: left out of a config's document while they are their default (off),
 #: so that a config that does not ask for them keeps its generate.json and job key.
-_LATER_PARTS = {"effects": EffectsRandomisation, "framing": FramingRandomisation}
+_LATER_PARTS = {"effects": EffectsRandomisation, "framing": FramingRandomisation, "settings": SettingsRandomisation}
 
 
 @dataclass(frozen=True)
@@ -356,6 +373,7 @@ class RandomisationConfig:
     district: DistrictRandomisation = field(default_factory=DistrictRandomisation)
     effects: EffectsRandomisation = field(default_factory=EffectsRandomisation)
     framing: FramingRandomisation = field(default_factory=FramingRandomisation)
+    settings: SettingsRandomisation = field(default_factory=SettingsRandomisation)
 
     def __post_init__(self) -> None:
         if self.devices.enabled and not self.crowd.enabled:
@@ -368,6 +386,9 @@ class RandomisationConfig:
         if self.district.enabled and not self.crowd.enabled:
             raise InputError("randomise.district: enabled while randomise.crowd is not; expected the crowd randomised "
                              "too (the scenario's own crowd walks the routes of its own district)")
+        if self.settings.enabled and not self.crowd.enabled:
+            raise InputError("randomise.settings: enabled while randomise.crowd is not; expected the crowd randomised "
+                             "too (a procedural setting has no crowd of its own)")
 
     @classmethod
     def from_document(cls, doc: dict | None, source: str = "randomise") -> "RandomisationConfig | None":

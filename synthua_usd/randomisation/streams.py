@@ -6,7 +6,9 @@ which worker renders the image, nor on what it rendered before) and one scope's 
 - ``scene``: (seed) the crowd's cast and looks, the devices, the twin's material variants;
 - ``view``: (seed, camera, time code) the camera's jitter, then where each person stands;
 - ``light``: (seed, camera, time code, condition) the sun, sky and exposure;
-- ``effects``: (seed, camera, time code, condition) the camera effects applied after rendering.
+- ``effects``: (seed, camera, time code, condition) the camera effects applied after rendering;
+- ``framing``: (seed, camera, time code) the photographer's view of an aid user;
+- ``setting``: (seed) whether the scene is in the district or a procedural setting, and which.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import zlib
 import numpy as np
 
 _SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "cutout_group": 6, "cutout_view": 7,
-           "framing": 8}
+           "framing": 8, "setting": 9}
 
 
 def _key(value) -> int:

@@ -34,15 +34,17 @@ def scenario_stages(spec: ScenarioSpec, class_map: ClassMap) -> dict[str, Usd.St
     return {LAYER_FILE[role]: stage for role, stage in stages.items() if stage is not None}
 
 
-def write_scenario(spec: ScenarioSpec, out_dir: str | Path, class_map: ClassMap | None = None) -> list[Path]:
+def write_scenario(spec: ScenarioSpec, out_dir: str | Path, class_map: ClassMap | None = None,
+                   dataset_part: bool = False) -> list[Path]:
     """Write every layer of ``spec`` and ``scenario.usda`` into ``out_dir``; returns the final paths.
 
-    Files of ``out_dir`` that are not part of the scenario are left alone."""
+    Files of ``out_dir`` that are not part of the scenario are left alone. ``dataset_part``: ``out_dir`` is a part
+    of the dataset being generated (a randomised scene's scenario, :func:`synthua_usd.core.atomic.output_set`)."""
     class_map = class_map or ClassMap.default()
     out_dir = Path(out_dir)
     stages = scenario_stages(spec, class_map)
     names = list(stages) + [ROOT_FILE]
-    with output_set(out_dir) as staging:
+    with output_set(out_dir, dataset_part=dataset_part) as staging:
         for name, stage in stages.items():
             save_layer_atomic(stage.GetRootLayer(), staging / name)
         names += [str(p.relative_to(staging)) for p in write_texture_images(spec.twin.images, staging)]
