@@ -12,7 +12,10 @@ is read and loaded afresh.
 
 What a draw needs of the scenario itself (the twin's walkable surfaces and materials, the cameras, the
 conditions) is read from a second composition of the same root layer with an empty session layer, so it never
-sees an earlier image's randomisation. The scenario a scene is in (the dataset's, a district's, a setting's: :mod:`synthua_usd.pipeline.scenes`) is the
+sees an earlier image's randomisation. With ``distractors`` on, a new scene also scatters its distractors
+(:mod:`synthua_usd.randomisation.distractors`) into the scene layer (:mod:`synthua_usd.usd.distractor_layer`); the
+crowd is then placed clear of them, and they hide what is behind them when aid users are placed in view. The
+scenario a scene is in (the dataset's, a district's, a setting's: :mod:`synthua_usd.pipeline.scenes`) is the
 caller's to open; the randomiser records it.
 """
 
@@ -32,13 +35,15 @@ from synthua_usd.core.errors import StageError
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.scenes import SceneKey, scene_of
 from synthua_usd.randomisation.config import RandomisationConfig
+from synthua_usd.randomisation.distractors import DistractorsDraw, SurfaceTops, draw_distractors
 from synthua_usd.randomisation.framing import draw_framing
 from synthua_usd.randomisation.light import LightDraw, draw_light
 from synthua_usd.randomisation.scene import SceneDraw, draw_scene
 from synthua_usd.randomisation.streams import stream
 from synthua_usd.randomisation.view import CameraJitter, ViewDraw, WalkArea, draw_camera, place_cast
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
-from synthua_usd.usd.cameras import camera_rig_type, read_camera
+from synthua_usd.usd.cameras import camera_paths, camera_rig_type, read_camera
+from synthua_usd.usd.distractor_layer import author_distractors
 from synthua_usd.usd.conditions import read_condition
 from synthua_usd.usd.randomisation_layer import (RANDOM_ROOT, camera_override, export_layers, recolourable_objects,
                                                  scene_layers, view_layer)
@@ -51,7 +56,8 @@ log = logging.getLogger(__name__)
 class ImageRandomisation:
     """What one image drew: the randomisation seed, its scene, its view, its light (None without a condition),
     and the SHA-256 of its view layer as authored (the same draws author the same bytes); with the ``settings``
-    part on, the scene's ``setting`` (None in the district; absent from the record with the part off)."""
+    part on, the scene's ``setting`` (None in the district; absent from the record with the part off), and with
+    ``distractors`` on, the scene's ``distractors``."""
 
     seed: int
     scene: SceneDraw
@@ -60,13 +66,17 @@ class ImageRandomisation:
     view_layer_digest: str
     settings_on: bool = False
     setting: object = None
+    distractors: DistractorsDraw | None = None
 
     def to_dict(self) -> dict:
         out = {"seed": self.seed, "scene_seed": self.scene.scene_seed, "district_seed": self.scene.district_seed,
                "view_layer_sha256": self.view_layer_digest, "scene": self.scene.to_dict(),
                "view": self.view.to_dict(), "light": None if self.light is None else self.light.to_dict()}
-        if self.settings_on:  # absent, not null, where the part is off: records as before it existed
+        # absent, not null, where the parts are off: records as before they existed
+        if self.settings_on:
             out["setting"] = None if self.setting is None else self.setting.to_dict()
+        if self.distractors is not None:
+            out["distractors"] = self.distractors.to_dict()
         return out
 
 
@@ -115,11 +125,15 @@ class Randomiser:
         t = self.base.GetStartTimeCode() if time_code is None else time_code
         snapshot = StageReader(_without_agents(stage), class_map).snapshot(float(t))
         twin = [m for m in snapshot.meshes if not m.prim_path.startswith((AGENTS_ROOT + "/", RANDOM_ROOT + "/"))]
-        self.area = None
-        if config.crowd.enabled or config.camera.enabled:
+        self.area = self.tops = None
+        if config.crowd.enabled or config.camera.enabled or config.distractors.enabled:
             vertices, faces, owner = snapshot.world_triangles(twin)
             names = np.array([class_map.by_id(m.class_id).name for m in twin], object)
-            self.area = WalkArea.build(vertices, faces, names[owner] if len(owner) else np.zeros(0, object))
+            face_class = names[owner] if len(owner) else np.zeros(0, object)
+            self.area = WalkArea.build(vertices, faces, face_class)
+            if config.distractors.enabled:
+                self.tops = SurfaceTops.find(vertices, faces, face_class, self.area)
+                self.cameras_xy = np.array([read_camera(self.base, p, float(t)).origin[:2] for p in camera_paths(self.base)])
         self.materials = snapshot.materials
         self.objects, self.bound = ([], {})
         if config.materials.enabled:
@@ -135,6 +149,8 @@ class Randomiser:
         stage.GetSessionLayer().subLayerPaths.insert(0, self.view_layer.identifier)
         self._scene: SceneDraw | None = None
         self._cast = None  # the scene's CastPrims
+        self._distractors: DistractorsDraw | None = None
+        self._area = self.area  # the scene's: the twin's, with the distractors among the occluders
 
     def close(self) -> None:
         """Take the layers out of the stage's session layer again (the stage as composed before)."""
@@ -153,6 +169,13 @@ class Randomiser:
                           district_seed=None if key is None else key.district_seed)
         prototypes, scene, cast = scene_layers(draw, self.meta, self.class_map.taxonomy, self.bodies, self.materials,
                                                self.bound, deactivate_agents=self.has_agents and self.config.crowd.enabled)
+        self._distractors, self._area = None, self.area
+        if self.config.distractors.enabled:
+            self._distractors = draw_distractors(stream(self.config.seed, seed, "distractors"), self.config.distractors,
+                                                 self.area, self.tops, self.cameras_xy)
+            author_distractors(scene, self._distractors, self.class_map.taxonomy)
+            self._area = self.area.with_occluders((points, triangles) for item in self._distractors.items
+                                                  for _, points, triangles, _, _ in item.parts())
         with Sdf.ChangeBlock():  # both at once: the stage never composes the old instances over new prototypes
             if self._scene is None:
                 linked = Sdf.Layer.CreateAnonymous("scene.usda")
@@ -187,12 +210,13 @@ class Randomiser:
             camera = jitter.camera(base_camera)
         placements = ()
         if self.config.crowd.enabled and scene.cast:
-            placements = place_cast(rng, scene.cast, self.area, camera, self.size, self.config.crowd)
+            placements = place_cast(rng, scene.cast, self._area, camera, self.size, self.config.crowd,
+                                    self._distractors.discs() if self._distractors is not None else ())
         framing = None
         if (self.config.framing.enabled and placements and self.area is not None
                 and camera_rig_type(self.base, camera_path) in self.config.framing.rig_types):
             framing = draw_framing(stream(self.config.seed, seed, "framing", camera_path, time_code),
-                                   self.config.framing, scene.cast, placements, self.area, camera, self.size,
+                                   self.config.framing, scene.cast, placements, self._area, camera, self.size,
                                    self.bodies.bank)
             if framing is not None:
                 camera = framing.camera(base_camera)
@@ -214,7 +238,8 @@ class Randomiser:
         fresh.subLayerPaths.append(self.scene_layer.identifier)
         self.view_layer.TransferContent(fresh)
         return ImageRandomisation(self.config.seed, scene, ViewDraw(jitter, placements, framing), light, digest,
-                                  self.config.settings.enabled, None if key is None else key.setting)
+                                  self.config.settings.enabled, None if key is None else key.setting,
+                                  self._distractors)
 
     def export(self, out: Path, anchor: Path | None = None) -> tuple[Path, Path, Path]:
         """Write the current image's layers: ``out`` (the view layer), ``<stem>.scene.usda`` and

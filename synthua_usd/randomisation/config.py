@@ -2,8 +2,9 @@
 (``schemas/generate.schema.json``, ``$defs.randomise``) as checked, frozen plain data.
 
 Every range is ``(low, high)`` with ``low <= high`` (equal ends fix the value). Each part has ``enabled``
-(default true; ``district``, ``effects``, ``framing`` and ``settings`` default false; the last is defined in
-:mod:`synthua_usd.randomisation.settings`), so a part is switched off without deleting its ranges; a config without a ``randomise`` block (or with ``null``)
+(default true; ``district``, ``effects``, ``framing``, ``settings`` and ``distractors`` default false; the last two
+are defined in :mod:`synthua_usd.randomisation.settings` and :mod:`synthua_usd.randomisation.distractors`), so a
+part is switched off without deleting its ranges; a config without a ``randomise`` block (or with ``null``)
 randomises nothing and renders the scenario as composed, as before. The meaning of
 every field is documented once, in the schema's descriptions; the defaults are owned here and a test holds
 the schema's documentation to them.
@@ -21,6 +22,7 @@ from synthua_usd.assets.hair import HAIR_STYLES
 from synthua_usd.assets.look_images import LOWER_FABRICS, SHOES, UPPER_FABRICS
 from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES
 from synthua_usd.model.ranges import SEED
+from synthua_usd.randomisation.distractors import DistractorRandomisation
 from synthua_usd.randomisation.settings import SettingsRandomisation
 
 #: The mobility-aid classes a randomised crowd can use (the device classes of the agent profiles).
@@ -351,10 +353,12 @@ class FramingRandomisation:
 _PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "hair": HairRandomisation,
           "looks": LooksRandomisation, "materials": MaterialRandomisation,
           "light": LightRandomisation, "camera": CameraRandomisation, "district": DistrictRandomisation,
-          "effects": EffectsRandomisation, "framing": FramingRandomisation, "settings": SettingsRandomisation}
+          "effects": EffectsRandomisation, "framing": FramingRandomisation, "settings": SettingsRandomisation,
+          "distractors": DistractorRandomisation}
 #: Parts that came after datasets were made: left out of a config's document while they are their default (off),
 #: so that a config that does not ask for them keeps its generate.json and job key.
-_LATER_PARTS = {"effects": EffectsRandomisation, "framing": FramingRandomisation, "settings": SettingsRandomisation}
+_LATER_PARTS = {"effects": EffectsRandomisation, "framing": FramingRandomisation, "settings": SettingsRandomisation,
+                "distractors": DistractorRandomisation}
 
 
 @dataclass(frozen=True)
@@ -374,6 +378,7 @@ class RandomisationConfig:
     effects: EffectsRandomisation = field(default_factory=EffectsRandomisation)
     framing: FramingRandomisation = field(default_factory=FramingRandomisation)
     settings: SettingsRandomisation = field(default_factory=SettingsRandomisation)
+    distractors: DistractorRandomisation = field(default_factory=DistractorRandomisation)
 
     def __post_init__(self) -> None:
         if self.devices.enabled and not self.crowd.enabled:

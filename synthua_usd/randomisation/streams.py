@@ -8,7 +8,8 @@ which worker renders the image, nor on what it rendered before) and one scope's 
 - ``light``: (seed, camera, time code, condition) the sun, sky and exposure;
 - ``effects``: (seed, camera, time code, condition) the camera effects applied after rendering;
 - ``framing``: (seed, camera, time code) the photographer's view of an aid user;
-- ``setting``: (seed) whether the scene is in the district or a procedural setting, and which.
+- ``setting``: (seed) whether the scene is in the district or a procedural setting, and which;
+- ``distractors``: (seed) the objects scattered in the scene, their looks and places.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import zlib
 import numpy as np
 
 _SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "cutout_group": 6, "cutout_view": 7,
-           "framing": 8, "setting": 9}
+           "framing": 8, "setting": 9, "distractors": 10}
 
 
 def _key(value) -> int:

@@ -80,6 +80,23 @@ class WalkArea:
     def area_m2(self) -> float:
         return self.grid.area_m2()
 
+    def with_occluders(self, meshes) -> "WalkArea":
+        """The same area whose occluders also hold ``meshes`` ((points (n, 3), triangles (m, 3)) world metres: a
+        scene's distractors), which then hide people from a camera; the walkable grid is the twin's."""
+        import trimesh
+
+        meshes = list(meshes)
+        if not meshes:
+            return self
+        vertices, faces = [self.occluders.vertices], [self.occluders.faces]
+        offset = len(self.occluders.vertices)
+        for points, triangles in meshes:
+            vertices.append(np.asarray(points, float))
+            faces.append(np.asarray(triangles, np.int64) + offset)
+            offset += len(points)
+        mesh = trimesh.Trimesh(np.concatenate(vertices), np.concatenate(faces), process=False, validate=False)
+        return replace(self, occluders=mesh)
+
     def choices(self, profile: AgentProfile) -> tuple[np.ndarray, list[np.ndarray]]:
         """For ``profile``: indices into :attr:`nodes` of the cells it may stand on (at least one edge it can
         travel, and for a wide agent all eight neighbours walkable), and per such cell the unit directions
@@ -273,7 +290,8 @@ def companion_offsets(cast: tuple[CastMember, ...], k: int) -> list[tuple[int, f
 
 
 def place_cast(rng: np.random.Generator, cast: tuple[CastMember, ...], area: WalkArea, camera: PinholeCamera,
-               size: tuple[int, int], config: CrowdRandomisation) -> tuple[Placement, ...]:
+               size: tuple[int, int], config: CrowdRandomisation,
+               blocked: tuple[tuple[float, float, float], ...] = ()) -> tuple[Placement, ...]:
     """A placement for every member of ``cast``, no two discs (profile radii) within 0.1 m.
 
     First U{aid_users_in_view} of the aid users (a random choice of them) go where ``camera`` (at render
@@ -283,8 +301,9 @@ def place_cast(rng: np.random.Generator, cast: tuple[CastMember, ...], area: Wal
     free place turns up in :data:`PLACE_TRIES` tries takes the freest of them; ``in_view`` says who was placed
     free in view. An aid user with companions is placed with them as one unit (:func:`companion_offsets`: its
     pusher behind it, the others beside it, all at its heading and pace, every one of them on a walkable
-    cell), each companion with a phase of its own."""
-    taken: list[tuple[float, float, float]] = []
+    cell), each companion with a phase of its own. ``blocked`` (x, y, radius) discs are kept clear as people's are
+    (the scene's distractors on the ground)."""
+    taken: list[tuple[float, float, float]] = list(blocked)
     placements: list[Placement | None] = [None] * len(cast)
     aid_users = [k for k, m in enumerate(cast) if m.aid is not None]
     lo, hi = config.aid_users_in_view

@@ -125,8 +125,10 @@ def draw_wear(rng: np.random.Generator, wardrobe: Wardrobe) -> Wear:
     return Wear(int(u[0] * len(wardrobe.uppers)), int(u[1] * len(wardrobe.lowers)), int(u[2] * len(wardrobe.shoes)))
 
 
-def _masked(key: str, stem: str, c1, c2, roughness: float, offset: float = 0.0, wrap: str = "repeat",
-            normal: bool = True, **extra) -> Material:
+def masked_material(key: str, stem: str, c1, c2, roughness: float, offset: float = 0.0, wrap: str = "repeat",
+                    normal: bool = True, **extra) -> Material:
+    """A material showing the look image ``stem``'s mask between ``c1`` and ``c2`` (linear RGB), with its normal
+    map unless ``normal`` is False."""
     scale, bias = two_colour(c1, c2, offset)
     base = Texture(str(image_path(stem)), color_space="raw", wrap_s=wrap, wrap_t=wrap, scale=scale, bias=bias)
     normals = Texture(str(image_path(f"{stem}_normal")), color_space="raw", scale=NORMAL_SCALE,
@@ -139,15 +141,15 @@ def skin_material(key: str, skin) -> Material:
     """The skin of tone ``skin`` (RGB) with the face image (clamped: plain skin wherever the face is not) and a
     clear coat."""
     coat, coat_roughness = SKIN_CLEARCOAT
-    return _masked(key, "face", skin, FACE_FEATURES, SKIN_ROUGHNESS, offset=FACE_OFFSET, wrap="clamp", normal=False,
+    return masked_material(key, "face", skin, FACE_FEATURES, SKIN_ROUGHNESS, offset=FACE_OFFSET, wrap="clamp", normal=False,
                    clearcoat=coat, clearcoat_roughness=coat_roughness)
 
 
 def garment_material(key: str, garment: Garment) -> Material:
     """The material of ``garment``: its fabric's mask between its two colours, the fabric's normal map."""
-    return _masked(key, f"fabric_{garment.fabric}", garment.colour, garment.second, FABRIC_ROUGHNESS)
+    return masked_material(key, f"fabric_{garment.fabric}", garment.colour, garment.second, FABRIC_ROUGHNESS)
 
 
 def shoes_material(key: str, shoes: Shoes) -> Material:
     """The material of ``shoes``: the shoe image's mask between the upper's and the sole's colour."""
-    return _masked(key, f"shoe_{shoes.kind}", shoes.colour, shoes.sole, SHOE_ROUGHNESS[shoes.kind])
+    return masked_material(key, f"shoe_{shoes.kind}", shoes.colour, shoes.sole, SHOE_ROUGHNESS[shoes.kind])

@@ -19,9 +19,9 @@ from synthua_usd.randomisation.settings import SETTING_KINDS
 
 def test_off_by_default_and_absent_from_the_document():
     config = RandomisationConfig()
-    assert not config.settings.enabled
+    assert not config.settings.enabled and not config.distractors.enabled
     document = config.to_document()
-    assert "settings" not in document
+    assert "settings" not in document and "distractors" not in document
     assert all(scene_of(config, seed) is None for seed in range(50))
     on = RandomisationConfig.from_document({"settings": {"enabled": True, "variants": 3}})
     assert RandomisationConfig.from_document(on.to_document()) == on and on.to_document()["settings"]["variants"] == 3
