@@ -73,3 +73,20 @@ def test_randomise_refuses_an_option_the_record_fixes(refuse, workdir, generated
     record = sorted((generated_random / "records").glob("*.json"))[0]
     refuse("randomise", SCENARIO, "--record", record, option, value, "--out", workdir / "r" / "layer.usda",
            mentions=(option, "--record", "one or the other"))
+
+
+@pytest.mark.parametrize("block, mentions", [
+    ({"settings": {"enabled": True, "variants": 0}}, ("randomise.settings.variants", "0")),
+    ({"settings": {"enabled": True, "kinds": ["moon"]}}, ("randomise.settings.kinds", "moon")),
+    ({"settings": {"enabled": True}, "crowd": {"enabled": False}}, ("randomise.settings: enabled while",)),
+    ({"distractors": {"enabled": True, "on_surfaces": [0.5, 2]}}, ("randomise.distractors.on_surfaces",
+                                                                   "two whole numbers")),
+    ({"distractors": {"enabled": True, "objects": ["piano"]}}, ("randomise.distractors.objects", "piano")),
+    ({"distractors": {"enabled": True, "primitive_size_m": [0.5, 0.1]}}, ("randomise.distractors.primitive_size_m",)),
+])
+def test_impossible_settings_and_distractors_are_refused(refuse, workdir, block, mentions):
+    """Each a line naming the file and the field, exit 2, before anything is planned or written."""
+    document = doc(RANDOM_CONFIG)
+    document["randomise"] |= block
+    config = write(workdir / "parts.json", document)
+    refuse("generate", SCENARIO, "--config", config, "--out", workdir / "dataset", mentions=("parts.json", *mentions))
