@@ -39,6 +39,7 @@ from synthua_usd.randomisation.distractors import DistractorsDraw, SurfaceTops, 
 from synthua_usd.randomisation.framing import draw_framing
 from synthua_usd.randomisation.light import LightDraw, draw_light
 from synthua_usd.randomisation.scene import SceneDraw, draw_scene
+from synthua_usd.randomisation.settings import CAMERA_CLEARANCE_M
 from synthua_usd.randomisation.streams import stream
 from synthua_usd.randomisation.view import CameraJitter, ViewDraw, WalkArea, draw_camera, place_cast
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
@@ -210,8 +211,10 @@ class Randomiser:
             camera = jitter.camera(base_camera)
         placements = ()
         if self.config.crowd.enabled and scene.cast:
-            placements = place_cast(rng, scene.cast, self._area, camera, self.size, self.config.crowd,
-                                    self._distractors.discs() if self._distractors is not None else ())
+            blocked = self._distractors.discs() if self._distractors is not None else ()
+            if key is not None and key.setting is not None:  # nobody at the lens (a setting's cameras stand on its floors)
+                blocked += ((float(camera.origin[0]), float(camera.origin[1]), CAMERA_CLEARANCE_M),)
+            placements = place_cast(rng, scene.cast, self._area, camera, self.size, self.config.crowd, blocked)
         framing = None
         if (self.config.framing.enabled and placements and self.area is not None
                 and camera_rig_type(self.base, camera_path) in self.config.framing.rig_types):

@@ -3,8 +3,8 @@ what a randomised scene in that setting renders.
 
 The setting scenario has the dataset scenario's stage metadata (axes, units, time codes), its conditions (indoors
 without their weather: :func:`synthua_usd.model.conditions.indoors`), its render settings (camera, resolution,
-samples) and every one of its cameras at the same prim path, with the same rig type and lens, placed in the setting
-(:func:`synthua_usd.demo.settings.layout.setting_cameras`); the twin and semantics are the setting's own, with
+samples) and every one of its cameras at the same prim path, with the same rig type and filmback (the focal length
+its rig type's lens starts at), placed in the setting (:func:`synthua_usd.demo.settings.layout.setting_cameras`); the twin and semantics are the setting's own, with
 their textures. It has no crowd of its own: the randomised crowd is placed on its walkable floors. Everything is
 authored by the one scenario writer (:func:`synthua_usd.usd.scenario_writer.write_scenario`).
 """

@@ -25,6 +25,10 @@ SETTING_KINDS = ("corridor", "hall", "shop", "clinic", "lift_lobby", "park", "ve
 INDOOR_KINDS = ("corridor", "hall", "shop", "clinic", "lift_lobby")
 #: Most layouts of one kind a config may ask for (each one drawn is a scenario written into the dataset).
 MAX_VARIANTS = 10_000
+#: In a setting, nobody is placed within this horizontal distance (plus their own radius) of the view's camera,
+#: metres: its cameras stand on the floors people walk, and a person at the lens fills the frame (a room's CCTV
+#: hangs only 2-3 m up).
+CAMERA_CLEARANCE_M = 1.5
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from synthua_usd.composition.rigs import RIG_TYPES
 from synthua_usd.demo.settings import BUILDERS, build_setting
 from synthua_usd.demo.settings.layout import room_layout, setting_cameras
 from synthua_usd.model.cameras import CameraSpec
@@ -81,8 +82,10 @@ def test_every_rig_type_gets_a_camera_aimed_at_the_focus():
     by = {c.name: c for c in placed}
     assert by["A"].eye != by["B"].eye and by["C"].eye[:2] != by["D"].eye[:2]  # other corners, other ends
     assert by["C"].eye[2] == pytest.approx(1.6) and by["D"].eye[2] == pytest.approx(1.2)
-    for cam in placed:
-        assert cam.eye[2] < 3.0 and cam.focal_length_mm == 4.0
+    for cam, asked in zip(placed, wanted):
+        # the rig type's widest focal length (a room is smaller than the street a rig was zoomed for), else its own
+        assert cam.focal_length_mm == (RIG_TYPES[asked.rig_type].lens.default_focal_mm if asked.rig_type else 4.0)
+        assert cam.eye[2] < 3.0 and cam.horizontal_aperture_mm == 4.8
         forward = np.subtract(cam.target, cam.eye)
         to_focus = np.subtract(layout.focus, cam.eye)
         cos = forward @ to_focus / np.linalg.norm(forward) / np.linalg.norm(to_focus)

@@ -21,6 +21,7 @@ from synthua_usd.backends.images import read_image
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.pipeline.scenes import SceneKey, scene_of
 from synthua_usd.pipeline.verify import replay, verify
+from synthua_usd.randomisation.settings import CAMERA_CLEARANCE_M
 
 CONFIG = DATA / "configs" / "settings.json"
 
@@ -50,6 +51,11 @@ def test_each_setting_is_written_once_and_every_image_records_its_scene(generate
         assert all(i["class_name"] not in ("person",) for i in mine)
         people = [i for i in record["instances"] if i["class_name"] == "person"]
         assert all("/World/Randomisation/Crowd/" in i["prim_path"] for i in people)
+        if key is not None:  # in a setting, nobody placed free stands at the lens
+            eye = np.array(drawn["view"]["camera"]["camera_to_world"])[:2, 3]
+            for place in drawn["view"]["placements"]:
+                if place["in_view"]:
+                    assert np.hypot(*(np.array(place["position"][:2]) - eye)) >= CAMERA_CLEARANCE_M
 
 
 def test_labels_in_the_settings_are_exact(generated_settings, class_map):

@@ -42,6 +42,17 @@ def _signs_over_doors(b: TwinBuilder, room: Room, rng: np.random.Generator, shar
             b.add("Signage", "DoorSign", "signage", place(interior.wall_sign(0.5, 0.16, _pick(rng, SIGNS)), at, heading))
 
 
+def _clear_of_sightlines(xy, layout: Layout, clearance: float) -> bool:
+    """Whether ``xy`` is ``clearance`` metres or more from every line from a high spot (a CCTV) to the focus."""
+    p, f = np.asarray(xy, float), np.asarray(layout.focus[:2], float)
+    for spot in layout.high_spots:
+        a = np.asarray(spot[:2], float)
+        t = np.clip((p - a) @ (f - a) / max(float((f - a) @ (f - a)), 1e-9), 0.0, 1.0)
+        if np.linalg.norm(a + t * (f - a) - p) < clearance:
+            return False
+    return True
+
+
 def corridor(rng: np.random.Generator) -> tuple[list[TwinObject], Layout]:
     """A corridor 18-32 m long and 2.2-3.2 m wide: doors along both walls every 3-5 m, windows along one wall
     between its doors (half of them), a double door at one end, handrails (60 %), a row of seats in a recess-free
@@ -75,8 +86,8 @@ def corridor(rng: np.random.Generator) -> tuple[list[TwinObject], Layout]:
 
 def hall(rng: np.random.Generator) -> tuple[list[TwinObject], Layout]:
     """A station or entrance hall 16-26 x 12-18 m, 4.5-6.5 m high: tall windows along its south wall, entrance
-    doors in the north wall, pillars every 6 m, rows of seats, a kiosk counter, signs on posts and hanging,
-    potted plants, ceiling lights every 3.5 m."""
+    doors in the north wall, pillars every 6 m (none within 1 m of a CCTV's line of sight to the focus), rows of
+    seats, a kiosk counter, signs on posts and hanging, potted plants, ceiling lights every 3.5 m."""
     b = TwinBuilder()
     length, width, height = float(rng.uniform(16, 26)), float(rng.uniform(12, 18)), float(rng.uniform(4.5, 6.5))
     room = Room(-length / 2, -width / 2, length / 2, width / 2, height)
@@ -86,7 +97,9 @@ def hall(rng: np.random.Generator) -> tuple[list[TwinObject], Layout]:
         room.door("N", x + float(rng.uniform(-1, 1)), 1.8)
     room.door("W", float(rng.uniform(-2, 2)), 1.6)
     _finish(b, room, rng, 3.5)
-    pillars = [(float(x), float(y)) for x in np.arange(-6.0, length / 2 - 3.0, 6.0) for y in (-width / 4, width / 4)]
+    layout = room_layout(room.x0, room.y0, room.x1, room.y1, height)
+    pillars = [(float(x), float(y)) for x in np.arange(-6.0, length / 2 - 3.0, 6.0) for y in (-width / 4, width / 4)
+               if _clear_of_sightlines((float(x), float(y)), layout, 1.0)]
     for x, y in pillars:
         b.add("Structure", "Pillar", "building", place(interior.pillar(0.5, height), (x, y, 0.0)))
     rows = int(rng.integers(2, 5))
@@ -100,13 +113,13 @@ def hall(rng: np.random.Generator) -> tuple[list[TwinObject], Layout]:
               place(interior.hanging_sign(1.4, 0.4, 1.2, _pick(rng, SIGNS)), (x + 1.5, y, height)))
     for x, y in pillars[1::3]:
         b.add("Nature", "Plant", "vegetation", place(interior.potted_plant(float(rng.uniform(1.0, 1.6))), (x + 0.7, y + 0.7, 0.0)))
-    return b.objects, room_layout(room.x0, room.y0, room.x1, room.y1, height)
+    return b.objects, layout
 
 
 def shop(rng: np.random.Generator) -> tuple[list[TwinObject], Layout]:
-    """A shop 10-16 x 8-12 m, 3.0-3.6 m high: a glazed front (south) with a double door, gondola shelving in
-    aisles 1.6-2.0 m wide, shelving along the back wall, a counter by the door, signs hanging over the aisles,
-    ceiling lights every 2.5 m."""
+    """A shop 10-16 x 8-12 m, 3.0-3.6 m high: a glazed front (south) with a double door, gondola shelving along the
+    room in rows either side of a middle aisle (aisles 1.6-2.0 m wide, a cross aisle halfway), shelving along the
+    back wall, a counter by the door, signs hanging over the aisles, ceiling lights every 2.5 m."""
     b = TwinBuilder()
     length, width, height = float(rng.uniform(10, 16)), float(rng.uniform(8, 12)), float(rng.uniform(3.0, 3.6))
     room = Room(-length / 2, -width / 2, length / 2, width / 2, height)
@@ -117,17 +130,24 @@ def shop(rng: np.random.Generator) -> tuple[list[TwinObject], Layout]:
             room.window("S", (a + z) / 2, z - a - 0.2, 0.4, 2.6)
     _finish(b, room, rng, 2.5)
     aisle = float(rng.uniform(1.6, 2.0))
-    shelf_len = float(rng.uniform(3.0, 4.5))
     goods = _pick(rng, ("Goods", "PlasticWhite", "CanvasRed", "CanvasBlue", "CanvasYellow"))
-    for x in np.arange(room.x0 + 3.0, room.x1 - 2.5, 0.5 + aisle):
-        b.add("Furniture", "Shelving", "furniture", place(interior.shelf(shelf_len, 1.8, goods=goods), (float(x), room.y1 - 2.5 - shelf_len / 2, 0.0)))
+    run = (length - 5.0 - 1.6) / 2  # each half of a row, a cross aisle between them
+    y = aisle / 2 + 0.25
+    while y + 0.25 < width / 2 - 2.2:  # the front 2.2 m (door, till) and the back wall's shelving kept clear
+        for side in (-1.0, 1.0):
+            if side < 0 or y + 0.25 < width / 2 - 1.5:
+                for x in (-(run + 1.6) / 2, (run + 1.6) / 2):
+                    b.add("Furniture", "Shelving", "furniture", place(interior.shelf(run, 1.8, goods=goods),
+                                                                      (x, side * y, 0.0), 90.0))
+        y += 0.5 + aisle
+    for x in (-(run + 1.6) / 2, (run + 1.6) / 2):
         b.add("Signage", "AisleSign", "signage", place(interior.hanging_sign(0.9, 0.3, 0.5, _pick(rng, SIGNS)),
-                                                        (float(x) + 0.25 + aisle / 2, room.y1 - 2.5 - shelf_len / 2, height), 90.0))
+                                                        (x, 0.0, height)))
     for x in np.arange(room.x0 + 2.0, room.x1 - 2.0, 2.1):
         at, heading = room.at("N", float(x), 0.3)
         b.add("Furniture", "WallShelving", "furniture", place(interior.shelf(2.0, 2.0, 0.5, goods=goods), at, heading))
     till = door + (2.5 if door < 0 else -2.5)
-    b.add("Shop", "Counter", "stand", place(interior.counter(2.0), (till, room.y0 + 2.0, 0.0), 90.0))
+    b.add("Shop", "Counter", "stand", place(interior.counter(2.0), (till, room.y0 + 1.2, 0.0), 90.0))
     return b.objects, room_layout(room.x0, room.y0, room.x1, room.y1, height)
 
 

@@ -2,7 +2,9 @@
 
 A setting scenario must offer every camera of the dataset's scenario at the same prim path (a sampled image names
 its camera by path, whatever its scene): :func:`setting_cameras` places each of them by its rig type, with its
-own lens, aimed at the setting's :attr:`Layout.focus` (the middle of where people stand):
+lens (its filmback, the focal length its rig type's lens starts at: a setting is smaller than the street a rig
+was zoomed for; a camera without a rig type keeps its own), aimed at the setting's :attr:`Layout.focus` (the middle
+of where people stand):
 
 | rig type | where |
 |---|---|
@@ -22,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from synthua_usd.composition.rigs import RIG_TYPES
 from synthua_usd.model.cameras import CameraSpec
 
 #: Camera heights above the floor of the eye-level rigs, metres (their rig types' defaults).
@@ -64,7 +67,8 @@ def room_layout(x0: float, y0: float, x1: float, y1: float, height: float, inset
 
 def setting_cameras(layout: Layout, cameras: list[CameraSpec]) -> tuple[CameraSpec, ...]:
     """``cameras`` (the dataset scenario's, by name, rig type and lens) placed in the setting of ``layout``: the
-    same names, rig types, lenses and clipping, new eyes and targets (see the module's docstring)."""
+    same names, rig types, filmbacks and clipping, the rig type's default focal length, new eyes and targets (see
+    the module's docstring)."""
     focus = np.asarray(layout.focus, float)
     counters: dict[str, int] = {}
     out = []
@@ -96,7 +100,9 @@ def setting_cameras(layout: Layout, cameras: list[CameraSpec]) -> tuple[CameraSp
         else:
             eye = np.asarray(layout.high_spots[k % len(layout.high_spots)], float)
             target = focus
-        out.append(CameraSpec(cam.name, tuple(map(float, eye)), tuple(map(float, target)), cam.focal_length_mm,
+        rig = RIG_TYPES.get(cam.rig_type or "")
+        focal = rig.lens.default_focal_mm if rig is not None else cam.focal_length_mm
+        out.append(CameraSpec(cam.name, tuple(map(float, eye)), tuple(map(float, target)), focal,
                               cam.horizontal_aperture_mm, cam.vertical_aperture_mm,
                               f"{cam.doc or cam.name} (placed in the setting as a {kind} view)".strip(),
                               cam.clip_near_m, cam.clip_far_m, cam.rig_type))

@@ -151,8 +151,8 @@ def vehicle_ramp(rng: np.random.Generator) -> tuple[list[TwinObject], Layout]:
     walk = road + depth / 2
     eyes = ((max(fx - 9.0, -half + 1.5), walk, KERB_H), (min(fx + 9.0, half - 1.5), walk, KERB_H))
     z = KERB_H + OUTDOOR_CCTV_M
-    # all on the north sidewalk (a bus at the north kerb hides its ramp from the south side): at its back edge and
-    # by the kerb, either side of the ramp
-    highs = ((fx - 10.0, road + depth - 0.6, z), (fx + 10.0, road + depth - 0.6, z), (fx - 7.0, road + 0.6, z),
-             (fx + 7.0, road + 0.6, z))
+    # all on the north sidewalk (a bus at the north kerb hides its ramp from the south side), either side of the
+    # ramp: at its back edge and over its middle (the light poles stand by the kerb)
+    highs = ((fx - 10.0, road + depth - 0.6, z), (fx + 10.0, road + depth - 0.6, z), (fx - 7.0, walk, z),
+             (fx + 7.0, walk, z))
     return b.objects, Layout((fx, min(fy, walk), KERB_H + 0.8), eyes, highs)
