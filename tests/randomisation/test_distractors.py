@@ -165,3 +165,21 @@ def test_impossible_values_are_refused_in_one_line(values, mentions):
     with pytest.raises(InputError) as err:
         RandomisationConfig.from_document({"distractors": values})
     assert mentions in str(err.value) and "\n" not in str(err.value)
+
+
+def test_an_empty_wheelchair_is_boxed_alone_under_every_convention():
+    """A wheelchair without a user (an empty-wheelchair distractor) is boxed as a wheelchair, its box its own frame's
+    under both named conventions, while a used chair's box covers its user (with_user); no person box comes of it."""
+    from synthua_usd.analytics.detection_targets import image_boxes, targets_for
+
+    used = {"class_name": "manual_wheelchair", "prim_path": "/World/Randomisation/Crowd/Agent_0000/ManualWheelchair",
+            "area": 50, "bbox": [10, 20, 10, 10], "relations": {}}
+    user = {"class_name": "person", "prim_path": "/World/Randomisation/Crowd/Agent_0000/Person", "area": 80,
+            "bbox": [11, 5, 8, 20], "relations": {"uses": used["prim_path"], "uses_class": "manual_wheelchair"}}
+    empty = {"class_name": "manual_wheelchair", "prim_path": "/World/Randomisation/Distractors/D000_EmptyManualWheelchair",
+             "area": 40, "bbox": [40, 20, 10, 10], "relations": {}}
+    for convention, people in (("synthua", 1), ("wheelchair-sets", 0)):
+        boxes = image_boxes([used, user, empty], targets_for(convention))
+        chairs = [(b.x, b.y, b.w, b.h) for b in boxes if b.label == "manual_wheelchair"]
+        assert chairs == [(10, 5, 10, 25), (40, 20, 10, 10)], convention
+        assert sum(b.label == "person" for b in boxes) == people
