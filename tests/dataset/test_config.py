@@ -23,7 +23,8 @@ def load(tmp_path, **changes):
 
 
 @pytest.mark.parametrize("name", ["demo.json", "district.json", "demo_random.json", "district_random.json",
-                                  "district_sequences.json", "sim2real.json", "sim2real_street.json"])
+                                  "settings_random.json", "district_sequences.json", "sim2real.json",
+                                  "sim2real_street.json"])
 def test_shipped_configs_load_and_round_trip(name):
     config = GenerationConfig.load(REPO / "configs" / name)
     assert GenerationConfig.from_document(config.to_document()) == config
