@@ -336,7 +336,7 @@ def main() -> int:
     probe.install()
     load_before = os.getloadavg()
     try:
-        summary = generate(GenerateRequest(scenario=scenario, config_path=config_path, out_dir=out,
+        summary = generate(GenerateRequest(scenario=scenario, config_path=config_path, out_dir=out, count_compiles=True,
                                            workers=args.workers, variant=args.variant),
                            show_progress=not args.no_progress)
         load_after = os.getloadavg()

@@ -12,12 +12,16 @@ from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, say
 
 def worker_time_shares(seconds: dict[str, float]) -> str:
     """"render 80 % (rgb 50 %, ...), annotate 10 %, write 10 %": the workers' time by phase. ``render`` holds its
-    ``render_*`` parts (where the render time went), so the whole is the phases without the parts."""
-    busy = sum(v for k, v in seconds.items() if not k.startswith("render_")) or 1.0
+    ``render_*`` parts (where the render time went), so the whole is the phases without the parts (``write_*``, the
+    encoders' seconds per file, overlap the next render: they are left to the benchmarks)."""
+    def part(key: str) -> bool:
+        return key.startswith(("render_", "write_"))
+
+    busy = sum(v for k, v in seconds.items() if not part(k)) or 1.0
     parts = ", ".join(f"{k[len('render_'):]} {100 * v / busy:.0f} %" for k, v in seconds.items()
                       if k.startswith("render_") and v > 0)
     return ", ".join(f"{k} {100 * v / busy:.0f} %" + (f" ({parts})" if k == "render" and parts else "")
-                     for k, v in seconds.items() if not k.startswith("render_"))
+                     for k, v in seconds.items() if not part(k))
 
 
 @click.command()

@@ -60,6 +60,8 @@ class WorkerJob:
     yolo_classes: dict = field(default_factory=dict)
     #: With randomised districts: district seed -> the scenario of that district in the dataset.
     scenes: dict = field(default_factory=dict)
+    #: Report the seconds of kernel compiles per image (``render_compile``; a profile's, see RenderSession).
+    count_compiles: bool = False
 
 
 @dataclass
@@ -95,7 +97,8 @@ def init_worker(job: WorkerJob) -> WorkerState:
     from synthua_usd.backends.mitsuba.session import RenderSession
 
     class_map = ClassMap.from_document(job.class_map_document, source="class_map.json")
-    state = WorkerState(job=job, stage=None, reader=None, session=RenderSession(job.render), class_map=class_map)
+    state = WorkerState(job=job, stage=None, reader=None, session=RenderSession(job.render, job.count_compiles),
+                        class_map=class_map)
     _open(state, job.scenario, None)
     return state
 
@@ -182,9 +185,12 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
         district = district_of(job.config.randomise, seed)
         if district != state.district:
             _open(state, job.scenes[district] if district is not None else job.scenario, district)
+        state.randomiser.scene(seed, district)  # (a new seed's scene: drawn and authored; else kept)
+        t_scene = time.perf_counter() - t0
         randomised = state.randomiser.apply(seed, camera_path, time_code, condition_name, district)
     t_randomise = time.perf_counter() - t0
     snapshot = state.reader.snapshot(time_code)
+    t_snapshot = time.perf_counter() - t0 - t_randomise
     camera = read_camera(state.stage, camera_path, time_code)
     condition = state.condition(condition_name)
     rendered = state.session.render(snapshot, camera, rgb=True, condition=condition, seed=seed)
@@ -197,9 +203,12 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
     amodal = state.session.amodal(snapshot, camera, wanted) if wanted else {}
     # "render" is all of it (snapshot, session, amodal); the render_* parts say where it went
     seconds = {"render": time.perf_counter() - t0, "render_amodal": time.perf_counter() - t_amodal,
-               **{f"render_{key}": value for key, value in rendered.seconds.items()}}
+               "render_snapshot": t_snapshot, **{f"render_{key}": value for key, value in rendered.seconds.items()}}
     if randomised is not None:
-        seconds["render_randomise"] = t_randomise
+        # the scene (crowd, looks, materials: drawn and authored for a new seed) and the view (camera, placements,
+        # light: drawn and authored for every image)
+        seconds["render_randomise_scene"] = t_scene
+        seconds["render_randomise_view"] = t_randomise - t_scene
 
     t0 = time.perf_counter()
     meshes_of: dict[int, list] = {}
@@ -349,15 +358,16 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
             continue  # a link to the RGB image, made once that exists
         data = image.arrays[key]
         if key == "yolo_label":
-            jobs.append(state.writer.encoders.submit(write_text_atomic, path, data))
+            jobs.append(state.writer.encoders.submit(_timed, write_text_atomic, path, data))
         elif key == "onehot":
             num_classes = max(c.id for c in state.class_map.classes) + 1
             jobs.append(state.writer.encoders.submit(
-                lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)), path, data))
+                _timed, lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)), path, data))
         else:
-            jobs.append(state.writer.encoders.submit(_WRITERS[key], path, data))
-    for job in jobs:
-        job.result()
+            jobs.append(state.writer.encoders.submit(_timed, _WRITERS[key], path, data))
+    spent = {}
+    for key, job in zip([k for k in targets if k != "cs_leftImg8bit"], jobs):
+        spent[f"write_{key}"] = job.result()[1]  # seconds of an encoder thread (it overlaps the next render)
     if "cs_leftImg8bit" in targets:
         _link_or_copy(targets["rgb_png"], targets["cs_leftImg8bit"])
     record["checksums"] = {key: file_entry(layout.root, rel) for key, rel in sorted(record["files"].items())}
@@ -365,8 +375,14 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
     record_path = layout.path(Layout.record(record["name"]))
     record_path.parent.mkdir(parents=True, exist_ok=True)
     write_json_atomic(record_path, record, indent=1)
-    seconds = dict(image.seconds, write=time.perf_counter() - t0)
+    seconds = dict(image.seconds, write=time.perf_counter() - t0, **spent)
     return {"record": record, "seconds": seconds}
+
+
+def _timed(writer, path: Path, data) -> tuple[object, float]:
+    """``writer(path, data)`` and the seconds it took."""
+    t0 = time.perf_counter()
+    return writer(path, data), time.perf_counter() - t0
 
 
 def _link_or_copy(source: Path, target: Path) -> None:

@@ -69,6 +69,8 @@ class GenerateRequest:
     variant: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
+    #: Workers report the seconds of kernel compiles (a benchmark's profile; Dr.Jit's kernel history).
+    count_compiles: bool = False
 
 
 @dataclass
@@ -225,8 +227,9 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     todo = [p for p in plan if p.id not in done]
     summary.resumed = len(done)
     # the scenario as this run names it (it may have moved since the plan; its layers are the same)
-    job = worker_job_from_document(job_document, out, scenario=request.scenario,
-                                   allow_external_assets=request.allow_external_assets)
+    job = replace(worker_job_from_document(job_document, out, scenario=request.scenario,
+                                           allow_external_assets=request.allow_external_assets),
+                  count_compiles=request.count_compiles)
     seconds = {"render": 0.0, "annotate": 0.0, "write": 0.0}
     peaks: dict = {}
     config_workers = request.workers or config.workers or default_workers()
