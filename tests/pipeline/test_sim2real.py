@@ -48,7 +48,7 @@ def test_train_records_what_it_trained_on(run, generated_random):
     assert about["seed"] == 3 and about["device"] == "cpu" and about["epochs_done"] == 1
     assert about["model"] == "yolo26n.yaml" and about["init"] is None
     assert about["versions"]["ultralytics"] == "8.4.190" and about["versions"]["torch"]
-    assert about["downloaded"] == []                                      # no weights fetched
+    assert about["downloaded"] == [] and about["network"] == []            # nothing fetched, nothing even tried
     assert about["targets"]["aid_box"] == "with_user" and about["classes"][0] == "person"
     assert (run / "weights.pt").stat().st_size > 1_000_000 and (run / "results.csv").is_file()
 
@@ -152,7 +152,13 @@ def test_fine_tuning_on_a_real_set_starts_from_the_run(run, generated_random, tm
     assert main(["train", str(generated_random), "--format", "yolo", "--init", str(run), "--epochs", "1",
                  "--imgsz", "64", "--batch", "2", "--device", "cpu", "--out", str(out)]) == 0
     about = json.loads((out / "train.json").read_text())
-    assert about["init"]["weights"] == str(run / "weights.pt") and about["model"] is None
+    init = about["init"]
+    assert init["kind"] == "run" and init["weights"] == str((run / "weights.pt").resolve()) and about["model"] is None
+    assert init["sha256"] == hashlib.sha256((run / "weights.pt").read_bytes()).hexdigest()
+    assert init["run"] == json.loads((run / "train.json").read_text())
+    # the weights were taken, by Ultralytics' own count: all of them, the head's class rows matched by class name
+    taken, of = init["transferred"]
+    assert taken == of > 0 and f"Transferred {taken}/{of} items" in (out / "train.log").read_text()
     assert about["train_set"]["layout"] == "yolo" and about["targets"] is None
     assert about["classes"][:2] == ["curb_ramp", "crosswalk"]          # the generated data.yaml's names
     assert not list((generated_random / "labels").glob("*.cache"))      # Ultralytics' cache went to its own copy
@@ -172,3 +178,56 @@ def test_refusals_are_one_line(run, generated_random, tmp_path, capsys):
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("synthua: error:") and found in err[0], err
         assert not (tmp_path / "out").exists()
+
+
+# --- starting from an Ultralytics checkpoint file (made here, never downloaded) ---------------------------------------
+
+@pytest.fixture(scope="module")
+def checkpoints(detector_python, tmp_path_factory) -> dict[str, Path]:
+    """Checkpoints as Ultralytics saves them, of freshly built models: ``detect`` a YOLO11n detector with COCO's 80
+    classes (a stand-in for a user's COCO-pretrained yolo11n.pt: same file layout, untrained weights), ``classify``
+    a YOLO11n classifier, and ``garbage``, a .pt file that is no checkpoint."""
+    import os
+    import subprocess
+
+    folder = tmp_path_factory.mktemp("checkpoints")
+    script = ("import sys\nfrom ultralytics import YOLO\n"
+              "YOLO('yolo11n.yaml').save(sys.argv[1])\nYOLO('yolo11n-cls.yaml').save(sys.argv[2])\n")
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    env |= {"YOLO_OFFLINE": "1", "YOLO_CONFIG_DIR": str(folder / "settings")}
+    out = {"detect": folder / "yolo11n.pt", "classify": folder / "yolo11n-cls.pt", "garbage": folder / "garbage.pt"}
+    subprocess.run([str(detector_python), "-c", script, str(out["detect"]), str(out["classify"])], check=True,
+                   env=env, cwd=folder, capture_output=True, timeout=300)
+    out["garbage"].write_bytes(b"not a checkpoint\n")
+    return out
+
+
+def test_train_from_a_checkpoint_file(checkpoints, generated_random, tmp_path, capsys):
+    out = tmp_path / "from_checkpoint"
+    assert main(["train", str(generated_random), "--init", str(checkpoints["detect"]), "--epochs", "1", "--imgsz", "64",
+                 "--batch", "2", "--device", "cpu", "--out", str(out)]) == 0
+    assert "from checkpoint yolo11n.pt (yolo11n.yaml, 80 classes, sha256" in capsys.readouterr().out
+    about = json.loads((out / "train.json").read_text())
+    init = about["init"]
+    assert init["kind"] == "checkpoint" and init["weights"] == str(checkpoints["detect"].resolve())
+    assert init["sha256"] == hashlib.sha256(checkpoints["detect"].read_bytes()).hexdigest()
+    assert init["checkpoint"]["task"] == "detect" and init["checkpoint"]["architecture"] == "yolo11n.yaml"
+    assert len(init["checkpoint"]["names"]) == 80 and init["checkpoint"]["saved_with"] == "8.4.190"
+    taken, of = init["transferred"]   # all but the head's class layers: no class name of ours is among its 0..79
+    assert 0.9 * of < taken < of
+    assert about["model"] is None and about["downloaded"] == [] and about["network"] == []
+
+
+def test_a_checkpoint_that_cannot_start_a_detector_is_refused_in_one_line(checkpoints, generated_random, tmp_path,
+                                                                         capsys):
+    cases = [(checkpoints["garbage"], "garbage.pt: Ultralytics cannot load it ("),
+             (checkpoints["classify"], "an Ultralytics classify checkpoint; expected a detection checkpoint"),
+             (tmp_path / "yolo26n.pt", "yolo26n.pt: not found; expected a run folder of `synthua train` or an "
+                                       "Ultralytics checkpoint file")]
+    for path, found in cases:
+        assert main(["train", str(generated_random), "--init", str(path), "--epochs", "1", "--imgsz", "64",
+                     "--out", str(tmp_path / "out")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("synthua: error: --init: ") and found in err[0], err
+        assert not (tmp_path / "out").exists()
+
