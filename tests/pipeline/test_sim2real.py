@@ -231,3 +231,73 @@ def test_a_checkpoint_that_cannot_start_a_detector_is_refused_in_one_line(checkp
         assert len(err) == 1 and err[0].startswith("synthua: error: --init: ") and found in err[0], err
         assert not (tmp_path / "out").exists()
 
+
+# --- tools/sim2real.py end to end: every arm from one checkpoint ------------------------------------------------------
+
+def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path, capsys):
+    """The randomised dataset (train 2 images, val 4) as the synthetic set, as the stand-in "real" photos (its val
+    split the test) and as the mixed set of arm d; one real photo drawn; 4 image-steps a training at imgsz 64; one
+    seed (the seeds' spread is tested against NumPy in test_sim2real_plan.py). Hand-worked: (a) 4 / 2 images = 2
+    epochs; (b) and (c) 4 / 1 photo = 4 epochs; (d) 1 photo + 2 mixed: 4 / 3 = 1.33 -> 1 epoch, 3 image-steps."""
+    import importlib.util
+    import sys
+
+    from conftest import REPO
+
+    spec = importlib.util.spec_from_file_location("sim2real_e2e", REPO / "tools" / "sim2real.py")
+    tool = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = tool
+    spec.loader.exec_module(tool)
+    work = tmp_path / "work"
+    args = ["--synthetic", str(generated_random), "--synthetic-split", "none", "--stand-in", str(generated_random),
+            "--stand-in-test-split", "val", "--mix", str(generated_random), "--arms", "a,b,c,d", "--real-sizes", "1",
+            "--seeds", "0", "--budget-images", "4", "--imgsz", "64", "--batch", "2", "--device", "cpu",
+            "--init", str(checkpoints["detect"]), "--work", str(work)]
+    assert tool.main(args) == 0
+    doc = json.loads((work / "sim2real.json").read_text())
+    plan = doc["plan"]
+    assert (plan["synthetic_images"], plan["real_photos"], plan["mix_images"]) == (2, 2, {"1": 2})
+    runs = {r["name"]: r for r in doc["runs"]}
+    assert list(runs) == ["a_synthetic_s0", "b_n0001_s0", "c_n0001_s0", "d_n0001_s0"]
+    ckpt_sha = hashlib.sha256(checkpoints["detect"].read_bytes()).hexdigest()
+    for name, r in runs.items():
+        epochs, images = {"a": (2, 2), "b": (4, 1), "c": (4, 1), "d": (1, 3)}[r["arm"]]
+        about = json.loads((Path(r["run"]) / "train.json").read_text())
+        assert (r["epochs"], r["images"], r["image_steps"]) == (epochs, images, epochs * images), name
+        assert about["budget"]["epochs"] == r["epochs_done"] == epochs and about["seed"] == r["seed"] == 0
+        assert about["train_set"]["images"]["train"] == images and r["device"] == "cpu" and r["seconds"] > 0
+        assert r["command"].startswith("synthua train ") and f"--epochs {epochs} " in r["command"]
+        if r["arm"] == "c":        # (a)'s run of the same seed, fine-tuned
+            a_weights = Path(runs["a_synthetic_s0"]["run"]) / "weights.pt"
+            assert r["init"]["kind"] == "run" and r["init"]["sha256"] == hashlib.sha256(a_weights.read_bytes()).hexdigest()
+        else:                      # every other arm from the one checkpoint
+            assert r["init"]["kind"] == "checkpoint" and r["init"]["sha256"] == ckpt_sha
+            assert f"--init {checkpoints['detect'].resolve()}" in r["command"]
+        assert r["init"]["transferred"][0] > 0 and r["network"] == [] and r["downloaded"] == []
+    assert "d_n0001_s0: 4 image-steps / 3 images = 1.33 epochs, trained as 1: 3 image-steps (-25.0 %)" in doc["notes"]
+    assert "1 seed: a spread from fewer than 3 seeds is not a figure to quote" in doc["notes"]
+    # the subset is stated and linked; arm d's folder holds it and the mixed set
+    subset = json.loads((work / "subsets" / "n0001" / "subset.json").read_text())
+    assert subset["photos"] == doc["subsets"]["1"] and len(subset["photos"]) == 1
+    assert len(list((work / "mixed" / "n0001" / "images" / "train").iterdir())) == 3
+    # every run scored on the stand-in test, per class
+    assert {(s["arm"], s["class"]) for s in doc["summary"]} == {(a, c) for a in "abcd" for c in ("person", "wheelchair")}
+    for row in doc["scores"]:
+        s = next(s for s in doc["summary"] if (s["arm"], s["class"]) == (row["arm"], row["class"]))
+        assert s["AP50"]["mean"] == row["AP50"] and s["AP50"]["std"] is None and s["seeds"] == [0]
+    text = (work / "sim2real.md").read_text()
+    assert "| (d) real + mixed set | 1 + 2 mixed | 0 | 1 × 3 = 3 |" in text
+    assert "| (c) synthetic, then real | 1 | 0 | 4 × 1 = 4 after (a)'s 4 |" in text
+    assert "every arm from checkpoint yolo11n.pt (yolo11n.yaml, 80 classes" in text
+    assert (work / "sim2real.png").stat().st_size > 5000
+    # run again: every run and score is kept (nothing trains); another budget is refused on the first kept run
+    stamps = {n: (Path(r["run"]) / "train.json").stat().st_mtime_ns for n, r in runs.items()}
+    capsys.readouterr()
+    assert tool.main(args) == 0
+    out = capsys.readouterr().out
+    assert "sim2real: training" not in out and out.count("sim2real: kept ") == 4
+    assert stamps == {n: (Path(r["run"]) / "train.json").stat().st_mtime_ns for n, r in runs.items()}
+    assert json.loads((work / "sim2real.json").read_text())["scores"] == doc["scores"]
+    assert tool.main([a if a != "4" else "8" for a in args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "a_synthetic_s0: kept from an earlier run with epochs 2 (planned 4)" in err[0], err
