@@ -267,3 +267,11 @@ def test_stats_and_the_metadata_table_read_a_composite_dataset(unlabelled, tmp_p
     records = _records(unlabelled)
     assert table["pastes"] == [len(r["composite"]["pastes"]) for r in sorted(records, key=lambda r: r["id"])]
     assert table["fx"] == [r["camera"]["focal_px"] for r in sorted(records, key=lambda r: r["id"])]
+
+
+def test_help_teaches_with_examples(run_cli):
+    code, out, _ = run_cli("composite", "--help")
+    assert code == 0 and "synthua composite photos/ --bank bank/ --config configs/composite.json" in out
+    assert "BACKGROUNDS is a folder of photos without labels" in out and "box" in out
+    code, out, _ = run_cli("replay", "--help")
+    assert code == 0 and "synthua composite" in out
