@@ -15,9 +15,11 @@ step):
 2. **Shadows** of every paste on the photo: each pixel times ``1 - strength x (1 - shadow)``, the shadows of all
    pastes multiplied (they fall on the ground, under every paste).
 3. **Pastes**, far to near (their ``order``), each with its mode: ``hard`` (the paste covers exactly its labelled
-   pixels), ``feather`` (alpha x clip(d / feather_px, 0, 1), d the distance in pixels from the pixel to the nearest
-   one the paste does not label: the edge fades inwards, and nothing shows outside the labels), ``blur`` (alpha and premultiplied colour blurred by a Gaussian of ``sigma_px``) or
-   ``poisson`` (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px).
+   pixels, in its straight colour; a labelled pixel no sample of the cut-out covered, a spoke thinner than a pixel,
+   keeps the photo), ``feather`` (alpha x clip(d / feather_px, 0, 1), d the distance in pixels from the pixel to the
+   nearest one the paste does not label: the edge fades inwards, and nothing shows outside the labels), ``blur``
+   (alpha and premultiplied colour blurred by a Gaussian of ``sigma_px``) or ``poisson``
+   (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px).
 
 Labels: a pasted pixel takes the instance of the cut-out's ``ids`` there (nearest, :mod:`.cutout_pixels`), a nearer
 paste over a farther one; the photo's pixels are void (class 0, no instance). Amodal masks are each cut-out's own,
@@ -122,8 +124,10 @@ def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: 
         colour_b = ndimage.gaussian_filter(colour, (sigma, sigma, 0), mode="constant")
         return region * (1.0 - alpha_b)[..., None] + colour_b
     labelled = placed.ids > 0
-    straight = np.where(alpha[..., None] > 1e-6, colour / np.maximum(alpha, 1e-6)[..., None], 0.0)
-    hard = np.where(labelled[..., None], straight, region)
+    # a labelled pixel no sample covered (a spoke thinner than a pixel) has no colour: the photo shows there
+    covered = labelled & (alpha > 1e-6)
+    straight = colour / np.maximum(alpha, 1e-6)[..., None]
+    hard = np.where(covered[..., None], straight, region)
     if mode == "hard":
         return hard
     domain = ndimage.binary_dilation(labelled, iterations=POISSON_MARGIN_PX)

@@ -193,3 +193,20 @@ def test_depth_for_effects_puts_each_paste_at_its_distance(bank):
     ground = np.full((60, 80), 3.0, np.float32)
     depth = composite_depth(ground, painted, [7.5])
     assert (depth[painted.instance_ids > 0] == 7.5).all() and (depth[painted.instance_ids == 0] == 3.0).all()
+
+
+def test_a_labelled_pixel_no_sample_covered_keeps_the_photo(bank):
+    from synthua_usd.backends.cutout_pixels import CutoutPixels
+
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    premultiplied = pixels.premultiplied.copy()
+    premultiplied[30, 20:28] = 0.0                 # a row of the torso that no sample of the render hit
+    thin = CutoutPixels(pixels.rgba, pixels.ids, pixels.amodal, pixels.shadow, premultiplied)
+    photo = _photo()
+    anchor = (40.0, 50.0)                          # scale 1: cut-out pixel (u, v) is frame pixel (u + 16, v - 12)
+    painted = compose(photo, [PasteInput(entry, thin, _placement(entry, anchor, 1.0, 0))], ClassMap.default(),
+                      NO_MATCH)
+    assert (painted.instance_ids[18, 36:44] == 1).all()          # still labelled the person
+    np.testing.assert_array_equal(painted.rgb[18, 36:44], photo[18, 36:44])
+    assert np.abs(painted.rgb[18, 34].astype(int) - [200, 40, 40]).max() <= 1
