@@ -6,7 +6,8 @@ Order of operations, all in linear light (8-bit sRGB decoded by the sRGB curve, 
 step):
 
 1. **Gains** of each paste, measured on the photo as it came: the mean linear RGB of the photo in the paste's box
-   widened by ``surround_share`` of its size on every side (the paste's own pixels, alpha > 0, left out) against
+   widened by ``surround_share`` of its size on every side (every other pixel of every other row; the paste's own
+   pixels, alpha > 0, left out) against
    the paste's alpha-weighted mean colour. Exposure gain ``clip((Y_photo / Y_paste) ^ exposure_strength)``; white
    balance gains per channel ``(c_photo ^ white_balance_strength)``, with ``c = rgb / Y`` the chromaticity of the
    photo around the paste (grey world: the cast of its light, (1, 1, 1) for a neutral one), normalised to keep
@@ -94,7 +95,8 @@ def paste_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSet
     if ox0 < ox1 and oy0 < oy1:
         keep[oy0 - wy0:oy1 - wy0, ox0 - wx0:ox1 - wx0] &= placed.premultiplied[oy0 - ry0:oy1 - ry0,
                                                                                ox0 - rx0:ox1 - rx0, 3] <= 0
-    around = LINEAR_LUT[photo[wy0:wy1, wx0:wx1]][keep].astype(np.float64)
+    # every other pixel of every other row: the mean of a few thousand pixels, at a quarter of the cost
+    around = LINEAR_LUT[photo[wy0:wy1:2, wx0:wx1:2]][keep[::2, ::2]].astype(np.float64)
     weight = float(placed.premultiplied[..., 3].sum())
     if around.size == 0 or weight <= 0:
         return 1.0, [1.0, 1.0, 1.0]

@@ -62,10 +62,12 @@ def pasted_visibility(points: np.ndarray, instance_id: int, instance_ids: np.nda
     """(k,) COCO flags of a pasted cut-out's keypoints ``points`` (k, 3): frame x, y and the flag the cut-out gives
     (rendered alone). A keypoint outside the image, or not labelled, is 0; one the cut-out shows (2) stays 2 where
     ``instance_ids`` shows its instance within :data:`WINDOW_PX` pixels, and becomes 1 where a nearer paste covers
-    it; an occluded one (1) stays 1."""
+    it; an occluded one (1) stays 1. The pixel looked around is that of the coordinates as written (rounded as
+    :func:`coco_keypoints` rounds them), so that a reader checking the flags finds the same pixel."""
     height, width = instance_ids.shape
     flags = np.zeros(len(points), np.int64)
     for k, (x, y, v) in enumerate(np.asarray(points, np.float64)):
+        x, y = round(float(x), 2), round(float(y), 2)
         if v == 0 or not (0 <= x < width and 0 <= y < height):
             continue
         col, row = int(x), int(y)

@@ -180,7 +180,7 @@ def test_keypoint_visibility_follows_the_occluding_pastes(inputs, unlabelled):
                     if flag == 0 or not (0 <= x < WIDTH and 0 <= y < HEIGHT):
                         assert flat[3 * k: 3 * k + 3] == [0.0, 0.0, 0]
                         continue
-                    col, row = int(x), int(y)
+                    col, row = int(round(x, 2)), int(round(y, 2))  # the pixel of the coordinates as written
                     window = ids[max(0, row - WINDOW_PX):row + WINDOW_PX + 1, max(0, col - WINDOW_PX):col + WINDOW_PX + 1]
                     expected = 2 if flag == 2 and (window == gid).any() else 1
                     assert flat[3 * k + 2] == expected
