@@ -17,7 +17,8 @@ import zlib
 
 import numpy as np
 
-_SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "composite": 6}
+#: Each scope's number, never reused (6 to 8 are the cut-out bank's and framing's streams, on main).
+_SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "composite": 9}
 
 
 def _key(value) -> int:
