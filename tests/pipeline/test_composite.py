@@ -275,3 +275,23 @@ def test_help_teaches_with_examples(run_cli):
     assert "BACKGROUNDS is a folder of photos without labels" in out and "box" in out
     code, out, _ = run_cli("replay", "--help")
     assert code == 0 and "synthua composite" in out
+
+
+def test_a_coco_set_is_a_labelled_background_too(inputs, tmp_path):
+    photos = sorted((inputs / "photos").glob("*.png"))
+    coco = {"images": [{"id": k + 1, "file_name": p.name, "width": 96, "height": 72} for k, p in enumerate(photos)],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 7, "bbox": [20.0, 30.0, 12.0, 30.0],
+                             "iscrowd": 0}],
+            "categories": [{"id": 7, "name": "person"}]}
+    (inputs / "photos" / "coco.json").write_text(json.dumps(coco))
+    try:
+        out = _composite(inputs, "photos/coco.json", "out_coco", 1)
+    finally:
+        (inputs / "photos" / "coco.json").unlink()
+    records = _records(out)
+    assert {r["composite"]["background"]["layout"] for r in records} == {"coco"}
+    boxed = [r for r in records if r["composite"]["background"]["path"] == photos[0].name]
+    assert boxed and all(len(r["composite"]["background_boxes"]) == 1 for r in boxed)
+    box = boxed[0]["composite"]["background_boxes"][0]
+    # the 96x72 photo covers 64x48 at scale 2/3: x (20 - 0) * 2/3, y 30 * 2/3 - 0 (no cut), sizes * 2/3
+    assert box["label"] == "person" and box["bbox"] == pytest.approx([13.3333, 20.0, 8.0, 20.0], abs=1e-4)
