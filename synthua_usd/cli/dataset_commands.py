@@ -139,9 +139,10 @@ def verify(dataset: Path) -> int:
 @click.argument("dataset", type=click.Path(path_type=Path))
 @click.argument("image")
 def replay(dataset: Path, image: str) -> int:
-    """Render IMAGE (an image id or name) of DATASET again, as its generate.json says, and compare every
-    file with the dataset's file on disk byte for byte (each one that differs or is missing is listed).
-    Exit 0 when all are identical, 1 otherwise."""
+    """Render IMAGE (an image id or name) of DATASET again, as its generate.json says (a dataset of synthua
+    composite: make the composite again from the photos and bank it names), and compare every file with the
+    dataset's file on disk byte for byte (each one that differs or is missing is listed). Exit 0 when all are
+    identical, 1 otherwise."""
     from synthua_usd.pipeline.verify import replay as run_replay
 
     result = run_replay(dataset, image)

@@ -29,8 +29,8 @@ from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, onehot, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
-from synthua_usd.dataset.record import (IMAGE, ImageRecord, InstanceEntry, QAResult, RecordCamera, RecordRender,
-                                         check_record)
+from synthua_usd.dataset.record import (ImageRecord, InstanceEntry, QAResult, RecordCamera, RecordRender,
+                                         check_record, image_kind)
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.taxonomy import ClassMap
@@ -261,22 +261,11 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     name = image_name(planned.id, planned.camera_name, planned.time_code, planned.condition, planned.seed)
     split = planned.split
     cs = CityscapesName(job.city, job.camera_index.get(planned.camera_path, 0), planned.id)
-    files = {"rgb_png": Layout.rgb_png(split, name) if verdict != "rejected" else Layout.frame_file(name, "rgb_png"),
-             **{key: Layout.frame_file(name, key) for key in ("class", "semantic", "instance", "instance_preview")}}
-    arrays = {"rgb_png": display, "class": class_ids, "semantic": class_map.palette()[class_ids],
-              "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
+    yolo_text = (yolo.yolo_lines(instances, width, height, job.yolo_classes, instance_ids)
+                 if verdict != "rejected" else "")
+    files, arrays = label_files(name, split, cs, verdict == "rejected", display, class_ids, instance_ids,
+                                snapshot.instances, ignored, panoptic_png, yolo_text, class_map)
     if verdict != "rejected":
-        labels, instance_cs, colour = cityscapes.cityscapes_arrays(class_ids, instance_ids, snapshot.instances,
-                                                                  class_map, ignored)
-        files.update({"panoptic": Layout.panoptic_png(split, name),
-                      "cs_labelIds": Layout.cityscapes(split, cs, "labelIds"),
-                      "cs_instanceIds": Layout.cityscapes(split, cs, "instanceIds"),
-                      "cs_color": Layout.cityscapes(split, cs, "color"),
-                      "cs_leftImg8bit": Layout.cityscapes(split, cs, "leftImg8bit"),
-                      "yolo_label": Layout.yolo_label(split, name)})
-        arrays.update({"panoptic": panoptic_png, "cs_labelIds": labels, "cs_instanceIds": instance_cs,
-                       "cs_color": colour, "yolo_label": yolo.yolo_lines(instances, width, height,
-                                                                        job.yolo_classes, instance_ids)})
         outputs = job.config.outputs
         if outputs.depth:
             files["depth"] = Layout.frame_file(name, "depth")
@@ -315,6 +304,31 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     return ImageBuffers(record, arrays, verdict == "rejected", seconds)
 
 
+def label_files(name: str, split: str, cs: CityscapesName, rejected: bool, display: np.ndarray, class_ids: np.ndarray,
+                instance_ids: np.ndarray, scene_instances, ignored: set[int], panoptic_png: np.ndarray,
+                yolo_text: str, class_map: ClassMap) -> tuple[dict, dict]:
+    """The image's files (key -> path in the dataset) and their contents (key -> array or text): the RGB image,
+    class ids, class colours, instance ids and preview; unless ``rejected`` also the panoptic PNG, the Cityscapes
+    files (label ids, instance ids, colours, the RGB image's link) and the YOLO labels ``yolo_text``. What a
+    rendered image and a composite (:mod:`synthua_usd.pipeline.composite_worker`) write alike."""
+    files = {"rgb_png": Layout.rgb_png(split, name) if not rejected else Layout.frame_file(name, "rgb_png"),
+             **{key: Layout.frame_file(name, key) for key in ("class", "semantic", "instance", "instance_preview")}}
+    arrays = {"rgb_png": display, "class": class_ids, "semantic": class_map.palette()[class_ids],
+              "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
+    if not rejected:
+        labels, instance_cs, colour = cityscapes.cityscapes_arrays(class_ids, instance_ids, scene_instances,
+                                                                  class_map, ignored)
+        files.update({"panoptic": Layout.panoptic_png(split, name),
+                      "cs_labelIds": Layout.cityscapes(split, cs, "labelIds"),
+                      "cs_instanceIds": Layout.cityscapes(split, cs, "instanceIds"),
+                      "cs_color": Layout.cityscapes(split, cs, "color"),
+                      "cs_leftImg8bit": Layout.cityscapes(split, cs, "leftImg8bit"),
+                      "yolo_label": Layout.yolo_label(split, name)})
+        arrays.update({"panoptic": panoptic_png, "cs_labelIds": labels, "cs_instanceIds": instance_cs,
+                       "cs_color": colour, "yolo_label": yolo_text})
+    return files, arrays
+
+
 def camera_document(camera, planned, render_w: int, render_h: int, width: int, height: int) -> RecordCamera:
     """Intrinsics at the written size (K scaled from the render size) and extrinsics."""
     K = camera.intrinsics(render_w, render_h).copy()
@@ -329,7 +343,7 @@ def camera_document(camera, planned, render_w: int, render_h: int, width: int, h
                         distortion=camera.distortion.to_dict() if camera.distortion is not None else None)
 
 
-_WRITERS = {
+WRITERS = {
     "rgb_png": lambda path, data: images.write_color_png(path, data),
     "class": images.write_id_png,
     "semantic": images.write_color_png,
@@ -344,8 +358,11 @@ _WRITERS = {
 }
 
 
-def write_image(state: WorkerState, image: ImageBuffers) -> dict:
-    """Write every file of ``image`` (each atomically), then its record; returns the worker's result."""
+def write_image(state: WorkerState, image: ImageBuffers, writers: dict | None = None) -> dict:
+    """Write every file of ``image`` (each atomically, by ``writers``: key -> function(path, data); default
+    :data:`WRITERS`), then its record; returns the worker's result. ``state`` needs ``job.out_dir``, ``writer`` and
+    ``class_map`` only (a composite worker's state has them too)."""
+    writers = WRITERS if writers is None else writers
     t0 = time.perf_counter()
     layout = Layout(Path(state.job.out_dir))
     record = image.record
@@ -364,14 +381,14 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
             jobs.append(state.writer.encoders.submit(
                 _timed, lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)), path, data))
         else:
-            jobs.append(state.writer.encoders.submit(_timed, _WRITERS[key], path, data))
+            jobs.append(state.writer.encoders.submit(_timed, writers[key], path, data))
     spent = {}
     for key, job in zip([k for k in targets if k != "cs_leftImg8bit"], jobs):
         spent[f"write_{key}"] = job.result()[1]  # seconds of an encoder thread (it overlaps the next render)
     if "cs_leftImg8bit" in targets:
         _link_or_copy(targets["rgb_png"], targets["cs_leftImg8bit"])
     record["checksums"] = {key: file_entry(layout.root, rel) for key, rel in sorted(record["files"].items())}
-    check_record(record, IMAGE, Layout.record(record["name"]))
+    check_record(record, image_kind(record), Layout.record(record["name"]))
     record_path = layout.path(Layout.record(record["name"]))
     record_path.parent.mkdir(parents=True, exist_ok=True)
     write_json_atomic(record_path, record, indent=1)

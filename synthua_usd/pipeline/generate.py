@@ -471,10 +471,11 @@ def _complete_records(layout: Layout, plan) -> dict[int, ImageRecord]:
     return done
 
 
-def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, config: GenerationConfig,
-             job_document: dict, frames: dict | None = None) -> None:
+def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, config: GenerationConfig | None,
+             job_document: dict, frames: dict | None = None, provenance: dict | None = None) -> None:
     """Every dataset-level file, from the records alone (the images', and the sequences' ``frames``: (sequence,
-    frame) -> record); the manifest last."""
+    frame) -> record); the manifest last. Another command's dataset (``synthua composite``) gives its own
+    ``provenance`` and no generation ``config`` (no quotas, districts or sequences)."""
     root = layout.root
     written = []
     for split in SPLITS:
@@ -491,11 +492,13 @@ def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, co
         records, config, job_document.get("quota_targets"), job_document.get("pool"))))
     written.append(tables.write_rejected(records, layout.path(Layout.REJECTED)))
     written.append(_write_json(layout.path(Layout.CLASS_MAP), class_map.document()))
-    key = job_document["job_key"]
-    provenance = {**_versions(key["variant"]), "config": key["config"], "config_digest": document_digest(key["config"]),
-                  "scenario": Path(job_document["scenario"]).name, "layer_stack": job_document["layer_stack"]}
+    if provenance is None:
+        key = job_document["job_key"]
+        provenance = {**_versions(key["variant"]), "config": key["config"],
+                      "config_digest": document_digest(key["config"]), "scenario": Path(job_document["scenario"]).name,
+                      "layer_stack": job_document["layer_stack"]}
     images = [{"id": r["id"], "name": r["name"], "split": r["split"], "seed": r["seed"],
-               "layer_stack": r["layer_stack"], "qa": r["qa"]["verdict"],
+               **({"layer_stack": r["layer_stack"]} if "layer_stack" in r else {}), "qa": r["qa"]["verdict"],
                "files": [r["checksums"][k] for k in sorted(r["checksums"])]
                + [file_entry(root, Layout.record(r["name"]))]} for r in records]
     dataset_files = [file_entry(root, p.relative_to(root).as_posix()) for p in written]
@@ -504,7 +507,7 @@ def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, co
 
     dataset_files += [file_entry(root, p.relative_to(root).as_posix()) for p in sorted((root / SCENES_FOLDER).rglob("*"))
                       if p.is_file()] if (root / SCENES_FOLDER).is_dir() else []
-    if config.sequences is not None:
+    if config is not None and config.sequences is not None:
         from synthua_usd.dataset.sequences import PlannedSequence
         from synthua_usd.pipeline.sequences import assemble_sequences, sequence_files
 

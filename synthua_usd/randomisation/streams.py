@@ -6,7 +6,9 @@ which worker renders the image, nor on what it rendered before) and one scope's 
 - ``scene``: (seed) the crowd's cast and looks, the devices, the twin's material variants;
 - ``view``: (seed, camera, time code) the camera's jitter, then where each person stands;
 - ``light``: (seed, camera, time code, condition) the sun, sky and exposure;
-- ``effects``: (seed, camera, time code, condition) the camera effects applied after rendering.
+- ``effects``: (seed, camera, time code, condition) the camera effects applied after rendering (a composite's:
+  (its number, background path));
+- ``composite``: (its number, background path) a composite's camera model and pastes (``synthua composite``).
 """
 
 from __future__ import annotations
@@ -15,8 +17,9 @@ import zlib
 
 import numpy as np
 
+#: Each scope's number, never reused.
 _SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "cutout_group": 6, "cutout_view": 7,
-           "framing": 8}
+           "framing": 8, "composite": 9}
 
 
 def _key(value) -> int:
