@@ -85,8 +85,8 @@ def test_boxes_outside_their_image(case, run_cli):
             "annotations": [{"id": 1, "image_id": 1, "category_id": 1, "bbox": [80, 10, 30, 20]}],
             "categories": [{"id": 1, "name": "person"}]}
     (case / "labelled" / "images" / "coco.json").write_text(json.dumps(coco))
-    _refused(run_cli, case, case / "labelled" / "images" / "coco.json", "photo_00.png: box 0 (person)",
-             "expected a box inside the 96x72 image")
+    _refused(run_cli, case, case / "labelled" / "images" / "coco.json", "annotations[0].bbox: [80, 10, 30, 20]",
+             "expected a box inside its image photo_00.png (96x72 pixels)")
 
 
 def test_a_bank_of_another_version_or_with_a_damaged_file(case, run_cli):
