@@ -21,7 +21,13 @@ from synthua_usd.cli.dataset_commands import worker_time_shares
               help="Dataset folder: created (an existing one must be empty).")
 @click.option("--workers", type=click.IntRange(1, 1024),
               help="Worker processes [default: the config's, else one per CPU core].")
-def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, workers: int | None) -> int:
+@click.option("--split", type=click.Choice(["default", "train", "val", "test", "all"]), default="default",
+              show_default=True,
+              help="Which photos of a labelled YOLO set: default is its train split where it names one (its val and "
+                   "test photos are what a detector trained on the composites is scored on: pasting into them "
+                   "would leak), else all.")
+def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, workers: int | None,
+              split: str) -> int:
     """Paste the cut-outs of --bank onto the photos of BACKGROUNDS, as --config says, into the dataset --out.
 
     \b
@@ -33,7 +39,8 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
       synthua replay out/composites 7          # make composite 7 again: byte-identical
     \b
     BACKGROUNDS is a folder of photos without labels (empty streets, corridors, CCTV frames), or a labelled
-    YOLO set (data.yaml, or images/ + labels/) or COCO .json whose boxes are kept. Photos are read in place.
+    YOLO set (data.yaml, or images/ + labels/: its train split unless --split says otherwise) or COCO .json
+    whose boxes are kept. Photos are read in place.
     \b
     Per composite: the photo scaled down and cut to the config's output size; a camera model (horizon row,
     camera height, focal length: from the config, its per-folder defaults, or the photo's EXIF); cut-outs
@@ -52,7 +59,8 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     from synthua_usd.pipeline.composite import CompositeRequest, composite as run_composite
 
     s = run_composite(CompositeRequest(backgrounds=backgrounds, bank=bank, config_path=config_path,
-                                       out_dir=out_dir, workers=workers), show_progress=sys.stderr.isatty())
+                                       out_dir=out_dir, workers=workers, split=split),
+                     show_progress=sys.stderr.isatty())
     kind = "labelled" if s.labelled else "unlabelled (their pixels void, no boxes of their own)"
     say(f"dataset {s.out_dir}: {s.images - s.rejected} composites ({s.flagged} flagged by QA) and {s.rejected} "
         f"rejected by QA, from {s.backgrounds} {kind} photos; {s.pastes} pastes")

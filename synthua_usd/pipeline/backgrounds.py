@@ -3,8 +3,10 @@
 BACKGROUNDS is one of:
 
 * a folder of photos without labels (every JPEG, PNG, TIFF, BMP, WebP and HEIC file below it, in path order);
-* a labelled Ultralytics YOLO set (a ``data.yaml``, or a folder holding one or ``images/`` + ``labels/``): every
-  split it names, read by :func:`synthua_usd.analytics.detection_sets.read_yolo`;
+* a labelled Ultralytics YOLO set (a ``data.yaml``, or a folder holding one or ``images/`` + ``labels/``): its
+  ``train`` split where it has one (a set's val and test photos are what a detector trained on its composites is
+  scored on: pasting into them would leak), another split or all of them when asked, read by
+  :func:`synthua_usd.analytics.detection_sets.read_yolo`;
 * a COCO instances ``.json`` (its images in the file's folder): :func:`synthua_usd.analytics.detection_sets.read_coco`.
 
 Photos are read in place, never copied: a background is named by its path relative to the set's folder (the
@@ -21,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from synthua_usd.analytics.detection_sets import IMAGE_SUFFIXES, MAX_IMAGES, TOLERANCE, Box, label_path, read_coco, \
-    read_yolo
+    read_data_yaml, read_yolo
 from synthua_usd.analytics.detection_sets import ALL_SPLITS
 from synthua_usd.analytics.detection_sources import detect_format
 from synthua_usd.backends.photos import HEIC_SUFFIXES, cover_region, photo_header
@@ -72,11 +74,12 @@ def _photos_below(folder: Path) -> list[Path]:
     return found
 
 
-def _check_yolo_labels(root: Path, images: list[Path]) -> None:
-    """Every label file of a YOLO folder names an image of the set (``labels/.../x.txt`` needs ``images/.../x.*``)."""
+def _check_yolo_labels(root: Path, images: list[Path], whole: bool = True) -> None:
+    """Every label file of a YOLO folder names an image of the set (``labels/.../x.txt`` needs ``images/.../x.*``):
+    of its whole ``labels/`` folder when ``whole`` (every split read), else of the read images' label folders."""
     expected = {label_path(p).resolve() for p in images}
-    for labels in sorted({label_path(p).parent for p in images} | ({root / "labels"} if (root / "labels").is_dir()
-                                                                   else set())):
+    for labels in sorted({label_path(p).parent for p in images} | ({root / "labels"} if whole and (root / "labels")
+                                                                   .is_dir() else set())):
         if not labels.is_dir():
             continue
         for label in sorted(labels.rglob("*.txt")):
@@ -93,9 +96,25 @@ def _check_boxes(image: Path, boxes: tuple[Box, ...], width: int, height: int) -
                              f"a box inside the {width}x{height} image")
 
 
-def read_backgrounds(path: str | Path, output: tuple[int, int] | None) -> BackgroundSet:
+#: ``split`` of :func:`read_backgrounds`: a labelled YOLO set's train split where it names one, else all its photos.
+DEFAULT_SPLIT = "default"
+SPLIT_CHOICES = (DEFAULT_SPLIT, "train", "val", "test", ALL_SPLITS)
+
+
+def _yolo_split(path: Path, split: str) -> str:
+    """The split of the YOLO set at ``path`` that ``split`` (:data:`SPLIT_CHOICES`) reads."""
+    if split != DEFAULT_SPLIT:
+        return split
+    yaml = path if path.is_file() else path / "data.yaml"
+    if yaml.is_file():
+        return "train" if read_data_yaml(yaml).get("train") else ALL_SPLITS
+    return "train" if (path / "images" / "train").is_dir() else ALL_SPLITS
+
+
+def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: str = DEFAULT_SPLIT) -> BackgroundSet:
     """The background set at ``path`` (see the module docstring), every photo's header checked against
-    ``output`` (W, H; None: any size)."""
+    ``output`` (W, H; None: any size); of a labelled YOLO set, the photos of ``split`` (:data:`SPLIT_CHOICES`;
+    the default: its train split where it names one, else all)."""
     path = Path(path)
     if not path.exists():
         raise InputError(f"{shown(path)}: not found; expected a folder of photos, a YOLO set or a COCO .json")
@@ -113,9 +132,10 @@ def read_backgrounds(path: str | Path, output: tuple[int, int] | None) -> Backgr
             raise InputError(f"{shown(path)}: no photos; expected JPEG, PNG, TIFF, BMP, WebP or HEIC files below it")
         images, names = [(p, (), None) for p in paths], ()
     elif layout == "yolo":
-        found = read_yolo(path, ALL_SPLITS)
+        chosen = _yolo_split(path, split)
+        found = read_yolo(path, chosen)
         folder = (path if path.is_dir() else path.parent).resolve()
-        _check_yolo_labels(folder, [Path(i.path) for i in found.images])
+        _check_yolo_labels(folder, [Path(i.path) for i in found.images], whole=chosen == ALL_SPLITS)
         images, names = [(Path(i.path), i.boxes, (i.width, i.height)) for i in found.images], found.names
     else:
         found = read_coco(path)

@@ -39,7 +39,7 @@ from synthua_usd.dataset.formats import cityscapes
 from synthua_usd.dataset.layout import Layout, cityscapes_city, composite_name
 from synthua_usd.dataset.manifest import document_digest
 from synthua_usd.dataset.sampling import split_of
-from synthua_usd.pipeline.backgrounds import BackgroundSet, read_backgrounds
+from synthua_usd.pipeline.backgrounds import DEFAULT_SPLIT, BackgroundSet, read_backgrounds
 from synthua_usd.pipeline.composite_worker import CompositeJob, PlannedComposite
 
 #: Composites a worker makes before its shard ends and it takes the next.
@@ -55,6 +55,8 @@ class CompositeRequest:
     config_path: Path
     out_dir: Path
     workers: int | None = None
+    #: Which photos of a labelled YOLO set (backgrounds.SPLIT_CHOICES; default: its train split where it has one).
+    split: str = DEFAULT_SPLIT
 
 
 @dataclass
@@ -133,7 +135,7 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
     cityscapes.check_class_map(bank.class_map)
     out = Path(request.out_dir)
     _check_out(out)
-    backgrounds = read_backgrounds(request.backgrounds, config.output)
+    backgrounds = read_backgrounds(request.backgrounds, config.output, request.split)
     _check_classes(backgrounds, config, bank, str(request.config_path))
     plan = plan_composites(backgrounds, config)
     workers = request.workers or config.workers or default_workers()
@@ -142,7 +144,7 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
     job_key["config"].pop("workers")
     job_document = {"synthua": __version__, "command": COMMAND, "job_key": job_key,
                     "job_key_digest": document_digest(job_key), "backgrounds": str(Path(request.backgrounds).resolve()),
-                    "backgrounds_layout": backgrounds.layout, "bank": str(Path(request.bank).resolve()),
+                    "backgrounds_layout": backgrounds.layout, "backgrounds_split": request.split, "bank": str(Path(request.bank).resolve()),
                     "plan": [p.to_dict() for p in plan]}
     summary = CompositeSummary(out_dir=out, backgrounds=len(backgrounds.images), labelled=backgrounds.labelled,
                                workers=workers)
@@ -199,7 +201,8 @@ def remake(job_document: dict, planned: dict, out_dir: Path) -> dict:
 
     try:
         config = CompositeConfig.from_document(job_document["job_key"]["config"], source="generate.json")
-        backgrounds = read_backgrounds(job_document["backgrounds"], config.output)
+        backgrounds = read_backgrounds(job_document["backgrounds"], config.output,
+                                       job_document.get("backgrounds_split", DEFAULT_SPLIT))
         item = PlannedComposite(**planned)
         job = CompositeJob(out_dir=str(out_dir), config_document=job_document["job_key"]["config"],
                            class_map_document=job_document["job_key"]["class_map"], bank_root=job_document["bank"],

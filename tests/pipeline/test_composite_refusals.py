@@ -114,3 +114,23 @@ def test_a_config_field_and_an_out_that_is_not_empty(case, run_cli):
     (case / "full" / "mine.txt").write_text("keep me")
     _refused(run_cli, case, case / "photos", "full: not empty", "expected an empty folder", out=case / "full")
     assert (case / "full" / "mine.txt").read_text() == "keep me"
+
+
+def test_a_yolo_sets_val_photos_are_not_pasted_into_unless_asked(tmp_path):
+    """The photos a detector trained on composites is scored on must not become composites: of a YOLO data.yaml
+    naming train and val splits, only the train photos are backgrounds by default."""
+    from synthua_usd.pipeline.backgrounds import read_backgrounds
+
+    root = tmp_path / "set"
+    from PIL import Image
+
+    for split, names in (("train", ("a", "b")), ("val", ("c",))):
+        (root / "images" / split).mkdir(parents=True)
+        (root / "labels" / split).mkdir(parents=True)
+        for name in names:
+            Image.new("RGB", (96, 72), (120, 120, 120)).save(root / "images" / split / f"{name}.png")
+            (root / "labels" / split / f"{name}.txt").write_text("0 0.5 0.5 0.2 0.4\n")
+    (root / "data.yaml").write_text("path: .\ntrain: images/train\nval: images/val\nnames:\n  0: person\n")
+    assert [b.relative for b in read_backgrounds(root, (64, 48)).images] == ["images/train/a.png", "images/train/b.png"]
+    assert [b.relative for b in read_backgrounds(root, (64, 48), "val").images] == ["images/val/c.png"]
+    assert len(read_backgrounds(root, (64, 48), "all").images) == 3
