@@ -135,7 +135,7 @@ def checked_image_size(path: Path, whole: bool = True) -> tuple[int, int]:
 
 # --- Ultralytics YOLO ----------------------------------------------------------------------------------------
 
-def _yaml(path: Path) -> dict:
+def read_data_yaml(path: Path) -> dict:
     text = read_input_text(path, MAX_DOCUMENT_BYTES, "an Ultralytics data.yaml")
     try:
         doc = yaml.safe_load(text)
@@ -305,7 +305,7 @@ def read_yolo(data_yaml: str | Path, split: str | None = None) -> DetectionSet:
     if data_yaml.is_dir():
         data_yaml = data_yaml / "data.yaml"
     where = shown(data_yaml)
-    doc = _yaml(data_yaml)
+    doc = read_data_yaml(data_yaml)
     names = yolo_names(doc, where)
     base = data_yaml.parent
     if isinstance(doc.get("path"), str) and doc["path"]:

@@ -1,4 +1,5 @@
-"""The boxes a detector is trained on, derived from a generated dataset's records.
+"""The boxes a detector is trained on, derived from a generated dataset's records (a composite's too: its pasted
+instances', and the boxes of its labelled photo that the pastes left visible).
 
 A real photo's ``wheelchair`` box is drawn around what a person sees as "a wheelchair" in the street: the chair
 *with the person sitting in it* (the Mobility Aids dataset of Vasquez et al., 2017, and the public "wheelchair"
@@ -129,6 +130,23 @@ def image_boxes(instances: list[dict], targets: DetectionTargets) -> tuple[Box, 
     return tuple(out)
 
 
+def background_boxes(record: dict, targets: DetectionTargets) -> tuple[Box, ...]:
+    """The kept boxes of a composite's labelled photo (its record's ``composite.background_boxes``) whose class is
+    trained, as labelled there (in the photo set's own box convention); none for a rendered image."""
+    wanted, out = set(targets.classes), []
+    for box in (record.get("composite") or {}).get("background_boxes", ()):
+        if box["kept"] and box["class_name"] in wanted:
+            x, y, w, h = (float(v) for v in box["bbox"])
+            out.append(Box(box["class_name"], x, y, w, h, ignore=h < targets.min_height_px))
+    return tuple(out)
+
+
+def record_boxes(record: dict, targets: DetectionTargets) -> tuple[Box, ...]:
+    """Every target box of one image record: its instances' (:func:`image_boxes`), then a composite's photo's own
+    (:func:`background_boxes`)."""
+    return image_boxes(record["instances"], targets) + background_boxes(record, targets)
+
+
 def read_generated(root, split: str | None, targets: DetectionTargets) -> DetectionSet:
     """The target boxes of the images of ``split`` (every split when None) of a dataset ``synthua generate``
     wrote; images QA rejected are left out, as every training format leaves them out."""
@@ -152,7 +170,7 @@ def read_generated(root, split: str | None, targets: DetectionTargets) -> Detect
         path = layout.path(Layout.record(name))
         record = read_json(path, "an image record")
         try:
-            boxes = image_boxes(record["instances"], targets)
+            boxes = record_boxes(record, targets)
             width, height = int(record["width"]), int(record["height"])
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"{shown(path)}: {type(exc).__name__} {exc}; expected an image record written by "

@@ -246,3 +246,38 @@ def distribution_comparison(samples: dict, rows: list[str], measures: list[str],
     fig.suptitle("Ours against the real set: empirical distribution functions (KS statistic D)")
     fig.tight_layout()
     return _save(fig, path)
+
+
+def low_data_curve(panels: dict[str, dict[str, dict]], title: str, path: Path, measure: str = "AP50") -> Path:
+    """One panel per class (``panels``: class -> arm label -> series): a series with ``x`` (real training images)
+    draws its ``mean`` as a line with markers and its ``lo``..``hi`` (e.g. the seeds' min and max) as error bars and
+    shaded; one without ``x`` (an arm that sees no real image) is a dashed level across the panel, its range shaded the
+    same way. Values are fractions, drawn in %; x on a log scale, ticked at the sizes."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, max(1, len(panels)), figsize=(5.2 * max(1, len(panels)), 4.2), squeeze=False)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    sizes = sorted({x for series in panels.values() for s in series.values() for x in (s.get("x") or [])})
+    for ax, (name, series) in zip(axes[0], panels.items()):
+        for k, (label, s) in enumerate(series.items()):
+            colour = colours[k % len(colours)]
+            mean, lo, hi = (100 * np.asarray(s[key], dtype=float) for key in ("mean", "lo", "hi"))
+            if s.get("x"):
+                ax.errorbar(s["x"], mean, yerr=[mean - lo, hi - mean], fmt="o-", capsize=3, color=colour, label=label)
+                ax.fill_between(s["x"], lo, hi, color=colour, alpha=0.2, linewidth=0)
+            else:
+                ax.axhline(float(mean[0]), color=colour, linestyle="--", label=label)
+                ax.axhspan(float(lo[0]), float(hi[0]), color=colour, alpha=0.15, linewidth=0)
+        if len(sizes) > 1:
+            ax.set_xscale("log")
+        if sizes:
+            ax.set_xticks(sizes)
+            ax.set_xticklabels([str(x) for x in sizes])
+            ax.minorticks_off()
+        ax.set_xlabel("real training images")
+        ax.set_ylabel(f"{name} {measure} (%)")
+        ax.set_ylim(0, max(1.0, ax.get_ylim()[1]))      # all zeros still shows a scale in %
+        ax.grid(alpha=0.3)
+        ax.set_title(name)
+        ax.legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, path)

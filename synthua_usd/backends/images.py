@@ -72,9 +72,19 @@ def write_display_png(path: Path, rgb: np.ndarray) -> Path:
     return _write(path, linear_to_display(rgb), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE})
 
 
-def write_color_png(path: Path, rgb8: np.ndarray) -> Path:
-    """(H, W, 3) uint8 sRGB values written as they are (class colours)."""
-    return _write(path, rgb8.astype(np.uint8), "uint8", {"oiio:ColorSpace": DISPLAY_SPACE})
+#: zlib level of a fast PNG (``compression=FAST_PNG``): about 3x faster to write than OpenImageIO's default (6) for
+#: a 640x480 photo, 6 % larger (measured 24 against 70 ms, 464 against 438 kB).
+FAST_PNG = 1
+
+
+def _png(attributes: dict, compression: int | None) -> dict:
+    return attributes if compression is None else {**attributes, "png:compressionLevel": int(compression)}
+
+
+def write_color_png(path: Path, rgb8: np.ndarray, compression: int | None = None) -> Path:
+    """(H, W, 3) uint8 sRGB values written as they are (class colours); ``compression`` the zlib level (None:
+    OpenImageIO's default)."""
+    return _write(path, rgb8.astype(np.uint8), "uint8", _png({"oiio:ColorSpace": DISPLAY_SPACE}, compression))
 
 
 def write_rgba_png(path: Path, rgba8: np.ndarray) -> Path:
@@ -89,10 +99,11 @@ def write_color_jpeg(path: Path, rgb8: np.ndarray, quality: int = 95) -> Path:
                                                          "compression": f"jpeg:{int(quality)}"})
 
 
-def write_id_png(path: Path, ids: np.ndarray) -> Path:
-    """(H, W) uint8 or uint16 ids written raw: no colour conversion, one channel."""
+def write_id_png(path: Path, ids: np.ndarray, compression: int | None = None) -> Path:
+    """(H, W) uint8 or uint16 ids written raw: no colour conversion, one channel; ``compression`` as
+    :func:`write_color_png`'s."""
     fmt = "uint8" if ids.dtype == np.uint8 else "uint16"
-    return _write(path, ids, fmt, {"oiio:ColorSpace": "Raw"}, channel_names=["Y"])
+    return _write(path, ids, fmt, _png({"oiio:ColorSpace": "Raw"}, compression), channel_names=["Y"])
 
 
 def write_depth_exr(path: Path, depth: np.ndarray, description: str) -> Path:

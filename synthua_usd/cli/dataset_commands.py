@@ -12,12 +12,16 @@ from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, say
 
 def worker_time_shares(seconds: dict[str, float]) -> str:
     """"render 80 % (rgb 50 %, ...), annotate 10 %, write 10 %": the workers' time by phase. ``render`` holds its
-    ``render_*`` parts (where the render time went), so the whole is the phases without the parts."""
-    busy = sum(v for k, v in seconds.items() if not k.startswith("render_")) or 1.0
+    ``render_*`` parts (where the render time went), so the whole is the phases without the parts (``write_*``, the
+    encoders' seconds per file, overlap the next render: they are left to the benchmarks)."""
+    def part(key: str) -> bool:
+        return key.startswith(("render_", "write_"))
+
+    busy = sum(v for k, v in seconds.items() if not part(k)) or 1.0
     parts = ", ".join(f"{k[len('render_'):]} {100 * v / busy:.0f} %" for k, v in seconds.items()
                       if k.startswith("render_") and v > 0)
     return ", ".join(f"{k} {100 * v / busy:.0f} %" + (f" ({parts})" if k == "render" and parts else "")
-                     for k, v in seconds.items() if not k.startswith("render_"))
+                     for k, v in seconds.items() if not part(k))
 
 
 @click.command()
@@ -135,9 +139,10 @@ def verify(dataset: Path) -> int:
 @click.argument("dataset", type=click.Path(path_type=Path))
 @click.argument("image")
 def replay(dataset: Path, image: str) -> int:
-    """Render IMAGE (an image id or name) of DATASET again, as its generate.json says, and compare every
-    file with the dataset's file on disk byte for byte (each one that differs or is missing is listed).
-    Exit 0 when all are identical, 1 otherwise."""
+    """Render IMAGE (an image id or name) of DATASET again, as its generate.json says (a dataset of synthua
+    composite: make the composite again from the photos and bank it names), and compare every file with the
+    dataset's file on disk byte for byte (each one that differs or is missing is listed). Exit 0 when all are
+    identical, 1 otherwise."""
     from synthua_usd.pipeline.verify import replay as run_replay
 
     result = run_replay(dataset, image)

@@ -19,6 +19,7 @@ from synthua_usd.cli.analytics_commands import evaluate, stats
 from synthua_usd.cli.cameras_commands import cameras
 from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map, say
 from synthua_usd.cli.cutout_commands import cutouts
+from synthua_usd.cli.composite_commands import composite
 from synthua_usd.cli.common import parse_time_codes as _time_codes
 from synthua_usd.cli.dataset_commands import generate, replay, verify
 from synthua_usd.cli.failures import configure_logging, guarded
@@ -275,8 +276,8 @@ def render(scenario: Path, cameras: tuple[str, ...], time_codes: tuple[float, ..
     return EXIT_OK
 
 
-for _group in (twin, agents, cameras, survey, contact_sheet, generate, verify, replay, randomise, stats, evaluate, train,
-               evaluate_real, cutouts):
+for _group in (twin, agents, cameras, survey, contact_sheet, generate, cutouts, composite, verify, replay, randomise, stats,
+               evaluate, train, evaluate_real):
     cli.add_command(_group)
 
 

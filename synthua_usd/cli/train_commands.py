@@ -35,7 +35,10 @@ _DEVICE = click.Choice(L.DEVICES)
               help="Architecture shipped inside the Ultralytics wheel, trained from scratch (e.g. yolo26s.yaml, "
                    "yolo11n.yaml); no weights are downloaded.")
 @click.option("--init", "init", type=click.Path(path_type=Path),
-              help="Start from the weights of an earlier run folder (fine-tuning), instead of from scratch.")
+              help="Start from these weights instead of from scratch (--model): an Ultralytics checkpoint file on "
+                   "this machine, e.g. a COCO-pretrained yolo11n.pt or yolo26n.pt (the usual start; its architecture "
+                   "is the checkpoint's), or a run folder of `synthua train` (fine-tuning). Nothing is downloaded: "
+                   "a missing file is refused. train.json records its kind, path and SHA-256.")
 @click.option("--convention", type=click.Choice(list(CONVENTIONS)),
               help="Box convention of a generated TRAIN_SET, named: " + "; ".join(
                   f"{name}: {c.about}" for name, c in CONVENTIONS.items())
@@ -64,7 +67,8 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
           seed: int, model: str, init: Path | None, convention: str | None, classes: str | None, aid_box: str | None,
           aid_users_as_person: bool | None, min_height_px: float, fmt: str, images_dir: Path | None,
           python: Path | None) -> int:
-    """Train an object detector (Ultralytics YOLO, from scratch) on TRAIN_SET within a bounded budget.
+    """Train an object detector (Ultralytics YOLO) on TRAIN_SET within a bounded budget, from scratch or from
+    weights (--init).
 
     \b
     Examples:
@@ -72,6 +76,7 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
       synthua train out/sim2real --minutes 30 --imgsz 320 --out out/runs/synthetic
       synthua evaluate-real out/runs/synthetic real_photos/ --out out/eval_real
       synthua train real_photos/ --init out/runs/synthetic --minutes 10 --out out/runs/finetuned
+      synthua train real_photos/ --init ~/weights/yolo11n.pt --epochs 50 --out out/runs/from_coco
       synthua train out/sim2real --convention wheelchair-sets --out out/runs/as_wheelchair_sets
     \b
     TRAIN_SET is a dataset `synthua generate` wrote (trained on its train split; boxes from its records: by
@@ -86,6 +91,7 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
     library versions.
     """
     from synthua_usd.analytics.detection_targets import targets_for
+    from synthua_usd.pipeline.init_weights import describe
     from synthua_usd.pipeline.train import Budget, TrainRequest
     from synthua_usd.pipeline.train import train as run
 
@@ -98,7 +104,7 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
     losses = ", ".join(f"{k.split('/')[-1]} {float(v):.3f}" for k, v in final.items() if k.startswith("train/"))
     images = doc["train_set"]["images"]
     click.echo(f"trained {', '.join(doc['classes'])} on {images['train']} images (validated on {images['val']}) "
-               f"for {doc['epochs_done']} epochs in {doc['seconds']:.0f} s "
+               f"from {describe(doc['init'], doc['model'])} for {doc['epochs_done']} epochs in {doc['seconds']:.0f} s "
                f"on {doc['device']} (Ultralytics {doc['versions']['ultralytics']}, torch {doc['versions']['torch']})"
                f"{': ' + losses if losses else ''}")
     click.echo(f"-> {out_dir}")

@@ -52,7 +52,7 @@ def _quota(name: str, key: str | None, asked: int, achieved: int, pool: int | No
     return entry, f"{label}: asked {asked}{what}, got {achieved}{why}"
 
 
-def coverage(records: Sequence[ImageRecord], config: GenerationConfig, targets: dict | None = None,
+def coverage(records: Sequence[ImageRecord], config: GenerationConfig | None, targets: dict | None = None,
              pool: dict | None = None) -> dict:
     """The coverage report as a JSON-serialisable dict.
 
@@ -60,6 +60,8 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig, targets: 
     ----------
     records : the final per-image records (spec: ``camera.rig_type``, ``condition.name``, ``split``,
         ``instances`` with ``relations``, ``qa.verdict``).
+    config : the generation config; None for a dataset without quotas (``synthua composite``'s): no quota is
+        checked
     targets : :func:`sampling.quota_targets` of the pool (what balanced quotas asked per key); None
         takes the explicit counts and shares balanced ones over the keys the records hold.
     pool : :func:`sampling.pool_summary`; when given, shortfalls say what the pool held.
@@ -71,7 +73,7 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig, targets: 
     """
     verdicts = Counter((r.get("qa") or {}).get("verdict", "accepted") for r in records)
     kept = [r for r in records if (r.get("qa") or {}).get("verdict") != "rejected"]
-    quota_aid = config.quotas.aid_users
+    quota_aid = None if config is None else config.quotas.aid_users
 
     per_condition = Counter(_condition_key(r) for r in kept)
     per_rig = Counter(_rig_key(r) for r in kept)
@@ -95,7 +97,9 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig, targets: 
         splits[split] = {"images": len(members), "share": round(len(members) / len(kept), 6) if kept else 0.0,
                          "cameras": len({(r.get("camera") or {}).get("prim_path") for r in members})}
 
-    if targets is None:
+    if config is None:
+        targets = {}
+    elif targets is None:
         total = config.images
         targets = {
             "images": total,
@@ -114,11 +118,12 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig, targets: 
         if shortfall:
             shortfalls.append(shortfall)
 
-    entry, short = _quota("images", None, config.images, len(kept), pool.get("candidates"), "")
-    if short and verdicts["rejected"]:
-        short = f"images: asked {config.images}, got {len(kept)} ({verdicts['rejected']} rejected by QA" + (
-            f"; the pool had {pool['candidates']})" if "candidates" in pool else ")")
-    add((entry, short))
+    if config is not None:
+        entry, short = _quota("images", None, config.images, len(kept), pool.get("candidates"), "")
+        if short and verdicts["rejected"]:
+            short = f"images: asked {config.images}, got {len(kept)} ({verdicts['rejected']} rejected by QA" + (
+                f"; the pool had {pool['candidates']})" if "candidates" in pool else ")")
+        add((entry, short))
     if targets.get("aid_users") is not None:
         occl = "" if quota_aid.max_occlusion is None else f", occluded at most {quota_aid.max_occlusion:g}"
         add(_quota("aid_users", None, targets["aid_users"], qualifying, pool.get("aid_users"),

@@ -60,6 +60,24 @@ def visibility(uv: np.ndarray, z: np.ndarray, instance_id: int, instance_ids: np
     return flags
 
 
+def pasted_visibility(points: np.ndarray, instance_id: int, instance_ids: np.ndarray) -> np.ndarray:
+    """(k,) COCO flags of a pasted cut-out's keypoints ``points`` (k, 3): frame x, y and the flag the cut-out gives
+    (rendered alone). A keypoint outside the image, or not labelled, is 0; one the cut-out shows (2) stays 2 where
+    ``instance_ids`` shows its instance within :data:`WINDOW_PX` pixels, and becomes 1 where a nearer paste covers
+    it; an occluded one (1) stays 1. The pixel looked around is that of the coordinates as written (rounded as
+    :func:`coco_keypoints` rounds them), so that a reader checking the flags finds the same pixel."""
+    height, width = instance_ids.shape
+    flags = np.zeros(len(points), np.int64)
+    for k, (x, y, v) in enumerate(np.asarray(points, np.float64)):
+        x, y = round(float(x), 2), round(float(y), 2)
+        if v == 0 or not (0 <= x < width and 0 <= y < height):
+            continue
+        col, row = int(x), int(y)
+        window = instance_ids[max(0, row - WINDOW_PX):row + WINDOW_PX + 1, max(0, col - WINDOW_PX):col + WINDOW_PX + 1]
+        flags[k] = 2 if v == 2 and (window == instance_id).any() else 1
+    return flags
+
+
 def coco_keypoints(uv: np.ndarray, flags: np.ndarray) -> list[float]:
     """COCO's flat ``[x1, y1, v1, x2, ...]``: coordinates rounded to 0.01 px, ``x = y = 0`` where ``v = 0``."""
     out = []

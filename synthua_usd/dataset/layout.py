@@ -59,6 +59,12 @@ def image_name(image_id: int, camera_name: str, time_code: float, condition: str
             f"_s{int(seed)}")
 
 
+def composite_name(image_id: int, background: str, number: int) -> str:
+    """File stem of a composite of ``synthua composite``: ``000017_street-04_c1`` (id, the background photo's file
+    stem, which composite of that photo it is)."""
+    return f"{image_id:06d}_{safe_component(PurePosixPath(background).stem)}_c{int(number)}"
+
+
 @dataclass(frozen=True)
 class CityscapesName:
     """Cityscapes' ``{city}_{seq:06d}_{frame:06d}`` naming: city from the scenario's name (letters and digits

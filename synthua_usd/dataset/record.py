@@ -1,9 +1,11 @@
 """The record of a dataset image and of a tracking sequence's frame, typed: their keys written once.
 
-``records/{name}.json`` holds an :class:`ImageRecord`, ``sequences/{sequence}/records/{frame}.json`` a
-:class:`SequenceFrameRecord`; both are documents of ``schemas/record.schema.json`` (its ``$defs/image`` and
+``records/{name}.json`` holds an :class:`ImageRecord` (a composite of ``synthua composite``: a
+:class:`CompositeRecord`), ``sequences/{sequence}/records/{frame}.json`` a :class:`SequenceFrameRecord`; all are
+documents of ``schemas/record.schema.json`` (its ``$defs/image``, ``$defs/composite_image`` and
 ``$defs/sequence_frame``), whose descriptions say what each field means. The writers
-(:mod:`synthua_usd.pipeline.dataset_worker`, :mod:`synthua_usd.pipeline.sequences`) build these TypedDicts and
+(:mod:`synthua_usd.pipeline.dataset_worker`, :mod:`synthua_usd.pipeline.composite_worker`,
+:mod:`synthua_usd.pipeline.sequences`) build these TypedDicts and
 validate each record before writing it (:func:`check_record`); the readers (``synthua verify``, the dataset
 formats, analytics, ``synthua randomise --record``) take them, and verify reports a record that does not
 validate as a problem of the dataset (:func:`record_problem`). A test holds the keys here to the schema's.
@@ -16,8 +18,8 @@ from typing import Any, NotRequired, TypedDict
 from synthua_usd.core.schemas import schema_problem, validate_document
 
 SCHEMA = "record"
-#: The schema's definitions of the two kinds of record.
-IMAGE, SEQUENCE_FRAME = "image", "sequence_frame"
+#: The schema's definitions of the kinds of record.
+IMAGE, COMPOSITE, SEQUENCE_FRAME = "image", "composite_image", "sequence_frame"
 
 
 class FileEntry(TypedDict):
@@ -128,6 +130,53 @@ class ImageRecord(FrameRecord):
     randomisation: NotRequired[dict[str, Any]]
 
 
+class PhotoCameraEntry(TypedDict):
+    """The camera model of a composite's photo (``$defs/photo_camera``;
+    :class:`synthua_usd.dataset.composite_plan.DrawnCamera`)."""
+
+    width_px: int
+    height_px: int
+    horizon_row_px: float
+    height_m: float
+    focal_px: float
+    pitch_deg: float
+    K: list[list[float]]
+    sources: dict[str, str]
+    exif_focal_35mm: float | None
+    light: dict[str, float] | None
+
+
+class CompositeEntry(TypedDict):
+    """What a composite was made of (``$defs/composite``): its background, bank, pastes (``$defs/paste``), the
+    background's boxes (``$defs/background_box``) and the camera effects."""
+
+    background: dict[str, Any]
+    bank: dict[str, str]
+    pastes: list[dict[str, Any]]
+    background_boxes: list[dict[str, Any]]
+    effects: dict[str, Any] | None
+
+
+class CompositeRecord(TypedDict):
+    """``records/{name}.json`` of a composite (``$defs/composite_image``)."""
+
+    id: int
+    name: str
+    split: str
+    width: int
+    height: int
+    seed: int
+    camera: PhotoCameraEntry
+    files: dict[str, str]
+    class_pixel_counts: dict[str, int]
+    instances: list[InstanceEntry]
+    panoptic_segments: list[PanopticSegment]
+    qa: QAResult
+    composite: CompositeEntry
+    #: Added once the files are written (every record on disk has it).
+    checksums: NotRequired[dict[str, FileEntry]]
+
+
 class SequenceFrameRecord(FrameRecord):
     """``sequences/{sequence}/records/{frame}.json`` (``$defs/sequence_frame``)."""
 
@@ -135,9 +184,15 @@ class SequenceFrameRecord(FrameRecord):
     frame: int
 
 
-def check_record(record: ImageRecord | SequenceFrameRecord, kind: str, source: str) -> None:
+def image_kind(record: Any) -> str:
+    """The kind of record a dataset image's record is: :data:`COMPOSITE` when it holds ``composite``, else
+    :data:`IMAGE`."""
+    return COMPOSITE if isinstance(record, dict) and "composite" in record else IMAGE
+
+
+def check_record(record: ImageRecord | CompositeRecord | SequenceFrameRecord, kind: str, source: str) -> None:
     """Raise :class:`SchemaError` naming ``source`` and the field when ``record`` is not a valid record of
-    ``kind`` (:data:`IMAGE` or :data:`SEQUENCE_FRAME`)."""
+    ``kind`` (:data:`IMAGE`, :data:`COMPOSITE` or :data:`SEQUENCE_FRAME`)."""
     validate_document(record, SCHEMA, source, kind)
 
 

@@ -26,7 +26,14 @@ def encode_srgb8(linear: np.ndarray) -> np.ndarray:
     return np.round(from_linear(c) * 255.0).astype(np.uint8)
 
 
+#: ``to_linear(v / 255.0)`` of every 8-bit value v: :func:`decode_srgb8` looks the values up (the same float64s
+#: the formula gives, a tenth of its time on a 640x480 image).
+_DECODED = to_linear(np.arange(256) / 255.0)
+
+
 def decode_srgb8(pixels: np.ndarray) -> np.ndarray:
     """8-bit sRGB → linear float64 (what a renderer decodes)."""
-    c = pixels / 255.0
-    return to_linear(c)
+    pixels = np.asarray(pixels)
+    if pixels.dtype == np.uint8:
+        return _DECODED[pixels]
+    return to_linear(pixels / 255.0)

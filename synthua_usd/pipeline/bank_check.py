@@ -1,6 +1,6 @@
 """``synthua verify BANK``: a cut-out bank checked against its manifest and its own images, without rendering.
 
-``bank.json`` must be of this version's format (:data:`~synthua_usd.pipeline.cutouts.BANK_FORMAT`); every file it
+``bank.json`` must be of this version's format (:mod:`synthua_usd.dataset.cutout_bank`, which reads it); every file it
 lists present with its size and SHA-256, and no other file; every cut-out's four images of one size, the entry's
 ``size``; each instance's visible box and area those of its index in ``ids.png``, its amodal box and area those of
 its bit in ``amodal.png`` (which holds every visible pixel of it), its visible keypoints inside the crop; the
@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.core.errors import InputError
 
 #: The share of an instance's labelled pixels its coverage may leave at 0 (sub-pixel structures; see below).
 COVERAGE_TOLERANCE = 0.01
@@ -36,56 +35,36 @@ class BankCheck:
         return not self.problems
 
 
-def read_bank(bank: str | Path) -> dict:
-    """``bank.json`` of the bank folder ``bank``, of this version's format; else an :class:`InputError` naming
-    what is wrong."""
-    from synthua_usd.core.schemas import read_json
-    from synthua_usd.pipeline.cutouts import BANK_FILE, BANK_FORMAT
-
-    path = Path(bank) / BANK_FILE
-    if not path.is_file():
-        raise InputError(f"{bank}: holds no {BANK_FILE}; expected a cut-out bank that synthua cutouts wrote")
-    document = read_json(path, "a cut-out bank's manifest")
-    found = document.get("format") if isinstance(document, dict) else None
-    if found != BANK_FORMAT:
-        raise InputError(f"{path}: format {found!r}; expected {BANK_FORMAT!r} (a bank made by this version of "
-                         f"synthua: make it again with synthua cutouts)")
-    if not isinstance(document.get("cutouts"), list) or not isinstance(document.get("files"), list):
-        raise InputError(f"{path}: no cutouts or files list; expected the manifest synthua cutouts writes")
-    return document
-
-
 def check_bank(bank: str | Path) -> BankCheck:
-    """Check the bank folder ``bank`` (see the module)."""
+    """Check the bank folder ``bank`` (see the module); a ``bank.json`` that is not of this version's format, or
+    malformed, is an :class:`InputError` (:func:`synthua_usd.dataset.cutout_bank.read_bank`)."""
     from synthua_usd.backends.images import read_image
+    from synthua_usd.dataset.cutout_bank import BANK_FILE, FILE_KEYS, read_bank
     from synthua_usd.dataset.manifest import file_entry
-    from synthua_usd.pipeline.cutouts import BANK_FILE, FILES
 
-    bank = Path(bank)
-    document = read_bank(bank)
-    out = BankCheck(cutouts=len(document["cutouts"]))
+    folder = Path(bank)
+    read = read_bank(folder)
+    out = BankCheck(cutouts=len(read.entries))
     listed = set()
-    for entry in document["files"]:
-        path = entry.get("path", "") if isinstance(entry, dict) else ""
+    for entry in read.files:
+        path = entry["path"]
         listed.add(path)
-        target = bank / path
-        if not path or ".." in Path(path).parts or Path(path).is_absolute() or not target.is_file():
-            out.problems.append(f"{path or entry}: missing (listed in {BANK_FILE})")
+        if not (folder / path).is_file():
+            out.problems.append(f"{path}: missing (listed in {BANK_FILE})")
             continue
         out.files += 1
-        if file_entry(bank, path) != entry:
+        if file_entry(folder, path) != entry:
             out.problems.append(f"{path}: size or SHA-256 differs from {BANK_FILE}")
-    for path in sorted(p.relative_to(bank).as_posix() for p in bank.rglob("*") if p.is_file()):
+    for path in sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()):
         if path != BANK_FILE and path not in listed:
             out.problems.append(f"{path}: not listed in {BANK_FILE}")
-    for entry in document["cutouts"]:
-        name = entry.get("id", "?")
+    for entry in read.entries:
         try:
-            arrays = {key: read_image(bank / entry["files"][key])[0] for key in FILES}
-        except (OSError, KeyError, TypeError) as exc:
-            out.problems.append(f"cut-out {name}: its images cannot be read ({exc})")
+            arrays = {key: read_image(folder / entry.files[key])[0] for key in FILE_KEYS}
+        except (OSError, KeyError) as exc:
+            out.problems.append(f"cut-out {entry.id}: its images cannot be read ({exc})")
             continue
-        out.problems += [f"cut-out {name}: {p}" for p in _entry_problems(entry, arrays)]
+        out.problems += [f"cut-out {entry.id}: {p}" for p in _entry_problems(entry, arrays)]
     return out
 
 
@@ -96,16 +75,16 @@ def _box(mask: np.ndarray) -> list[float] | None:
     return [float(cols[0]), float(rows[0]), float(cols[-1] + 1 - cols[0]), float(rows[-1] + 1 - rows[0])]
 
 
-def _entry_problems(entry: dict, arrays: dict[str, np.ndarray]) -> list[str]:
+def _entry_problems(entry, arrays: dict[str, np.ndarray]) -> list[str]:
     problems = []
-    w, h = entry["size"]
+    w, h = entry.size
     for key, array in arrays.items():
         if array.shape[:2] != (h, w):
             problems.append(f"{key} is {array.shape[1]}x{array.shape[0]}; expected {w}x{h}")
     if problems:
         return problems
     ids, bits, alpha = arrays["ids"][..., 0], arrays["amodal"][..., 0], arrays["rgba"][..., 3]
-    indices = {inst["index"] for inst in entry["instances"]}
+    indices = {inst.index for inst in entry.instances}
     stray = sorted(set(np.unique(ids).tolist()) - indices - {0})
     if stray:
         problems.append(f"ids.png holds indices {stray} that no instance has")
@@ -114,22 +93,22 @@ def _entry_problems(entry: dict, arrays: dict[str, np.ndarray]) -> list[str]:
     bare = int(np.count_nonzero((ids > 0) & (alpha == 0)))
     if bare > max(2, int(COVERAGE_TOLERANCE * np.count_nonzero(ids))):
         problems.append(f"ids.png names an instance on {bare} pixels where rgba.png's alpha is 0")
-    for inst in entry["instances"]:
-        k = inst["index"]
+    for inst in entry.instances:
+        k = inst.index
         visible, amodal = ids == k, ((bits >> (k - 1)) & 1).astype(bool)
-        box = _box(visible)
-        if int(visible.sum()) != inst["area"] or (box or [0.0, 0.0, 0.0, 0.0]) != inst["bbox"]:
-            problems.append(f"instance {k} ({inst['class_name']}): box {inst['bbox']} area {inst['area']}; its "
-                            f"pixels in ids.png give {box} and {int(visible.sum())}")
+        box = _box(visible) or [0.0, 0.0, 0.0, 0.0]
+        if int(visible.sum()) != inst.area or box != list(inst.bbox):
+            problems.append(f"instance {k} ({inst.class_name}): box {list(inst.bbox)} area {inst.area}; its pixels in "
+                            f"ids.png give {box} and {int(visible.sum())}")
         if np.any(visible & ~amodal):
             problems.append(f"instance {k}: visible pixels outside its amodal mask")
-        if int(amodal.sum()) != inst["amodal_area"] or (_box(amodal) or []) != inst["amodal_bbox"]:
-            problems.append(f"instance {k}: amodal box {inst['amodal_bbox']} area {inst['amodal_area']}; amodal.png "
+        if int(amodal.sum()) != inst.amodal_area or (_box(amodal) or []) != list(inst.amodal_bbox):
+            problems.append(f"instance {k}: amodal box {list(inst.amodal_bbox)} area {inst.amodal_area}; amodal.png "
                             f"gives {_box(amodal)} and {int(amodal.sum())}")
-        for x, y, v in inst.get("keypoints") or []:
+        for x, y, v in inst.keypoints or ():
             if v and not (0 <= x <= w and 0 <= y <= h):
                 problems.append(f"instance {k}: a keypoint at ({x}, {y}) outside the {w}x{h} crop")
-    for x, y in [entry["anchor"], *entry["ground_points"]]:
+    for x, y in [entry.anchor, *entry.ground_points]:
         if not (-0.5 <= x <= w + 0.5 and -0.5 <= y <= h + 0.5):
             problems.append(f"a ground point ({x}, {y}) outside the {w}x{h} crop")
     return problems

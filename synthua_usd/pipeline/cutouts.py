@@ -6,7 +6,8 @@ once and seen from ``views_per_group`` cameras and lights; per view one label pa
 every pixel centre and the amodal masks (as a dataset image's), the path tracer the group's colour and coverage
 (:func:`~synthua_usd.backends.mitsuba.cutout_passes.render_rgba`), shadow rays the shadow it casts on the ground
 (:func:`~synthua_usd.backends.mitsuba.cutout_passes.ground_shadow`). The crop holding the group and its shadow is
-written as four PNGs and an entry of ``bank.json`` (the format: docs/compositing.md and :data:`BANK_FORMAT`):
+written as four PNGs and an entry of ``bank.json`` (the format: docs/cutouts.md, read by
+:mod:`synthua_usd.dataset.cutout_bank`):
 instances with visible and amodal boxes, keypoints, the ground points, the camera, the light. Groups run on
 worker processes (:func:`synthua_usd.pipeline.executors.run_shards`); the bank is written as a set (a staging
 folder renamed into place when complete) with a manifest of checksums. The same config gives the same bytes.
@@ -24,16 +25,14 @@ import numpy as np
 
 from synthua_usd import __version__
 from synthua_usd.core.atomic import output_set, write_json_atomic
+from synthua_usd.dataset.cutout_bank import BANK_FILE, BANK_FORMAT, FILE_KEYS, MAX_INSTANCES
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.randomisation.cutouts import CutoutsConfig, GroupDraw, draw_group, draw_view
 
-#: The bank format this code writes and reads.
-BANK_FORMAT = "synthua-cutouts/1"
-BANK_FILE = "bank.json"
 FOLDER = "cutouts"
-#: The four images of a cut-out, by key: their file suffixes.
-FILES = {"rgba": "rgba.png", "ids": "ids.png", "amodal": "amodal.png", "shadow": "shadow.png"}
+#: The four images of a cut-out (:data:`~synthua_usd.dataset.cutout_bank.FILE_KEYS`): their file suffixes.
+FILES = {key: f"{key}.png" for key in FILE_KEYS}
 #: Pixels around the group and its shadow in a crop.
 MARGIN_PX = 4
 #: A vertex this close to the ground (metres) touches it.
@@ -43,8 +42,6 @@ GROUND_TOUCH_M = 0.02
 SKY_REACH = 1.5
 #: The shadow factor below which the ground counts as shadowed (for the crop).
 SHADOWED = 0.98
-#: At most this many people and devices in a group (the amodal bit field is 16 bits wide).
-MAX_INSTANCES = 16
 
 
 @dataclass(frozen=True)

@@ -29,8 +29,8 @@ from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, onehot, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
-from synthua_usd.dataset.record import (IMAGE, ImageRecord, InstanceEntry, QAResult, RecordCamera, RecordRender,
-                                         check_record)
+from synthua_usd.dataset.record import (ImageRecord, InstanceEntry, QAResult, RecordCamera, RecordRender,
+                                         check_record, image_kind)
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.taxonomy import ClassMap
@@ -61,6 +61,8 @@ class WorkerJob:
     #: With randomised districts or settings: scene key -> its scenario in the dataset
     #: (:mod:`synthua_usd.pipeline.scenes`).
     scenes: dict = field(default_factory=dict)
+    #: Report the seconds of kernel compiles per image (``render_compile``; a profile's, see RenderSession).
+    count_compiles: bool = False
 
 
 @dataclass
@@ -96,7 +98,8 @@ def init_worker(job: WorkerJob) -> WorkerState:
     from synthua_usd.backends.mitsuba.session import RenderSession
 
     class_map = ClassMap.from_document(job.class_map_document, source="class_map.json")
-    state = WorkerState(job=job, stage=None, reader=None, session=RenderSession(job.render), class_map=class_map)
+    state = WorkerState(job=job, stage=None, reader=None, session=RenderSession(job.render, job.count_compiles),
+                        class_map=class_map)
     _open(state, job.scenario, None)
     return state
 
@@ -183,9 +186,12 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
         scene = scene_of(job.config.randomise, seed)
         if scene != state.scene:
             _open(state, job.scenes[scene] if scene is not None else job.scenario, scene)
+        state.randomiser.scene(seed, scene)  # (a new seed's scene: drawn and authored; else kept)
+        t_scene = time.perf_counter() - t0
         randomised = state.randomiser.apply(seed, camera_path, time_code, condition_name, scene)
     t_randomise = time.perf_counter() - t0
     snapshot = state.reader.snapshot(time_code)
+    t_snapshot = time.perf_counter() - t0 - t_randomise
     camera = read_camera(state.stage, camera_path, time_code)
     condition = state.condition(condition_name)
     rendered = state.session.render(snapshot, camera, rgb=True, condition=condition, seed=seed)
@@ -198,9 +204,12 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
     amodal = state.session.amodal(snapshot, camera, wanted) if wanted else {}
     # "render" is all of it (snapshot, session, amodal); the render_* parts say where it went
     seconds = {"render": time.perf_counter() - t0, "render_amodal": time.perf_counter() - t_amodal,
-               **{f"render_{key}": value for key, value in rendered.seconds.items()}}
+               "render_snapshot": t_snapshot, **{f"render_{key}": value for key, value in rendered.seconds.items()}}
     if randomised is not None:
-        seconds["render_randomise"] = t_randomise
+        # the scene (crowd, looks, materials: drawn and authored for a new seed) and the view (camera, placements,
+        # light: drawn and authored for every image)
+        seconds["render_randomise_scene"] = t_scene
+        seconds["render_randomise_view"] = t_randomise - t_scene
 
     t0 = time.perf_counter()
     meshes_of: dict[int, list] = {}
@@ -253,22 +262,11 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     name = image_name(planned.id, planned.camera_name, planned.time_code, planned.condition, planned.seed)
     split = planned.split
     cs = CityscapesName(job.city, job.camera_index.get(planned.camera_path, 0), planned.id)
-    files = {"rgb_png": Layout.rgb_png(split, name) if verdict != "rejected" else Layout.frame_file(name, "rgb_png"),
-             **{key: Layout.frame_file(name, key) for key in ("class", "semantic", "instance", "instance_preview")}}
-    arrays = {"rgb_png": display, "class": class_ids, "semantic": class_map.palette()[class_ids],
-              "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
+    yolo_text = (yolo.yolo_lines(instances, width, height, job.yolo_classes, instance_ids)
+                 if verdict != "rejected" else "")
+    files, arrays = label_files(name, split, cs, verdict == "rejected", display, class_ids, instance_ids,
+                                snapshot.instances, ignored, panoptic_png, yolo_text, class_map)
     if verdict != "rejected":
-        labels, instance_cs, colour = cityscapes.cityscapes_arrays(class_ids, instance_ids, snapshot.instances,
-                                                                  class_map, ignored)
-        files.update({"panoptic": Layout.panoptic_png(split, name),
-                      "cs_labelIds": Layout.cityscapes(split, cs, "labelIds"),
-                      "cs_instanceIds": Layout.cityscapes(split, cs, "instanceIds"),
-                      "cs_color": Layout.cityscapes(split, cs, "color"),
-                      "cs_leftImg8bit": Layout.cityscapes(split, cs, "leftImg8bit"),
-                      "yolo_label": Layout.yolo_label(split, name)})
-        arrays.update({"panoptic": panoptic_png, "cs_labelIds": labels, "cs_instanceIds": instance_cs,
-                       "cs_color": colour, "yolo_label": yolo.yolo_lines(instances, width, height,
-                                                                        job.yolo_classes, instance_ids)})
         outputs = job.config.outputs
         if outputs.depth:
             files["depth"] = Layout.frame_file(name, "depth")
@@ -307,6 +305,31 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     return ImageBuffers(record, arrays, verdict == "rejected", seconds)
 
 
+def label_files(name: str, split: str, cs: CityscapesName, rejected: bool, display: np.ndarray, class_ids: np.ndarray,
+                instance_ids: np.ndarray, scene_instances, ignored: set[int], panoptic_png: np.ndarray,
+                yolo_text: str, class_map: ClassMap) -> tuple[dict, dict]:
+    """The image's files (key -> path in the dataset) and their contents (key -> array or text): the RGB image,
+    class ids, class colours, instance ids and preview; unless ``rejected`` also the panoptic PNG, the Cityscapes
+    files (label ids, instance ids, colours, the RGB image's link) and the YOLO labels ``yolo_text``. What a
+    rendered image and a composite (:mod:`synthua_usd.pipeline.composite_worker`) write alike."""
+    files = {"rgb_png": Layout.rgb_png(split, name) if not rejected else Layout.frame_file(name, "rgb_png"),
+             **{key: Layout.frame_file(name, key) for key in ("class", "semantic", "instance", "instance_preview")}}
+    arrays = {"rgb_png": display, "class": class_ids, "semantic": class_map.palette()[class_ids],
+              "instance": instance_ids, "instance_preview": previews.instance_preview(instance_ids)}
+    if not rejected:
+        labels, instance_cs, colour = cityscapes.cityscapes_arrays(class_ids, instance_ids, scene_instances,
+                                                                  class_map, ignored)
+        files.update({"panoptic": Layout.panoptic_png(split, name),
+                      "cs_labelIds": Layout.cityscapes(split, cs, "labelIds"),
+                      "cs_instanceIds": Layout.cityscapes(split, cs, "instanceIds"),
+                      "cs_color": Layout.cityscapes(split, cs, "color"),
+                      "cs_leftImg8bit": Layout.cityscapes(split, cs, "leftImg8bit"),
+                      "yolo_label": Layout.yolo_label(split, name)})
+        arrays.update({"panoptic": panoptic_png, "cs_labelIds": labels, "cs_instanceIds": instance_cs,
+                       "cs_color": colour, "yolo_label": yolo_text})
+    return files, arrays
+
+
 def camera_document(camera, planned, render_w: int, render_h: int, width: int, height: int) -> RecordCamera:
     """Intrinsics at the written size (K scaled from the render size) and extrinsics."""
     K = camera.intrinsics(render_w, render_h).copy()
@@ -321,7 +344,7 @@ def camera_document(camera, planned, render_w: int, render_h: int, width: int, h
                         distortion=camera.distortion.to_dict() if camera.distortion is not None else None)
 
 
-_WRITERS = {
+WRITERS = {
     "rgb_png": lambda path, data: images.write_color_png(path, data),
     "class": images.write_id_png,
     "semantic": images.write_color_png,
@@ -336,8 +359,11 @@ _WRITERS = {
 }
 
 
-def write_image(state: WorkerState, image: ImageBuffers) -> dict:
-    """Write every file of ``image`` (each atomically), then its record; returns the worker's result."""
+def write_image(state: WorkerState, image: ImageBuffers, writers: dict | None = None) -> dict:
+    """Write every file of ``image`` (each atomically, by ``writers``: key -> function(path, data); default
+    :data:`WRITERS`), then its record; returns the worker's result. ``state`` needs ``job.out_dir``, ``writer`` and
+    ``class_map`` only (a composite worker's state has them too)."""
+    writers = WRITERS if writers is None else writers
     t0 = time.perf_counter()
     layout = Layout(Path(state.job.out_dir))
     record = image.record
@@ -350,24 +376,31 @@ def write_image(state: WorkerState, image: ImageBuffers) -> dict:
             continue  # a link to the RGB image, made once that exists
         data = image.arrays[key]
         if key == "yolo_label":
-            jobs.append(state.writer.encoders.submit(write_text_atomic, path, data))
+            jobs.append(state.writer.encoders.submit(_timed, write_text_atomic, path, data))
         elif key == "onehot":
             num_classes = max(c.id for c in state.class_map.classes) + 1
             jobs.append(state.writer.encoders.submit(
-                lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)), path, data))
+                _timed, lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)), path, data))
         else:
-            jobs.append(state.writer.encoders.submit(_WRITERS[key], path, data))
-    for job in jobs:
-        job.result()
+            jobs.append(state.writer.encoders.submit(_timed, writers[key], path, data))
+    spent = {}
+    for key, job in zip([k for k in targets if k != "cs_leftImg8bit"], jobs):
+        spent[f"write_{key}"] = job.result()[1]  # seconds of an encoder thread (it overlaps the next render)
     if "cs_leftImg8bit" in targets:
         _link_or_copy(targets["rgb_png"], targets["cs_leftImg8bit"])
     record["checksums"] = {key: file_entry(layout.root, rel) for key, rel in sorted(record["files"].items())}
-    check_record(record, IMAGE, Layout.record(record["name"]))
+    check_record(record, image_kind(record), Layout.record(record["name"]))
     record_path = layout.path(Layout.record(record["name"]))
     record_path.parent.mkdir(parents=True, exist_ok=True)
     write_json_atomic(record_path, record, indent=1)
-    seconds = dict(image.seconds, write=time.perf_counter() - t0)
+    seconds = dict(image.seconds, write=time.perf_counter() - t0, **spent)
     return {"record": record, "seconds": seconds}
+
+
+def _timed(writer, path: Path, data) -> tuple[object, float]:
+    """``writer(path, data)`` and the seconds it took."""
+    t0 = time.perf_counter()
+    return writer(path, data), time.perf_counter() - t0
 
 
 def _link_or_copy(source: Path, target: Path) -> None:

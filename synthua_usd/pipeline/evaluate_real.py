@@ -29,7 +29,8 @@ from synthua_usd.core.input_files import shown
 from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.model import detection_limits as L
 from synthua_usd.model.box_conventions import CONVENTIONS
-from synthua_usd.pipeline.train import check_imgsz, run_weights
+from synthua_usd.pipeline.init_weights import run_weights
+from synthua_usd.pipeline.train import check_imgsz
 
 #: Confidence below which predictions are dropped before scoring (COCO's AP ranks every detection).
 PREDICT_CONFIDENCE = 0.001
@@ -125,7 +126,7 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
         "prediction": {"confidence_floor": PREDICT_CONFIDENCE, "nms_iou": PREDICT_IOU, "max_det": MAX_DETECTIONS,
                        "imgsz": imgsz, "device": result["device"], "seconds": round(result["seconds"], 2),
                        "merge_iou": request.merge_iou},
-        "versions": result["versions"], "downloaded": result["downloaded"],
+        "versions": result["versions"], "downloaded": result["downloaded"], "network": result["network"],
     }
     write_detection_report(request.out_dir, test, evaluation, detections, document, inputs)
     return EvaluateResult(evaluation, document | evaluation.document(), Path(request.out_dir))

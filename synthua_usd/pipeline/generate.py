@@ -68,6 +68,8 @@ class GenerateRequest:
     variant: str | None = None
     class_map_path: Path | None = None
     allow_external_assets: bool = False
+    #: Workers report the seconds of kernel compiles (a benchmark's profile; Dr.Jit's kernel history).
+    count_compiles: bool = False
 
 
 @dataclass
@@ -217,8 +219,9 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     todo = [p for p in plan if p.id not in done]
     summary.resumed = len(done)
     # the scenario as this run names it (it may have moved since the plan; its layers are the same)
-    job = worker_job_from_document(job_document, out, scenario=request.scenario,
-                                   allow_external_assets=request.allow_external_assets)
+    job = replace(worker_job_from_document(job_document, out, scenario=request.scenario,
+                                           allow_external_assets=request.allow_external_assets),
+                  count_compiles=request.count_compiles)
     seconds = {"render": 0.0, "annotate": 0.0, "write": 0.0}
     peaks: dict = {}
     config_workers = request.workers or config.workers or default_workers()
@@ -457,10 +460,11 @@ def _complete_records(layout: Layout, plan) -> dict[int, ImageRecord]:
     return done
 
 
-def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, config: GenerationConfig,
-             job_document: dict, frames: dict | None = None) -> None:
+def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, config: GenerationConfig | None,
+             job_document: dict, frames: dict | None = None, provenance: dict | None = None) -> None:
     """Every dataset-level file, from the records alone (the images', and the sequences' ``frames``: (sequence,
-    frame) -> record); the manifest last."""
+    frame) -> record); the manifest last. Another command's dataset (``synthua composite``) gives its own
+    ``provenance`` and no generation ``config`` (no quotas, districts or sequences)."""
     root = layout.root
     written = []
     for split in SPLITS:
@@ -477,11 +481,13 @@ def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, co
         records, config, job_document.get("quota_targets"), job_document.get("pool"))))
     written.append(tables.write_rejected(records, layout.path(Layout.REJECTED)))
     written.append(_write_json(layout.path(Layout.CLASS_MAP), class_map.document()))
-    key = job_document["job_key"]
-    provenance = {**_versions(key["variant"]), "config": key["config"], "config_digest": document_digest(key["config"]),
-                  "scenario": Path(job_document["scenario"]).name, "layer_stack": job_document["layer_stack"]}
+    if provenance is None:
+        key = job_document["job_key"]
+        provenance = {**_versions(key["variant"]), "config": key["config"],
+                      "config_digest": document_digest(key["config"]), "scenario": Path(job_document["scenario"]).name,
+                      "layer_stack": job_document["layer_stack"]}
     images = [{"id": r["id"], "name": r["name"], "split": r["split"], "seed": r["seed"],
-               "layer_stack": r["layer_stack"], "qa": r["qa"]["verdict"],
+               **({"layer_stack": r["layer_stack"]} if "layer_stack" in r else {}), "qa": r["qa"]["verdict"],
                "files": [r["checksums"][k] for k in sorted(r["checksums"])]
                + [file_entry(root, Layout.record(r["name"]))]} for r in records]
     dataset_files = [file_entry(root, p.relative_to(root).as_posix()) for p in written]
@@ -490,7 +496,7 @@ def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, co
 
     dataset_files += [file_entry(root, p.relative_to(root).as_posix()) for p in sorted((root / SCENES_FOLDER).rglob("*"))
                       if p.is_file()] if (root / SCENES_FOLDER).is_dir() else []
-    if config.sequences is not None:
+    if config is not None and config.sequences is not None:
         from synthua_usd.dataset.sequences import PlannedSequence
         from synthua_usd.pipeline.sequences import assemble_sequences, sequence_files
 

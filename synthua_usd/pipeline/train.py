@@ -4,18 +4,20 @@ The set is a dataset ``synthua generate`` wrote (its boxes derived by
 :class:`~synthua_usd.analytics.detection_targets.DetectionTargets`: a wheelchair's box covers its user by default),
 or any Ultralytics YOLO or COCO set (a few real photos, say). Its ``train`` split is trained on; its ``val`` split is
 what Ultralytics validates the last epoch on (the train split when there is none). The model is built from an
-architecture that ships inside the Ultralytics wheel (``yolo26n.yaml``, from scratch: no weights exist to download),
-or starts from the weights of an earlier run (``init``: fine-tuning; Ultralytics carries over every layer whose
-shape fits, so a head with other classes starts anew).
+architecture that ships inside the Ultralytics wheel (``yolo26n.yaml``, from scratch: nothing is downloaded), or
+starts from weights (``init``, :mod:`.init_weights`): an earlier run's (fine-tuning) or an Ultralytics checkpoint
+file a user has, such as a COCO-pretrained ``yolo11n.pt``. Ultralytics carries over every tensor whose name and shape
+fit (a head with other classes starts anew, but for the rows of classes both name) and says how many (recorded).
 
 The run folder, written as a set (nothing of it appears unless training finished)::
 
     weights.pt     the model at the end of the budget (Ultralytics' last.pt)
     train.json     what was trained on what: the set (its path, SHA-256 of what it holds, for a generated dataset
                    the SHA-256 of its manifest, its generation config and name), the classes and box policy, the
-                   model and its initial weights (with their run's train.json), the budget (minutes or epochs,
-                   image size, batch), seed, device, library versions, epochs done, seconds, final losses, and
-                   every file Ultralytics fetched (none)
+                   model and its initial weights (kind, path, SHA-256; a run's train.json or what a checkpoint
+                   holds; the tensors taken from them), the budget (minutes or epochs, image size, batch), seed,
+                   device, library versions, epochs done, seconds, final losses, every file Ultralytics fetched
+                   (none) and every network use it tried (none: the job refuses them)
     results.csv    Ultralytics' losses per epoch
     train.log      Ultralytics' output
 """
@@ -42,6 +44,7 @@ from synthua_usd.core.input_guard import check_not_inputs
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.schemas import read_json
 from synthua_usd.model import detection_limits as L
+from synthua_usd.pipeline.init_weights import InitWeights, inspect_checkpoint, locate_init
 
 log = logging.getLogger(__name__)
 
@@ -83,15 +86,17 @@ class Budget:
 @dataclass(frozen=True)
 class TrainRequest:
     """``train_set``: a generated dataset, a YOLO data.yaml folder or a COCO .json (``fmt``, ``images_dir`` for
-    COCO); ``init``: a run folder (or its weights.pt) to fine-tune from; ``threads``: torch threads (default: the
-    cores this process may use)."""
+    COCO); ``model``: the architecture trained from scratch; ``init``: weights to start from instead, a run folder
+    (or its weights.pt) or an Ultralytics checkpoint file, or an :class:`~.init_weights.InitWeights` already
+    located and inspected (an experiment of many runs from one checkpoint inspects it once); ``threads``: torch threads
+    (default: the cores this process may use)."""
 
     train_set: Path
     out_dir: Path
     budget: Budget = field(default_factory=Budget)
     targets: DetectionTargets = field(default_factory=DetectionTargets)
     model: str = L.DEFAULT_MODEL
-    init: Path | None = None
+    init: Path | InitWeights | None = None
     fmt: str = "auto"
     images_dir: Path | None = None
     device: str = "auto"
@@ -99,17 +104,6 @@ class TrainRequest:
     workers: int = 2
     threads: int | None = None
     python: Path | None = None
-
-
-def run_weights(path: str | Path) -> tuple[Path, dict]:
-    """The weights and train.json of a run folder of `synthua train` (or of its weights.pt)."""
-    path = Path(path)
-    folder = path.parent if path.suffix == ".pt" else path
-    weights, about = folder / "weights.pt", folder / "train.json"
-    if not weights.is_file() or not about.is_file():
-        raise InputError(f"{shown(path)}: no weights.pt and train.json; expected a run folder written by "
-                         f"`synthua train`")
-    return weights, read_json(about, "a run's train.json")
 
 
 def _splits(request: TrainRequest) -> tuple[dict[str, DetectionSet], DetectionSet]:
@@ -144,17 +138,20 @@ def train(request: TrainRequest) -> dict:
     """Train, write the run folder (see the module's docstring) and return its train.json document."""
     if request.device not in L.DEVICES:
         raise InputError(f"--device: {request.device!r}; expected one of {', '.join(L.DEVICES)}")
-    inputs = {"TRAIN_SET": request.train_set, "--init": request.init, "--images": request.images_dir}
+    given = request.init.weights if isinstance(request.init, InitWeights) else request.init
+    inputs = {"TRAIN_SET": request.train_set, "--init": given, "--images": request.images_dir}
     check_not_inputs([Path(request.out_dir) / name for name in RUN_FILES], inputs)  # before the training
     splits, train_set = _splits(request)
-    init_weights, init_about = run_weights(request.init) if request.init is not None else (None, None)
+    init = request.init if isinstance(request.init, InitWeights) else locate_init(request.init, request.model)
     python = find_detector_python(request.python)
     threads = request.threads or len(os.sched_getaffinity(0))
     names = train_set.names
+    with tempfile.TemporaryDirectory(prefix="synthua-inspect-") as scratch:
+        init = inspect_checkpoint(init, python, Path(scratch))
     with output_set(request.out_dir, inputs=inputs) as stage, tempfile.TemporaryDirectory(prefix="synthua-train-") as scratch:
         data_yaml = write_yolo_boxes(Path(scratch) / "data", splits, names)
         b = request.budget
-        job = {"action": "train", "data": str(data_yaml), "model": str(init_weights.resolve()) if init_weights else request.model,
+        job = {"action": "train", "data": str(data_yaml), "model": init.model,
                "imgsz": b.imgsz, "epochs": b.epochs, "minutes": b.minutes, "batch": b.batch, "workers": request.workers,
                "device": request.device, "seed": request.seed, "threads": threads,
                "project": str(Path(scratch) / "runs")}
@@ -172,15 +169,17 @@ def train(request: TrainRequest) -> dict:
             "synthua": __version__, "python": platform.python_version(),
             "train_set": _set_document(train_set, splits), "classes": list(names),
             "targets": request.targets.document() if train_set.layout == "synthua" else None,
-            "model": request.model if init_weights is None else None,
-            "init": None if init_weights is None else {"weights": str(init_weights), "run": init_about},
+            "model": init.architecture, "init": init.document(result.get("transferred")),
             "budget": b.document(), "seed": request.seed, "device": result["device"], "threads": threads,
             "versions": result["versions"], "epochs_done": result["epochs_done"],
             "epochs_planned": result["epochs_planned"], "seconds": round(result["seconds"], 1),
             "parameters": result["parameters"], "final": result["results"][-1] if result["results"] else None,
-            "downloaded": result["downloaded"],
+            "downloaded": result["downloaded"], "network": result["network"],
         }
         write_json_atomic(stage / "train.json", document)
+    if result["network"]:
+        log.warning("Ultralytics tried to reach the network during training (refused): %s",
+                    ", ".join(sorted({a["host"] for a in result["network"]})))
     log.info("trained %s in %.0f s (%d epochs) -> %s", ", ".join(names), result["seconds"], result["epochs_done"],
              request.out_dir)
     return document

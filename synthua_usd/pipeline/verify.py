@@ -35,7 +35,7 @@ from synthua_usd.core.schemas import read_json, type_name
 from synthua_usd.dataset.annotations import rle_problem
 from synthua_usd.dataset.layout import SPLITS, Layout
 from synthua_usd.dataset.manifest import read_manifest, sha256_file
-from synthua_usd.dataset.record import IMAGE, SEQUENCE_FRAME, ImageRecord, record_problem
+from synthua_usd.dataset.record import SEQUENCE_FRAME, ImageRecord, image_kind, record_problem
 
 #: Problems listed in full; beyond this many, verify counts the rest.
 MAX_LISTED = 50
@@ -147,7 +147,7 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         record = _document(layout, relative, "an image record", result)
         if record is None:
             continue
-        problem = record_problem(record, IMAGE)
+        problem = record_problem(record, image_kind(record))
         if problem is None:
             records.append(record)
         else:
@@ -189,12 +189,13 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
             panoptic_by_image[ann["image_id"]] = ann
     config = (job.get("job_key") or {}).get("config") or {}
     min_px = config.get("min_instance_px", 0) if isinstance(config, dict) else 0
+    convention = config.get("convention") if isinstance(config, dict) else None
     for record in tqdm(records, desc="consistency", unit="image", disable=not show_progress):
         if is_rejected(record) or damaged & set(record["files"].values()):
             continue  # a damaged file is reported already; its image is not read
         try:
             _check_image(layout, record, coco_by_image.get(record["id"], []), panoptic_by_image.get(record["id"]),
-                         yolo_classes, result, min_px, class_map)
+                         yolo_classes, result, min_px, class_map, convention)
         except Exception as exc:  # noqa: BLE001 - whatever a broken file raises, it is a problem of the dataset
             result.add(f"image {record['id']} ({record['name']}): cannot be checked: {type(exc).__name__}: "
                        f"{echo(exc)}")
@@ -304,10 +305,12 @@ def _read(layout: Layout, relative: str) -> np.ndarray:
 
 
 def _check_image(layout: Layout, record: ImageRecord, coco_annotations: list[dict], panoptic_annotation: dict | None,
-                 yolo_classes: dict[int, int], result: Verification, min_px: int = 0, class_map=None) -> None:
+                 yolo_classes: dict[int, int], result: Verification, min_px: int = 0, class_map=None,
+                 convention: str | None = None) -> None:
     """The record and the image's annotations against its label maps (each PNG read once); an instance with fewer
     than ``min_px`` pixels in ``instance.png`` must be an ignore region (COCO iscrowd 1, no YOLO line) and every
-    other one must not."""
+    other one must not. A composite's YOLO file must be its boxes under the job's ``convention``, as its record
+    makes them."""
     from pycocotools import mask as mask_utils
 
     where = f"image {record['id']} ({record['name']})"
@@ -362,7 +365,15 @@ def _check_image(layout: Layout, record: ImageRecord, coco_annotations: list[dic
         result.add(f"{where}: {files['cs_labelIds']} differs from {files['class']}")
     if class_map is not None and {"cs_instanceIds", "cs_color"} & set(files):
         _check_cityscapes(layout, where, record, instance_ids, class_ids, class_map, result)
-    if "yolo_label" in files:
+    if "yolo_label" in files and "composite" in record:
+        from synthua_usd.model.taxonomy import ClassMap
+        from synthua_usd.pipeline.composite_worker import composite_yolo_text
+
+        expected_text = composite_yolo_text(record, ClassMap.load(layout.path(Layout.CLASS_MAP)), convention)
+        if layout.path(files["yolo_label"]).read_text(encoding="utf-8") != expected_text:
+            result.add(f"{where}: {files['yolo_label']} is not the boxes its record makes under the convention "
+                       f"{convention} (pasted instances, then the photo's kept boxes)")
+    elif "yolo_label" in files:
         lines = [ln for ln in layout.path(files["yolo_label"]).read_text(encoding="utf-8").splitlines() if ln.strip()]
         pixels = np.bincount(instance_ids.reshape(-1).astype(np.int64))
         expected = sum(1 for i in record["instances"] if i["category_id"] in yolo_classes
@@ -528,6 +539,10 @@ def replay(root: Path, image: str) -> Replay:
     if not root.is_dir():
         raise InputError(f"{shown(root)}: not a folder; expected a dataset folder written by `synthua generate`")
     job_doc = _job(root)
+    from synthua_usd.pipeline.composite import is_composite_job
+
+    if is_composite_job(job_doc):
+        return _compare(root, _replay_composite(root, job_doc, image))
     try:
         plan = [PlannedImage(**p) for p in job_doc["plan"]]
     except (TypeError, ValueError) as exc:
@@ -542,6 +557,34 @@ def replay(root: Path, image: str) -> Replay:
         raise InputError(f"{echo(image)}: no such image id or name in {root / Layout.CONFIG}; expected one of "
                          f"1..{len(plan)}")
     planned = chosen[0]
+
+    def remake(scratch: Path) -> dict:
+        try:
+            job = worker_job_from_document(job_doc, scratch, dataset=root)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"{shown(root / Layout.CONFIG)}: {type(exc).__name__} {echo(exc)}; expected the "
+                             f"generate.json `synthua generate` writes") from None
+        state = init_worker(job)
+        return (work(state, planned) + work(state, FLUSH))[-1]["record"]
+
+    return _compare(root, remake)
+
+
+def _replay_composite(root: Path, job_doc: dict, image: str):
+    """The remaking of the planned composite ``image`` (its id or name) of a ``synthua composite`` dataset."""
+    from synthua_usd.pipeline.composite import remake
+
+    plan = job_doc.get("plan") or []
+    chosen = [p for p in plan if str(p.get("id")) in (str(image), str(image).lstrip("0")) or p.get("name") == image]
+    if not chosen:
+        raise InputError(f"{echo(image)}: no such image id or name in {root / Layout.CONFIG}; expected one of "
+                         f"1..{len(plan)}")
+    return lambda scratch: remake(job_doc, chosen[0], scratch)
+
+
+def _compare(root: Path, remake) -> Replay:
+    """Make an image again with ``remake(scratch) -> record`` into a scratch folder beside the dataset and compare
+    each of its files, and those the dataset's record lists, with the dataset's file on disk."""
     layout = Layout(root)
     try:
         scratch = Path(tempfile.mkdtemp(prefix=".replay-", dir=root.parent))
@@ -550,18 +593,12 @@ def replay(root: Path, image: str) -> Replay:
                           f"({exc.strerror}); expected a writable folder") from None
     try:
         with named_as(scratch, root):  # a failure names the dataset, never the scratch folder
-            try:
-                job = worker_job_from_document(job_doc, scratch, dataset=root)
-            except (KeyError, TypeError, ValueError) as exc:
-                raise InputError(f"{shown(root / Layout.CONFIG)}: {type(exc).__name__} {echo(exc)}; expected the "
-                                 f"generate.json `synthua generate` writes") from None
-            state = init_worker(job)
-            results = work(state, planned) + work(state, FLUSH)
-        record = results[-1]["record"]
-        out = Replay(planned.id, record["name"])
+            record = remake(scratch)
+        out = Replay(record["id"], record["name"])
         record_path = Layout.record(record["name"])
         original = _document(layout, record_path, "an image record", Verification())
-        theirs = set(original["files"].values()) if record_problem(original, IMAGE) is None else set()
+        theirs = (set(original["files"].values()) if record_problem(original, image_kind(original)) is None
+                  else set())
         for rel in sorted(set(record["files"].values()) | theirs | {record_path}):
             ours = _sha256_or_none(scratch / rel)
             same = ours is not None and ours == _sha256_or_none(layout.path(rel))

@@ -43,7 +43,7 @@ class ScoreJob:
 
 class ViewScorer:
     """Scores views one after the other, keeping the stage, the randomiser (its scene of the last seed) and the
-    label session between them: views of one district and seed in a row cost a scene once."""
+    label session between them: views of one scene and seed in a row cost a scene once."""
 
     def __init__(self, job: ScoreJob, stage=None) -> None:
         from synthua_usd.backends.mitsuba.session import RenderSession
@@ -55,21 +55,21 @@ class ViewScorer:
                                                   variant=render.variant))
         self.scale = job.output_size[0] * job.output_size[1] / (render.width * render.height)
         self._stage = stage  # the job's scenario, when the caller has it open
-        self._district: object = object()
+        self._scene: object = object()
         self.reader = self.randomiser = None
 
-    def _open(self, district: int | None) -> None:
+    def _open(self, scene) -> None:
         from synthua_usd.usd.reader import StageReader
         from synthua_usd.usd.stage_io import open_stage
 
         if self.randomiser is not None:
             self.randomiser.close()
-        if district is None:
+        if scene is None:
             if self._stage is None:
                 self._stage = open_stage(self.job.scenario, self.job.allow_external_assets)
             stage = self._stage
         else:  # the dataset's own scenario of the scene, checked when it was written
-            stage = open_stage(self.job.scenes[district], allow_external_assets=True)
+            stage = open_stage(self.job.scenes[scene], allow_external_assets=True)
         self.reader = StageReader(stage, self.class_map)
         self.randomiser = None
         if self.job.randomise is not None:
@@ -77,17 +77,17 @@ class ViewScorer:
 
             self.randomiser = Randomiser(stage, self.job.randomise, self.class_map,
                                          (self.job.render.width, self.job.render.height))
-        self._district = district
+        self._scene = scene
 
     def score(self, view: View) -> sampling.ViewScore:
         """The aid users ``view`` shows."""
         from synthua_usd.usd.cameras import read_camera
 
-        district, seed, tc, path = view
-        if district != self._district:
-            self._open(district)
+        scene, seed, tc, path = view
+        if scene != self._scene:
+            self._open(scene)
         if self.randomiser is not None:
-            self.randomiser.apply(seed, path, tc, None, district)
+            self.randomiser.apply(seed, path, tc, None, scene)
         snapshot = self.reader.snapshot(tc)
         ids = self.session.quick_labels(snapshot, read_camera(self.reader.stage, path, tc))
         counts = np.bincount(ids.ravel(), minlength=len(snapshot.instances) + 1)

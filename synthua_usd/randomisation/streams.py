@@ -6,8 +6,10 @@ which worker renders the image, nor on what it rendered before) and one scope's 
 - ``scene``: (seed) the crowd's cast and looks, the devices, the twin's material variants;
 - ``view``: (seed, camera, time code) the camera's jitter, then where each person stands;
 - ``light``: (seed, camera, time code, condition) the sun, sky and exposure;
-- ``effects``: (seed, camera, time code, condition) the camera effects applied after rendering;
+- ``effects``: (seed, camera, time code, condition) the camera effects applied after rendering (a composite's:
+  (its number, background path));
 - ``framing``: (seed, camera, time code) the photographer's view of an aid user;
+- ``composite``: (its number, background path) a composite's camera model and pastes (``synthua composite``);
 - ``setting``: (seed) whether the scene is in the district or a procedural setting, and which;
 - ``distractors``: (seed) the objects scattered in the scene, their looks and places.
 """
@@ -18,8 +20,9 @@ import zlib
 
 import numpy as np
 
+#: Each scope's number, never reused.
 _SCOPES = {"district": 1, "scene": 2, "view": 3, "light": 4, "effects": 5, "cutout_group": 6, "cutout_view": 7,
-           "framing": 8, "setting": 9, "distractors": 10}
+           "framing": 8, "composite": 9, "setting": 10, "distractors": 11}
 
 
 def _key(value) -> int:

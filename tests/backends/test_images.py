@@ -80,3 +80,15 @@ def test_exr_files_depend_only_on_their_pixels(tmp_path, monkeypatch):
     _images.write_depth_exr(tmp_path / "b_z.exr", pixels[..., 0], "z")
     assert (tmp_path / "a.exr").read_bytes() == (tmp_path / "b.exr").read_bytes()
     assert (tmp_path / "a_z.exr").read_bytes() == (tmp_path / "b_z.exr").read_bytes()
+
+
+def test_a_fast_png_holds_the_same_pixels(tmp_path):
+    from synthua_usd.backends.images import FAST_PNG, read_image, write_color_png, write_id_png
+
+    rgb = np.random.default_rng(3).integers(0, 256, (12, 16, 3), dtype=np.uint8)
+    ids = np.random.default_rng(4).integers(0, 2**16, (12, 16), dtype=np.uint16)
+    write_color_png(tmp_path / "slow.png", rgb)
+    write_color_png(tmp_path / "fast.png", rgb, compression=FAST_PNG)
+    write_id_png(tmp_path / "ids.png", ids, compression=FAST_PNG)
+    np.testing.assert_array_equal(read_image(tmp_path / "fast.png")[0], read_image(tmp_path / "slow.png")[0])
+    np.testing.assert_array_equal(read_image(tmp_path / "ids.png")[0][..., 0], ids)

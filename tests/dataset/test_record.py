@@ -11,8 +11,9 @@ import pytest
 
 from synthua_usd.core.errors import SchemaError
 from synthua_usd.core.schemas import load_schema, schema_problem
-from synthua_usd.dataset.record import (IMAGE, SEQUENCE_FRAME, FileEntry, ImageRecord, InstanceEntry, PanopticSegment,
-                                        QAResult, RecordCamera, RecordRender, SequenceFrameRecord, check_record,
+from synthua_usd.dataset.record import (COMPOSITE, IMAGE, SEQUENCE_FRAME, CompositeEntry, CompositeRecord, FileEntry,
+                                        ImageRecord, InstanceEntry, PanopticSegment, PhotoCameraEntry, QAResult,
+                                        RecordCamera, RecordRender, SequenceFrameRecord, check_record, image_kind,
                                         record_problem)
 
 
@@ -23,6 +24,7 @@ def _keys(typed) -> set[str]:
 @pytest.mark.parametrize("typed, definition", [
     (ImageRecord, IMAGE), (SequenceFrameRecord, SEQUENCE_FRAME), (RecordCamera, "camera"), (RecordRender, "render"),
     (InstanceEntry, "instance"), (PanopticSegment, "panoptic_segment"), (QAResult, "qa"),
+    (CompositeRecord, COMPOSITE), (PhotoCameraEntry, "photo_camera"), (CompositeEntry, "composite"),
 ])
 def test_typed_keys_are_the_schema_properties(typed, definition):
     assert _keys(typed) == set(load_schema("record")["$defs"][definition]["properties"])
@@ -62,3 +64,12 @@ def test_a_wrong_field_is_named(generated):
     record = _records(generated)[0]
     del record["instances"][0]["segmentation"]
     assert record_problem(record, IMAGE).startswith("instances[0]: 'segmentation' is a required property")
+
+
+def test_a_record_is_a_composite_when_it_says_so(generated):
+    record = _records(generated)[0]
+    assert image_kind(record) == IMAGE
+    assert image_kind({**record, "composite": {}}) == COMPOSITE
+    # the schema as a whole sends a record with 'composite' to $defs/composite_image, which has no render
+    problem = schema_problem({**record, "composite": {}}, "record")
+    assert "not a key of the document" in problem and problem.split(":")[0] in ("render", "time_code", "layer_stack")

@@ -181,7 +181,7 @@ def test_verify_finds_a_tampered_bank(bank, tmp_path):
     # another version's bank is refused in one line
     document["format"] = "synthua-cutouts/0"
     (copy / BANK_FILE).write_text(json.dumps(document), encoding="utf-8")
-    assert_refused(run_synthua("verify", str(copy)), "format 'synthua-cutouts/0'")
+    assert_refused(run_synthua("verify", str(copy)), "format: 'synthua-cutouts/0'")
 
 
 @pytest.mark.parametrize("change, says", [

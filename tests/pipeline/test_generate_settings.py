@@ -35,8 +35,8 @@ def test_each_setting_is_written_once_and_every_image_records_its_scene(generate
     out = generated_settings
     assert verify(out).ok
     randomise = GenerationConfig.load(CONFIG).randomise
-    keys = {seed: scene_of(randomise, seed) for seed in (0, 1, 7)}
-    assert keys == {0: SceneKey("vehicle_ramp", 0), 1: SceneKey("shop", 0), 7: None}  # the scenes the seeds draw
+    keys = {seed: scene_of(randomise, seed) for seed in (0, 4, 5)}
+    assert keys == {0: SceneKey("shop", 0), 4: SceneKey("vehicle_ramp", 0), 5: None}  # the scenes the seeds draw
     assert sorted(p.name for p in (out / "scenes").iterdir()) == ["shop_0", "vehicle_ramp_0"]
     listed = {f["path"] for f in json.loads((out / "manifest.json").read_text())["dataset_files"]}
     assert {"scenes/shop_0/twin.usdc", "scenes/vehicle_ramp_0/cameras.usda", "scenes/shop_0/scenario.usda"} <= listed

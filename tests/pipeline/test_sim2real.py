@@ -48,7 +48,7 @@ def test_train_records_what_it_trained_on(run, generated_random):
     assert about["seed"] == 3 and about["device"] == "cpu" and about["epochs_done"] == 1
     assert about["model"] == "yolo26n.yaml" and about["init"] is None
     assert about["versions"]["ultralytics"] == "8.4.190" and about["versions"]["torch"]
-    assert about["downloaded"] == []                                      # no weights fetched
+    assert about["downloaded"] == [] and about["network"] == []            # nothing fetched, nothing even tried
     assert about["targets"]["aid_box"] == "with_user" and about["classes"][0] == "person"
     assert (run / "weights.pt").stat().st_size > 1_000_000 and (run / "results.csv").is_file()
 
@@ -152,7 +152,13 @@ def test_fine_tuning_on_a_real_set_starts_from_the_run(run, generated_random, tm
     assert main(["train", str(generated_random), "--format", "yolo", "--init", str(run), "--epochs", "1",
                  "--imgsz", "64", "--batch", "2", "--device", "cpu", "--out", str(out)]) == 0
     about = json.loads((out / "train.json").read_text())
-    assert about["init"]["weights"] == str(run / "weights.pt") and about["model"] is None
+    init = about["init"]
+    assert init["kind"] == "run" and init["weights"] == str((run / "weights.pt").resolve()) and about["model"] is None
+    assert init["sha256"] == hashlib.sha256((run / "weights.pt").read_bytes()).hexdigest()
+    assert init["run"] == json.loads((run / "train.json").read_text())
+    # the weights were taken, by Ultralytics' own count: all of them, the head's class rows matched by class name
+    taken, of = init["transferred"]
+    assert taken == of > 0 and f"Transferred {taken}/{of} items" in (out / "train.log").read_text()
     assert about["train_set"]["layout"] == "yolo" and about["targets"] is None
     assert about["classes"][:2] == ["curb_ramp", "crosswalk"]          # the generated data.yaml's names
     assert not list((generated_random / "labels").glob("*.cache"))      # Ultralytics' cache went to its own copy
@@ -172,3 +178,126 @@ def test_refusals_are_one_line(run, generated_random, tmp_path, capsys):
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("synthua: error:") and found in err[0], err
         assert not (tmp_path / "out").exists()
+
+
+# --- starting from an Ultralytics checkpoint file (made here, never downloaded) ---------------------------------------
+
+@pytest.fixture(scope="module")
+def checkpoints(detector_python, tmp_path_factory) -> dict[str, Path]:
+    """Checkpoints as Ultralytics saves them, of freshly built models: ``detect`` a YOLO11n detector with COCO's 80
+    classes (a stand-in for a user's COCO-pretrained yolo11n.pt: same file layout, untrained weights), ``classify``
+    a YOLO11n classifier, and ``garbage``, a .pt file that is no checkpoint."""
+    import os
+    import subprocess
+
+    folder = tmp_path_factory.mktemp("checkpoints")
+    script = ("import sys\nfrom ultralytics import YOLO\n"
+              "YOLO('yolo11n.yaml').save(sys.argv[1])\nYOLO('yolo11n-cls.yaml').save(sys.argv[2])\n")
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    env |= {"YOLO_OFFLINE": "1", "YOLO_CONFIG_DIR": str(folder / "settings")}
+    out = {"detect": folder / "yolo11n.pt", "classify": folder / "yolo11n-cls.pt", "garbage": folder / "garbage.pt"}
+    subprocess.run([str(detector_python), "-c", script, str(out["detect"]), str(out["classify"])], check=True,
+                   env=env, cwd=folder, capture_output=True, timeout=300)
+    out["garbage"].write_bytes(b"not a checkpoint\n")
+    return out
+
+
+def test_train_from_a_checkpoint_file(checkpoints, generated_random, tmp_path, capsys):
+    out = tmp_path / "from_checkpoint"
+    assert main(["train", str(generated_random), "--init", str(checkpoints["detect"]), "--epochs", "1", "--imgsz", "64",
+                 "--batch", "2", "--device", "cpu", "--out", str(out)]) == 0
+    assert "from checkpoint yolo11n.pt (yolo11n.yaml, 80 classes, sha256" in capsys.readouterr().out
+    about = json.loads((out / "train.json").read_text())
+    init = about["init"]
+    assert init["kind"] == "checkpoint" and init["weights"] == str(checkpoints["detect"].resolve())
+    assert init["sha256"] == hashlib.sha256(checkpoints["detect"].read_bytes()).hexdigest()
+    assert init["checkpoint"]["task"] == "detect" and init["checkpoint"]["architecture"] == "yolo11n.yaml"
+    assert len(init["checkpoint"]["names"]) == 80 and init["checkpoint"]["saved_with"] == "8.4.190"
+    taken, of = init["transferred"]   # all but the head's class layers: no class name of ours is among its 0..79
+    assert 0.9 * of < taken < of
+    assert about["model"] is None and about["downloaded"] == [] and about["network"] == []
+
+
+def test_a_checkpoint_that_cannot_start_a_detector_is_refused_in_one_line(checkpoints, generated_random, tmp_path,
+                                                                         capsys):
+    cases = [(checkpoints["garbage"], "garbage.pt: Ultralytics cannot load it ("),
+             (checkpoints["classify"], "an Ultralytics classify checkpoint; expected a detection checkpoint"),
+             (tmp_path / "yolo26n.pt", "yolo26n.pt: not found; expected a run folder of `synthua train` or an "
+                                       "Ultralytics checkpoint file")]
+    for path, found in cases:
+        assert main(["train", str(generated_random), "--init", str(path), "--epochs", "1", "--imgsz", "64",
+                     "--out", str(tmp_path / "out")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("synthua: error: --init: ") and found in err[0], err
+        assert not (tmp_path / "out").exists()
+
+
+# --- tools/sim2real.py end to end: every arm from one checkpoint ------------------------------------------------------
+
+def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path, capsys):
+    """The randomised dataset (train 2 images, val 4) as the synthetic set, as the stand-in "real" photos (its val
+    split the test) and as the mixed set of arm d; one real photo drawn; 4 image-steps a training at imgsz 64; one
+    seed (the seeds' spread is tested against NumPy in test_sim2real_plan.py). Hand-worked: (a) 4 / 2 images = 2
+    epochs; (b) and (c) 4 / 1 photo = 4 epochs; (d) 1 photo + 2 mixed: 4 / 3 = 1.33 -> 1 epoch, 3 image-steps."""
+    import importlib.util
+    import sys
+
+    from conftest import REPO
+
+    spec = importlib.util.spec_from_file_location("sim2real_e2e", REPO / "tools" / "sim2real.py")
+    tool = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = tool
+    spec.loader.exec_module(tool)
+    work = tmp_path / "work"
+    args = ["--synthetic", str(generated_random), "--synthetic-split", "none", "--stand-in", str(generated_random),
+            "--stand-in-test-split", "val", "--mix", str(generated_random), "--arms", "a,b,c,d", "--real-sizes", "1",
+            "--seeds", "0", "--budget-images", "4", "--imgsz", "64", "--batch", "2", "--device", "cpu",
+            "--init", str(checkpoints["detect"]), "--work", str(work)]
+    assert tool.main(args) == 0
+    doc = json.loads((work / "sim2real.json").read_text())
+    plan = doc["plan"]
+    assert (plan["synthetic_images"], plan["real_photos"], plan["mix_images"]) == (2, 2, {"1": 2})
+    runs = {r["name"]: r for r in doc["runs"]}
+    assert list(runs) == ["a_synthetic_s0", "b_n0001_s0", "c_n0001_s0", "d_n0001_s0"]
+    ckpt_sha = hashlib.sha256(checkpoints["detect"].read_bytes()).hexdigest()
+    for name, r in runs.items():
+        epochs, images = {"a": (2, 2), "b": (4, 1), "c": (4, 1), "d": (1, 3)}[r["arm"]]
+        about = json.loads((Path(r["run"]) / "train.json").read_text())
+        assert (r["epochs"], r["images"], r["image_steps"]) == (epochs, images, epochs * images), name
+        assert about["budget"]["epochs"] == r["epochs_done"] == epochs and about["seed"] == r["seed"] == 0
+        assert about["train_set"]["images"]["train"] == images and r["device"] == "cpu" and r["seconds"] > 0
+        assert r["command"].startswith("synthua train ") and f"--epochs {epochs} " in r["command"]
+        if r["arm"] == "c":        # (a)'s run of the same seed, fine-tuned
+            a_weights = Path(runs["a_synthetic_s0"]["run"]) / "weights.pt"
+            assert r["init"]["kind"] == "run" and r["init"]["sha256"] == hashlib.sha256(a_weights.read_bytes()).hexdigest()
+        else:                      # every other arm from the one checkpoint
+            assert r["init"]["kind"] == "checkpoint" and r["init"]["sha256"] == ckpt_sha
+            assert f"--init {checkpoints['detect'].resolve()}" in r["command"]
+        assert r["init"]["transferred"][0] > 0 and r["network"] == [] and r["downloaded"] == []
+    assert "d_n0001_s0: 4 image-steps / 3 images = 1.33 epochs, trained as 1: 3 image-steps (-25.0 %)" in doc["notes"]
+    assert "1 seed: a spread from fewer than 3 seeds is not a figure to quote" in doc["notes"]
+    # the subset is stated and linked; arm d's folder holds it and the mixed set
+    subset = json.loads((work / "subsets" / "n0001" / "subset.json").read_text())
+    assert subset["photos"] == doc["subsets"]["1"] and len(subset["photos"]) == 1
+    assert len(list((work / "mixed" / "n0001" / "images" / "train").iterdir())) == 3
+    # every run scored on the stand-in test, per class
+    assert {(s["arm"], s["class"]) for s in doc["summary"]} == {(a, c) for a in "abcd" for c in ("person", "wheelchair")}
+    for row in doc["scores"]:
+        s = next(s for s in doc["summary"] if (s["arm"], s["class"]) == (row["arm"], row["class"]))
+        assert s["AP50"]["mean"] == row["AP50"] and s["AP50"]["std"] is None and s["seeds"] == [0]
+    text = (work / "sim2real.md").read_text()
+    assert "| (d) real + mixed set | 1 + 2 mixed | 0 | 1 × 3 = 3 |" in text
+    assert "| (c) synthetic, then real | 1 | 0 | 4 × 1 = 4 after (a)'s 4 |" in text
+    assert "every arm from checkpoint yolo11n.pt (yolo11n.yaml, 80 classes" in text
+    assert (work / "sim2real.png").stat().st_size > 5000
+    # run again: every run and score is kept (nothing trains); another budget is refused on the first kept run
+    stamps = {n: (Path(r["run"]) / "train.json").stat().st_mtime_ns for n, r in runs.items()}
+    capsys.readouterr()
+    assert tool.main(args) == 0
+    out = capsys.readouterr().out
+    assert "sim2real: training" not in out and out.count("sim2real: kept ") == 4
+    assert stamps == {n: (Path(r["run"]) / "train.json").stat().st_mtime_ns for n, r in runs.items()}
+    assert json.loads((work / "sim2real.json").read_text())["scores"] == doc["scores"]
+    assert tool.main([a if a != "4" else "8" for a in args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "a_synthetic_s0: kept from an earlier run with epochs 2 (planned 4)" in err[0], err

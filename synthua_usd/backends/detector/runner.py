@@ -9,6 +9,7 @@ folder, and nothing is fetched), their output logged to a file beside the job.
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
 import os
@@ -46,14 +47,22 @@ def find_detector_python(explicit: str | Path | None = None) -> Path:
     if not candidate.exists():
         raise DetectorUnavailable(f"the detector (Ultralytics) is not installed: no interpreter at {candidate}; "
                                   f"{INSTALL_HINT}")
+    _probe(str(candidate))
+    return candidate
+
+
+@functools.lru_cache(maxsize=8)
+def _probe(candidate: str) -> None:
+    """Import Ultralytics in ``candidate`` once per process: the probe takes about 3 s, and an experiment of many
+    trainings (tools/sim2real.py) asks for the interpreter before each one. A failure is not remembered (lru_cache
+    keeps no exceptions), so an interpreter installed meanwhile is found on the next call."""
     with tempfile.TemporaryDirectory(prefix="synthua-detector-") as folder:  # Ultralytics writes settings on import
-        probe = subprocess.run([str(candidate), "-c", "import ultralytics, torch, torchvision"], capture_output=True,
+        probe = subprocess.run([candidate, "-c", "import ultralytics, torch, torchvision"], capture_output=True,
                                text=True, timeout=300, env=_environment(Path(folder)))
     if probe.returncode != 0:
         last = (probe.stderr.strip().splitlines() or ["no output"])[-1]
         raise DetectorUnavailable(f"the detector (Ultralytics) is not installed in {candidate} ({last}); "
                                   f"{INSTALL_HINT}")
-    return candidate
 
 
 def _environment(folder: Path) -> dict[str, str]:

@@ -46,12 +46,21 @@ class RenderSession:
     ``variant`` is picked (or checked) once, when the session is made.
     """
 
-    def __init__(self, config: RenderConfig) -> None:
+    def __init__(self, config: RenderConfig, count_compiles: bool = False) -> None:
         self.config = config
+        #: Whether :meth:`render` reports the seconds Dr.Jit spent compiling kernels (``compile``, from its kernel
+        #: history, which this turns on for the process): for benchmarks and profiles.
+        self.count_compiles = count_compiles
         self.mi = variants.activate(config.variant)
         self.variant = self.mi.variant()
+        if count_compiles and not self.variant.startswith("scalar"):
+            import drjit as dr
+
+            dr.set_flag(dr.JitFlag.KernelHistory, True)
         self.loads = 0
         self.reloads = 0
+        #: Seconds the last load spent translating the snapshot (the rest of ``load``: Mitsuba building the scene).
+        self.translate_seconds = 0.0
         self._scene = None
         self._params = None
         self._translation: Translation | None = None
@@ -82,7 +91,9 @@ class RenderSession:
         return self._denoiser
 
     def _load(self, snapshot: SceneSnapshot, camera: PinholeCamera, condition: Condition | None = None) -> None:
+        t0 = time.perf_counter()
         self._translation = translate(self.mi, snapshot, camera, self.config, condition)
+        self.translate_seconds = time.perf_counter() - t0
         # optimize=False: Mitsuba would otherwise merge meshes and lose the identity labels depend on.
         self._scene = self._translation.load(self.mi)
         self._params = self.mi.traverse(self._scene)
@@ -172,14 +183,20 @@ class RenderSession:
         ``rgb``, ``denoise`` (with the config's ``denoise``: fireflies and OIDN, before any weather) and
         ``weather`` (fog, rain and exposure in image space)."""
         seconds = {}
+        if self.count_compiles and not self.variant.startswith("scalar"):
+            import drjit as dr
+
+            dr.kernel_history()  # what came before this frame is not its
         t0 = time.perf_counter()
         if self._scene is None:
             self._load(snapshot, camera, condition)
             seconds["load"] = time.perf_counter() - t0
+            seconds["load_translate"] = self.translate_seconds
         elif not self._same_layout(snapshot, condition):
             self._load(snapshot, camera, condition)
             self.reloads += 1
             seconds["load"] = time.perf_counter() - t0
+            seconds["load_translate"] = self.translate_seconds
         else:
             self._update(snapshot, camera, condition)
             seconds["update"] = time.perf_counter() - t0
@@ -217,6 +234,11 @@ class RenderSession:
                                       self.config.seed if seed is None else seed)
             exposure = choose_exposure(image, hits.mesh_index >= 0, camera.exposure_ev)
             seconds["weather"] = time.perf_counter() - t0
+        if self.count_compiles and not self.variant.startswith("scalar"):
+            import drjit as dr
+
+            seconds["compile"] = sum(k.get("codegen_time", 0.0) + k.get("backend_time", 0.0)
+                                     for k in dr.kernel_history() if not k.get("cache_hit", True)) / 1000.0
         return RenderedFrame(rgb=image, class_ids=class_ids, instance_ids=instance_ids, hits=hits,
                              variant=self.variant, seconds=seconds, exposure=exposure, condition=condition,
                              denoised=denoised)

@@ -10,7 +10,9 @@ Columns, in this order:
   condition (a list or dict parameter is JSON text);
 * ``instances.CLASS`` and ``pixels.CLASS`` for every class of the class map (instances: the record's
   instance entries of that class; pixels: its class pixel counts);
-* ``qa_verdict``, ``qa_reasons`` (joined by ``"; "``) and ``qa.MEASURE`` for each QA measure.
+* ``qa_verdict``, ``qa_reasons`` (joined by ``"; "``) and ``qa.MEASURE`` for each QA measure;
+* in a dataset of ``synthua composite``: ``background`` (the photo's path), ``background_labelled``,
+  ``horizon_row_px``, ``camera_height_m``, ``pastes`` and the photo's ``boxes_kept`` and ``boxes_dropped``.
 
 A value a record does not have is empty in the CSV and null in Parquet.
 """
@@ -49,6 +51,7 @@ def metadata_rows(records: Iterable[ImageRecord], class_map: ClassMap) -> list[d
     records = ordered(records)
     condition_keys = sorted({k for r in records for k in (r.get("condition") or {}) if k != "name"})
     measure_keys = sorted({k for r in records for k in ((r.get("qa") or {}).get("measures") or {})})
+    composites = any("composite" in r for r in records)
     rows = []
     for r in records:
         cam = r.get("camera") or {}
@@ -65,7 +68,8 @@ def metadata_rows(records: Iterable[ImageRecord], class_map: ClassMap) -> list[d
                "vertical_aperture_mm": cam.get("vertical_aperture_mm")}
         row |= _matrix("camera_to_world", cam.get("camera_to_world"))
         row |= _matrix("world_to_camera_opencv", cam.get("world_to_camera_opencv"))
-        row |= {"time_code": float(r["time_code"]), "seed": int(r["seed"]), "condition": cond.get("name")}
+        row |= {"time_code": None if r.get("time_code") is None else float(r["time_code"]), "seed": int(r["seed"]),
+                "condition": cond.get("name")}
         row |= {f"condition.{k}": _scalar(cond.get(k)) for k in condition_keys}
         counts = {c.name: 0 for c in class_map.classes}
         for inst in r.get("instances", ()):
@@ -75,8 +79,23 @@ def metadata_rows(records: Iterable[ImageRecord], class_map: ClassMap) -> list[d
         row |= {f"pixels.{c.name}": int(pixels.get(c.name, 0)) for c in class_map.classes}
         row |= {"qa_verdict": qa.get("verdict"), "qa_reasons": "; ".join(qa.get("reasons") or ())}
         row |= {f"qa.{k}": (qa.get("measures") or {}).get(k) for k in measure_keys}
+        if composites:
+            row |= _composite_columns(r)
         rows.append(row)
     return rows
+
+
+def _composite_columns(record: ImageRecord) -> dict:
+    """The columns of a composite (None for a rendered image in the same table)."""
+    composite, camera = record.get("composite"), record.get("camera") or {}
+    if composite is None:
+        return dict.fromkeys(("background", "background_labelled", "horizon_row_px", "camera_height_m", "pastes",
+                              "boxes_kept", "boxes_dropped"))
+    boxes = composite["background_boxes"]
+    return {"background": composite["background"]["path"], "background_labelled": composite["background"]["labelled"],
+            "horizon_row_px": camera.get("horizon_row_px"), "camera_height_m": camera.get("height_m"),
+            "pastes": len(composite["pastes"]), "boxes_kept": sum(b["kept"] for b in boxes),
+            "boxes_dropped": sum(not b["kept"] for b in boxes)}
 
 
 def write_tables(rows: list[dict], csv_path: str | Path, parquet_path: str | Path) -> None:

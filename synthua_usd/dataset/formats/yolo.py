@@ -249,3 +249,15 @@ def yolo_lines(record_instances: Sequence[dict], width: int, height: int, class_
         coords = " ".join(f"{columns[px]} {rows[py]}" for px, py in poly.tolist())
         lines.append(f"{k} {coords}")
     return "".join(line + "\n" for line in lines)
+
+
+def box_lines(boxes: Sequence[tuple[int, float, float, float, float]], width: int, height: int,
+              class_index: dict[int, int]) -> str:
+    """A detection label file's text: one line ``index cx cy w h`` (normalised by the image's ``width`` and
+    ``height``) per box ``(class id, x, y, w, h)`` (pixels, pixel edges) whose class is in ``class_index``, in the
+    order given. What a composite's boxes under a box convention are written as (they are boxes, not masks)."""
+    def text(v: float) -> str:
+        return f"{v:.{DECIMALS}f}".rstrip("0").rstrip(".")
+
+    return "".join(f"{class_index[c]} {text((x + w / 2) / width)} {text((y + h / 2) / height)} {text(w / width)} "
+                   f"{text(h / height)}\n" for c, x, y, w, h in boxes if c in class_index)

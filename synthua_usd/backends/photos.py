@@ -1,0 +1,135 @@
+"""Photos read as backgrounds: their header (size, EXIF focal length, orientation) and their pixels cut to the
+written size, through Pillow (which reads EXIF, and HEIC when its plugin pillow-heif is installed).
+
+The written image *covers* the output size: the photo is scaled by ``max(W / w, H / h)`` (never above 1: a photo
+smaller than the output is refused) and its centre cut out, ``region`` in photo pixels. A photo with an EXIF
+orientation other than 1 is turned upright first (as viewers and Ultralytics' loader do); its size and boxes are
+then the upright photo's. Colours are taken as 8-bit sRGB (an embedded ICC profile is not applied).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageOps, UnidentifiedImageError
+from PIL.ExifTags import Base, IFD
+
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.input_files import shown
+
+#: Suffixes of HEIC/HEIF photos (phones' default), read only with pillow-heif installed.
+HEIC_SUFFIXES = (".heic", ".heif")
+#: Pillow's orientation tag.
+_ORIENTATION = 0x0112
+
+
+def heic_decoder() -> bool:
+    """Whether a HEIC decoder (pillow-heif) is installed; registers it with Pillow when it is."""
+    try:
+        import pillow_heif  # noqa: PLC0415 - optional
+    except ImportError:
+        return False
+    pillow_heif.register_heif_opener()
+    return True
+
+
+def _open(path: Path, data: bytes | None = None) -> Image.Image:
+    path = Path(path)
+    if path.suffix.lower() in HEIC_SUFFIXES and not heic_decoder():
+        raise InputError(f"{shown(path)}: a HEIC image, and no HEIC decoder is installed; expected a JPEG, PNG, TIFF, "
+                         f"BMP or WebP photo, or `pip install pillow-heif` to read HEIC")
+    try:
+        return Image.open(io.BytesIO(data) if data is not None else path)
+    except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError) as exc:
+        raise InputError(f"{shown(path)}: not an image Pillow can read ({type(exc).__name__}); expected a photo "
+                         f"(JPEG, PNG, TIFF, BMP, WebP)") from None
+
+
+@dataclass(frozen=True)
+class PhotoHeader:
+    """A photo's upright size (pixels), its EXIF FocalLengthIn35mmFilm (mm; None when absent or 0) and EXIF
+    orientation (1: stored upright)."""
+
+    width: int
+    height: int
+    focal_35mm: float | None
+    orientation: int
+
+
+def _header(image: Image.Image) -> PhotoHeader:
+    exif = image.getexif()
+    orientation = int(exif.get(_ORIENTATION, 1) or 1)
+    focal = exif.get_ifd(IFD.Exif).get(Base.FocalLengthIn35mmFilm)
+    width, height = image.size
+    if orientation in (5, 6, 7, 8):  # turned a quarter: the upright photo's sides swap
+        width, height = height, width
+    focal = float(focal) if isinstance(focal, (int, float)) and focal > 0 else None
+    return PhotoHeader(width, height, focal, orientation)
+
+
+def photo_header(path: str | Path) -> PhotoHeader:
+    """The header of the photo at ``path`` (no pixels decoded)."""
+    with _open(Path(path)) as image:
+        return _header(image)
+
+
+def cover_region(size: tuple[int, int], output: tuple[int, int] | None, path: Path) -> tuple[tuple[float, ...], float]:
+    """The photo ``region`` (x0, y0, x1, y1, photo pixels) that covers ``output`` (W, H) at the centre, and the
+    ``scale`` (written px per photo px, <= 1); ``output`` None: the whole photo at scale 1. A photo smaller than the
+    output raises :class:`InputError`."""
+    width, height = size
+    if output is None:
+        return (0.0, 0.0, float(width), float(height)), 1.0
+    out_w, out_h = output
+    if width < out_w or height < out_h:
+        raise InputError(f"{shown(path)}: {width}x{height} pixels; expected at least the output size {out_w}x{out_h} "
+                         f"(photos are scaled down, never up: set output smaller, or null for each photo's own size)")
+    scale = max(out_w / width, out_h / height)
+    cut_w, cut_h = out_w / scale, out_h / scale
+    x0, y0 = (width - cut_w) / 2.0, (height - cut_h) / 2.0
+    return (x0, y0, x0 + cut_w, y0 + cut_h), scale
+
+
+@dataclass(frozen=True, eq=False)
+class Photo:
+    """A photo read for one composite: ``pixels`` (H, W, 3) uint8 at the written size, the file's SHA-256, its
+    header, and the ``region`` and ``scale`` it was cut with (:func:`cover_region`)."""
+
+    pixels: np.ndarray
+    sha256: str
+    header: PhotoHeader
+    region: tuple[float, float, float, float]
+    scale: float
+
+
+def read_photo(path: str | Path, output: tuple[int, int] | None) -> Photo:
+    """Read, turn upright and cut the photo at ``path`` to ``output`` (W, H; None: its own size). A truncated or
+    damaged file raises :class:`InputError`."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{shown(path)}: cannot be read ({exc.strerror}); expected a readable photo") from None
+    with _open(path, data) as image:
+        header = _header(image)
+        try:
+            image.load()
+            upright = ImageOps.exif_transpose(image) if header.orientation != 1 else image
+            rgb = upright.convert("RGB")
+        except (OSError, ValueError, SyntaxError) as exc:
+            raise InputError(f"{shown(path)}: truncated or damaged ({str(exc)[:60]}); expected a complete "
+                             f"image") from None
+    region, scale = cover_region(rgb.size, output, path)
+    x0, y0, x1, y1 = region
+    size = output or rgb.size
+    whole = all(float(v).is_integer() for v in region) and math.isclose(scale, 1.0)
+    if whole:
+        pixels = np.asarray(rgb, np.uint8)[int(y0):int(y1), int(x0):int(x1)]
+    else:
+        pixels = np.asarray(rgb.resize(size, Image.Resampling.LANCZOS, box=region), np.uint8)
+    return Photo(np.ascontiguousarray(pixels), hashlib.sha256(data).hexdigest(), header, region, scale)

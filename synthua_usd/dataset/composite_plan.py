@@ -1,0 +1,222 @@
+"""Where the cut-outs of one composite go: the photo's camera model drawn, then each paste's cut-out, anchor,
+scale, order, blend mode and shadow, as plain data (no pixel is touched here; :mod:`synthua_usd.backends.compositing`
+paints what this plans).
+
+A paste is planned on the ground plane of the photo's camera (:class:`synthua_usd.model.photo_camera.PhotoCamera`):
+
+1. its kind (aid user or pedestrian) and its share of the frame height, drawn from the config's range;
+2. the anchor row that shows a group of the kind's median height that tall (at most the image's last row: a
+   camera that cannot show the group that large takes the largest share it can, recorded as ``share``);
+3. the elevation the camera is seen from there; the cut-outs are ranked by how far their own camera elevation
+   is (over ``elevation_tolerance_deg``), plus how unalike their light is when the config gives the photo's;
+   one of the best ``choose_among`` is drawn;
+4. the anchor row again for the chosen cut-out's own height (the share kept), its scale
+   ``(y_a - y_h) / (H scale_px_per_m)``, and a column where its box lies in the frame, tried ``placement_tries``
+   times for one that covers at most ``max_overlap`` of each earlier paste's box and at most
+   ``drop_covered_share`` of each background box (else the least overlapping);
+5. a blend mode by the config's weights (Poisson at most once a composite) and a shadow strength.
+
+Pastes are drawn far to near (by anchor row): ``order`` 0 is drawn first, and a nearer paste covers a farther one.
+Every draw comes from the generator handed in, in a fixed order, so a composite's plan depends on its seed only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from statistics import median
+from typing import Sequence
+
+import numpy as np
+
+from synthua_usd.dataset.composite_config import BLEND_MODES, CameraSettings, CompositeConfig
+from synthua_usd.dataset.cutout_bank import BankEntry, Light
+from synthua_usd.model.photo_camera import PhotoCamera, focal_px_from_35mm
+
+#: Least drop, in pixels, from the horizon to an anchor (a paste right at the horizon would be infinitely far).
+MIN_DROP_PX = 1.0
+
+
+@dataclass(frozen=True)
+class DrawnCamera:
+    """A composite's camera model and where each of its values came from (``config``, ``folder:<name>``,
+    ``exif`` or ``pitch_deg`` of one of those); ``light`` the photo's light when the config gives it."""
+
+    camera: PhotoCamera
+    sources: dict
+    light: Light | None
+    exif_focal_35mm: float | None
+
+    def to_dict(self) -> dict:
+        return {**self.camera.to_dict(), "K": self.camera.intrinsics().tolist(), "sources": dict(self.sources),
+                "exif_focal_35mm": self.exif_focal_35mm, "light": None if self.light is None else asdict(self.light)}
+
+
+def draw_camera(settings: CameraSettings, sources: dict, size: tuple[int, int], exif_focal_35mm: float | None,
+                source_size: tuple[int, int], scale: float, rng: np.random.Generator) -> DrawnCamera:
+    """The camera model of one composite of ``size`` (W, H), written from a photo of ``source_size`` at ``scale``
+    (written px per photo px). Its three ranges are always drawn, in one order, used or not."""
+    width, height = size
+    horizon_share = float(rng.uniform(*settings.horizon_row_share))
+    height_m = float(rng.uniform(*settings.height_m))
+    focal_share = float(rng.uniform(*settings.focal_width_share))
+    if settings.use_exif and exif_focal_35mm:
+        focal = focal_px_from_35mm(exif_focal_35mm, *source_size) * scale
+        focal_source = "exif"
+    else:
+        focal, focal_source = focal_share * max(width, height), sources["focal_width_share"]
+    if settings.pitch_deg is not None:
+        camera = PhotoCamera.from_pitch(width, height, settings.pitch_deg, height_m, focal)
+        horizon_source = f"pitch_deg:{sources['pitch_deg']}"
+    else:
+        camera = PhotoCamera(width, height, horizon_share * height, height_m, focal)
+        horizon_source = sources["horizon_row_share"]
+    return DrawnCamera(camera, {"horizon_row_px": horizon_source, "height_m": sources["height_m"],
+                                "focal_px": focal_source}, settings.light,
+                       None if not exif_focal_35mm else float(exif_focal_35mm))
+
+
+@dataclass(frozen=True)
+class Placement:
+    """One planned paste. ``anchor_px`` (x, y) is where the cut-out's anchor lands (written px, continuous:
+    pixel centres at + 0.5); a cut-out point (u, v) lands at ``anchor_px + scale * ((u, v) - entry.anchor)``.
+    ``box`` (x0, y0, x1, y1) is its group's amodal box in the frame. ``share`` the group's height over the
+    frame's as placed, ``share_drawn`` as drawn; ``distance_m`` and ``elevation_deg`` of the anchor on the photo's
+    ground plane, ``cutout_elevation_deg`` the cut-out's own; ``blend`` the mode and its parameter
+    (``feather_px`` or ``sigma_px``); ``order`` 0 is drawn first (the farthest)."""
+
+    entry_id: str
+    kind: str
+    anchor_px: tuple[float, float]
+    scale: float
+    share: float
+    share_drawn: float
+    distance_m: float
+    elevation_deg: float
+    cutout_elevation_deg: float
+    light_distance: float | None
+    box: tuple[float, float, float, float]
+    overlap: float
+    blend: dict
+    shadow_strength: float
+    order: int
+
+    def to_dict(self) -> dict:
+        out = asdict(self)
+        out["anchor_px"], out["box"] = list(self.anchor_px), list(self.box)
+        return out
+
+
+def _box_in_frame(entry: BankEntry, anchor: tuple[float, float], scale: float) -> tuple[float, float, float, float]:
+    x0, y0, x1, y1 = entry.group_box()
+    ax, ay = entry.anchor
+    return (anchor[0] + scale * (x0 - ax), anchor[1] + scale * (y0 - ay),
+            anchor[0] + scale * (x1 - ax), anchor[1] + scale * (y1 - ay))
+
+
+def covered_share(box, by) -> float:
+    """The share of ``box``'s area (x0, y0, x1, y1) that ``by`` covers (0 for an empty box)."""
+    area = max(0.0, box[2] - box[0]) * max(0.0, box[3] - box[1])
+    w = max(0.0, min(box[2], by[2]) - max(box[0], by[0]))
+    h = max(0.0, min(box[3], by[3]) - max(box[1], by[1]))
+    return w * h / area if area > 0 else 0.0
+
+
+def _rank(candidates: Sequence[BankEntry], elevation: float, light: Light | None, tolerance: float):
+    """(score, entry id, entry) of each candidate, best first (ties by id: the order never depends on the bank's
+    listing)."""
+    def score(e: BankEntry) -> float:
+        s = abs(e.camera.elevation_deg - elevation) / tolerance
+        return s + (light.distance(e.light) if light is not None else 0.0)
+    return sorted(((score(e), e.id, e) for e in candidates), key=lambda t: t[:2])
+
+
+def _blend(config: CompositeConfig, poisson_used: bool, rng: np.random.Generator) -> dict:
+    weights = config.blend.weights
+    if poisson_used:
+        weights = dict(weights, poisson=0.0)
+    total = sum(weights.values())
+    mode = "hard" if total <= 0 else BLEND_MODES[int(np.searchsorted(
+        np.cumsum([weights[m] / total for m in BLEND_MODES]), rng.random(), side="right").clip(0, 3))]
+    value = float(rng.uniform(*(config.blend.feather_px if mode == "feather" else config.blend.blur_sigma_px)))
+    return {"mode": mode, **({"feather_px": value} if mode == "feather" else {"sigma_px": value} if mode == "blur"
+                             else {})}
+
+
+def eligible(entries: Sequence[BankEntry], config: CompositeConfig) -> dict[str, list[BankEntry]]:
+    """The bank's cut-outs the config lets a composite paste, by kind (``aid_user``, ``pedestrian``)."""
+    out: dict[str, list[BankEntry]] = {"aid_user": [], "pedestrian": []}
+    for e in entries:
+        if e.kind == "aid_user" and ((config.pastes.aids is not None and e.aid not in config.pastes.aids)
+                                     or (config.pastes.groups is not None and e.group not in config.pastes.groups)):
+            continue
+        out[e.kind].append(e)
+    return out
+
+
+def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: CompositeConfig,
+                background_boxes: Sequence[tuple[float, float, float, float]],
+                rng: np.random.Generator) -> list[Placement]:
+    """The pastes of one composite (see the module docstring), sorted far to near with their ``order``.
+    ``background_boxes`` (x0, y0, x1, y1, written px) are the labelled boxes a paste should not cover."""
+    camera, settings = drawn.camera, config.pastes
+    frame_w, frame_h = camera.width_px, camera.height_px
+    count = int(rng.integers(settings.per_image[0], settings.per_image[1] + 1))
+    planned: list[dict] = []
+    poisson_used = False
+    for k in range(count):
+        kinds = [kind for kind in ("aid_user", "pedestrian") if pools.get(kind)]
+        draw_kind, share_drawn = rng.random(), float(rng.uniform(*settings.height_share))
+        if not kinds:
+            break
+        if len(kinds) == 1:
+            kind = kinds[0]
+        elif k == 0 and settings.at_least_one_aid_user:
+            kind = "aid_user"
+        else:
+            kind = "aid_user" if draw_kind < settings.aid_user_share else "pedestrian"
+        pool = pools[kind]
+        nominal = median(e.subject_height_m for e in pool)
+        lowest = camera.lowest_anchor_row()
+        if lowest - camera.horizon_row_px < MIN_DROP_PX:
+            break  # the horizon lies below the image: no ground to stand on
+        largest = camera.pixel_height(nominal, lowest) / frame_h
+        share = min(share_drawn, largest)
+        anchor_row = max(camera.anchor_row(nominal, share * frame_h), camera.horizon_row_px + MIN_DROP_PX)
+        elevation = camera.elevation_deg(anchor_row)
+        ranked = _rank(pool, elevation, drawn.light, settings.elevation_tolerance_deg)
+        _, _, entry = ranked[int(rng.integers(min(settings.choose_among, len(ranked))))]
+        anchor_row = min(lowest, max(camera.anchor_row(entry.subject_height_m, share * frame_h),
+                                     camera.horizon_row_px + MIN_DROP_PX))
+        scale = (anchor_row - camera.horizon_row_px) / (camera.height_m * entry.scale_px_per_m)
+        x0, _, x1, _ = entry.group_box()
+        lo = -scale * (x0 - entry.anchor[0])
+        hi = frame_w - scale * (x1 - entry.anchor[0])
+        columns = rng.uniform(0.0, 1.0, settings.placement_tries)
+        blend = _blend(config, poisson_used, rng)
+        shadow = float(rng.uniform(*config.shadow_strength))
+        if lo > hi:
+            continue  # wider than the frame at this size
+        best = None
+        for c in columns:
+            anchor = (float(lo + c * (hi - lo)), float(anchor_row))
+            box = _box_in_frame(entry, anchor, scale)
+            excess = max([covered_share(p["box"], box) - settings.max_overlap for p in planned]
+                         + [covered_share(b, box) - config.background_labels.drop_covered_share
+                            for b in background_boxes] + [0.0])
+            if best is None or excess < best[0]:
+                best = (excess, anchor, box)
+            if excess <= 0:
+                break
+        excess, anchor, box = best
+        poisson_used |= blend["mode"] == "poisson"
+        overlap = max([covered_share(p["box"], box) for p in planned] + [0.0])
+        planned.append(dict(
+            entry_id=entry.id, kind=kind, anchor_px=anchor, scale=float(scale),
+            share=float(camera.pixel_height(entry.subject_height_m, anchor_row) / frame_h), share_drawn=share_drawn,
+            distance_m=camera.distance_m(anchor_row), elevation_deg=camera.elevation_deg(anchor_row),
+            cutout_elevation_deg=entry.camera.elevation_deg,
+            light_distance=None if drawn.light is None else drawn.light.distance(entry.light),
+            box=tuple(float(v) for v in box), overlap=float(overlap), blend=blend, shadow_strength=shadow, k=k))
+    planned.sort(key=lambda p: (p["anchor_px"][1], p["k"]))
+    return [Placement(**{key: v for key, v in p.items() if key != "k"}, order=n) for n, p in enumerate(planned)]
+

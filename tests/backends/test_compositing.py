@@ -1,0 +1,212 @@
+"""Painting a composite: label maps by the painter's rule (checked with labels resampled here pixel by pixel), the
+photo untouched outside pastes and shadows, shadows darkening by the factor the shadow layer gives, hard edges
+showing the cut-out's own colours, soft edges soft, the gains of exposure and white balance as defined, and Poisson
+blending solving its equation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bank_maker import write_bank
+from synthua_usd.backends.compositing import PasteInput, compose, composite_depth, paste_gains
+from synthua_usd.backends.cutout_pixels import LINEAR_LUT, place, read_cutout
+from synthua_usd.backends.poisson_blend import poisson_blend
+from synthua_usd.dataset.composite_config import MatchSettings
+from synthua_usd.dataset.composite_plan import Placement
+from synthua_usd.dataset.cutout_bank import read_bank
+from synthua_usd.model.srgb import from_linear, to_linear
+from synthua_usd.model.taxonomy import ClassMap
+
+NO_MATCH = MatchSettings(exposure_strength=0.0, white_balance_strength=0.0)
+
+
+@pytest.fixture(scope="module")
+def bank(tmp_path_factory):
+    return read_bank(write_bank(tmp_path_factory.mktemp("bank") / "bank"))
+
+
+def _placement(entry, anchor, scale, order, mode="hard", shadow=0.0, **blend) -> Placement:
+    x0, y0, x1, y1 = entry.group_box()
+    ax, ay = entry.anchor
+    box = (anchor[0] + scale * (x0 - ax), anchor[1] + scale * (y0 - ay), anchor[0] + scale * (x1 - ax),
+           anchor[1] + scale * (y1 - ay))
+    return Placement(entry.id, entry.kind, anchor, scale, 0.5, 0.5, 5.0, 10.0, entry.camera.elevation_deg, None, box,
+                     0.0, {"mode": mode, **blend}, shadow, order)
+
+
+def _nearest(array, entry, anchor, scale, shape):
+    """The cut-out's value under every frame pixel centre (0 off the cut-out), one pixel at a time."""
+    out = np.zeros(shape + array.shape[2:], array.dtype)
+    for row in range(shape[0]):
+        for col in range(shape[1]):
+            u = entry.anchor[0] + (col + 0.5 - anchor[0]) / scale
+            v = entry.anchor[1] + (row + 0.5 - anchor[1]) / scale
+            if 0 <= u < array.shape[1] and 0 <= v < array.shape[0]:
+                out[row, col] = array[int(math.floor(v)), int(math.floor(u))]
+    return out
+
+
+def _photo(h=60, w=80, seed=0):
+    return np.random.default_rng(seed).integers(30, 220, (h, w, 3), dtype=np.uint8)
+
+
+def test_labels_follow_the_painter_rule_and_amodal_masks_stay_whole(bank):
+    far, near = bank.entries[0], bank.entries[3]
+    photo = _photo()
+    pastes = [PasteInput(far, read_cutout(bank.root, far), _placement(far, (40.0, 45.0), 0.7, 0)),
+              PasteInput(near, read_cutout(bank.root, near), _placement(near, (44.0, 58.0), 0.8, 1))]
+    painted = compose(photo, pastes, ClassMap.default(), NO_MATCH)
+    ids_far = _nearest(read_cutout(bank.root, far).ids, far, (40.0, 45.0), 0.7, (60, 80)).astype(np.uint16)
+    ids_near = _nearest(read_cutout(bank.root, near).ids, near, (44.0, 58.0), 0.8, (60, 80)).astype(np.uint16)
+    expected = np.where(ids_far > 0, ids_far, 0)                     # far: ids 1 (person), 2 (wheelchair)
+    expected = np.where(ids_near > 0, ids_near + 2, expected)        # near: id 3 (person), drawn over
+    np.testing.assert_array_equal(painted.instance_ids, expected)
+    classes = np.array([0, 18, 29, 18], np.uint8)
+    np.testing.assert_array_equal(painted.class_ids, classes[expected])
+    amodal_far = _nearest(read_cutout(bank.root, far).amodal, far, (40.0, 45.0), 0.7, (60, 80))
+    person_far = np.flatnonzero((amodal_far & 1).reshape(-1))
+    np.testing.assert_array_equal(painted.amodal[1], person_far)
+    hidden = np.isin(person_far, np.flatnonzero((expected == 3).reshape(-1)))
+    assert hidden.any(), "the nearer pedestrian covers part of the farther aid user"
+    assert [p["instance_ids"] for p in painted.pastes] == [[1, 2], [3]]
+    assert {i.id: i.relations for i in painted.instances}[1] == (("uses", f"/pastes/p0/{far.id}/device2"),)
+
+
+def test_the_photo_is_untouched_away_from_pastes_and_darkened_by_the_shadow_factor(bank):
+    entry = bank.entries[0]
+    photo = _photo()
+    anchor, scale, strength = (40.0, 50.0), 1.0, 0.8
+    painted = compose(photo, [PasteInput(entry, read_cutout(bank.root, entry),
+                                         _placement(entry, anchor, scale, 0, shadow=strength))],
+                      ClassMap.default(), NO_MATCH)
+    shadow = _nearest(read_cutout(bank.root, entry).shadow, entry, anchor, scale, (60, 80))
+    rgba = _nearest(read_cutout(bank.root, entry).rgba, entry, anchor, scale, (60, 80))
+    free = (painted.instance_ids == 0) & (rgba[..., 3] == 0)
+    # at scale 1 the shadow's interior is the drawn value; away from it and from the paste, the photo as it was
+    untouched = free & (shadow == 255)
+    np.testing.assert_array_equal(painted.rgb[untouched], photo[untouched])
+    dark = free & (shadow == 110)
+    assert dark.sum() > 20
+    factor = 1.0 - strength * (1.0 - 110 / 255)
+    expected = np.round(from_linear(np.clip(to_linear(photo[dark] / 255.0) * factor, 0, 1)) * 255)
+    assert np.abs(painted.rgb[dark].astype(int) - expected.astype(int)).max() <= 1
+
+
+def test_hard_edges_show_the_cutout_colours_and_soft_edges_are_soft(bank):
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    photo = _photo()
+    anchor, scale = (40.0, 52.0), 0.9
+    ids = _nearest(pixels.ids, entry, anchor, scale, (60, 80))
+    rgba = _nearest(pixels.rgba, entry, anchor, scale, (60, 80))
+    hard = compose(photo, [PasteInput(entry, pixels, _placement(entry, anchor, scale, 0))], ClassMap.default(),
+                   NO_MATCH).rgb
+    deep = (ids == 1)
+    deep[[0, -1], :] = deep[:, [0, -1]] = False  # the frame's edge cuts the head: not inside
+    for _ in range(2):  # two pixels in from every edge of the person: the filter sees only the person's colour
+        deep[1:-1, 1:-1] &= deep[:-2, 1:-1] & deep[2:, 1:-1] & deep[1:-1, :-2] & deep[1:-1, 2:]
+    assert deep.sum() > 10
+    assert np.abs(hard[deep].astype(int) - np.array([200, 40, 40])).max() <= 1
+    far_out = np.ones_like(ids, bool)
+    around = (rgba[..., 3] > 0) | (ids > 0)
+    for dy in range(-4, 5):
+        for dx in range(-4, 5):
+            far_out &= ~np.roll(np.roll(around, dy, 0), dx, 1)
+    for blend in ({"mode": "feather", "feather_px": 2.0}, {"mode": "blur", "sigma_px": 1.0}):
+        soft = compose(photo, [PasteInput(entry, pixels, _placement(entry, anchor, scale, 0, **blend))],
+                       ClassMap.default(), NO_MATCH).rgb
+        inner = deep.copy()
+        for _ in range(3):
+            inner[1:-1, 1:-1] &= inner[:-2, 1:-1] & inner[2:, 1:-1] & inner[1:-1, :-2] & inner[1:-1, 2:]
+        assert np.abs(soft[inner].astype(int) - hard[inner].astype(int)).max() <= 1, blend
+        np.testing.assert_array_equal(soft[far_out], photo[far_out])
+        opaque = rgba[..., 3] == 255
+        edge = (ids == 1) & ~(np.roll(opaque, 1, 0) & np.roll(opaque, -1, 0) & np.roll(opaque, 1, 1)
+                              & np.roll(opaque, -1, 1))  # the person's pixels on the group's outline
+        edge[[0, -1], :] = False
+        assert edge.sum() > 10
+        assert (soft[edge] != hard[edge]).any(axis=1).mean() > 0.8, blend  # the outline blends with the photo
+
+
+def test_gains_match_the_photo_around_the_paste(bank):
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    photo = np.zeros((60, 80, 3), np.uint8)
+    photo[...] = (90, 120, 160)                     # a bluish, darker surround
+    placement = _placement(entry, (40.0, 50.0), 0.8, 0)
+    placed = place(pixels, entry, placement.anchor_px, placement.scale, (80, 60))
+    settings = MatchSettings(exposure_strength=0.5, exposure_gain=(0.1, 10.0), white_balance_strength=1.0,
+                             white_balance_gain=(0.1, 10.0))
+    exposure, balance = paste_gains(photo, placed, placement.box, settings)
+    m_photo = LINEAR_LUT[np.array([90, 120, 160])].astype(np.float64)
+    alpha = placed.premultiplied[..., 3].astype(np.float64)
+    m_paste = placed.premultiplied[..., :3].astype(np.float64).sum(axis=(0, 1)) / alpha.sum()
+    luminance = np.array([0.2126, 0.7152, 0.0722])
+    assert exposure == pytest.approx((m_photo @ luminance / (m_paste @ luminance)) ** 0.5, rel=1e-5)
+    cast = m_photo / (m_photo @ luminance)
+    assert balance == pytest.approx(list(cast / (cast @ luminance)), rel=1e-5)
+    assert balance[2] > 1 > balance[0]             # the paste takes the photo's blue cast
+    clamped = paste_gains(photo, placed, placement.box, MatchSettings())
+    assert 0.5 <= clamped[0] <= 2.0 and all(0.8 <= g <= 1.25 for g in clamped[1])
+
+
+def test_poisson_blending_solves_its_equation():
+    rng = np.random.default_rng(1)
+    target = rng.random((20, 24, 3))
+    source = rng.random((20, 24, 3))
+    domain = np.zeros((20, 24), bool)
+    domain[4:15, 5:19] = True
+    domain[9, 19:22] = True
+    f = poisson_blend(target, source, domain)
+    np.testing.assert_array_equal(f[~domain], target[~domain])
+    for y, x in zip(*np.nonzero(domain)):
+        lhs = 4 * f[y, x] - sum(f[y + dy, x + dx] for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1)))
+        rhs = sum(source[y, x] - source[y + dy, x + dx] for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1)))
+        np.testing.assert_allclose(lhs, rhs, atol=1e-9)
+    np.testing.assert_allclose(poisson_blend(target, target, domain), target, atol=1e-9)
+    with pytest.raises(ValueError, match="touches the border"):
+        poisson_blend(target, source, np.ones((20, 24), bool))
+
+
+def test_a_poisson_paste_keeps_the_photo_on_its_edge(bank):
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    photo = _photo()
+    painted = compose(photo, [PasteInput(entry, pixels, _placement(entry, (40.0, 52.0), 0.9, 0, mode="poisson"))],
+                      ClassMap.default(), NO_MATCH)
+    labelled = painted.instance_ids > 0
+    near = labelled.copy()
+    for _ in range(3):
+        near[1:-1, 1:-1] |= near[:-2, 1:-1] | near[2:, 1:-1] | near[1:-1, :-2] | near[1:-1, 2:]
+    np.testing.assert_array_equal(painted.rgb[~near], photo[~near])
+    assert (painted.rgb[labelled] != photo[labelled]).any()
+
+
+def test_depth_for_effects_puts_each_paste_at_its_distance(bank):
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    painted = compose(_photo(), [PasteInput(entry, pixels, _placement(entry, (40.0, 52.0), 0.9, 0))],
+                      ClassMap.default(), NO_MATCH)
+    ground = np.full((60, 80), 3.0, np.float32)
+    depth = composite_depth(ground, painted, [7.5])
+    assert (depth[painted.instance_ids > 0] == 7.5).all() and (depth[painted.instance_ids == 0] == 3.0).all()
+
+
+def test_a_labelled_pixel_no_sample_covered_keeps_the_photo(bank):
+    from synthua_usd.backends.cutout_pixels import CutoutPixels
+
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    premultiplied = pixels.premultiplied.copy()
+    premultiplied[30, 20:28] = 0.0                 # a row of the torso that no sample of the render hit
+    thin = CutoutPixels(pixels.rgba, pixels.ids, pixels.amodal, pixels.shadow, premultiplied)
+    photo = _photo()
+    anchor = (40.0, 50.0)                          # scale 1: cut-out pixel (u, v) is frame pixel (u + 16, v - 12)
+    painted = compose(photo, [PasteInput(entry, thin, _placement(entry, anchor, 1.0, 0))], ClassMap.default(),
+                      NO_MATCH)
+    assert (painted.instance_ids[18, 36:44] == 1).all()          # still labelled the person
+    np.testing.assert_array_equal(painted.rgb[18, 36:44], photo[18, 36:44])
+    assert np.abs(painted.rgb[18, 34].astype(int) - [200, 40, 40]).max() <= 1

@@ -1,0 +1,84 @@
+"""The composite config: the schema documents the dataclasses' defaults, the shipped config is valid, and what a
+schema cannot say is refused in one line."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from conftest import REPO
+from synthua_usd.core.errors import InputError
+from synthua_usd.core.schemas import load_schema
+from synthua_usd.dataset.composite_config import CompositeConfig
+
+
+def _defaults(node, schema) -> dict:
+    """Dotted path -> the default the schema documents, for every property that documents one."""
+    out = {}
+    for name, prop in (node.get("properties") or {}).items():
+        target = prop
+        if "$ref" in prop and prop["$ref"].startswith("#/$defs/"):
+            target = schema["$defs"][prop["$ref"].split("/")[-1]]
+        if "default" in prop:
+            out[name] = prop["default"]
+        for key, value in _defaults(target, schema).items():
+            out[f"{name}.{key}"] = value
+    return out
+
+
+def test_the_schema_documents_the_dataclass_defaults():
+    schema = load_schema("composite")
+    written = CompositeConfig().to_document()
+    documented = _defaults(schema, schema)
+    documented["camera"] = schema["$defs"]["camera"]["default"]
+    assert documented, "the schema documents defaults"
+    for path, default in documented.items():
+        if path == "shadow":
+            continue
+        value = written
+        for part in path.split("."):
+            value = value[part]
+        if isinstance(default, dict) and not default:
+            continue  # an empty object: its fields' own defaults are checked one by one
+        assert value == default, path
+
+
+def test_an_empty_document_is_the_defaults_and_a_document_round_trips():
+    config = CompositeConfig.from_document({})
+    assert config == CompositeConfig()
+    assert CompositeConfig.from_document(config.to_document()) == config
+
+
+def test_the_shipped_config_is_valid():
+    config = CompositeConfig.load(REPO / "configs" / "composite.json")
+    assert config.output == (640, 480) and config.convention == "wheelchair-sets"
+    assert config.background_labels.our_class("wheelchair") == "manual_wheelchair"
+    assert config.background_labels.our_class("person") == "person"
+
+
+@pytest.mark.parametrize("document, message", [
+    ({"bogus": 1}, r"x\.json: bogus: not a key of the document; expected one of \$schema, background_labels"),
+    ({"pastes": {"height_share": [0.9, 0.2]}}, r"x\.json: pastes\.height_share: \[0\.9, 0\.2\]; expected two finite "
+                                               r"numbers with low <= high"),
+    ({"split": {"train": 0.5, "val": 0.1, "test": 0.1}}, r"x\.json: split: train \+ val \+ test = 0\.7; expected"),
+    ({"blend": {"hard": 0, "feather": 0, "blur": 0, "poisson": 0}}, r"x\.json: blend: weights"),
+    ({"camera": {"height_m": [2, 1]}}, r"x\.json: camera\.height_m: \[2, 1\]"),
+    ({"folders": {"a": {"height_m": -1}}}, r"x\.json: folders\.a\.height_m"),
+    ({"output": {"width": 8, "height": 48}}, r"x\.json: output"),
+])
+def test_bad_documents_are_refused_naming_the_field(document, message):
+    with pytest.raises(InputError, match=message):
+        CompositeConfig.from_document(document, "x.json")
+
+
+def test_folders_override_the_camera_by_the_longest_match():
+    config = CompositeConfig.from_document({
+        "camera": {"height_m": 1.5, "horizon_row_share": [0.3, 0.4]},
+        "folders": {"cctv": {"height_m": 6.0, "horizon_row_share": 0.1}, "cctv/north/": {"height_m": 8.0}}})
+    settings, sources = config.camera_for("cctv/north/frame1.jpg")
+    assert settings.height_m == (8.0, 8.0) and settings.horizon_row_share == (0.1, 0.1)
+    assert sources["height_m"] == "folder:cctv/north" and sources["horizon_row_share"] == "folder:cctv"
+    settings, sources = config.camera_for("street/a.jpg")
+    assert settings.height_m == (1.5, 1.5) and sources["height_m"] == "config"
+    assert json.loads(json.dumps(config.to_document()))["folders"]["cctv/north"] == {"height_m": 8.0}

@@ -1,0 +1,124 @@
+"""Planning a composite's pastes: every paste stands on the photo's ground plane at the share of the frame it was
+drawn for, its cut-out's camera elevation is among the nearest to the paste's, nearer pastes come later, Poisson at
+most once; checked against the ground-plane relations computed here again."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bank_maker import default_cutouts, write_bank
+from synthua_usd.dataset.composite_config import CameraSettings, CompositeConfig
+from synthua_usd.dataset.composite_plan import covered_share, draw_camera, eligible, plan_pastes
+from synthua_usd.dataset.cutout_bank import read_bank
+from synthua_usd.model.photo_camera import PhotoCamera
+
+
+@pytest.fixture(scope="module")
+def bank(tmp_path_factory):
+    return read_bank(write_bank(tmp_path_factory.mktemp("bank") / "bank"))
+
+
+def _drawn(camera: PhotoCamera, light=None):
+    from synthua_usd.dataset.composite_plan import DrawnCamera
+
+    return DrawnCamera(camera, {"horizon_row_px": "config", "height_m": "config", "focal_px": "config"}, light, None)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_pastes_stand_on_the_ground_plane_at_their_share(bank, seed):
+    config = CompositeConfig.from_document({"pastes": {"per_image": [3, 3], "height_share": [0.2, 0.6],
+                                                       "choose_among": 2}})
+    camera = PhotoCamera(320, 240, 40.0, 1.4, 300.0)
+    pools = eligible(bank.entries, config)
+    placements = plan_pastes(_drawn(camera), pools, config, [], np.random.default_rng(seed))
+    assert len(placements) == 3
+    assert [p.order for p in placements] == [0, 1, 2]
+    assert [p.anchor_px[1] for p in placements] == sorted(p.anchor_px[1] for p in placements)  # far to near
+    assert placements[0].kind == "aid_user" or any(p.kind == "aid_user" for p in placements)
+    for p in placements:
+        entry = bank.entry(p.entry_id)
+        drop = p.anchor_px[1] - camera.horizon_row_px
+        z = camera.focal_px * camera.height_m / drop
+        assert p.distance_m == pytest.approx(z)
+        assert p.elevation_deg == pytest.approx(math.degrees(math.atan2(camera.height_m, z)))
+        # the group's pixel height on the ground plane is the drawn share of the frame (the camera allows 0.6)
+        assert entry.subject_height_m * drop / camera.height_m == pytest.approx(p.share * 240)
+        assert p.share == pytest.approx(p.share_drawn)
+        assert 0.2 <= p.share <= 0.6
+        # its scale makes its pixels per metre at the anchor the ground plane's: f / Z
+        assert p.scale * entry.scale_px_per_m == pytest.approx(camera.focal_px / z)
+        # the group's box lies within the frame's width
+        assert -1e-9 <= p.box[0] and p.box[2] <= 320 + 1e-9
+        # the cut-out is among the `choose_among` best for the elevation of the paste of the kind's median height
+        kind = [e for e in bank.entries if e.kind == p.kind]
+        nominal = float(np.median([e.subject_height_m for e in kind]))
+        elevation = math.degrees(math.atan(p.share * 240 * camera.height_m / nominal / camera.focal_px))
+        ranked = sorted(kind, key=lambda e: (abs(e.camera.elevation_deg - elevation), e.id))
+        assert entry.id in [e.id for e in ranked[:config.pastes.choose_among]]
+
+
+def test_the_first_paste_is_an_aid_user_and_poisson_comes_once(bank):
+    config = CompositeConfig.from_document({"pastes": {"per_image": [4, 4], "aid_user_share": 0.0},
+                                            "blend": {"hard": 0, "feather": 0, "blur": 0, "poisson": 1}})
+    camera = PhotoCamera(640, 480, 100.0, 1.5, 500.0)
+    for seed in range(5):
+        placements = plan_pastes(_drawn(camera), eligible(bank.entries, config), config, [],
+                                 np.random.default_rng(seed))
+        kinds = sorted(p.kind for p in placements)
+        assert kinds == ["aid_user", "pedestrian", "pedestrian", "pedestrian"]
+        modes = [p.blend["mode"] for p in placements]
+        assert modes.count("poisson") == 1 and modes.count("hard") == 3  # the others fall back to hard
+
+
+def test_a_camera_that_cannot_show_the_share_takes_the_largest_it_can(bank):
+    config = CompositeConfig.from_document({"pastes": {"per_image": [1, 1], "height_share": [0.9, 0.9]}})
+    camera = PhotoCamera(320, 240, 200.0, 1.5, 300.0)     # horizon low: the ground is a strip of 40 rows
+    (p,) = plan_pastes(_drawn(camera), eligible(bank.entries, config), config, [], np.random.default_rng(0))
+    entry = bank.entry(p.entry_id)
+    assert p.anchor_px[1] == pytest.approx(camera.lowest_anchor_row())
+    assert p.share == pytest.approx(entry.subject_height_m * (239.5 - 200.0) / 1.5 / 240)
+    assert p.share_drawn == pytest.approx(0.9)
+
+
+def test_pastes_keep_off_earlier_ones_and_background_boxes_where_they_can(bank):
+    config = CompositeConfig.from_document({"pastes": {"per_image": [3, 3], "height_share": [0.3, 0.3],
+                                                       "max_overlap": 0.0, "placement_tries": 200}})
+    camera = PhotoCamera(640, 480, 100.0, 1.5, 500.0)
+    kept = [(0.0, 0.0, 200.0, 480.0)]
+    for seed in range(4):
+        placements = plan_pastes(_drawn(camera), eligible(bank.entries, config), config, kept,
+                                 np.random.default_rng(seed))
+        for a in placements:
+            assert covered_share(kept[0], a.box) <= config.background_labels.drop_covered_share
+            for b in placements:
+                if a is not b:
+                    assert covered_share(a.box, b.box) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_the_camera_draw_names_its_sources():
+    settings = CameraSettings(horizon_row_share=(0.25, 0.25), height_m=(1.6, 1.6), focal_width_share=(0.5, 0.5),
+                              use_exif=True)
+    sources = {"horizon_row_share": "folder:x", "height_m": "config", "focal_width_share": "config",
+               "use_exif": "config", "pitch_deg": "config", "light": "config"}
+    rng = np.random.default_rng(0)
+    drawn = draw_camera(settings, sources, (640, 480), 28.0, (4000, 3000), 0.16, rng)
+    assert drawn.camera.focal_px == pytest.approx(28.0 / 36.0 * 4000 * 0.16)
+    assert drawn.camera.horizon_row_px == pytest.approx(120.0)
+    assert drawn.sources == {"horizon_row_px": "folder:x", "height_m": "config", "focal_px": "exif"}
+    drawn = draw_camera(CameraSettings(focal_width_share=(0.5, 0.5), pitch_deg=-10.0), sources, (640, 480), None,
+                        (640, 480), 1.0, rng)
+    assert drawn.camera.focal_px == pytest.approx(320.0)
+    assert drawn.camera.horizon_row_px == pytest.approx(240 + 320 * math.tan(math.radians(-10.0)))
+    assert drawn.sources["horizon_row_px"] == "pitch_deg:config" and drawn.sources["focal_px"] == "config"
+
+
+def test_the_plan_depends_on_the_seed_only(bank):
+    config = CompositeConfig()
+    camera = PhotoCamera(640, 480, 150.0, 1.5, 500.0)
+    runs = [plan_pastes(_drawn(camera), eligible(bank.entries, config), config, [], np.random.default_rng(7))
+            for _ in range(2)]
+    assert runs[0] == runs[1]
+    assert len(default_cutouts()) == len(bank.entries)

@@ -1,0 +1,297 @@
+"""``synthua composite`` end to end on tiny drawn banks and photos: the dataset has generate's layout and verifies,
+the same inputs give the same bytes on one and two workers, replay is byte-identical, stats reads it; and every
+label claim checked against its own computation: instance and class maps against the cut-outs' ids resampled here,
+COCO masks and boxes against the instance map, keypoint visibility against the occluding pastes, YOLO boxes
+against the box convention, a labelled photo's dropped boxes against the share the pastes cover."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from PIL import Image
+
+from bank_maker import write_bank, write_photos
+from synthua_usd.cli.main import main
+from synthua_usd.dataset.cutout_bank import read_bank
+
+WIDTH, HEIGHT = 64, 48
+CONFIG = {"output": {"width": WIDTH, "height": HEIGHT}, "images_per_background": 2, "seed": 3,
+          "pastes": {"per_image": [2, 3], "height_share": [0.3, 0.7], "max_overlap": 1.0, "placement_tries": 1},
+          "effects": {"enabled": True, "defocus_probability": 0.5, "noise_probability": 0.5},
+          "background_labels": {"classes": {"wheelchair": "manual_wheelchair"}, "drop_covered_share": 0.3},
+          "convention": "wheelchair-sets", "min_instance_px": 4}
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory) -> Path:
+    root = tmp_path_factory.mktemp("composite_inputs")
+    write_bank(root / "bank")
+    write_photos(root / "photos", 3, (96, 72))
+    write_photos(root / "photos" / "more", 1, (64, 48), suffix=".jpg", seed=1)
+    labelled = root / "labelled"
+    for k, path in enumerate(write_photos(labelled / "images" / "train", 3, (96, 48), seed=2)):
+        label = labelled / "labels" / "train" / f"{path.stem}.txt"
+        label.parent.mkdir(parents=True, exist_ok=True)
+        # the cut to 64x48 keeps columns 16..80: a person cut a little, a wheelchair user in the middle, a person
+        # the cut leaves out
+        label.write_text(f"0 0.2 0.6 0.15 0.5\n1 0.{4 + k} 0.6 0.2 0.6\n0 0.05 0.5 0.08 0.3\n")
+    (labelled / "data.yaml").write_text("path: .\ntrain: images/train\nnames:\n  0: person\n  1: wheelchair\n")
+    (root / "config.json").write_text(json.dumps(CONFIG))
+    return root
+
+
+def _composite(inputs: Path, backgrounds: str, out: str, workers: int) -> Path:
+    """``synthua composite`` of ``inputs / backgrounds`` with the bank and config of ``inputs``."""
+    assert main([str(a) for a in ("composite", inputs / backgrounds, "--bank", inputs / "bank", "--config",
+                                  inputs / "config.json", "--out", inputs / out, "--workers", workers)]) == 0
+    return inputs / out
+
+
+@pytest.fixture(scope="module")
+def unlabelled(inputs) -> Path:
+    return _composite(inputs, "photos", "out_unlabelled", 2)
+
+
+@pytest.fixture(scope="module")
+def labelled(inputs) -> Path:
+    return _composite(inputs, "labelled", "out_labelled", 1)
+
+
+def _records(root: Path) -> list[dict]:
+    return [json.loads(p.read_text()) for p in sorted((root / "records").glob("*.json"))]
+
+
+def _png(path: Path) -> np.ndarray:
+    return np.asarray(Image.open(path))
+
+
+def _tree(root: Path) -> dict[str, str]:
+    return {p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_the_dataset_has_generates_layout_and_verifies(unlabelled, run_cli):
+    for relative in ("data.yaml", "manifest.json", "generate.json", "metadata.csv", "metadata.parquet",
+                     "coverage.json", "class_map.json", "annotations/instances_train.json",
+                     "annotations/person_keypoints_train.json", "annotations/panoptic_train.json"):
+        assert (unlabelled / relative).is_file(), relative
+    records = _records(unlabelled)
+    assert len(records) == 8 and {r["seed"] for r in records} == {0, 1}
+    for r in records:
+        assert set(r["files"]) >= {"rgb_png", "class", "semantic", "instance", "instance_preview", "panoptic",
+                                   "cs_labelIds", "yolo_label"}
+        assert (unlabelled / r["files"]["rgb_png"]).is_file()
+    code, out, _ = run_cli("verify", unlabelled)
+    assert code == 0 and out.strip().endswith("ok"), out
+    job = json.loads((unlabelled / "generate.json").read_text())
+    assert job["command"] == "composite" and len(job["plan"]) == 8
+
+
+def test_one_and_two_workers_give_the_same_bytes_and_replay_is_byte_identical(inputs, unlabelled, run_cli):
+    again = _composite(inputs, "photos", "out_one_worker", 1)
+    assert _tree(again) == _tree(unlabelled)
+    code, out, _ = run_cli("replay", again, "3")
+    assert code == 0 and "byte-identical" in out, out
+    name = _records(again)[2]["name"]
+    (again / "frames" / name / "class.png").write_bytes((again / "frames" / _records(again)[0]["name"] /
+                                                         "class.png").read_bytes())
+    code, out, _ = run_cli("replay", again, name)
+    assert code == 1 and f"differs: frames/{name}/class.png" in out, out
+
+
+def _expected_maps(record: dict, bank) -> tuple[np.ndarray, np.ndarray]:
+    """Instance and class maps of a composite from its bank's cut-outs, each placed by its record's anchor and scale
+    (the cut-out pixel under each pixel centre), far to near."""
+    from synthua_usd.model.taxonomy import ClassMap
+
+    class_map = ClassMap.default()
+    instances = np.zeros((HEIGHT, WIDTH), np.int64)
+    classes = np.zeros((HEIGHT, WIDTH), np.int64)
+    for paste in sorted(record["composite"]["pastes"], key=lambda p: p["order"]):
+        entry = bank.entry(paste["cutout"]["entry"])
+        ids = _png(bank.root / entry.files["ids"])
+        (ax, ay), s = entry.anchor, paste["scale"]
+        for row in range(HEIGHT):
+            for col in range(WIDTH):
+                u = ax + (col + 0.5 - paste["anchor_px"][0]) / s
+                v = ay + (row + 0.5 - paste["anchor_px"][1]) / s
+                if 0 <= u < ids.shape[1] and 0 <= v < ids.shape[0] and ids[int(math.floor(v)), int(math.floor(u))]:
+                    index = int(ids[int(math.floor(v)), int(math.floor(u))])
+                    instances[row, col] = paste["instance_ids"][index - 1]
+                    name = next(i.class_name for i in entry.instances if i.index == index)
+                    classes[row, col] = class_map.resolve(name).id
+    return instances, classes
+
+
+def test_label_maps_are_the_cutouts_resampled_far_to_near(inputs, unlabelled):
+    bank = read_bank(inputs / "bank")
+    for record in _records(unlabelled):
+        instances, classes = _expected_maps(record, bank)
+        np.testing.assert_array_equal(_png(unlabelled / record["files"]["instance"]), instances, record["name"])
+        np.testing.assert_array_equal(_png(unlabelled / record["files"]["class"]), classes, record["name"])
+        # an unlabelled photo: marked so, and its own pixels void
+        assert record["composite"]["background"]["labelled"] is False
+        assert record["composite"]["background_boxes"] == []
+        sha = hashlib.sha256((inputs / "photos" / record["composite"]["background"]["path"]).read_bytes()).hexdigest()
+        assert record["composite"]["background"]["sha256"] == sha
+
+
+def test_coco_masks_and_boxes_are_the_instance_maps(unlabelled):
+    from pycocotools import mask as mask_utils
+    from pycocotools.coco import COCO
+
+    coco = COCO(str(unlabelled / "annotations" / "instances_train.json"))
+    by_id = {r["id"]: r for r in _records(unlabelled)}
+    assert coco.getAnnIds()
+    for ann in coco.loadAnns(coco.getAnnIds()):
+        record = by_id[ann["image_id"]]
+        truth = _png(unlabelled / record["files"]["instance"]) == ann["instance_id"]
+        np.testing.assert_array_equal(mask_utils.decode(ann["segmentation"]).astype(bool), truth)
+        ys, xs = np.nonzero(truth)
+        assert ann["bbox"] == [xs.min(), ys.min(), xs.max() - xs.min() + 1, ys.max() - ys.min() + 1]
+        amodal = mask_utils.decode(ann["amodal_segmentation"]).astype(bool)
+        assert (amodal | truth).sum() == amodal.sum()          # the amodal mask holds the visible one
+        assert ann["occlusion"] == pytest.approx(1 - truth.sum() / amodal.sum())
+
+
+def test_keypoint_visibility_follows_the_occluding_pastes(inputs, unlabelled):
+    from synthua_usd.dataset.keypoints import WINDOW_PX
+
+    bank = read_bank(inputs / "bank")
+    downgraded = 0
+    for record in _records(unlabelled):
+        ids = _png(unlabelled / record["files"]["instance"])
+        by_id = {i["id"]: i for i in record["instances"]}
+        for paste in record["composite"]["pastes"]:
+            entry = bank.entry(paste["cutout"]["entry"])
+            for inst, gid in zip(entry.instances, paste["instance_ids"]):
+                if gid not in by_id or inst.keypoints is None:
+                    continue
+                flat = by_id[gid]["keypoints"]["keypoints"]
+                for k, (u, v, flag) in enumerate(inst.keypoints):
+                    x = paste["anchor_px"][0] + paste["scale"] * (u - entry.anchor[0])
+                    y = paste["anchor_px"][1] + paste["scale"] * (v - entry.anchor[1])
+                    if flag == 0 or not (0 <= x < WIDTH and 0 <= y < HEIGHT):
+                        assert flat[3 * k: 3 * k + 3] == [0.0, 0.0, 0]
+                        continue
+                    col, row = int(round(x, 2)), int(round(y, 2))  # the pixel of the coordinates as written
+                    window = ids[max(0, row - WINDOW_PX):row + WINDOW_PX + 1, max(0, col - WINDOW_PX):col + WINDOW_PX + 1]
+                    expected = 2 if flag == 2 and (window == gid).any() else 1
+                    assert flat[3 * k + 2] == expected
+                    assert flat[3 * k] == pytest.approx(x, abs=0.006) and flat[3 * k + 1] == pytest.approx(y, abs=0.006)
+                    if flag == 2 and expected == 1:
+                        downgraded += 1
+                        # what hides it there is another paste (a nearer one), or its own device
+                        others = set(np.unique(window).tolist()) - {0, gid}
+                        assert others, (record["name"], gid, k)
+    assert downgraded, "some visible keypoint of a cut-out is covered in a composite"
+
+
+def test_a_labelled_photo_keeps_its_boxes_except_those_the_pastes_cover(inputs, labelled, run_cli):
+    code, out, _ = run_cli("verify", labelled)
+    assert code == 0, out
+    reasons = set()
+    for record in _records(labelled):
+        composite = record["composite"]
+        assert composite["background"]["labelled"] is True and composite["background"]["layout"] == "yolo"
+        ids = _png(labelled / record["files"]["instance"])
+        for box in composite["background_boxes"]:
+            reasons.add(box["reason"])
+            assert box["class_name"] == {"person": "person", "wheelchair": "manual_wheelchair"}[box["label"]]
+            if box["reason"] == "cropped":
+                continue
+            x, y, w, h = box["bbox"]
+            cols = [c for c in range(WIDTH) if x <= c + 0.5 < x + w]
+            rows = [r for r in range(HEIGHT) if y <= r + 0.5 < y + h]
+            covered = float((ids[np.ix_(rows, cols)] > 0).mean()) if rows and cols else 0.0
+            assert box["covered_share"] == pytest.approx(covered)
+            assert box["kept"] == (covered <= 0.3) and (box["reason"] == "covered") == (covered > 0.3)
+    assert {None, "cropped"} <= reasons
+    # the YOLO labels: the convention's boxes of the pastes, then the kept boxes of the photo
+    names = {name: k for k, name in yaml.safe_load((labelled / "data.yaml").read_text())["names"].items()}
+    for record in _records(labelled):
+        lines = (labelled / record["files"]["yolo_label"]).read_text().splitlines()
+        expected = []
+        index = {18: names["person"], 29: names["manual_wheelchair"]}
+        things = [i for i in record["instances"] if not i["ignore"]]
+        by_path = {i["prim_path"]: i for i in things}
+        for inst in things:
+            x, y, w, h = inst["bbox"]
+            if inst["class_name"] == "person" and "uses" in inst["relations"]:
+                continue  # wheelchair-sets: a seated user has no person box
+            if inst["class_name"] == "manual_wheelchair":
+                users = [p for p in things if p["relations"].get("uses") == inst["prim_path"]]
+                for u in users:
+                    x0, y0 = min(x, u["bbox"][0]), min(y, u["bbox"][1])
+                    x1, y1 = max(x + w, u["bbox"][0] + u["bbox"][2]), max(y + h, u["bbox"][1] + u["bbox"][3])
+                    x, y, w, h = x0, y0, x1 - x0, y1 - y0
+            expected.append((index[inst["category_id"]], x, y, w, h))
+        assert by_path is not None
+        for box in record["composite"]["background_boxes"]:
+            if box["kept"]:
+                expected.append((names[box["class_name"]], *box["bbox"]))
+        expected = [e for e in expected if e[4] >= 8]  # boxes lower than 8 px are ignored (no YOLO line)
+        assert len(lines) == len(expected), record["name"]
+        for line, (k, x, y, w, h) in zip(lines, expected):
+            values = [float(v) for v in line.split()]
+            assert int(values[0]) == k
+            np.testing.assert_allclose(values[1:], [(x + w / 2) / WIDTH, (y + h / 2) / HEIGHT, w / WIDTH, h / HEIGHT],
+                                       atol=1e-8)
+
+
+def test_training_targets_take_the_kept_boxes_of_the_photo(labelled):
+    from synthua_usd.analytics.detection_targets import read_generated, targets_for
+
+    dataset = read_generated(labelled, None, targets_for("wheelchair-sets"))
+    by_name = {r["name"]: r for r in _records(labelled)}
+    for image in dataset.images:
+        record = by_name[Path(image.path).stem]
+        kept = [b for b in record["composite"]["background_boxes"] if b["kept"]]
+        photo_boxes = [b for b in image.boxes if [b.x, b.y, b.w, b.h] in [k["bbox"] for k in kept]]
+        assert len(photo_boxes) == len(kept)
+
+
+def test_stats_and_the_metadata_table_read_a_composite_dataset(unlabelled, tmp_path, run_cli):
+    import pyarrow.parquet as pq
+
+    code, out, err = run_cli("stats", unlabelled, "--out", tmp_path / "stats")
+    assert code == 0, out + err
+    assert (tmp_path / "stats" / "statistics.json").is_file()
+    table = pq.read_table(unlabelled / "metadata.parquet").to_pydict()
+    records = _records(unlabelled)
+    assert table["pastes"] == [len(r["composite"]["pastes"]) for r in sorted(records, key=lambda r: r["id"])]
+    assert table["fx"] == [r["camera"]["focal_px"] for r in sorted(records, key=lambda r: r["id"])]
+
+
+def test_help_teaches_with_examples(run_cli):
+    code, out, _ = run_cli("composite", "--help")
+    assert code == 0 and "synthua composite photos/ --bank bank/ --config configs/composite.json" in out
+    assert "BACKGROUNDS is a folder of photos without labels" in out and "box" in out
+    code, out, _ = run_cli("replay", "--help")
+    assert code == 0 and "synthua composite" in out
+
+
+def test_a_coco_set_is_a_labelled_background_too(inputs, tmp_path):
+    photos = sorted((inputs / "photos").glob("*.png"))
+    coco = {"images": [{"id": k + 1, "file_name": p.name, "width": 96, "height": 72} for k, p in enumerate(photos)],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 7, "bbox": [20.0, 30.0, 12.0, 30.0],
+                             "iscrowd": 0}],
+            "categories": [{"id": 7, "name": "person"}]}
+    (inputs / "photos" / "coco.json").write_text(json.dumps(coco))
+    try:
+        out = _composite(inputs, "photos/coco.json", "out_coco", 1)
+    finally:
+        (inputs / "photos" / "coco.json").unlink()
+    records = _records(out)
+    assert {r["composite"]["background"]["layout"] for r in records} == {"coco"}
+    boxed = [r for r in records if r["composite"]["background"]["path"] == photos[0].name]
+    assert boxed and all(len(r["composite"]["background_boxes"]) == 1 for r in boxed)
+    box = boxed[0]["composite"]["background_boxes"][0]
+    # the 96x72 photo covers 64x48 at scale 2/3: x (20 - 0) * 2/3, y 30 * 2/3 - 0 (no cut), sizes * 2/3
+    assert box["label"] == "person" and box["bbox"] == pytest.approx([13.3333, 20.0, 8.0, 20.0], abs=1e-4)

@@ -1,0 +1,245 @@
+"""The sim-to-real experiment's design without a detector: epochs of an image-step budget against numbers worked
+out by hand, nested subsets of the real photos, the runs planned, the seeds' spread against NumPy, the report, and
+tools/sim2real.py's plan (--plan-only) and one-line refusals on a hand-made YOLO set of tiny images."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from conftest import REPO
+from synthua_usd.core.errors import InputError
+from synthua_usd.pipeline import sim2real as S
+from synthua_usd.pipeline.sim2real_report import cell, curve, markdown
+from synthua_usd.pipeline.sim2real_sets import VAL_IMAGES
+
+
+@pytest.mark.parametrize("budget, images, epochs, steps", [
+    (7500, 50, 150, 7500),       # 150 epochs of the 50 photos: exact
+    (7500, 25, 300, 7500),
+    (7500, 100, 75, 7500),
+    (7500, 200, 38, 7600),       # 37.5: halves round up
+    (7500, 449, 17, 7633),       # 16.70 -> 17
+    (7500, 450, 17, 7650),       # 50 photos + 400 composites: 16.67 -> 17
+    (7500, 2000, 4, 8000),       # 3.75 -> 4
+    (7500, 3001, 2, 6002),       # 2.499 -> 2
+    (10, 40, 1, 40),             # 0.25 -> at least one epoch
+    (1, 1, 1, 1),
+])
+def test_epochs_of_an_image_step_budget(budget, images, epochs, steps):
+    b = S.epochs_for(budget, images)
+    assert (b.epochs, b.image_steps, b.exact) == (epochs, steps, steps == budget)
+    assert (b.note() is None) == (steps == budget)
+
+
+def test_the_rounding_note_states_the_change():
+    assert S.epochs_for(7500, 449).note() == ("7,500 image-steps / 449 images = 16.70 epochs, trained as 17: "
+                                               "7,633 image-steps (+1.8 %)")
+    assert S.epochs_for(10, 40).note().endswith("trained as 1: 40 image-steps (+300.0 %)")
+    assert S.epochs_for(7500, 3001).note().endswith("6,002 image-steps (-20.0 %)")
+    with pytest.raises(InputError, match="--budget-images: 0"):
+        S.epochs_for(0, 10)
+
+
+def test_lists_of_arms_seeds_and_sizes():
+    assert S.parse_arms("d, b") == ("b", "d") and S.parse_arms("a,b,c,d") == tuple(S.ARMS)
+    assert S.parse_seeds("2,0,1") == (2, 0, 1)
+    assert S.parse_sizes("all,25,50", 449) == (25, 50, 449) and S.parse_sizes("449,all", 449) == (449,)
+    for call, found in [(lambda: S.parse_arms("b,e"), "--arms: e; expected some of a (synthetic only)"),
+                        (lambda: S.parse_arms("b,b"), "expected each value once"),
+                        (lambda: S.parse_seeds("0,x"), "--seeds: 'x'"),
+                        (lambda: S.parse_seeds("-1"), "--seeds: '-1'"),
+                        (lambda: S.parse_seeds(" , "), "expected a comma-separated list"),
+                        (lambda: S.parse_sizes("25,500", 449), "--real-sizes: '500'; expected numbers of real "
+                                                               "training photos from 1 to 449"),
+                        (lambda: S.parse_sizes("0", 449), "--real-sizes: '0'")]:
+        with pytest.raises(InputError, match=found.replace("(", r"\(").replace(")", r"\)")):
+            call()
+
+
+def test_subsets_are_nested_seeded_and_independent_of_the_listing_order():
+    names = [f"images/train/{k:03d}.jpg" for k in range(449)]
+    subsets = S.nested_subsets(names, (25, 50, 100, 200, 449), seed=0)
+    for small, large in zip((25, 50, 100, 200), (50, 100, 200, 449)):
+        assert subsets[small] == subsets[large][:small] and set(subsets[small]) < set(subsets[large])
+    assert sorted(subsets[449]) == names and len(set(subsets[449])) == 449
+    # the draw: numpy's default_rng(seed).permutation over the sorted names
+    order = np.random.default_rng(0).permutation(449)
+    assert subsets[25] == tuple(names[k] for k in order[:25])
+    assert S.nested_subsets(list(reversed(names)), (25,), seed=0)[25] == subsets[25]
+    assert S.nested_subsets(names, (25,), seed=1)[25] != subsets[25]
+
+
+def test_the_runs_planned_seed_by_seed():
+    runs = S.plan_runs(("a", "b", "c", "d"), (25, 449), (0, 1), 7500, 30000, synthetic_images=2000,
+                       mixed_images={25: 200, 449: 400})
+    assert [r.name for r in runs[:7]] == ["a_synthetic_s0", "b_n0025_s0", "c_n0025_s0", "d_n0025_s0", "b_n0449_s0",
+                                         "c_n0449_s0", "d_n0449_s0"]
+    assert len(runs) == 14 and [r.seed for r in runs] == [0] * 7 + [1] * 7
+    by = {r.name: r for r in runs}
+    assert (by["a_synthetic_s0"].budget.epochs, by["a_synthetic_s0"].budget.image_steps) == (15, 30000)
+    assert by["c_n0025_s1"].pretraining == "a_synthetic_s1" and by["b_n0025_s1"].pretraining is None
+    assert by["c_n0025_s0"].budget == by["b_n0025_s0"].budget == S.epochs_for(7500, 25)        # (b)'s budget
+    assert (by["d_n0025_s0"].budget.images, by["d_n0025_s0"].budget.epochs) == (225, 33)      # 33.33 -> 33
+    assert (by["d_n0449_s0"].budget.images, by["d_n0449_s0"].budget.epochs) == (849, 9)       # 8.83 -> 9
+    only_c = S.plan_runs(("c",), (50,), (0,), 7500, 7500, synthetic_images=100)
+    assert [r.name for r in only_c] == ["a_synthetic_s0", "c_n0050_s0"]   # (c) needs (a)'s run
+
+
+def test_the_spread_over_seeds_is_numpys():
+    rng = np.random.default_rng(4)
+    values = list(rng.random(5))
+    s = S.spread(values + [None])                     # None: no box of the class, left out
+    x = np.asarray(values)
+    assert s["n"] == 5
+    assert s["mean"] == pytest.approx(np.mean(x), abs=1e-15) and s["std"] == pytest.approx(np.std(x, ddof=1), abs=1e-15)
+    assert (s["min"], s["max"]) == (np.min(x), np.max(x))
+    assert S.spread([0.3]) == {"n": 1, "mean": 0.3, "min": 0.3, "max": 0.3, "std": None}
+    assert S.spread([None])["n"] == 0 and S.spread([])["mean"] is None
+    # two seeds 0.35 and 0.39: mean 0.37, sample sd |a - b| / sqrt(2)
+    assert S.spread([0.35, 0.39])["std"] == pytest.approx(0.04 / np.sqrt(2))
+
+
+def _scores():
+    rows = []
+    for seed, (b, c) in enumerate([(0.35, 0.40), (0.39, 0.46), (0.31, 0.49)]):
+        for arm, v in (("b", b), ("c", c)):
+            rows.append({"run": f"{arm}_n0050_s{seed}", "arm": arm, "real_images": 50, "seed": seed, "test": "dev-val",
+                         "class": "wheelchair", "AP50": v, "AP50_95": v / 2})
+    rows.append({"run": "a_synthetic_s0", "arm": "a", "real_images": None, "seed": 0, "test": "dev-val",
+                 "class": "wheelchair", "AP50": 0.1, "AP50_95": None})
+    return rows
+
+
+def test_summaries_group_runs_over_seeds():
+    summary = S.summarise(_scores())
+    assert [(s["arm"], s["real_images"]) for s in summary] == [("b", 50), ("c", 50), ("a", None)]
+    b = summary[0]
+    assert b["seeds"] == [0, 1, 2]
+    assert b["AP50"]["mean"] == pytest.approx(np.mean([0.35, 0.39, 0.31]))
+    assert b["AP50"]["std"] == pytest.approx(np.std([0.35, 0.39, 0.31], ddof=1))
+    assert b["AP50_95"]["max"] == pytest.approx(0.195)
+    assert summary[2]["AP50_95"]["n"] == 0 and cell(summary[2]["AP50_95"]) == "–"
+    assert cell(summary[2]["AP50"]) == "10.0"
+    assert cell(b["AP50"]) == "35.0 (31.0–39.0) sd 4.0"
+
+
+def _document():
+    runs = []
+    for seed in range(3):
+        runs.append({"name": "a_synthetic_s0", "arm": "a", "real_images": None, "mixed_images": 0, "seed": seed,
+                     "train_set": "out/sim", "images": 2000, "epochs": 4, "image_steps": 8000, "pretraining": None,
+                     "init": None, "model": "yolo26n.yaml", "seconds": 700.0, "images_per_s": 11.4, "device": "cpu",
+                     "versions": {"ultralytics": "8.4.190", "torch": "2.14.1"}})
+        for arm in ("b", "c"):
+            runs.append({"name": f"{arm}_n0050_s{seed}", "arm": arm, "real_images": 50, "mixed_images": 0, "seed": seed,
+                         "train_set": "work/subsets/n0050", "images": 50, "epochs": 150, "image_steps": 7500,
+                         "pretraining": "a_synthetic_s0" if arm == "c" else None, "init": None, "model": "yolo26n.yaml",
+                         "seconds": 680.0, "images_per_s": 11.0, "device": "cpu"})
+    scores = _scores()
+    return {"date": "2026-12-05T10:00:00+00:00", "command": "python tools/sim2real.py ...",
+            "plan": {"arms": ["a", "b", "c"], "seeds": [0, 1, 2], "budget_images": 7500,
+                     "synthetic_budget_images": 8000, "imgsz": 320, "batch": 16, "init": None, "model": "yolo26n.yaml",
+                     "subset_seed": 0, "real_photos": 449,
+                     "tests": [{"label": "dev-val", "path": "real/", "split": "val", "images": 53}]},
+            "runs": runs, "scores": scores, "summary": S.summarise(scores), "notes": ["a note"]}
+
+
+def test_the_markdown_and_the_curve(tmp_path):
+    text = markdown(_document())
+    assert "| (b) real only | 50 | 0,1,2 | 150 × 50 = 7,500 | 35.0 (31.0–39.0) sd 4.0 |" in text
+    assert "| (c) synthetic, then real | 50 | 0,1,2 | 150 × 50 = 7,500 after (a)'s 8,000 |" in text
+    assert "every arm from scratch (yolo26n.yaml)" in text and "(8,000 for (a))" in text and "- a note" in text
+    png = curve(_document(), tmp_path / "curve.png", ["wheelchair", "person"])
+    assert png.stat().st_size > 5000 and Image.open(png).size[0] > 300
+    assert curve(_document(), tmp_path / "none.png", ["bicycle"]) is None
+
+
+# --- tools/sim2real.py without a detector: the plan and the refusals -------------------------------------------------
+
+@pytest.fixture(scope="module")
+def tool():
+    spec = importlib.util.spec_from_file_location("sim2real_tool", REPO / "tools" / "sim2real.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def real(tmp_path_factory) -> Path:
+    """A YOLO set of tiny images: train 20 (one person box each, every fourth a wheelchair too), val 3."""
+    root = tmp_path_factory.mktemp("real")
+    for split, count in (("train", 20), ("val", 3)):
+        (root / "images" / split).mkdir(parents=True)
+        (root / "labels" / split).mkdir(parents=True)
+        for k in range(count):
+            Image.fromarray(np.full((48, 64, 3), 10 * k, np.uint8)).save(root / "images" / split / f"{split}{k:02d}.png")
+            lines = "0 0.5 0.5 0.25 0.5\n" + ("1 0.3 0.6 0.3 0.4\n" if k % 4 == 0 else "")
+            (root / "labels" / split / f"{split}{k:02d}.txt").write_text(lines)
+    (root / "data.yaml").write_text("path: .\ntrain: images/train\nval: images/val\nnames: [person, wheelchair]\n")
+    return root
+
+
+def test_plan_only_writes_nested_subsets_of_links(tool, real, tmp_path, capsys):
+    work = tmp_path / "work"
+    args = ["--real-train", str(real), "--test", str(real), "--real-sizes", "5,12,all", "--budget-images", "30",
+            "--seeds", "0,1,2", "--subset-seed", "3", "--plan-only", "--work", str(work)]
+    assert tool.main(args) == 0
+    out = [" ".join(line.split()) for line in capsys.readouterr().out.splitlines()]
+    assert "b_n0012_s0 3 epochs x 12 images = 36 image-steps (30 image-steps / 12 images = 2.50 epochs, trained as " \
+           "3: 36 image-steps (+20.0 %))" in out                        # 2.5: halves up
+    assert "b_n0005_s2 6 epochs x 5 images = 30 image-steps" in out and len(out) == 1 + 9 + 1   # no note: 3 seeds
+    doc = json.loads((work / "sim2real.json").read_text())
+    assert doc["plan"]["real_sizes"] == [5, 12, 20] and doc["plan"]["real_photos"] == 20
+    assert doc["plan"]["tests"][0]["split"] == "val" and doc["plan"]["init"] is None
+    subsets = {int(n): names for n, names in doc["subsets"].items()}
+    assert subsets[5] == subsets[12][:5] and subsets[12] == subsets[20][:12] and len(set(subsets[20])) == 20
+    assert subsets[12] == list(S.nested_subsets(subsets[20], (12,), 3)[12])
+    assert any("b_n0012_s0: 30 image-steps / 12 images = 2.50 epochs, trained as 3: 36" in n for n in doc["notes"])
+    for n, names in subsets.items():
+        folder = work / "subsets" / f"n{n:04d}"
+        assert json.loads((folder / "subset.json").read_text())["photos"] == names
+        links = sorted((folder / "images" / "train").iterdir())
+        assert [p.is_symlink() for p in links] == [True] * n                # linked, never copied
+        assert [str(p.resolve().relative_to(real)) for p in links] == names   # in the draw's order
+        assert len(list((folder / "images" / "val").iterdir())) == min(n, VAL_IMAGES)
+        assert (folder / "labels" / "train" / "000001.txt").read_text().startswith("0 0.5000000 0.5000000")
+    # another draw into the same work folder is refused: the runs kept there were trained on this one
+    assert tool.main([a if a != "3" else "4" for a in args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "holds another draw" in err[0]
+
+
+def test_refusals_are_one_line(tool, real, tmp_path, capsys):
+    work = ["--work", str(tmp_path / "w"), "--plan-only"]
+    base = ["--real-train", str(real), "--test", str(real)]
+    cases = [
+        (base, "--budget-images: not given; expected the image-steps"),
+        (base + ["--budget-images", "10", "--arms", "d"], "--arms d: arm d (real + mixed set) needs --real-train and --mix"),
+        (base + ["--budget-images", "10", "--arms", "a"], "arm a (synthetic only) needs --synthetic"),
+        (base + ["--budget-images", "10", "--real-sizes", "30"], "--real-sizes: '30'; expected numbers of real training "
+                                                               "photos from 1 to 20"),
+        (base + ["--budget-images", "10", "--seeds", "0,one"], "--seeds: 'one'"),
+        (base + ["--budget-images", "10", "--imgsz", "100"], "multiple of 32"),
+        (["--real-train", str(real), "--test", str(real / "data.yaml"), "--budget-images", "10", "--real-sizes", "5",
+          "--mix", "6=" + str(real)], "--mix 6="),
+        (["--real-train", str(real), "--budget-images", "10"], "--test: none given"),
+        (base + ["--budget-images", "10", "--init", str(tmp_path / "yolo11n.pt")], "--init: "),
+        (base + ["--budget-images", "10", "--bogus"], "unrecognized arguments: --bogus"),
+    ]
+    for args, found in cases:
+        assert tool.main(args + work) == 2, args
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("synthua: error:") and found in err[0], (found, err)
+    # a test set that shares photos with the training photos is no test
+    (tmp_path / "leak").mkdir()
+    (tmp_path / "leak" / "data.yaml").write_text(f"path: {real}\ntest: images/train\nnames: [person, wheelchair]\n")
+    assert tool.main(["--real-train", str(real), "--test", str(tmp_path / "leak"), "--budget-images", "10"] + work) == 2
+    assert "20 of its 20 images are among the real training photos" in capsys.readouterr().err
