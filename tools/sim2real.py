@@ -73,13 +73,15 @@ class _Parser(argparse.ArgumentParser):
 def _train_command(train_set: Path, out: Path, budget: Budget, seed: int, device: str, init: Path | None,
                    convention: str | None) -> str:
     parts = ["synthua", "train", str(train_set)] + (["--convention", convention] if convention else [])
-    parts += ["--epochs", str(budget.epochs), "--imgsz", str(budget.imgsz), "--batch", str(budget.batch),
+    parts += ["--epochs", str(budget.epochs), "--close-mosaic", str(budget.close_mosaic), "--imgsz", str(budget.imgsz), "--batch", str(budget.batch),
               "--seed", str(seed), "--device", device] + (["--init", str(init)] if init else []) + ["--out", str(out)]
     return shlex.join(parts)
 
 
 def _check_kept(out: Path, about: dict, expected: dict) -> None:
-    found = {"epochs": about["budget"]["epochs"], "imgsz": about["budget"]["imgsz"], "batch": about["budget"]["batch"],
+    # a run from before close_mosaic was recorded trained with Ultralytics' default, 10
+    found = {"epochs": about["budget"]["epochs"], "close_mosaic": about["budget"].get("close_mosaic", 10),
+             "imgsz": about["budget"]["imgsz"], "batch": about["budget"]["batch"],
              "seed": about["seed"], "images": about["train_set"]["images"]["train"],
              "init": (about.get("init") or {}).get("sha256")}
     if found != expected:
@@ -142,6 +144,10 @@ def _parse(argv):
                       "e.g. 7500 = 150 epochs of 50 photos (required)")
     plan.add_argument("--synthetic-budget-images", type=int, metavar="N",
                       help="image-steps of (a), which is also (c)'s pretraining [--budget-images]")
+    plan.add_argument("--close-mosaic-share", type=float, default=S.CLOSE_MOSAIC_SHARE, metavar="F",
+                      help="share of every arm's epochs trained without mosaic augmentation at the end (Ultralytics' "
+                           "close_mosaic is an epoch count: 10 epochs are 7 %% of 150 epochs of 50 photos but 59 %% of "
+                           "17 epochs of 450 images) [1/15: the 10 of 150]")
     plan.add_argument("--seeds", default="0,1,2", metavar="LIST",
                       help="training seeds, each arm once per seed; at least 3 for figures to quote [0,1,2]")
     plan.add_argument("--real-sizes", default=S.ALL, metavar="LIST",
@@ -335,13 +341,15 @@ def plan_document(args, arms, seeds, got: Inputs, command: str, work: Path, note
 def train_one(planned: S.PlannedRun, args, got: Inputs, folders: dict, work: Path, targets) -> dict:
     """Train one planned run (or keep it when trained before with the same plan); its record."""
     out = work / "runs" / planned.name
-    budget = Budget(minutes=None, epochs=planned.budget.epochs, imgsz=args.imgsz, batch=args.batch)
+    budget = Budget(minutes=None, epochs=planned.budget.epochs, imgsz=args.imgsz, batch=args.batch,
+                    close_mosaic=planned.budget.close_mosaic)
     if planned.arm == "a":
         train_set, start = args.synthetic, got.init
     else:
         train_set = folders[("d" if planned.arm == "d" else "b", planned.real_images)]
         start = locate_init(work / "runs" / planned.pretraining) if planned.arm == "c" else got.init
-    expected = {"epochs": planned.budget.epochs, "imgsz": args.imgsz, "batch": args.batch, "seed": planned.seed,
+    expected = {"epochs": planned.budget.epochs, "close_mosaic": planned.budget.close_mosaic, "imgsz": args.imgsz,
+                "batch": args.batch, "seed": planned.seed,
                 "images": planned.budget.images, "init": start.sha256}
     wall = None
     if (out / "train.json").is_file():               # a finished run is kept: rerun to resume or to rescore
@@ -358,7 +366,7 @@ def train_one(planned: S.PlannedRun, args, got: Inputs, folders: dict, work: Pat
     b = planned.budget
     return {"name": planned.name, "arm": planned.arm, "real_images": planned.real_images,
             "mixed_images": planned.mixed_images, "seed": planned.seed, "train_set": str(train_set),
-            "images": b.images, "epochs": b.epochs, "image_steps": b.image_steps, "budget_images": b.budget_images,
+            "images": b.images, "epochs": b.epochs, "close_mosaic": b.close_mosaic, "image_steps": b.image_steps, "budget_images": b.budget_images,
             "rounding": b.note(), "pretraining": planned.pretraining,
             "command": _train_command(Path(train_set), out, budget, planned.seed, args.device,
                                       start.weights if start.kind != "scratch" else None,
@@ -404,7 +412,8 @@ def run(argv: list[str] | None) -> int:
     got = read_inputs(args, arms, targets)
     folders = write_folders(got, args, arms, work)
     runs = S.plan_runs(arms, got.sizes, seeds, args.budget_images, args.synthetic_budget_images or args.budget_images,
-                       got.synthetic_images, {n: len(got.mixes[p].images) for n, p in got.mix_paths.items()})
+                       got.synthetic_images, {n: len(got.mixes[p].images) for n, p in got.mix_paths.items()},
+                       args.close_mosaic_share)
     notes = [f"{len(seeds)} seed{'s' if len(seeds) > 1 else ''}: a spread from fewer than {S.MIN_SEEDS} seeds is not "
              f"a figure to quote"] if len(seeds) < S.MIN_SEEDS else []
     notes += [f"{r.name}: {r.budget.note()}" for r in runs if r.budget.note() and r.seed == seeds[0]]
@@ -413,7 +422,7 @@ def run(argv: list[str] | None) -> int:
           f"{', '.join(map(str, got.sizes)) or '-'}), every arm from {describe(got.init.document(), got.init.architecture)}")
     for r in runs:
         print(f"  {r.name:16s} {r.budget.epochs:5d} epochs x {r.budget.images:6,d} images = {r.budget.image_steps:9,d} "
-              f"image-steps" + (f"  ({r.budget.note()})" if r.budget.note() else ""))
+              f"image-steps, the last {r.budget.close_mosaic} without mosaic" + (f"  ({r.budget.note()})" if r.budget.note() else ""))
     if len(seeds) < S.MIN_SEEDS:
         print(f"  note: {notes[0]}")
     if args.plan_only:

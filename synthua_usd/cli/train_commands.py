@@ -28,6 +28,10 @@ _DEVICE = click.Choice(L.DEVICES)
 @click.option("--imgsz", type=InRange(L.IMGSZ), default=L.DEFAULT_IMGSZ, show_default=True,
               help="Training image size in pixels (long side; a multiple of 32).")
 @click.option("--batch", type=InRange(L.BATCH), default=L.DEFAULT_BATCH, show_default=True, help="Images per step.")
+@click.option("--close-mosaic", type=InRange(L.CLOSE_MOSAIC), default=L.DEFAULT_CLOSE_MOSAIC, show_default=True,
+              help="The last N epochs train without mosaic augmentation (Ultralytics' close_mosaic). An epoch count: "
+                   "when comparing trainings of the same image-steps over sets of other sizes, give each the same "
+                   "share of its epochs (tools/sim2real.py does).")
 @click.option("--device", type=_DEVICE, default="auto", show_default=True,
               help="auto: CUDA when torch sees a GPU, else the CPU.")
 @seed_option(help="Ultralytics' seed (deterministic mode on).")
@@ -63,8 +67,8 @@ _DEVICE = click.Choice(L.DEVICES)
               help="Folder of a COCO set's images [default: the .json's folder].")
 @click.option("--python", "python", type=click.Path(path_type=Path),
               help="Interpreter holding Ultralytics [default: $SYNTHUA_TRAIN_PYTHON, else .venv-train/bin/python].")
-def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, imgsz: int, batch: int, device: str,
-          seed: int, model: str, init: Path | None, convention: str | None, classes: str | None, aid_box: str | None,
+def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, imgsz: int, batch: int,
+          close_mosaic: int, device: str, seed: int, model: str, init: Path | None, convention: str | None, classes: str | None, aid_box: str | None,
           aid_users_as_person: bool | None, min_height_px: float, fmt: str, images_dir: Path | None,
           python: Path | None) -> int:
     """Train an object detector (Ultralytics YOLO) on TRAIN_SET within a bounded budget, from scratch or from
@@ -97,7 +101,8 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
 
     chosen = tuple(c.strip() for c in classes.split(",") if c.strip()) if classes is not None else None
     targets = targets_for(convention, chosen, aid_box, aid_users_as_person, min_height_px)
-    budget = Budget(minutes=None if epochs is not None else minutes, epochs=epochs or 300, imgsz=imgsz, batch=batch)
+    budget = Budget(minutes=None if epochs is not None else minutes, epochs=epochs or 300, imgsz=imgsz, batch=batch,
+                    close_mosaic=close_mosaic)
     doc = run(TrainRequest(train_set, out_dir, budget, targets, model, init, fmt, images_dir, device, seed,
                            python=python))
     final = doc["final"] or {}

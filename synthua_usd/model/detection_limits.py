@@ -17,6 +17,9 @@ IMGSZ = Range(32, 4096, "px", integer=True)
 DEFAULT_IMGSZ = 320
 BATCH = Range(1, 1024, integer=True)
 DEFAULT_BATCH = 16
+#: Epochs at the end of a training without mosaic augmentation (Ultralytics' ``close_mosaic``, its default 10).
+CLOSE_MOSAIC = Range(0, 100_000, integer=True)
+DEFAULT_CLOSE_MOSAIC = 10
 #: Boxes lower than this (pixels of the generated image) are neither trained on nor scored; 8 px: below it a
 #: person is a few pixels of colour at 320 px, and no real test set labels them.
 MIN_HEIGHT_PX = Range(0.0, 10_000.0, "px")

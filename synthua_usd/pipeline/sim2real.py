@@ -13,7 +13,11 @@ Arms (each trained once per seed, each from the same initial weights):
 A budget is a number of **image-steps** (epochs × training images), the same for every arm, because minutes
 drift 15–25 % between runs on a shared machine while image-steps do not. Each arm's epochs are the budget over
 its training set's size, rounded to the nearest whole number (halves up), at least 1; :class:`EpochBudget` says
-when that rounding changes the steps. The real photos are drawn once, in a seeded order, and a subset of n photos
+when that rounding changes the steps. Ultralytics turns mosaic augmentation off for the last ``close_mosaic``
+epochs, an epoch count: 10 of 150 epochs of 50 photos, but 10 of the 17 epochs of a 450-image mixed set (six tenths of
+its steps); every arm closes it for the same share of its epochs (:attr:`EpochBudget.close_mosaic`, by default
+:data:`CLOSE_MOSAIC_SHARE`, Ultralytics' 10 epochs of the 150 a 7,500-image-step budget gives 50 photos). The real
+photos are drawn once, in a seeded order, and a subset of n photos
 is the first n of that order, so the subsets are nested (25 ⊂ 50 ⊂ 100 ...) and the same for every arm and seed.
 """
 
@@ -34,16 +38,19 @@ REAL_ARMS = ("b", "c", "d")
 ALL = "all"
 #: The fewest seeds whose spread a comparison may quote.
 MIN_SEEDS = 3
+#: Share of an arm's epochs trained without mosaic augmentation at the end (``--close-mosaic-share``).
+CLOSE_MOSAIC_SHARE = 1 / 15
 
 
 @dataclass(frozen=True)
 class EpochBudget:
     """``budget_images`` image-steps over ``images`` training images: ``epochs`` (the quotient rounded to the nearest
-    whole number, halves up, at least 1)."""
+    whole number, halves up, at least 1), the last ``close_mosaic`` of them without mosaic augmentation."""
 
     budget_images: int
     images: int
     epochs: int
+    close_mosaic: int = 0
 
     @property
     def image_steps(self) -> int:
@@ -63,11 +70,19 @@ class EpochBudget:
                 f"epochs, trained as {self.epochs}: {self.image_steps:,} image-steps ({change:+.1f} %)")
 
 
-def epochs_for(budget_images: int, images: int) -> EpochBudget:
-    """The whole epochs of ``budget_images`` image-steps over ``images`` training images."""
+def _half_up(x: float) -> int:
+    return math.floor(x + 0.5)
+
+
+def epochs_for(budget_images: int, images: int, close_mosaic_share: float = CLOSE_MOSAIC_SHARE) -> EpochBudget:
+    """The whole epochs of ``budget_images`` image-steps over ``images`` training images, ``close_mosaic_share`` of
+    them (rounded, halves up) the last without mosaic augmentation."""
     if budget_images < 1 or images < 1:
         raise InputError(f"--budget-images: {budget_images} over {images} images; expected at least 1 of each")
-    return EpochBudget(budget_images, images, max(1, math.floor(budget_images / images + 0.5)))
+    if not 0.0 <= close_mosaic_share <= 1.0:
+        raise InputError(f"--close-mosaic-share: {close_mosaic_share:g}; expected a share in [0, 1]")
+    epochs = max(1, _half_up(budget_images / images))
+    return EpochBudget(budget_images, images, epochs, _half_up(epochs * close_mosaic_share))
 
 
 def _items(text: str, option: str) -> list[str]:
@@ -152,18 +167,22 @@ class PlannedRun:
 
 def plan_runs(arms: Sequence[str], sizes: Sequence[int], seeds: Sequence[int], budget_images: int,
               synthetic_budget_images: int, synthetic_images: int | None = None,
-              mixed_images: dict[int, int] | None = None) -> list[PlannedRun]:
+              mixed_images: dict[int, int] | None = None,
+              close_mosaic_share: float = CLOSE_MOSAIC_SHARE) -> list[PlannedRun]:
     """Every run of the experiment, seed by seed (so that an interrupted experiment has whole seeds): (a) first
     when (a) or (c) is asked (c starts from it), then (b), (c), (d) at each real size, smallest first.
-    ``mixed_images``: images of the mixed set at each size (arm d)."""
+    ``mixed_images``: images of the mixed set at each size (arm d); every run without mosaic for the last
+    ``close_mosaic_share`` of its epochs."""
     runs = []
     for seed in seeds:
         if "a" in arms or "c" in arms:
-            runs.append(PlannedRun("a", None, seed, epochs_for(synthetic_budget_images, synthetic_images)))
+            runs.append(PlannedRun("a", None, seed, epochs_for(synthetic_budget_images, synthetic_images,
+                                                                  close_mosaic_share)))
         for n in sizes:
             for arm in (a for a in REAL_ARMS if a in arms):
                 mixed = (mixed_images or {}).get(n, 0) if arm == "d" else 0
-                runs.append(PlannedRun(arm, n, seed, epochs_for(budget_images, n + mixed), mixed))
+                runs.append(PlannedRun(arm, n, seed, epochs_for(budget_images, n + mixed, close_mosaic_share),
+                                        mixed))
     return runs
 
 

@@ -64,11 +64,12 @@ def _score_tables(document: dict) -> list[str]:
 
 
 def _run_table(document: dict) -> list[str]:
-    lines = ["| run | trained on | images | epochs | image-steps | from | seconds | images/s | device |",
+    lines = ["| run | trained on | images | epochs (last without mosaic) | image-steps | from | seconds | images/s | device |",
              "|---|---|---|---|---|---|---|---|---|"]
     for r in document["runs"]:
         speed = f"{r['images_per_s']:.1f}" if r.get("images_per_s") else "–"
-        lines.append(f"| {r['name']} | `{r['train_set']}` | {r['images']:,} | {r['epochs']} | {r['image_steps']:,} | "
+        lines.append(f"| {r['name']} | `{r['train_set']}` | {r['images']:,} | {r['epochs']} ({r.get('close_mosaic', 10)}) | "
+                     f"{r['image_steps']:,} | "
                      f"{describe(r['init'], r['model'])} | {r['seconds']:.0f} | {speed} | {r['device']} |")
     return lines + [""]
 

@@ -64,12 +64,15 @@ def check_imgsz(imgsz: int) -> int:
 class Budget:
     """How long training may run: ``minutes`` of wall time (Ultralytics' ``time``: it stops mid-epoch when spent
     and fits its learning-rate schedule to it), or ``epochs`` when ``minutes`` is None; images resized to ``imgsz``
-    pixels (long side), ``batch`` images a step."""
+    pixels (long side), ``batch`` images a step; the last ``close_mosaic`` epochs without mosaic augmentation
+    (Ultralytics' schedule: an epoch count, so two trainings of the same image-steps over sets of other sizes keep
+    mosaic for other shares of their steps unless told)."""
 
     minutes: float | None = L.DEFAULT_MINUTES
     epochs: int = 300
     imgsz: int = L.DEFAULT_IMGSZ
     batch: int = L.DEFAULT_BATCH
+    close_mosaic: int = L.DEFAULT_CLOSE_MOSAIC
 
     def __post_init__(self):
         if self.minutes is not None:
@@ -77,10 +80,11 @@ class Budget:
         L.EPOCHS.check(self.epochs, "--epochs")
         check_imgsz(self.imgsz)
         L.BATCH.check(self.batch, "--batch")
+        L.CLOSE_MOSAIC.check(self.close_mosaic, "--close-mosaic")
 
     def document(self) -> dict:
         return {"minutes": self.minutes, "epochs": None if self.minutes is not None else self.epochs,
-                "imgsz": self.imgsz, "batch": self.batch}
+                "imgsz": self.imgsz, "batch": self.batch, "close_mosaic": self.close_mosaic}
 
 
 @dataclass(frozen=True)
@@ -152,7 +156,8 @@ def train(request: TrainRequest) -> dict:
         data_yaml = write_yolo_boxes(Path(scratch) / "data", splits, names)
         b = request.budget
         job = {"action": "train", "data": str(data_yaml), "model": init.model,
-               "imgsz": b.imgsz, "epochs": b.epochs, "minutes": b.minutes, "batch": b.batch, "workers": request.workers,
+               "imgsz": b.imgsz, "epochs": b.epochs, "minutes": b.minutes, "batch": b.batch,
+               "close_mosaic": b.close_mosaic, "workers": request.workers,
                "device": request.device, "seed": request.seed, "threads": threads,
                "project": str(Path(scratch) / "runs")}
         results = Path(scratch) / "runs" / "train" / "results.csv"
@@ -170,7 +175,8 @@ def train(request: TrainRequest) -> dict:
             "train_set": _set_document(train_set, splits), "classes": list(names),
             "targets": request.targets.document() if train_set.layout == "synthua" else None,
             "model": init.architecture, "init": init.document(result.get("transferred")),
-            "budget": b.document(), "seed": request.seed, "device": result["device"], "threads": threads,
+            # close_mosaic as the trainer ran it (what was asked, unless Ultralytics changed it)
+            "budget": {**b.document(), "close_mosaic": result["close_mosaic"]}, "seed": request.seed, "device": result["device"], "threads": threads,
             "versions": result["versions"], "epochs_done": result["epochs_done"],
             "epochs_planned": result["epochs_planned"], "seconds": round(result["seconds"], 1),
             "parameters": result["parameters"], "final": result["results"][-1] if result["results"] else None,

@@ -44,7 +44,7 @@ def test_train_records_what_it_trained_on(run, generated_random):
     assert about["train_set"]["dataset_id"] == hashlib.sha256(manifest).hexdigest()
     assert about["train_set"]["generation_config"] == json.loads(manifest)["provenance"]["config"]
     assert about["train_set"]["generation_config"]["randomise"]          # the scene randomisation made it
-    assert about["budget"] == {"minutes": None, "epochs": 1, "imgsz": 64, "batch": 2}
+    assert about["budget"] == {"minutes": None, "epochs": 1, "imgsz": 64, "batch": 2, "close_mosaic": 10}
     assert about["seed"] == 3 and about["device"] == "cpu" and about["epochs_done"] == 1
     assert about["model"] == "yolo26n.yaml" and about["init"] is None
     assert about["versions"]["ultralytics"] == "8.4.190" and about["versions"]["torch"]
@@ -252,7 +252,7 @@ def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path,
     args = ["--synthetic", str(generated_random), "--synthetic-split", "none", "--stand-in", str(generated_random),
             "--stand-in-test-split", "val", "--mix", str(generated_random), "--arms", "a,b,c,d", "--real-sizes", "1",
             "--seeds", "0", "--budget-images", "4", "--imgsz", "64", "--batch", "2", "--device", "cpu",
-            "--init", str(checkpoints["detect"]), "--work", str(work)]
+            "--close-mosaic-share", "0.5", "--init", str(checkpoints["detect"]), "--work", str(work)]
     assert tool.main(args) == 0
     doc = json.loads((work / "sim2real.json").read_text())
     plan = doc["plan"]
@@ -265,6 +265,8 @@ def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path,
         about = json.loads((Path(r["run"]) / "train.json").read_text())
         assert (r["epochs"], r["images"], r["image_steps"]) == (epochs, images, epochs * images), name
         assert about["budget"]["epochs"] == r["epochs_done"] == epochs and about["seed"] == r["seed"] == 0
+        # half of each arm's epochs without mosaic (halves up), as Ultralytics' trainer ran it
+        assert about["budget"]["close_mosaic"] == r["close_mosaic"] == {1: 1, 2: 1, 4: 2}[epochs], name
         assert about["train_set"]["images"]["train"] == images and r["device"] == "cpu" and r["seconds"] > 0
         assert r["command"].startswith("synthua train ") and f"--epochs {epochs} " in r["command"]
         if r["arm"] == "c":        # (a)'s run of the same seed, fine-tuned

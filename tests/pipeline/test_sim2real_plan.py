@@ -193,9 +193,9 @@ def test_plan_only_writes_nested_subsets_of_links(tool, real, tmp_path, capsys):
             "--seeds", "0,1,2", "--subset-seed", "3", "--plan-only", "--work", str(work)]
     assert tool.main(args) == 0
     out = [" ".join(line.split()) for line in capsys.readouterr().out.splitlines()]
-    assert "b_n0012_s0 3 epochs x 12 images = 36 image-steps (30 image-steps / 12 images = 2.50 epochs, trained as " \
+    assert "b_n0012_s0 3 epochs x 12 images = 36 image-steps, the last 0 without mosaic (30 image-steps / 12 images = 2.50 epochs, trained as " \
            "3: 36 image-steps (+20.0 %))" in out                        # 2.5: halves up
-    assert "b_n0005_s2 6 epochs x 5 images = 30 image-steps" in out and len(out) == 1 + 9 + 1   # no note: 3 seeds
+    assert "b_n0005_s2 6 epochs x 5 images = 30 image-steps, the last 0 without mosaic" in out and len(out) == 1 + 9 + 1   # no note: 3 seeds
     doc = json.loads((work / "sim2real.json").read_text())
     assert doc["plan"]["real_sizes"] == [5, 12, 20] and doc["plan"]["real_photos"] == 20
     assert doc["plan"]["tests"][0]["split"] == "val" and doc["plan"]["init"] is None
@@ -243,3 +243,21 @@ def test_refusals_are_one_line(tool, real, tmp_path, capsys):
     (tmp_path / "leak" / "data.yaml").write_text(f"path: {real}\ntest: images/train\nnames: [person, wheelchair]\n")
     assert tool.main(["--real-train", str(real), "--test", str(tmp_path / "leak"), "--budget-images", "10"] + work) == 2
     assert "20 of its 20 images are among the real training photos" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("budget, images, epochs, closed", [
+    (7500, 50, 150, 10),         # Ultralytics' default 10 of 150: the 50-photo real arm as it was
+    (7500, 450, 17, 1),          # 50 photos + 400 composites: 1.13 -> 1, not 10 of 17
+    (7500, 25, 300, 20),
+    (7500, 2000, 4, 0),          # 0.27 -> 0: mosaic to the end
+    (10, 40, 1, 0),
+])
+def test_every_arm_closes_mosaic_for_the_same_share_of_its_epochs(budget, images, epochs, closed):
+    b = S.epochs_for(budget, images)
+    assert (b.epochs, b.close_mosaic) == (epochs, closed)
+    assert S.epochs_for(budget, images, 0.0).close_mosaic == 0 and S.epochs_for(budget, images, 1.0).close_mosaic == epochs
+    with pytest.raises(InputError, match="--close-mosaic-share: 1.5"):
+        S.epochs_for(budget, images, 1.5)
+    runs = S.plan_runs(("b", "d"), (50,), (0,), 7500, 7500, None, {50: 400})
+    assert [(r.name, r.budget.epochs, r.budget.close_mosaic) for r in runs] == [("b_n0050_s0", 150, 10),
+                                                                              ("d_n0050_s0", 17, 1)]

@@ -17,7 +17,7 @@ expected: empty), beside every file that appeared in Ultralytics' weights folder
 Job documents (JSON)::
 
     {"action": "train", "data": "data.yaml", "model": "yolo26n.yaml" | "weights.pt", "imgsz": 320,
-     "epochs": 100, "minutes": 30 | null, "batch": 16, "workers": 2, "device": "cpu" | "cuda" | "auto",
+     "epochs": 100, "minutes": 30 | null, "batch": 16, "close_mosaic": 10, "workers": 2, "device": "cpu" | "cuda" | "auto",
      "seed": 0, "threads": 2, "project": "DIR", "result": "train_result.json"}
     {"action": "predict", "weights": "last.pt", "images": ["a.png", ...], "imgsz": 320, "conf": 0.001,
      "iou": 0.7, "max_det": 300, "device": "cpu", "threads": 2, "batch": 8, "progress": "done.txt" | null,
@@ -149,7 +149,8 @@ def train(job: dict) -> dict:
                 workers=int(job["workers"]), device=device, seed=int(job["seed"]), deterministic=True,
                 pretrained=from_weights, amp="bf16" if device == "cuda" else False, plots=False, val=False,
                 project=str(Path(job["project"]).resolve()), name="train", exist_ok=True, verbose=False,
-                cache=bool(job.get("cache", False)), patience=0)
+                cache=bool(job.get("cache", False)), patience=0,
+                close_mosaic=int(job["close_mosaic"]))
     seconds = time.perf_counter() - t0
     LOGGER.removeHandler(transferred)
     trainer = model.trainer
@@ -161,6 +162,7 @@ def train(job: dict) -> dict:
             rows = [{k.strip(): v.strip() for k, v in row.items()} for row in csv.DictReader(f)]
     return {"weights": str(Path(trainer.last).resolve()), "device": device, "seconds": seconds,
             "epochs_done": len(rows), "epochs_planned": int(trainer.epochs), "results": rows,
+            "close_mosaic": int(trainer.args.close_mosaic),
             "parameters": sum(p.numel() for p in model.model.parameters()),
             "transferred": transferred.counts if from_weights else None}
 
