@@ -22,12 +22,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pxr import UsdGeom
 
 from synthua_usd import __version__
 from synthua_usd.agents.walkable import WALKABLE
 from synthua_usd.composition.rigs import RigSpec
-from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.core import json_text
 from synthua_usd.core.atomic import atomic_path
 from synthua_usd.core.errors import InputError, StageError, echo
@@ -47,7 +45,7 @@ from synthua_usd.usd.authoring import check_layer_path, export_layer
 from synthua_usd.usd.cameras import camera_paths
 from synthua_usd.usd.reader import StageReader
 from synthua_usd.usd.rig_layer import PlacedRig, build_rig_layer
-from synthua_usd.usd.stage_io import check_time_code, open_stage, time_range
+from synthua_usd.usd.stage_io import check_time_code, open_stage, stage_metadata
 
 log = logging.getLogger(__name__)
 
@@ -101,11 +99,12 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
     _check_request(request)
     class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
     stage = open_stage(request.stage_path, request.allow_external_assets, request.layers)
-    if UsdGeom.GetStageUpAxis(stage) != UsdGeom.Tokens.z:
-        raise StageError(f"{request.stage_path}: upAxis is {UsdGeom.GetStageUpAxis(stage)!r}; camera rigs expect a "
-                         f"Z-up stage (heights are along +Z)")
-    span = time_range(stage)
-    start, end = span if span else (stage.GetStartTimeCode(),) * 2
+    # the rigs layer states the stage's metadata
+    meta = stage_metadata(stage)
+    if meta.up_axis != "Z":
+        raise StageError(f"{request.stage_path}: upAxis is {meta.up_axis!r}; camera rigs expect a Z-up stage "
+                         f"(heights are along +Z)")
+    start, end = meta.start_time_code, meta.end_time_code
     report_tcs = list(request.time_codes) or default_time_codes(start, end)
     for tc in report_tcs:
         check_time_code(stage, tc)
@@ -118,7 +117,7 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
     terrain = _terrain(first, class_map, str(request.stage_path))
     tracks = usd_targets.agents(stage, reader.instances, all_tcs)
     names = _names(request.rigs, {p.rsplit("/", 1)[-1] for p in camera_paths(stage)})
-    fps = stage.GetTimeCodesPerSecond()
+    fps = meta.time_codes_per_second
     groups = []
     for k, spec in enumerate(request.rigs):
         source = f"rig {k + 1} ({spec.type})"
@@ -136,9 +135,6 @@ def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
         rows.append(entry)
         if entry["status"] == "written":
             placed.append(rig)
-    meta = StageMetadata(up_axis="Z", meters_per_unit=float(UsdGeom.GetStageMetersPerUnit(stage)),
-                         time_codes_per_second=fps, start_time_code=start, end_time_code=end,
-                         default_prim=stage.GetRootLayer().defaultPrim or "World")
     layer = build_rig_layer(meta, placed, f"Camera rigs placed by synthua cameras author on {request.stage_path.name}; "
                                           f"report: {request.report_path.name}.")
     report = {

@@ -6,7 +6,8 @@ view layer, sublayering the scene layer, sublayering the prototypes layer: see
 :mod:`synthua_usd.usd.randomisation_layer`). :meth:`Randomiser.apply` draws an image's randomisation
 (:mod:`synthua_usd.randomisation`) and moves it into those layers: a new scene (another seed) replaces the
 scene and prototypes layers, every image replaces the view layer. Layers are replaced through
-``Sdf.Layer.TransferContent``, so USD notifies only what differs: a :class:`StageReader` of the stage then
+``Sdf.Layer.TransferContent`` (:class:`synthua_usd.usd.session_layers.RandomisationLayers`), so USD notifies only
+what differs: a :class:`StageReader` of the stage then
 re-places the crowd and a :class:`RenderSession` updates vertices, sensor and sky in place, while a new scene
 is read and loaded afresh.
 
@@ -21,16 +22,13 @@ caller's to open; the randomiser records it.
 
 from __future__ import annotations
 
-import hashlib
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-from pxr import Sdf, Usd, UsdGeom
 
 from synthua_usd.assets.postures import shared_body_parts
-from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.core.errors import StageError
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.scenes import SceneKey, scene_of
@@ -46,9 +44,11 @@ from synthua_usd.usd.agents_writer import AGENTS_ROOT
 from synthua_usd.usd.cameras import camera_paths, camera_rig_type, read_camera
 from synthua_usd.usd.distractor_layer import author_distractors
 from synthua_usd.usd.conditions import read_condition
-from synthua_usd.usd.randomisation_layer import (RANDOM_ROOT, camera_override, export_layers, recolourable_objects,
-                                                 scene_layers, view_layer)
+from synthua_usd.usd.randomisation_layer import (RANDOM_ROOT, camera_override, recolourable_objects, scene_layers,
+                                                 view_layer)
 from synthua_usd.usd.reader import StageReader
+from synthua_usd.usd.session_layers import RandomisationLayers, recompose
+from synthua_usd.usd.stage_io import stage_metadata
 
 log = logging.getLogger(__name__)
 
@@ -81,50 +81,26 @@ class ImageRandomisation:
         return out
 
 
-def _metadata(stage: Usd.Stage) -> StageMetadata:
-    return StageMetadata(up_axis=str(UsdGeom.GetStageUpAxis(stage)),
-                         meters_per_unit=float(UsdGeom.GetStageMetersPerUnit(stage)),
-                         time_codes_per_second=float(stage.GetTimeCodesPerSecond()),
-                         start_time_code=float(stage.GetStartTimeCode()), end_time_code=float(stage.GetEndTimeCode()),
-                         default_prim="World")
-
-
-def _replace_subtree(target: Sdf.Layer, fresh: Sdf.Layer) -> None:
-    """Replace ``target``'s :data:`RANDOM_ROOT` subtree and documentation with ``fresh``'s."""
-    root = Sdf.Path(RANDOM_ROOT)
-    parent = target.GetPrimAtPath(root.GetParentPath())
-    if parent is not None and root.name in parent.nameChildren:
-        del parent.nameChildren[root.name]
-    if fresh.GetPrimAtPath(root):
-        Sdf.CopySpec(fresh, root, target, root)
-    target.documentation = fresh.documentation
-
-
-def _without_agents(stage: Usd.Stage) -> Usd.Stage:
-    """``stage``'s root layer composed again with the scenario's own crowd inactive: what the randomiser reads
-    of the stage is the twin (walkable surfaces, recolourable objects, their materials), and the district's
-    crowd is three quarters of its gprims (a snapshot 2.1 -> 0.5 s)."""
-    twin = Usd.Stage.Open(stage.GetRootLayer(), Sdf.Layer.CreateAnonymous("twin-session.usda"))
-    if twin.GetPrimAtPath(AGENTS_ROOT):
-        with Usd.EditContext(twin, twin.GetSessionLayer()):
-            twin.GetPrimAtPath(AGENTS_ROOT).SetActive(False)
-    return twin
-
-
 class Randomiser:
-    """Randomises ``stage`` image by image under ``config``: ``size`` (width, height) is the render size (where a
-    person counts as seen), ``time_code`` the one the twin is read at (it does not move)."""
+    """Randomises ``stage`` (an opened ``Usd.Stage``) image by image under ``config``, in :attr:`layers` (a
+    :class:`~synthua_usd.usd.session_layers.RandomisationLayers` over the stage): ``size`` (width, height) is the
+    render size (where a person counts as seen), ``time_code`` the one the twin is read at (it does not move)."""
 
-    def __init__(self, stage: Usd.Stage, config: RandomisationConfig, class_map: ClassMap, size: tuple[int, int],
+    def __init__(self, stage, config: RandomisationConfig, class_map: ClassMap, size: tuple[int, int],
                  time_code: float | None = None) -> None:
         self.stage, self.config, self.class_map, self.size = stage, config, class_map, tuple(size)
-        if config.crowd.enabled and UsdGeom.GetStageUpAxis(stage) != UsdGeom.Tokens.z:
+        if config.crowd.enabled and stage_metadata(stage).up_axis != "Z":
             raise StageError(f"{stage.GetRootLayer().identifier}: is Y-up; crowd randomisation places people on "
                              f"Z-up stages (as synthua agents populate); expected upAxis Z, or randomise.crowd off")
-        self.base = Usd.Stage.Open(stage.GetRootLayer(), Sdf.Layer.CreateAnonymous("base-session.usda"))
-        self.meta = _metadata(self.base)
-        t = self.base.GetStartTimeCode() if time_code is None else time_code
-        snapshot = StageReader(_without_agents(stage), class_map).snapshot(float(t))
+        # what a draw reads of the scenario, never an earlier image's randomisation (the layers go over
+        # ``stage``); the layers are rooted at /World whatever the stage's default prim
+        self.base = recompose(stage, "base-session.usda")
+        self.meta = replace(stage_metadata(self.base), default_prim="World")
+        t = self.meta.start_time_code if time_code is None else time_code
+        # the twin alone (walkable surfaces, recolourable objects, their materials): the district's crowd is three
+        # quarters of its gprims (a snapshot 2.1 -> 0.5 s)
+        snapshot = StageReader(recompose(stage, "twin-session.usda", inactive=(AGENTS_ROOT,)),
+                               class_map).snapshot(float(t))
         twin = [m for m in snapshot.meshes if not m.prim_path.startswith((AGENTS_ROOT + "/", RANDOM_ROOT + "/"))]
         self.area = self.tops = None
         if config.crowd.enabled or config.camera.enabled or config.distractors.enabled:
@@ -141,13 +117,7 @@ class Randomiser:
             self.objects, self.bound = recolourable_objects(self.base, snapshot, config.materials.classes)
         self.has_agents = bool(self.base.GetPrimAtPath(AGENTS_ROOT))
         self.bodies = shared_body_parts()
-        # the three layers the stage composes, strongest first, each sublayering the next
-        self.prototypes = Sdf.Layer.CreateAnonymous("prototypes.usdc")
-        self.scene_layer = Sdf.Layer.CreateAnonymous("scene.usda")
-        self.scene_layer.subLayerPaths.append(self.prototypes.identifier)
-        self.view_layer = Sdf.Layer.CreateAnonymous("view.usda")
-        self.view_layer.subLayerPaths.append(self.scene_layer.identifier)
-        stage.GetSessionLayer().subLayerPaths.insert(0, self.view_layer.identifier)
+        self.layers = RandomisationLayers(stage)
         self._scene: SceneDraw | None = None
         self._cast = None  # the scene's CastPrims
         self._distractors: DistractorsDraw | None = None
@@ -155,9 +125,7 @@ class Randomiser:
 
     def close(self) -> None:
         """Take the layers out of the stage's session layer again (the stage as composed before)."""
-        session = self.stage.GetSessionLayer()
-        if self.view_layer.identifier in session.subLayerPaths:
-            session.subLayerPaths.remove(self.view_layer.identifier)
+        self.layers.close()
 
     def scene(self, seed: int, key: SceneKey | None = None) -> SceneDraw:
         """Make the scene of ``seed`` the stage's (drawn and authored once per seed in a row); ``key`` the scenario
@@ -177,20 +145,7 @@ class Randomiser:
             author_distractors(scene, self._distractors, self.class_map.taxonomy)
             self._area = self.area.with_occluders((points, triangles) for item in self._distractors.items
                                                   for _, points, triangles, _, _ in item.parts())
-        with Sdf.ChangeBlock():  # both at once: the stage never composes the old instances over new prototypes
-            if self._scene is None:
-                linked = Sdf.Layer.CreateAnonymous("scene.usda")
-                linked.TransferContent(scene)
-                linked.subLayerPaths.clear()
-                linked.subLayerPaths.append(self.prototypes.identifier)
-                self.prototypes.TransferContent(prototypes)
-                self.scene_layer.TransferContent(linked)
-            else:
-                # Everything outside RANDOM_ROOT (the scenario's crowd deactivated, the recoloured objects'
-                # bindings to Looks/Twin_<k>) is the same for every scene of a randomiser: only the subtree is
-                # swapped, so USD resyncs the crowd and its materials and nothing of the twin.
-                _replace_subtree(self.prototypes, prototypes)
-                _replace_subtree(self.scene_layer, scene)
+        self.layers.set_scene(prototypes, scene)
         self._scene, self._cast = draw, cast
         return draw
 
@@ -237,9 +192,7 @@ class Randomiser:
         fresh = view_layer(cast, placements, self.bodies, self.meta, override, randomised,
                            doc=f"synthua randomisation: scene {seed}, {camera_path} at time code {time_code:g}"
                                + (f", {condition}" if condition else ""))
-        digest = hashlib.sha256(fresh.ExportToString().encode("utf-8")).hexdigest()
-        fresh.subLayerPaths.append(self.scene_layer.identifier)
-        self.view_layer.TransferContent(fresh)
+        digest = self.layers.set_view(fresh)
         return ImageRandomisation(self.config.seed, scene, ViewDraw(jitter, placements, framing), light, digest,
                                   self.config.settings.enabled, None if key is None else key.setting,
                                   self._distractors)
@@ -248,7 +201,7 @@ class Randomiser:
         """Write the current image's layers: ``out`` (the view layer), ``<stem>.scene.usda`` and
         ``<stem>.prototypes.usdc`` beside it (:func:`synthua_usd.usd.randomisation_layer.export_layers`; asset
         paths relative to ``anchor``, the folder the files will be in, default ``out``'s)."""
-        return export_layers(self.view_layer, self.scene_layer, self.prototypes, Path(out), anchor)
+        return self.layers.export(Path(out), anchor)
 
 
 # --- synthua randomise: the layers of one image, written out ----------------------------------------------

@@ -47,13 +47,11 @@ def write_crowds(stage, config: GenerationConfig, class_map: ClassMap, out: Path
                  time_codes: tuple[float, ...]) -> dict[int, Path]:
     """Every seed's crowd layer of ``config.sequences`` (when it asks for a crowd) in the dataset ``out``, kept when
     already there; seed -> path. ``time_codes`` are the frames' (one sample each)."""
-    from pxr import UsdGeom
-
     from synthua_usd.agents.crowd import CrowdParams, populate_crowd
-    from synthua_usd.composition.scenario import StageMetadata
     from synthua_usd.usd.agents_writer import AGENTS_ROOT, build_agents_layer
     from synthua_usd.usd.authoring import save_layer_atomic
     from synthua_usd.usd.reader import StageReader
+    from synthua_usd.usd.stage_io import stage_metadata
 
     sequences = config.sequences
     if sequences is None or sequences.crowd is None:
@@ -66,17 +64,16 @@ def write_crowds(stage, config: GenerationConfig, class_map: ClassMap, out: Path
         twin = [m for m in snapshot.meshes if not m.prim_path.startswith(AGENTS_ROOT + "/")]
         vertices, faces, owner = snapshot.world_triangles(twin)
         names = np.array([class_map.by_id(m.class_id).name for m in twin], object)
-        tcps = float(stage.GetTimeCodesPerSecond())
-        meta = StageMetadata(up_axis=str(UsdGeom.GetStageUpAxis(stage)), meters_per_unit=1.0,
-                             time_codes_per_second=tcps, start_time_code=first, end_time_code=time_codes[-1],
-                             default_prim="World")
+        # the crowd's layer: in metres, rooted at /World, over the frames' time codes
+        meta = replace(stage_metadata(stage), meters_per_unit=1.0, start_time_code=first,
+                       end_time_code=time_codes[-1], default_prim="World")
+        tcps = meta.time_codes_per_second
         for seed in missing:
             params = CrowdParams(density_per_m2=sequences.crowd.density_per_m2, aid_share=sequences.crowd.aid_share,
                                  time_codes=len(time_codes), time_codes_per_second=sequences.fps, seed=int(seed))
             crowd = populate_crowd(vertices, faces, names[owner] if len(owner) else np.zeros(0, object), params)
             layer = build_agents_layer(crowd, meta, class_map.taxonomy, root_path=SEQUENCE_AGENTS,
-                                       time_step=tcps / sequences.fps)
-            layer.OverridePrim(AGENTS_ROOT).SetActive(False)
+                                       time_step=tcps / sequences.fps, deactivate=(AGENTS_ROOT,))
             wanted[seed].parent.mkdir(parents=True, exist_ok=True)
             save_layer_atomic(layer.GetRootLayer(), wanted[seed])
     return wanted
@@ -106,19 +103,13 @@ def init_sequence_worker(job: SequenceJob):
 
 def _use_crowd(state, seed: int) -> None:
     """Compose the crowd of ``seed`` over the stage (in place of another seed's) and reach its time range."""
-    from pxr import Usd
+    from synthua_usd.usd.session_layers import extend_end_time_code, use_session_sublayer
 
     job = state.sequence_job
     if state.crowd_seed == seed or seed not in job.crowds:
         return
-    session = state.stage.GetSessionLayer()
-    for path in job.crowds.values():
-        if path in session.subLayerPaths:
-            session.subLayerPaths.remove(path)
-    session.subLayerPaths.append(job.crowds[seed])
-    if state.stage.GetEndTimeCode() < job.end_time_code:
-        with Usd.EditContext(state.stage, session):
-            state.stage.SetEndTimeCode(job.end_time_code)
+    use_session_sublayer(state.stage, job.crowds[seed], among=job.crowds.values())
+    extend_end_time_code(state.stage, job.end_time_code)
     state.crowd_seed = seed
 
 

@@ -11,9 +11,10 @@ authored by the one scenario writer (:func:`synthua_usd.usd.scenario_writer.writ
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
-from synthua_usd.composition.scenario import CAMERAS_ROOT, ROOT_FILE, Environment, ScenarioSpec, StageMetadata
+from synthua_usd.composition.scenario import CAMERAS_ROOT, ROOT_FILE, Environment, ScenarioSpec
 from synthua_usd.core.errors import InputError
 from synthua_usd.model.cameras import CameraSpec
 from synthua_usd.model.conditions import indoors
@@ -30,14 +31,11 @@ def setting_spec(scenario: Path, kind: str, variant: int) -> ScenarioSpec:
     from synthua_usd.usd.cameras import camera_paths, camera_rig_type, read_camera
     from synthua_usd.usd.conditions import condition_names, read_condition, selected_condition
     from synthua_usd.usd.render_settings import render_defaults
-    from synthua_usd.usd.stage_io import open_stage
-    from pxr import UsdGeom
+    from synthua_usd.usd.stage_io import open_stage, stage_metadata
 
     stage = open_stage(scenario, allow_external_assets=True)
-    t = float(stage.GetStartTimeCode())
-    meta = StageMetadata(up_axis=str(UsdGeom.GetStageUpAxis(stage)), meters_per_unit=float(UsdGeom.GetStageMetersPerUnit(stage)),
-                         time_codes_per_second=float(stage.GetTimeCodesPerSecond()), start_time_code=t,
-                         end_time_code=float(stage.GetEndTimeCode()), default_prim="World")
+    meta = replace(stage_metadata(stage), default_prim="World")  # a setting's scenario is rooted at /World
+    t = meta.start_time_code
     if meta.up_axis != "Z" or meta.meters_per_unit != 1.0:
         raise InputError(f"{scenario}: randomise.settings builds Z-up scenes in metres; this scenario is "
                          f"{meta.up_axis}-up at {meta.meters_per_unit:g} m per unit; expected upAxis Z, metersPerUnit 1")

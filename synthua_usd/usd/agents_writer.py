@@ -169,10 +169,11 @@ def author_keypoints(prim: Usd.Prim, names, points: np.ndarray, times) -> None:
 
 
 def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str, root_path: str = AGENTS_ROOT,
-                       time_step: float = 1.0) -> Usd.Stage:
+                       time_step: float = 1.0, deactivate: tuple[str, ...] = ()) -> Usd.Stage:
     """The agents layer of ``crowd``: under ``root_path``, one time sample every ``time_step`` time codes from
     ``meta.start_time_code`` (the crowd is simulated at ``crowd.params.time_codes_per_second`` samples a second:
-    a sequence's crowd at its frame rate), labels of ``taxonomy``."""
+    a sequence's crowd at its frame rate), labels of ``taxonomy``; the prims at ``deactivate`` (the scenario's own
+    crowd, where this one stands in for it) overridden inactive."""
     trajectories, looks = crowd.trajectories, crowd.looks
     stage = new_layer(meta, crowd.doc)
     stage.SetDefaultPrim(stage.OverridePrim("/World"))
@@ -243,4 +244,6 @@ def build_agents_layer(crowd: Crowd, meta: StageMetadata, taxonomy: str, root_pa
             if device in STEPPING_AIDS and times:  # agent frame -> the stepping aid's own frame
                 contacts = contacts - np.asarray(shifts)[:, None, None] * np.array([1.0, 0.0, 0.0])
             author_keypoints(aid, KEYPOINT_CLASSES[device].names, contacts, times)
+    for path in deactivate:
+        stage.OverridePrim(path).SetActive(False)
     return stage

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdGeom
 
+from synthua_usd.composition.scenario import StageMetadata
 from synthua_usd.core.errors import StageError, echo
 
 USD_SUFFIXES = (".usda", ".usdc", ".usd", ".usdz")
@@ -193,6 +194,20 @@ def check_time_code(stage: Usd.Stage, time_code: float) -> None:
 
 def meters_per_unit(stage: Usd.Stage) -> float:
     return float(UsdGeom.GetStageMetersPerUnit(stage))
+
+
+def stage_metadata(stage: Usd.Stage) -> StageMetadata:
+    """What ``stage`` states of its axis, units and time: its upAxis, metersPerUnit, timeCodesPerSecond, time range
+    (:func:`time_range`; a stage without one: its start time code for both ends) and default prim (its root
+    layer's, else ``World``). A layer authored over the stage states the same (a caller whose layer differs, e.g.
+    one rooted at ``/World`` whatever the stage's default prim, replaces that field). Raises :class:`InputError`
+    for metadata :func:`check_stage_metadata` refuses (:func:`open_stage` has checked them)."""
+    span = time_range(stage)
+    start, end = span if span else (stage.GetStartTimeCode(),) * 2
+    return StageMetadata(up_axis=str(UsdGeom.GetStageUpAxis(stage)),
+                         meters_per_unit=float(UsdGeom.GetStageMetersPerUnit(stage)),
+                         time_codes_per_second=float(stage.GetTimeCodesPerSecond()), start_time_code=float(start),
+                         end_time_code=float(end), default_prim=stage.GetRootLayer().defaultPrim or "World")
 
 
 def layer_stack_digest(stage: Usd.Stage) -> dict:

@@ -193,8 +193,8 @@ def test_hair_off_authors_the_layers_of_a_bald_crowd(class_map):
     assert {m.hair.style for m in drawn.cast} - {"none"}
     prototypes, scene, _ = scene_layers(dataclasses.replace(drawn, cast=bald.cast), off.meta, class_map.taxonomy,
                                         off.bodies, off.materials, off.bound, deactivate_agents=off.has_agents)
-    assert prototypes.ExportToString() == off.prototypes.ExportToString()
-    assert _without_sublayers(scene) == _without_sublayers(off.scene_layer)
+    assert prototypes.ExportToString() == off.layers.prototypes.ExportToString()
+    assert _without_sublayers(scene) == _without_sublayers(off.layers.scene)
     snapshot = reader.snapshot(24.0)
     hair = [m for m in snapshot.meshes if f"/{HAIR_SEGMENT}/Hair/" in m.prim_path]
     haired = [k for k, m in enumerate(drawn.cast) if m.hair.style != "none"]

@@ -214,6 +214,17 @@ def test_same_crowd_gives_byte_identical_crate(crowd, tmp_path, class_map):
     assert paths[0].read_bytes() == paths[1].read_bytes()
 
 
+def test_a_crowd_standing_in_for_the_scenarios_deactivates_it(crowd, class_map):
+    """A sequence's crowd layer (under its own root) overrides the scenario's crowd inactive, and nothing else."""
+    built = build_agents_layer(crowd, META, class_map.taxonomy, root_path="/World/SequenceAgents",
+                               deactivate=(AGENTS_ROOT,))  # the stage owns its root layer: keep it
+    spec = built.GetRootLayer().GetPrimAtPath(Sdf.Path(AGENTS_ROOT))
+    assert spec.specifier == Sdf.SpecifierOver and spec.active is False and not spec.nameChildren
+    world = built.GetRootLayer().GetPrimAtPath(Sdf.Path("/World"))
+    assert list(world.nameChildren.keys()) == ["SequenceAgents", "Agents"]
+    assert not world.nameChildren["SequenceAgents"].HasInfo("active")
+
+
 def test_random_looks_draw_bodies_of_their_stratum_and_every_skin_tone():
     from synthua_usd.assets.bodies import load_bank
     from synthua_usd.model.materials import SKINS
