@@ -372,11 +372,14 @@ def main() -> int:
     wall = summary.wall_seconds
     phases = {"plan (score views)": probe.phase.get("plan", 0.0), "render (workers)": probe.phase.get("render", 0.0),
               "assemble": probe.phase.get("assemble", 0.0)}
-    phases["other (open, setup)"] = wall - sum(phases.values())
+    phases["other (open, setup)"] = max(0.0, wall - sum(phases.values()))
     print(f"\n{'phase':24} {'seconds':>9} {'share':>7}")
     for name, sec in phases.items():
         print(f"{name:24} {sec:9.1f} {sec / wall:7.1%}")
     print(f"{'wall':24} {wall:9.1f}")
+    if sum(phases.values()) > wall * 1.01:
+        print("(the phases overlap: planning scores its views on the job's workers, a render phase of its own that "
+              "the render row counts too)")
     render_wall = phases["render (workers)"] or float("nan")
     print(f"images/min: {60 * summary.rendered / wall:.2f} rendered end to end ({60 * kept / wall:.2f} kept, i.e. "
           f"not rejected), {60 * summary.rendered / render_wall:.2f} rendered over the render phase")
