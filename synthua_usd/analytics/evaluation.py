@@ -55,7 +55,7 @@ def ground_truth_images(gt_dir: Path, split: str | None) -> list[GroundTruthImag
 
 
 def _read_png(path: Path, what: str) -> np.ndarray:
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     check_input_file(path, MAX_PNG_BYTES, what)
     try:

@@ -49,7 +49,7 @@ class SynthuaDataset(torch.utils.data.Dataset):
         return len(self.entries)
 
     def _png(self, relative: str) -> np.ndarray:
-        from synthua_usd.backends.images import read_image
+        from synthua_usd.core.images import read_image
 
         return read_image(self.layout.path(relative))[0]
 

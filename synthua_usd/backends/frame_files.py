@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.backends import images, previews
+from synthua_usd.backends import previews
+from synthua_usd.core import images
 from synthua_usd.core.atomic import write_json_atomic
 from synthua_usd.core.outputs import DEPTH_DEFINITION, FRAME_DOCUMENT, RenderOutput
 from synthua_usd.core.schemas import validate_document

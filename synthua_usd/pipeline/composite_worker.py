@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from synthua_usd.analytics.detection_targets import background_boxes, image_boxes, targets_for
-from synthua_usd.backends import images
+from synthua_usd.core import images
 from synthua_usd.backends.camera_effects import apply_effects
 from synthua_usd.backends.compositing import PasteInput, compose, composite_depth
 from synthua_usd.backends.cutout_pixels import CutoutPixels, read_cutout

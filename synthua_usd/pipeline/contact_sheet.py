@@ -18,7 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from synthua_usd.backends.contact_sheet import class_overlay, compose, write_sheet
-from synthua_usd.backends.images import linear_to_display
+from synthua_usd.core.images import linear_to_display
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.backends.mitsuba.weather_scene import scene_key
 from synthua_usd.core.errors import InputError, StageError

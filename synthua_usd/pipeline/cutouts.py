@@ -183,7 +183,7 @@ def _aim(bounds: np.ndarray, heading_deg: float, view, frame) -> tuple[np.ndarra
 def render_cutout(session, snapshot, camera, condition, cast_prims, drawn: GroupDraw, config: CutoutsConfig,
                   seed: int, entry_id: str, folder: Path) -> dict:
     """Render one view of the studio's group, write its four images into ``folder`` and return its bank entry."""
-    from synthua_usd.backends import images
+    from synthua_usd.core import images
     from synthua_usd.backends.exposure import choose_exposure
     from synthua_usd.backends.mitsuba.cutout_passes import ground_light, ground_shadow, render_rgba
     from synthua_usd.dataset import annotations, keypoints

@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.backends import camera_effects, images, previews
+from synthua_usd.backends import camera_effects, previews
+from synthua_usd.core import images
 from synthua_usd.core.atomic import atomic_path, write_json_atomic, write_text_atomic
 from synthua_usd.core.outputs import DEPTH_DEFINITION
 from synthua_usd.dataset import annotations, keypoints, qa, resample

@@ -134,7 +134,7 @@ def work_frame(state, item) -> list[dict]:
 
 
 def _write_frame(state, frame: PlannedFrame, annotated) -> dict:
-    from synthua_usd.backends import images
+    from synthua_usd.core import images
 
     t0 = time.perf_counter()
     job = state.sequence_job.worker
@@ -228,7 +228,7 @@ def assemble_sequences(layout: Layout, sequences: list[PlannedSequence], records
 def boxed_frame(layout: Layout, record: dict, class_map: ClassMap) -> np.ndarray:
     """(H, W, 3) uint8: a sequence frame's image with the amodal box, id and class of every tracked object drawn,
     a device in its user's colour (what the preview video shows)."""
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
     from synthua_usd.backends.video import draw_boxes
 
     mot_classes = mot.tracked(class_map)

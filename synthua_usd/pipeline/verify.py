@@ -298,7 +298,7 @@ def _check_file(layout: Layout, entry: dict, result: Verification) -> bool:
 
 
 def _read(layout: Layout, relative: str) -> np.ndarray:
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     pixels, _ = read_image(layout.path(relative))
     return pixels

@@ -265,7 +265,7 @@ def _looked_up_albedo(snapshot, camera, W: int, H: int):
     has a base-colour texture, the texture's value there: the reader's st interpolated barycentrically, the image
     read by OpenImageIO (raw, 8-bit), bilinear with its wrap mode, times its scale plus its bias, clipped to [0, 1].
     Returns (H*W, 3) values and the (H*W,) mask of the pixels looked up."""
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
     from trimesh.ray.ray_pyembree import RayMeshIntersector
     import trimesh
 

@@ -7,7 +7,7 @@ import pytest
 from scipy import ndimage
 
 from label_scenes import W, H, crowded_scene, record, scene
-from synthua_usd.backends.images import write_color_png
+from synthua_usd.core.images import write_color_png
 from synthua_usd.dataset.annotations import annotate
 from synthua_usd.dataset.formats.yolo import (class_index, data_yaml, label_outlines, merge_parts, outer_outlines,
                                              yolo_lines)
