@@ -362,7 +362,7 @@ def make_bank(config_path: Path, out: Path, workers: int | None = None, class_ma
 
     started = time.perf_counter()
     config = CutoutsConfig.load(config_path)
-    class_map = ClassMap.load(class_map_path) if class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(class_map_path)
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise OutputError(f"{out}: exists and is not an empty folder; expected a new folder for the bank")

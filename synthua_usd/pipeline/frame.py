@@ -112,7 +112,7 @@ def time_code_folder(time_code: float) -> str:
 
 def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     """Check every input, render every frame from one session, then move all files into place together."""
-    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(request.class_map_path)
     stage = open_stage(request.stage_path, request.allow_external_assets, request.layers)
     defaults = render_defaults(stage)
     unknown = [n for n in defaults.var_names if n not in OUTPUT_NAMES]
