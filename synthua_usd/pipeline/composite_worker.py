@@ -32,7 +32,7 @@ from synthua_usd.dataset.composite_plan import draw_camera, eligible, plan_paste
 from synthua_usd.dataset.cutout_bank import BANK_FORMAT, read_bank
 from synthua_usd.dataset.formats import yolo
 from synthua_usd.dataset.layout import CityscapesName
-from synthua_usd.dataset.record import CompositeRecord, QAResult
+from synthua_usd.dataset.record import REJECTED, CompositeRecord, QAResult
 from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.background import BackgroundWriter
@@ -242,7 +242,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
                                          "reason": b["reason"]} for b in boxes],
                    "effects": None if effects is None else effects.to_dict()})
     cs = CityscapesName(job.city, index, planned.id)
-    rejected = verdict == "rejected"
+    rejected = verdict == REJECTED
     files, arrays = label_files(planned.name, planned.split, cs, rejected, display, class_ids, instance_ids,
                                 painted.instances, ignored, panoptic_png,
                                 "" if rejected else composite_yolo_text(record, class_map, config.convention),

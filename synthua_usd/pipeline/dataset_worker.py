@@ -30,7 +30,7 @@ from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, onehot, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
-from synthua_usd.dataset.record import (ImageRecord, InstanceEntry, QAResult, RecordCamera, RecordRender,
+from synthua_usd.dataset.record import (REJECTED, ImageRecord, InstanceEntry, QAResult, RecordCamera, RecordRender,
                                          check_record, image_kind)
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.render_config import RenderConfig
@@ -262,11 +262,11 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     name = image_name(planned.id, planned.camera_name, planned.time_code, planned.condition, planned.seed)
     split = planned.split
     cs = CityscapesName(job.city, job.camera_index.get(planned.camera_path, 0), planned.id)
-    yolo_text = (yolo.yolo_lines(instances, width, height, job.yolo_classes, instance_ids)
-                 if verdict != "rejected" else "")
-    files, arrays = label_files(name, split, cs, verdict == "rejected", display, class_ids, instance_ids,
+    rejected = verdict == REJECTED
+    yolo_text = "" if rejected else yolo.yolo_lines(instances, width, height, job.yolo_classes, instance_ids)
+    files, arrays = label_files(name, split, cs, rejected, display, class_ids, instance_ids,
                                 snapshot.instances, ignored, panoptic_png, yolo_text, class_map)
-    if verdict != "rejected":
+    if not rejected:
         outputs = job.config.outputs
         if outputs.depth:
             files["depth"] = Layout.frame_file(name, "depth")
@@ -302,7 +302,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     if randomised is not None:
         record["randomisation"] = randomised.to_dict() | ({} if effects is None else {"effects": effects.to_dict()})
     seconds["annotate"] += time.perf_counter() - t0
-    return ImageBuffers(record, arrays, verdict == "rejected", seconds)
+    return ImageBuffers(record, arrays, rejected, seconds)
 
 
 def label_files(name: str, split: str, cs: CityscapesName, rejected: bool, display: np.ndarray, class_ids: np.ndarray,
