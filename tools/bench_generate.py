@@ -38,6 +38,7 @@ each of its results (VmRSS now, VmHWM; local executor only), which must agree. N
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import os
@@ -336,8 +337,11 @@ def main() -> int:
     probe.install()
     load_before = os.getloadavg()
     try:
-        summary = generate(GenerateRequest(scenario=scenario, config_path=config_path, out_dir=out, count_compiles=True,
-                                           workers=args.workers, variant=args.variant),
+        # count_compiles: workers report kernel compile time; a revision before it (a --base) has no such field
+        counting = {"count_compiles": True} if "count_compiles" in {f.name for f in dataclasses.fields(GenerateRequest)} \
+            else {}
+        summary = generate(GenerateRequest(scenario=scenario, config_path=config_path, out_dir=out,
+                                           workers=args.workers, variant=args.variant, **counting),
                            show_progress=not args.no_progress)
         load_after = os.getloadavg()
         job = json.loads((out / "generate.json").read_text(encoding="utf-8"))

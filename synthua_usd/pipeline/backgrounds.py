@@ -20,6 +20,7 @@ photo's pixels fail when its composite decodes them (the run then stops and writ
 from __future__ import annotations
 
 from dataclasses import dataclass
+import os
 from pathlib import Path
 
 from synthua_usd.analytics.detection_sets import IMAGE_SUFFIXES, MAX_IMAGES, TOLERANCE, Box, label_path, read_coco, \
@@ -60,6 +61,12 @@ class BackgroundSet:
 
     def path(self, background: Background) -> Path:
         return self.folder / background.relative
+
+
+def _absolute(path: Path) -> Path:
+    """``path`` made absolute with ``..`` taken out as written, links not followed: a photo listed below a set's
+    folder is inside it even where it is a link to a file elsewhere (a nested subset of links to the photos)."""
+    return Path(os.path.abspath(path))
 
 
 def _photos_below(folder: Path) -> list[Path]:
@@ -126,7 +133,7 @@ def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: st
         raise InputError(f"{shown(path)}: {'a dataset written by synthua' if layout else 'not a folder'}; expected a "
                          f"folder of photos, a labelled YOLO set (data.yaml or images/ + labels/) or a COCO .json")
     if layout == "folder":
-        folder = path.resolve()
+        folder = _absolute(path)
         paths = _photos_below(folder)
         if not paths:
             raise InputError(f"{shown(path)}: no photos; expected JPEG, PNG, TIFF, BMP, WebP or HEIC files below it")
@@ -134,12 +141,12 @@ def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: st
     elif layout == "yolo":
         chosen = _yolo_split(path, split)
         found = read_yolo(path, chosen)
-        folder = (path if path.is_dir() else path.parent).resolve()
+        folder = _absolute(path if path.is_dir() else path.parent)
         _check_yolo_labels(folder, [Path(i.path) for i in found.images], whole=chosen == ALL_SPLITS)
         images, names = [(Path(i.path), i.boxes, (i.width, i.height)) for i in found.images], found.names
     else:
         found = read_coco(path)
-        folder = path.parent.resolve()
+        folder = _absolute(path.parent)
         images, names = [(Path(i.path), i.boxes, (i.width, i.height)) for i in found.images], found.names
     out = []
     for image, boxes, size in images:
@@ -154,7 +161,7 @@ def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: st
             _check_boxes(image, boxes, header.width, header.height)
         cover_region((header.width, header.height), output, image)
         try:
-            relative = image.resolve().relative_to(folder).as_posix()
+            relative = _absolute(image).relative_to(folder).as_posix()
         except ValueError:
             raise InputError(f"{shown(image)}: outside {shown(folder)}; expected the set's photos below its "
                              f"folder") from None

@@ -134,3 +134,33 @@ def test_a_yolo_sets_val_photos_are_not_pasted_into_unless_asked(tmp_path):
     assert [b.relative for b in read_backgrounds(root, (64, 48)).images] == ["images/train/a.png", "images/train/b.png"]
     assert [b.relative for b in read_backgrounds(root, (64, 48), "val").images] == ["images/val/c.png"]
     assert len(read_backgrounds(root, (64, 48), "all").images) == 3
+
+
+def _yolo_set(root: Path, train: str = "images/train") -> None:
+    from PIL import Image
+
+    (root / "images" / "train").mkdir(parents=True)
+    (root / "labels" / "train").mkdir(parents=True)
+    Image.new("RGB", (96, 72), (120, 120, 120)).save(root / "images" / "train" / "a.png")
+    (root / "labels" / "train" / "a.txt").write_text("0 0.5 0.5 0.2 0.4\n")
+    (root / "data.yaml").write_text(f"path: .\ntrain: {train}\nnames:\n  0: person\n")
+
+
+def test_a_set_of_links_to_photos_elsewhere_is_read_and_a_split_outside_it_is_refused(tmp_path):
+    """A nested subset (tools/sim2real.py's) links its photos to the whole set's: a photo listed below the set's
+    folder is the set's, wherever its link points; a data.yaml whose split climbs out of the folder is refused."""
+    from synthua_usd.core.errors import InputError
+    from synthua_usd.pipeline.backgrounds import read_backgrounds
+
+    _yolo_set(tmp_path / "whole")
+    subset = tmp_path / "subset"
+    for kind, name in (("images", "a.png"), ("labels", "a.txt")):
+        (subset / kind / "train").mkdir(parents=True)
+        (subset / kind / "train" / name).symlink_to(tmp_path / "whole" / kind / "train" / name)
+    (subset / "data.yaml").write_text("path: .\ntrain: images/train\nnames:\n  0: person\n")
+    read = read_backgrounds(subset, (64, 48))
+    assert [b.relative for b in read.images] == ["images/train/a.png"] and read.images[0].boxes
+    climbing = tmp_path / "climbing"
+    _yolo_set(climbing / "inner", train="../../whole/images/train")
+    with pytest.raises(InputError, match="outside"):
+        read_backgrounds(climbing / "inner", (64, 48))
