@@ -17,11 +17,15 @@ readers' use of them.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Final, Literal, NotRequired, TypedDict, final, overload
+from typing import TYPE_CHECKING, Any, Final, Literal, NotRequired, TypedDict, final, overload
 
 from synthua_usd.core.errors import SchemaError
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.schemas import read_json, schema_problem, validate_document
+
+if TYPE_CHECKING:
+    from synthua_usd.model.cameras import PinholeCamera
+    from synthua_usd.model.render_config import RenderConfig
 
 SCHEMA = "record"
 #: The schema's definitions of the kinds of record.
@@ -202,6 +206,34 @@ class SequenceFrameRecord(FrameRecord):
 
 #: The record of a dataset image (``records/{name}.json``): rendered, or a composite (it holds ``composite``).
 DatasetRecord = ImageRecord | CompositeRecord
+
+
+def record_camera(camera: PinholeCamera, render_size: tuple[int, int], written_size: tuple[int, int], *, name: str,
+                  rig_type: str | None) -> RecordCamera:
+    """The camera block of a record (``$defs/camera``), and the shared part of ``frame.json``'s: ``K`` at the
+    written size (the render size's, scaled: (3, 3), pixels, OpenCV's axes, pixel centres at +0.5), USD's
+    ``camera_to_world`` (column vectors, looking down -Z), OpenCV's ``world_to_camera_opencv``, the lens in mm, the
+    clipping range in metres and the distortion (None for an ideal pinhole). ``render_size`` and ``written_size`` are
+    (width, height) in pixels; ``name`` and ``rig_type`` are the planned camera's."""
+    (render_w, render_h), (width, height) = render_size, written_size
+    K = camera.intrinsics(render_w, render_h).copy()
+    K[0] *= width / render_w
+    K[1] *= height / render_h
+    return RecordCamera(prim_path=camera.path, name=name, rig_type=rig_type,
+                        K=K.tolist(), camera_to_world=camera.camera_to_world.tolist(),
+                        world_to_camera_opencv=camera.world_to_camera_opencv().tolist(),
+                        focal_length_mm=camera.focal_length_mm, horizontal_aperture_mm=camera.horizontal_aperture_mm,
+                        vertical_aperture_mm=camera.vertical_aperture_mm,
+                        clipping_range_m=[camera.clip_near_m, camera.clip_far_m],
+                        distortion=camera.distortion.to_dict() if camera.distortion is not None else None)
+
+
+def record_render(config: RenderConfig, variant: str, denoise: dict[str, Any] | None) -> RecordRender:
+    """The render block of a record (``$defs/render``), and the shared part of ``frame.json``'s: the settings an
+    image was rendered with (``config``: :func:`synthua_usd.model.render_config.resolve_render`'s), the Mitsuba
+    ``variant`` that ran and what the denoiser did (None: not denoised)."""
+    return RecordRender(variant=variant, spp=config.spp, pixel_filter=config.pixel_filter, max_depth=config.max_depth,
+                        width=config.width, height=config.height, denoise=denoise)
 
 
 def image_kind(record: Any) -> str:

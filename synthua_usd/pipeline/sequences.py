@@ -31,10 +31,10 @@ from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import mot
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.dataset.manifest import file_entry, files_written
-from synthua_usd.dataset.record import SEQUENCE_FRAME, SequenceFrameRecord, check_record, read_record
+from synthua_usd.dataset.record import SEQUENCE_FRAME, SequenceFrameRecord, check_record, read_record, record_camera
 from synthua_usd.dataset.sequences import PlannedFrame, PlannedSequence
 from synthua_usd.model.taxonomy import ClassMap
-from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, camera_document, init_worker, render_annotated
+from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, render_annotated
 
 #: Where a sequence crowd's agents live (the scenario's stay under /World/Agents, deactivated).
 SEQUENCE_AGENTS = "/World/SequenceAgents"
@@ -134,7 +134,7 @@ def work_frame(state, item) -> list[dict]:
 
 
 def _write_frame(state, frame: PlannedFrame, annotated) -> dict:
-    from synthua_usd.core import images
+    from synthua_usd.backends import frame_files
 
     t0 = time.perf_counter()
     job = state.sequence_job.worker
@@ -143,16 +143,16 @@ def _write_frame(state, frame: PlannedFrame, annotated) -> dict:
     files = {kind: Layout.sequence_frame(seq.name, frame.frame, kind) for kind in FRAME_KINDS[:2]}
     for rel in files.values():
         layout.path(rel).parent.mkdir(parents=True, exist_ok=True)
-    quality = job.config.sequences.jpeg_quality
-    images.write_color_jpeg(layout.path(files["img1"]), annotated.display(), quality)
-    images.write_id_png(layout.path(files["instances"]), annotated.instance_ids)
+    writers = frame_files.file_writers(jpeg_quality=job.config.sequences.jpeg_quality)
+    writers["img1"](layout.path(files["img1"]), annotated.display())
+    writers["instances"](layout.path(files["instances"]), annotated.instance_ids)
     tracked = set(mot.tracked(state.class_map))
     rendered = annotated.rendered
     record = SequenceFrameRecord(
         sequence=seq.name, frame=frame.frame, time_code=frame.time_code, seed=seq.seed,
         width=annotated.width, height=annotated.height,
-        camera=camera_document(annotated.camera, seq, job.render.width, job.render.height, annotated.width,
-                               annotated.height),
+        camera=record_camera(annotated.camera, (job.render.width, job.render.height),
+                             (annotated.width, annotated.height), name=seq.camera_name, rig_type=seq.rig_type),
         condition=annotated.condition.to_dict() if annotated.condition is not None else None,
         exposure=rendered.exposure.to_dict() if rendered.exposure is not None else None,
         files=files,
