@@ -43,7 +43,8 @@ demo: setup
 ## The whole test suite (slow tests included) on parallel workers (pytest-xdist: $(TEST_WORKERS), one more than
 ## the cores, at most 8: tests that wait on subprocesses, Ray or a killed job leave a core idle; on 2 cores three
 ## workers are the fastest, docs/tests.md gives the times; each test file runs on one worker, so its
-## module fixtures are built once), then the package's import layers (import-linter's contracts in pyproject.toml)
+## module fixtures are built once), then the package's import layers (import-linter's contracts in pyproject.toml),
+## the type check of the typed records and their readers (mypy: [tool.mypy] in pyproject.toml)
 ## and the documentation site built with --strict (a broken link or reference fails). The detector's environment
 ## first: where it cannot be made, its tests skip with the reason. `make test TEST_WORKERS=1` runs it on one worker.
 TEST_WORKERS ?= $(shell n=$$(nproc 2>/dev/null || echo 1); echo $$(( n + 1 > 8 ? 8 : n + 1 )))
@@ -52,6 +53,7 @@ test: setup
 	-@TRAIN_VENV=$(TRAIN_VENV) bash tools/setup_train.sh
 	SYNTHUA_TRAIN_PYTHON=$(TRAIN_VENV)/bin/python $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder
 	$(BIN)/lint-imports
+	$(BIN)/mypy
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet --site-dir build/site
 
 ## The documentation site from docs/ into site/ (offline: open site/index.html).

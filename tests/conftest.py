@@ -1,7 +1,13 @@
 """Shared fixtures: paths, the class map, a CLI runner, the shipped demo scenario, and Mitsuba variants.
 
-Only this conftest exists: the test folders mirror the package, and every test module can import
-``conftest``, ``reference_raycast`` and ``reference_images`` because pytest puts tests/ on sys.path.
+Three conftests exist: this one, and ``tests/importers/conftest.py`` and ``tests/cli/conftest.py``, which both
+only import the hostile-input suite's fixtures from ``importers/hostile_corpus.py``. The test folders mirror the
+package; pytest puts tests/ on sys.path, so every test module can import ``conftest`` and the 13 helper modules
+beside it: ``bank_maker`` (tiny cut-out banks), ``dataset_runs`` (a dataset's files and records, a generate run),
+``format_readers`` (the real format readers set up), ``frame_checks``, ``hostile`` (the hostile-input harness),
+``label_scenes`` (hand-made label maps and records), ``las_files``, ``layer_match`` (a generated file against its
+committed copy; ``test_layer_match.py`` tests it), ``normal_scenes``, ``reference_images``, ``reference_raycast``
+(the independent Embree label renderer), ``snapshot_checks`` and ``texture_checks``.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from synthua_usd.dataset.annotations import annotate, panoptic
+from synthua_usd.dataset.annotations import annotate, mark_ignored, panoptic
 from synthua_usd.model.scene import Instance
 
 H, W = 40, 48
@@ -79,6 +79,7 @@ def record(image_id: int, split: str, class_map, flip: bool = False, verdict: st
         cls, ins = np.ascontiguousarray(cls[:, ::-1]), np.ascontiguousarray(ins[:, ::-1])
         amodal = {k: np.sort((v // W) * W + (W - 1 - v % W)) for k, v in amodal.items()}
     instances = annotate(cls, ins, INSTANCES, amodal, truncation)
+    mark_ignored(instances, 0)  # every written entry has ``ignore`` (the schema requires it)
     _, segments = panoptic(cls, ins, INSTANCES, class_map)
     name = f"{image_id:06d}_cam-{image_id % 2}_t0024_clear-day_s{image_id}"
     rec = {

@@ -12,12 +12,12 @@ from __future__ import annotations
 import shutil
 
 import numpy as np
-import OpenImageIO as oiio
 import trimesh
 from conftest import DATA
 from pxr import Sdf, UsdGeom, UsdLux, UsdShade
 
 from synthua_usd.backends.mitsuba.translate import translate
+from synthua_usd.core.images import write_color_png
 from synthua_usd.model.render_config import RenderConfig
 
 
@@ -33,12 +33,9 @@ def textured_quads(folder, texels: np.ndarray = TEXELS):
 
 
 def write_png(path, pixels: np.ndarray) -> None:
+    """``pixels`` (H, W, C) uint8 as a PNG at ``path``, its folder made (the library's writer of texture images)."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    pixels = np.ascontiguousarray(pixels, np.uint8)
-    out = oiio.ImageOutput.create(str(path))
-    assert out.open(str(path), oiio.ImageSpec(pixels.shape[1], pixels.shape[0], pixels.shape[2], oiio.UINT8))
-    assert out.write_image(pixels)
-    out.close()
+    write_color_png(path, np.ascontiguousarray(pixels, np.uint8))
 
 
 def bilinear(image: np.ndarray, st: np.ndarray) -> np.ndarray:

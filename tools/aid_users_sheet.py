@@ -66,7 +66,7 @@ def main() -> int:
     parser.add_argument("--out", type=Path, default=REPO / "docs" / "images" / "aid_users.jpg")
     args = parser.parse_args()
 
-    from synthua_usd.backends import images
+    from synthua_usd.core import images
     from synthua_usd.backends.contact_sheet import class_overlay
     from synthua_usd.backends.mitsuba.session import RenderSession
     from synthua_usd.model.render_config import RenderConfig

@@ -88,7 +88,7 @@ def main() -> int:
     import numpy as np
 
     from synthua_usd.backends import denoise as denoise_module
-    from synthua_usd.backends import images
+    from synthua_usd.core import images
     from synthua_usd.backends.denoise import FireflyReport
     from synthua_usd.backends.image_quality import psnr_db, reference_ceiling_db, reference_scale, ssim
     from synthua_usd.backends.mitsuba.session import RenderSession

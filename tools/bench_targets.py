@@ -321,7 +321,7 @@ def measure_cycles(args, session_out: dict, targets_db: dict, psnr, views) -> di
 
 def save_display(path: Path, rgb: np.ndarray, scale: float) -> None:
     """``rgb`` as an sRGB PNG at exposure ``scale`` (what the PSNR compares)."""
-    from synthua_usd.backends.images import write_display_png
+    from synthua_usd.core.images import write_display_png
 
     path.parent.mkdir(parents=True, exist_ok=True)
     write_display_png(path, rgb * np.float32(scale))

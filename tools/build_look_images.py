@@ -18,14 +18,14 @@ REPO = Path(__file__).resolve().parents[1]
 
 def main() -> int:
     from synthua_usd.assets.look_images import LOOKS_DIR, look_images
-    from synthua_usd.core.texture_images import write_png
+    from synthua_usd.core.images import write_color_png
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=LOOKS_DIR)
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     for stem, pixels in sorted(look_images().items()):
-        path = write_png(args.out / f"{stem}.png", pixels)
+        path = write_color_png(args.out / f"{stem}.png", pixels)
         print(f"wrote {path} ({path.stat().st_size // 1024} KiB)")
     return 0
 

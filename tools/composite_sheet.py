@@ -30,12 +30,13 @@ def main() -> int:
 
     from synthua_usd.backends.photos import read_photo
     from synthua_usd.dataset.composite_config import CompositeConfig
+    from synthua_usd.dataset.record import COMPOSITE, read_record
 
     job = json.loads((args.dataset / "generate.json").read_text(encoding="utf-8"))
     config = CompositeConfig.from_document(job["job_key"]["config"])
     folder = Path(job["backgrounds"])
     folder = folder if folder.is_dir() else folder.parent
-    records = sorted((json.loads(p.read_text(encoding="utf-8")) for p in (args.dataset / "records").glob("*.json")),
+    records = sorted((read_record(p, COMPOSITE) for p in (args.dataset / "records").glob("*.json")),
                      key=lambda r: r["id"])
     chosen = [r for r in records if r["id"] in args.ids] if args.ids else records[:args.images]
     rows = []

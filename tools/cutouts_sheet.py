@@ -29,7 +29,7 @@ def tile(bank: Path, entry: dict, height: int) -> np.ndarray:
     """One cut-out: (composite | labels) side by side, ``height`` pixels high."""
     from PIL import Image
 
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     rgba = read_image(bank / entry["files"]["rgba"])[0].astype(float)
     shadow = read_image(bank / entry["files"]["shadow"])[0][..., 0].astype(float) / 255

@@ -18,7 +18,7 @@ sys.path.insert(0, str(TESTS))
 
 from conftest import MITSUBA_VARIANTS  # noqa: E402  (tests/ is put on the path above)
 from reference_images import REF_SEED, REF_SPP, reference_path, render_reference, tiny_scene  # noqa: E402
-from synthua_usd.backends import images  # noqa: E402
+from synthua_usd.core import images  # noqa: E402
 from synthua_usd.backends.mitsuba import variants  # noqa: E402
 from synthua_usd.core.errors import InputError  # noqa: E402
 

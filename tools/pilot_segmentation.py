@@ -117,7 +117,7 @@ def main() -> int:
 
     from synthua_usd.analytics.dataset_index import load_index
     from synthua_usd.analytics.statistics import compute, mobility_aid_classes
-    from synthua_usd.backends.images import write_id_png
+    from synthua_usd.core.images import write_id_png
 
     torch.manual_seed(args.seed)
     torch.set_num_threads(args.threads)

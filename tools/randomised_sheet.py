@@ -61,7 +61,7 @@ def main() -> int:
 
     from dataclasses import replace
 
-    from synthua_usd.backends import images
+    from synthua_usd.core import images
     from synthua_usd.backends.mitsuba.session import RenderSession
     from synthua_usd.dataset.config import GenerationConfig
     from synthua_usd.model.render_config import RenderConfig

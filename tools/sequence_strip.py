@@ -11,7 +11,6 @@ scaled to --width, written as a JPEG. The frame numbers are printed, for a capti
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -32,6 +31,7 @@ def main() -> int:
     from PIL import Image
 
     from synthua_usd.dataset.layout import Layout
+    from synthua_usd.dataset.record import SEQUENCE_FRAME, read_record
     from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.pipeline.sequences import boxed_frame
 
@@ -42,7 +42,7 @@ def main() -> int:
         print(f"{args.dataset}: no records of sequence {args.sequence!r}", file=sys.stderr)
         return 2
     picks = sorted(set(np.linspace(0, len(records) - 1, args.frames).round().astype(int).tolist()))
-    tiles = [boxed_frame(layout, json.loads(records[k].read_text(encoding="utf-8")), class_map) for k in picks]
+    tiles = [boxed_frame(layout, read_record(records[k], SEQUENCE_FRAME), class_map) for k in picks]
     strip = Image.fromarray(np.concatenate(tiles, axis=1))
     strip = strip.resize((args.width, round(strip.height * args.width / strip.width)), Image.LANCZOS)
     args.out.parent.mkdir(parents=True, exist_ok=True)

@@ -5,7 +5,7 @@
 # ('operator torchvision::nms does not exist'), and the pair that imports together on x86-64 Linux,
 # torch 2.14.1 + torchvision 0.29.1, is a CUDA build of about 5.5 GB (it runs on the CPU too, and on a GPU when
 # one is present). synthua runs Ultralytics in a subprocess of this interpreter
-# (synthua_usd/backends/detector/runner.py). Safe to run again: it only does what is missing.
+# (synthua_usd/pipeline/detector/runner.py). Safe to run again: it only does what is missing.
 # Exit 0 when the detector is ready, 1 (with one line saying why) when it cannot be installed here.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -52,7 +52,7 @@ sys.path.insert(0, str(REPO))
 from synthua_usd.analytics.detection_sets import DetectionSet  # noqa: E402
 from synthua_usd.analytics.detection_sources import detect_format, read_detection_set, set_id  # noqa: E402
 from synthua_usd.analytics.detection_targets import targets_for  # noqa: E402
-from synthua_usd.backends.detector.runner import find_detector_python  # noqa: E402
+from synthua_usd.pipeline.detector.runner import find_detector_python  # noqa: E402
 from synthua_usd.cli.failures import describe as describe_failure  # noqa: E402
 from synthua_usd.core.atomic import write_json_atomic, write_text_atomic  # noqa: E402
 from synthua_usd.core.errors import InputError  # noqa: E402

@@ -1,8 +1,9 @@
 """What analytics reads of a generated dataset: the manifest (which images, their split and QA verdict),
-the dataset's class map and each image's record (``records/{name}.json``: condition, camera rig, class pixel
-counts, instances with areas, occlusion and relations, panoptic segments). No image file is opened here: the
-records hold every count the statistics need. Images rejected by QA are left out, as every training format
-leaves them out.
+the dataset's class map and each image's record (``records/{name}.json``, read and validated by
+:func:`synthua_usd.dataset.record.read_record`: condition, camera rig, class pixel counts, instances with areas,
+occlusion and relations, panoptic segments). No image file is opened here: the records hold every count the
+statistics need. Images rejected by QA are left out (:func:`synthua_usd.dataset.manifest.kept_images`), as every
+training format leaves them out.
 """
 
 from __future__ import annotations
@@ -12,12 +13,11 @@ from pathlib import Path
 
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
-from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.annotations import CROWD_ID_BASE, STUFF_ID_BASE
 from synthua_usd.dataset.layout import Layout
-from synthua_usd.dataset.manifest import read_manifest
+from synthua_usd.dataset.manifest import Manifest, kept_images, read_manifest
 from synthua_usd.dataset.qa import AidUser, aid_users
-from synthua_usd.dataset.record import ImageRecord
+from synthua_usd.dataset.record import DatasetRecord, read_record
 from synthua_usd.model.taxonomy import ClassMap
 
 
@@ -83,56 +83,48 @@ def load_class_map(root: Path) -> ClassMap:
     return ClassMap.load(Layout(root).path(Layout.CLASS_MAP))
 
 
-def manifest_images(root: Path) -> list[dict]:
-    """The manifest's image entries (``id``, ``name``, ``split``, ``qa``, ...); a folder without a manifest is
-    refused (the manifest is written last: without it the dataset is incomplete)."""
+def dataset_manifest(root: Path) -> Manifest:
+    """The manifest of the dataset at ``root`` (:func:`synthua_usd.dataset.manifest.read_manifest`); a folder without
+    one is refused (the manifest is written last: without it the dataset is incomplete)."""
     root = Path(root)
     if not root.is_dir():
         raise InputError(f"{shown(root)}: not a folder; expected a dataset folder written by `synthua generate`")
-    return read_manifest(root / Layout.MANIFEST)["images"]
+    return read_manifest(root / Layout.MANIFEST)
 
 
-def _objects(record: ImageRecord) -> tuple[tuple[int, int], ...]:
+def _objects(record: DatasetRecord) -> tuple[tuple[int, int], ...]:
     """(class id, area) of the record's visible thing instances and of its stuff segments (panoptic ids from
     STUFF_ID_BASE up to CROWD_ID_BASE)."""
-    things = [(int(i["category_id"]), int(i["area"])) for i in record.get("instances", ())
-              if i.get("isthing") and i.get("area", 0) > 0]
-    stuff = [(int(s["category_id"]), int(s["area"])) for s in record["panoptic_segments"]
-             if STUFF_ID_BASE <= int(s["id"]) < CROWD_ID_BASE]
+    things = [(i["category_id"], i["area"]) for i in record["instances"] if i["isthing"] and i["area"] > 0]
+    stuff = [(s["category_id"], s["area"]) for s in record["panoptic_segments"]
+             if STUFF_ID_BASE <= s["id"] < CROWD_ID_BASE]
     return tuple(things + stuff)
 
 
-def _summary(record: ImageRecord, verdict: str, where: str) -> ImageSummary:
-    try:
-        camera = record.get("camera") or {}
-        condition = (record.get("condition") or {}).get("name") or "stage"
-        return ImageSummary(
-            id=int(record["id"]), name=str(record["name"]), split=str(record["split"]), condition=str(condition),
-            rig_type=str(camera.get("rig_type") or "none"), width=int(record["width"]), height=int(record["height"]),
-            verdict=verdict, class_pixels={str(k): int(v) for k, v in record["class_pixel_counts"].items()},
-            segments=_objects(record),
-            aid_users=tuple(aid_users(record.get("instances", ()))), camera_path=str(camera.get("prim_path", "")),
-            time_code=float(record.get("time_code", 0.0)), seed=int(record.get("seed", 0)),
-            visible=tuple(str(i["prim_path"]) for i in record.get("instances", ()) if i.get("area", 0) > 0),
-            randomisation=record.get("randomisation") if isinstance(record.get("randomisation"), dict) else None)
-    except (KeyError, TypeError, ValueError) as exc:
-        raise InputError(f"{where}: {type(exc).__name__} {exc}; expected an image record written by "
-                         f"`synthua generate`") from None
+def _summary(record: DatasetRecord) -> ImageSummary:
+    """What the statistics see of one record; a composite has no condition, rig, camera prim or time code (its
+    photo's), and counts as ``stage`` and ``none``."""
+    if "composite" in record:
+        condition, rig_type, camera_path, time_code, randomisation = "stage", "none", "", 0.0, None
+    else:
+        condition = record["condition"]["name"] if record["condition"] else "stage"
+        rig_type, camera_path = record["camera"]["rig_type"] or "none", record["camera"]["prim_path"]
+        time_code, randomisation = float(record["time_code"]), record.get("randomisation")
+    return ImageSummary(
+        id=record["id"], name=record["name"], split=record["split"], condition=condition, rig_type=rig_type,
+        width=record["width"], height=record["height"], verdict=record["qa"]["verdict"],
+        class_pixels=dict(record["class_pixel_counts"]), segments=_objects(record),
+        aid_users=tuple(aid_users(record["instances"])), camera_path=camera_path, time_code=time_code,
+        seed=record["seed"], visible=tuple(i["prim_path"] for i in record["instances"] if i["area"] > 0),
+        randomisation=randomisation)
 
 
 def load_index(root: str | Path) -> DatasetIndex:
     """Manifest, class map and the records of every image not rejected by QA, by image id."""
     root = Path(root)
     layout = Layout(root)
-    entries = manifest_images(root)
+    manifest = dataset_manifest(root)
     class_map = load_class_map(root)
-    images, rejected = [], 0
-    for entry in entries:
-        verdict = str(entry.get("qa", "accepted"))
-        if verdict == "rejected":
-            rejected += 1
-            continue
-        path = layout.path(Layout.record(str(entry["name"])))
-        images.append(_summary(read_json(path, "an image record"), verdict, shown(path)))
-    images.sort(key=lambda i: i.id)
-    return DatasetIndex(root=root, class_map=class_map, images=tuple(images), rejected=rejected)
+    kept = kept_images(manifest)
+    images = tuple(_summary(read_record(layout.path(Layout.record(entry["name"])))) for entry in kept)
+    return DatasetIndex(root=root, class_map=class_map, images=images, rejected=len(manifest["images"]) - len(kept))

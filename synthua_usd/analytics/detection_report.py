@@ -58,7 +58,7 @@ def crop_around(rgb: np.ndarray, box: tuple[float, float, float, float]) -> tupl
 
 
 def _panels(test: DetectionSet, misses: tuple[Miss, ...]):
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     by_id = {im.id: im for im in test.images}
     panels = []

@@ -113,7 +113,7 @@ def checked_image_size(path: Path, whole: bool = True) -> tuple[int, int]:
     the images of a generated dataset, which ``synthua verify`` checks). A photo whose EXIF orientation turns it
     would be read turned by the detector (OpenCV applies it) and as stored here: refused rather than scored on boxes
     that do not fit."""
-    from synthua_usd.backends.images import decoded_image_size, image_size
+    from synthua_usd.core.images import decoded_image_size, image_size
 
     if not path.is_file():
         found = "file not found" if not path.exists() else "not a regular file"

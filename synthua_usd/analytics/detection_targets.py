@@ -24,13 +24,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from synthua_usd.analytics.dataset_index import load_class_map, manifest_images
+from synthua_usd.analytics.dataset_index import dataset_manifest, load_class_map
 from synthua_usd.analytics.detection_sets import Box, DetectionSet, MissingSplit, SetImage, checked_image_size
 from synthua_usd.assets.devices import DEVICES
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
-from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.layout import SPLITS, Layout
+from synthua_usd.dataset.manifest import kept_images
+from synthua_usd.dataset.record import DatasetRecord, InstanceEntry, read_record
 from synthua_usd.model.box_conventions import CONVENTIONS, DEFAULT_CONVENTION
 from synthua_usd.model.detection_limits import DEFAULT_MIN_HEIGHT_PX, MIN_HEIGHT_PX
 
@@ -107,41 +108,43 @@ def _union(a: list, b: list) -> list:
     return [x0, y0, max(a[0] + a[2], b[0] + b[2]) - x0, max(a[1] + a[3], b[1] + b[3]) - y0]
 
 
-def image_boxes(instances: list[dict], targets: DetectionTargets) -> tuple[Box, ...]:
-    """The target boxes of one record's ``instances`` (dicts with ``class_name``, ``prim_path``, ``area``,
-    ``bbox`` [x, y, w, h] and ``relations``), in instance order."""
-    visible = [i for i in instances if int(i.get("area", 0)) > 0]
-    user_of = {str(i["relations"]["uses"]): i for i in visible
-               if i.get("class_name") == PERSON and (i.get("relations") or {}).get("uses")}
+def image_boxes(instances: list[InstanceEntry], targets: DetectionTargets) -> tuple[Box, ...]:
+    """The target boxes of one record's ``instances`` (``class_name``, ``prim_path``, ``area``, ``bbox`` [x, y, w, h]
+    and ``relations`` of each), in instance order."""
+    visible = [i for i in instances if i["area"] > 0]
+    user_of = {i["relations"]["uses"]: i for i in visible if i["class_name"] == PERSON and i["relations"].get("uses")}
     wanted = set(targets.classes)
     out = []
     for inst in visible:
-        name = str(inst["class_name"])
+        name = inst["class_name"]
         if name not in wanted:
             continue
         bbox = [float(v) for v in inst["bbox"]]
         if name == PERSON:
-            device = (inst.get("relations") or {}).get("uses_class")
+            device = inst["relations"].get("uses_class")
             if not targets.aid_users_as_person and device in wanted:
                 continue
-        elif name in DEVICES and targets.aid_box == "with_user" and str(inst["prim_path"]) in user_of:
-            bbox = _union(bbox, [float(v) for v in user_of[str(inst["prim_path"])]["bbox"]])
-        out.append(Box(name, *bbox, ignore=bbox[3] < targets.min_height_px))
+        elif name in DEVICES and targets.aid_box == "with_user" and inst["prim_path"] in user_of:
+            bbox = _union(bbox, [float(v) for v in user_of[inst["prim_path"]]["bbox"]])
+        x, y, w, h = bbox
+        out.append(Box(name, x, y, w, h, ignore=h < targets.min_height_px))
     return tuple(out)
 
 
-def background_boxes(record: dict, targets: DetectionTargets) -> tuple[Box, ...]:
+def background_boxes(record: DatasetRecord, targets: DetectionTargets) -> tuple[Box, ...]:
     """The kept boxes of a composite's labelled photo (its record's ``composite.background_boxes``) whose class is
     trained, as labelled there (in the photo set's own box convention); none for a rendered image."""
+    if "composite" not in record:
+        return ()
     wanted, out = set(targets.classes), []
-    for box in (record.get("composite") or {}).get("background_boxes", ()):
+    for box in record["composite"]["background_boxes"]:
         if box["kept"] and box["class_name"] in wanted:
             x, y, w, h = (float(v) for v in box["bbox"])
             out.append(Box(box["class_name"], x, y, w, h, ignore=h < targets.min_height_px))
     return tuple(out)
 
 
-def record_boxes(record: dict, targets: DetectionTargets) -> tuple[Box, ...]:
+def record_boxes(record: DatasetRecord, targets: DetectionTargets) -> tuple[Box, ...]:
     """Every target box of one image record: its instances' (:func:`image_boxes`), then a composite's photo's own
     (:func:`background_boxes`)."""
     return image_boxes(record["instances"], targets) + background_boxes(record, targets)
@@ -159,22 +162,16 @@ def read_generated(root, split: str | None, targets: DetectionTargets) -> Detect
     if unknown:
         raise InputError(f"--classes: {', '.join(unknown)}: not thing classes of {shown(layout.path(Layout.CLASS_MAP))}"
                          f"; expected some of {', '.join(sorted(things))}")
-    entries = sorted((e for e in manifest_images(layout.root) if str(e.get("qa", "accepted")) != "rejected"
-                      and (split is None or e["split"] == split)), key=lambda e: int(e["id"]))
+    entries = kept_images(dataset_manifest(layout.root), split)
     if not entries:
         raise MissingSplit(f"{shown(layout.root)}: no images{f' in split {split}' if split else ''}; expected a "
                          f"dataset with images in the split (see its manifest.json)")
     images = []
     for n, entry in enumerate(entries, 1):
-        name, image_split = str(entry["name"]), str(entry["split"])
+        name, image_split = entry["name"], entry["split"]
         path = layout.path(Layout.record(name))
-        record = read_json(path, "an image record")
-        try:
-            boxes = record_boxes(record, targets)
-            width, height = int(record["width"]), int(record["height"])
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"{shown(path)}: {type(exc).__name__} {exc}; expected an image record written by "
-                             f"`synthua generate`") from None
+        record = read_record(path)
+        boxes, width, height = record_boxes(record, targets), record["width"], record["height"]
         image = layout.path(Layout.rgb_png(image_split, name))
         if checked_image_size(image, whole=False) != (width, height):  # its header: `synthua verify` checks the rest
             raise InputError(f"{shown(image)}: {'x'.join(map(str, checked_image_size(image, whole=False)))} pixels; "

@@ -94,7 +94,7 @@ def _people(images: list[ImageSummary]) -> tuple[dict, dict]:
 
 def class_map_disagreement(index: DatasetIndex, max_pairs: int = MAX_PAIRS) -> dict:
     """Mean and spread of the per-pixel class disagreement of image pairs sharing camera and time code."""
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     groups: dict[tuple, list[ImageSummary]] = {}
     for img in index.images:

@@ -19,12 +19,13 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.analytics import segmentation_metrics as sm
-from synthua_usd.analytics.dataset_index import load_class_map, manifest_images
+from synthua_usd.analytics.dataset_index import dataset_manifest, load_class_map
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.input_files import check_input_file, shown
 from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.annotations import rle_problem
 from synthua_usd.dataset.layout import SPLITS, Layout, inside
+from synthua_usd.dataset.manifest import kept_images
 from synthua_usd.model.taxonomy import ClassMap
 
 #: Largest prediction image read (bytes): far above any label map of a 16384-pixel-wide image in PNG.
@@ -46,16 +47,15 @@ def ground_truth_images(gt_dir: Path, split: str | None) -> list[GroundTruthImag
     """The images of the dataset at ``gt_dir`` that QA did not reject, of ``split`` when given, by id."""
     if split is not None and split not in SPLITS:
         raise InputError(f"--split: {split!r}; expected one of {', '.join(SPLITS)}")
-    out = [GroundTruthImage(int(e["id"]), str(e["name"]), str(e["split"])) for e in manifest_images(gt_dir)
-           if str(e.get("qa", "accepted")) != "rejected" and (split is None or e["split"] == split)]
+    out = [GroundTruthImage(e["id"], e["name"], e["split"]) for e in kept_images(dataset_manifest(gt_dir), split)]
     if not out:
         raise InputError(f"{shown(gt_dir)}: no images{f' in split {split}' if split else ''}; expected a dataset "
                          f"with images to evaluate")
-    return sorted(out, key=lambda g: g.id)
+    return out
 
 
 def _read_png(path: Path, what: str) -> np.ndarray:
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     check_input_file(path, MAX_PNG_BYTES, what)
     try:
@@ -173,7 +173,7 @@ def evaluate_coco(gt_dir: Path, results_path: Path, split: str | None = None) ->
     gt_dir = Path(gt_dir)
     images = ground_truth_images(gt_dir, split)
     splits = sorted({g.split for g in images})
-    merged = {"images": [], "annotations": [], "categories": None}
+    merged: dict = {"images": [], "annotations": [], "categories": None}
     for s in splits:
         doc = read_json(Layout(gt_dir).path(Layout.coco_instances(s)), "COCO instances")
         merged["images"] += doc["images"]
@@ -199,7 +199,7 @@ def evaluate_coco(gt_dir: Path, results_path: Path, split: str | None = None) ->
                              f"class map")
         _check_detection(r, images_by_id[r["image_id"]], f"{where}: [{i}]")
     iou_types = [t for t, key in (("segm", "segmentation"), ("bbox", "bbox")) if all(key in r for r in results)]
-    out = {"images": len(image_ids), "detections": len(results), "iou_types": {}}
+    out: dict = {"images": len(image_ids), "detections": len(results), "iou_types": {}}
     names = {c["id"]: c["name"] for c in merged["categories"]}
     with contextlib.redirect_stdout(io.StringIO()):
         gt = COCO()

@@ -77,7 +77,7 @@ def edge_density(y: np.ndarray, threshold: float = EDGE_THRESHOLD) -> float:
 
 
 def _read_rgb8(index: DatasetIndex, img: ImageSummary) -> np.ndarray:
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     path = image_file(index.root, img, img.rgb)
     expected = f"expected the {img.width}x{img.height} 8-bit RGB PNG of record {img.name}"
@@ -99,7 +99,7 @@ def image_measures(index: DatasetIndex, img: ImageSummary) -> dict[str, float]:
 
 def photo_measures(path) -> dict[str, float]:
     """RMS contrast and edge density of the image file at ``path`` (8- or 16-bit, grey or colour)."""
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     try:
         pixels, _ = read_image(path)

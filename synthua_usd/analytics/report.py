@@ -71,7 +71,7 @@ def overlay(rgb: np.ndarray, class_ids: np.ndarray, palette: np.ndarray, alpha: 
 
 
 def _read_pair(index: DatasetIndex, img: ImageSummary) -> tuple[np.ndarray, np.ndarray]:
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     paths = [image_file(index.root, img, relative) for relative in (img.rgb, img.class_png)]
     rgb, _ = read_image(paths[0])
@@ -140,7 +140,7 @@ def write_report(index: DatasetIndex, stats: DatasetStatistics, out_dir: str | P
                                           {(r.measure, r.class_name): r.ks_statistic for r in comparison.rows},
                                           p / "real_comparison.png", log_x=("aspect_ratio",))
         (stage / "gallery").mkdir()
-        from synthua_usd.backends.images import write_color_png
+        from synthua_usd.core.images import write_color_png
 
         shown_classes: set[int] = set()
         for img, (rgb, ids) in zip(chosen, pairs):

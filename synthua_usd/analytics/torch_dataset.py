@@ -21,10 +21,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from synthua_usd.analytics.dataset_index import manifest_images
+from synthua_usd.analytics.dataset_index import dataset_manifest
 from synthua_usd.core.errors import InputError
-from synthua_usd.core.schemas import read_json
 from synthua_usd.dataset.layout import SPLITS, Layout
+from synthua_usd.dataset.manifest import kept_images
+from synthua_usd.dataset.record import read_record
 
 
 def collate(batch):
@@ -41,15 +42,14 @@ class SynthuaDataset(torch.utils.data.Dataset):
             raise InputError(f"split: {split!r}; expected one of {', '.join(SPLITS)}")
         self.root = Path(root)
         self.layout = Layout(self.root)
-        self.entries = sorted((e for e in manifest_images(self.root) if str(e.get("qa", "accepted")) != "rejected"
-                               and (split is None or e["split"] == split)), key=lambda e: int(e["id"]))
+        self.entries = kept_images(dataset_manifest(self.root), split)
         self.transforms = transforms
 
     def __len__(self) -> int:
         return len(self.entries)
 
     def _png(self, relative: str) -> np.ndarray:
-        from synthua_usd.backends.images import read_image
+        from synthua_usd.core.images import read_image
 
         return read_image(self.layout.path(relative))[0]
 
@@ -57,12 +57,12 @@ class SynthuaDataset(torch.utils.data.Dataset):
         from pycocotools import mask as mask_utils
 
         entry = self.entries[i]
-        name, split = str(entry["name"]), str(entry["split"])
-        record = read_json(self.layout.path(Layout.record(name)), "an image record")
+        name, split = entry["name"], entry["split"]
+        record = read_record(self.layout.path(Layout.record(name)))
         rgb = self._png(Layout.rgb_png(split, name))[..., :3]
         semantic = self._png(Layout.frame_file(name, "class"))[..., 0]
         h, w = semantic.shape
-        things = [inst for inst in record["instances"] if inst.get("isthing", True) and inst["area"] > 0]
+        things = [inst for inst in record["instances"] if inst["isthing"] and inst["area"] > 0]
         if things:
             masks = mask_utils.decode([inst["segmentation"] for inst in things]).transpose(2, 0, 1)
         else:
@@ -73,7 +73,7 @@ class SynthuaDataset(torch.utils.data.Dataset):
                   "labels": torch.tensor([int(inst["category_id"]) for inst in things], dtype=torch.int64),
                   "masks": torch.from_numpy(np.ascontiguousarray(masks, np.uint8)),
                   "area": torch.tensor([float(inst["area"]) for inst in things], dtype=torch.float32),
-                  "iscrowd": torch.tensor([int(bool(inst.get("ignore"))) for inst in things], dtype=torch.int64),
+                  "iscrowd": torch.tensor([int(inst["ignore"]) for inst in things], dtype=torch.int64),
                   "image_id": int(record["id"]),
                   "semantic": torch.from_numpy(semantic.astype(np.int64)),
                   "name": name}

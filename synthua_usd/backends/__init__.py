@@ -1,1 +1,3 @@
-"""Backends: renderers and file writers. The only code that imports ``mitsuba`` or writes dataset files."""
+"""Backends: the renderers (Mitsuba; Blender Cycles for comparisons) and the work on rendered pixels (weather,
+exposure, denoising, camera effects, compositing, previews). The only code that imports ``mitsuba``; image files are
+written through :mod:`synthua_usd.core.images`."""

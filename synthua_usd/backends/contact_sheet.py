@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import OpenImageIO as oiio
 
-from synthua_usd.backends import images
+from synthua_usd.core import images
 
 log = logging.getLogger(__name__)
 

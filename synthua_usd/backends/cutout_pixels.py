@@ -46,7 +46,7 @@ class CutoutPixels:
 
 
 def _read(path: Path, channels: int, dtype, entry: BankEntry, key: str) -> np.ndarray:
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     try:
         pixels, _ = read_image(path)

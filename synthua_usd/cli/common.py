@@ -1,9 +1,7 @@
-"""What every ``synthua`` subcommand module shares: exit statuses, printing a line of output, and the class-map
-option's loader."""
+"""What every ``synthua`` subcommand module shares: exit statuses, printing a line of output, and the time-code
+options' parser (a ``--class-map`` option is read by :meth:`synthua_usd.model.taxonomy.ClassMap.load_or_bundled`)."""
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import click
 
@@ -16,13 +14,6 @@ def say(line: str) -> None:
     """Print ``line`` on stdout as one line, its control characters escaped as in the error messages: a path
     the user typed with a newline or a terminal escape in it cannot split the line or reach the terminal."""
     click.echo(escape_controls(line))
-
-
-def load_class_map(path: Path | None):
-    """The class map at ``path``, or the bundled one."""
-    from synthua_usd.model.taxonomy import ClassMap
-
-    return ClassMap.load(path) if path else ClassMap.default()
 
 
 def parse_time_codes(ctx, param, values: tuple[str, ...]) -> tuple[float, ...]:

@@ -17,7 +17,7 @@ from synthua_usd import __version__
 from synthua_usd.cli.agents_commands import agents
 from synthua_usd.cli.analytics_commands import evaluate, stats
 from synthua_usd.cli.cameras_commands import cameras
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, load_class_map, say
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_INPUT, EXIT_OK, say
 from synthua_usd.cli.cutout_commands import cutouts
 from synthua_usd.cli.composite_commands import composite
 from synthua_usd.cli.common import parse_time_codes as _time_codes
@@ -111,10 +111,11 @@ def validate_stage(stage: Path, class_map: Path | None, as_json: bool, strict: b
     settings name a real camera, every authored number is finite, Cube/Sphere/Cylinder/Cone/Capsule sizes
     are > 0; when none finds an error, the stage is read as render reads it.
     """
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.stage_checks import validate_stage as run_rules
     from synthua_usd.usd.stage_io import open_stage
 
-    cmap = load_class_map(class_map)
+    cmap = ClassMap.load_or_bundled(class_map)
     return _report(run_rules(open_stage(stage, allow_external_assets), cmap), as_json, strict)
 
 
@@ -152,10 +153,11 @@ def compose(out: Path, layers: tuple[Path, ...], allow_external_assets: bool) ->
               help="Accept layers outside the stage's folder tree (refused by default).")
 def inspect(stage: Path, class_map: Path | None, allow_external_assets: bool) -> int:
     """Print what STAGE holds: layer stack, prims per class, cameras, lights, conditions and time range."""
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.stage_io import open_stage
     from synthua_usd.usd.summary import summarize
 
-    click.echo(summarize(open_stage(stage, allow_external_assets), load_class_map(class_map)).format())
+    click.echo(summarize(open_stage(stage, allow_external_assets), ClassMap.load_or_bundled(class_map)).format())
     return EXIT_OK
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, load_class_map, say
+from synthua_usd.cli.common import EXIT_FINDINGS, EXIT_OK, say
 from synthua_usd.cli.options import AID_SHARE, DENSITY, InRange, seed_option
 from synthua_usd.core.errors import echo
 from synthua_usd.importers import limits as importer_limits
@@ -140,13 +140,14 @@ def twin_import(ctx: click.Context, kind: str, input_path: Path, out_dir: Path, 
     """
     from synthua_usd.importers import importers
     from synthua_usd.model.class_assignment import AssignmentRules
+    from synthua_usd.model.taxonomy import ClassMap
 
     _refuse_foreign_options(ctx, kind)
     _refuse_population_options(ctx, populate)
     if kind == "mesh" and rules is None:
         raise click.UsageError("--rules: missing; mesh import needs --rules FILE (meshes carry no classes of their "
                                "own; see schemas/semantic_rules.schema.json)", ctx)
-    cmap = load_class_map(class_map)
+    cmap = ClassMap.load_or_bundled(class_map)
     loaded_rules = AssignmentRules.load(rules, cmap) if rules else None
     t0 = time.perf_counter()
     model = importers()[kind](input_path, rules=loaded_rules, up_axis=up_axis, scale=scale, lod=lod, crs=crs,
@@ -219,10 +220,11 @@ def twin_demo(seed: int, out_dir: Path) -> int:
     (`synthua create district` writes all of it, people and aimed rigs included, in one step.)
     """
     from synthua_usd.demo.district import district_scenario
+    from synthua_usd.model.taxonomy import ClassMap
     from synthua_usd.usd.scenario_writer import write_scenario
 
     spec = district_scenario(seed, agents=False)
-    files = write_scenario(spec, out_dir, load_class_map(None))
+    files = write_scenario(spec, out_dir, ClassMap.default())
     say(f"district seed {seed}: {len(spec.twin.objects)} objects, {spec.twin.triangle_count()} triangles, "
         f"{len(spec.twin.label_counts())} classes, {len(spec.cameras)} cameras")
     for path in files:

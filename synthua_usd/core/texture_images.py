@@ -13,8 +13,7 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
-from synthua_usd.core.atomic import atomic_path
-from synthua_usd.core.errors import InputError, OutputError, echo
+from synthua_usd.core.errors import InputError, echo
 
 #: Where twins keep their images, relative to the twin layer.
 TEXTURE_FOLDER = "textures"
@@ -41,21 +40,14 @@ def check_image(path: str, pixels: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(array)
 
 
-def write_png(path: str | Path, pixels: np.ndarray) -> Path:
-    """Write (H, W, C) uint8 ``pixels`` to ``path`` as PNG, atomically."""
-    import OpenImageIO as oiio
-
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    h, w, c = pixels.shape
-    with atomic_path(path) as tmp:
-        out = oiio.ImageOutput.create(str(tmp))
-        if out is None or not out.open(str(tmp), oiio.ImageSpec(w, h, c, oiio.UINT8)) or not out.write_image(pixels):
-            raise OutputError(f"{path}: could not write the texture image: {echo(oiio.geterror())}")
-        out.close()
-    return path
-
-
 def write_texture_images(images: dict[str, np.ndarray], folder: str | Path) -> list[Path]:
-    """Write every image of ``images`` (relative path → pixels) below ``folder``; returns the paths written."""
-    return [write_png(Path(folder) / rel, check_image(rel, pixels)) for rel, pixels in sorted(images.items())]
+    """Write every image of ``images`` (relative path → pixels) below ``folder`` as 8-bit PNG
+    (:func:`synthua_usd.core.images.write_color_png`: the texels as they are); returns the paths written."""
+    from synthua_usd.core.images import write_color_png
+
+    written = []
+    for rel, pixels in sorted(images.items()):
+        path = Path(folder) / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        written.append(write_color_png(path, check_image(rel, pixels)))
+    return written

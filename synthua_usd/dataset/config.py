@@ -22,6 +22,7 @@ from synthua_usd.composition.rigs import RIG_TYPES
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.schemas import load_schema, read_json, validate_document
+from synthua_usd.dataset.record import REJECTED
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.timecodes import parse_time_code_spec
 from synthua_usd.randomisation.config import RandomisationConfig
@@ -156,7 +157,7 @@ class QAThresholds:
 
     def action(self, check: str) -> str:
         """``rejected`` or ``flagged``: what failing ``check`` does to an image."""
-        return "rejected" if check in self.reject else "flagged"
+        return REJECTED if check in self.reject else "flagged"
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from typing import Sequence
 from synthua_usd.dataset.config import NO_RIG, GenerationConfig
 from synthua_usd.dataset.layout import SPLITS
 from synthua_usd.dataset.qa import aid_users
-from synthua_usd.dataset.record import ImageRecord
+from synthua_usd.dataset.record import REJECTED, DatasetRecord, is_rejected
 from synthua_usd.dataset.sampling import condition_key
 
 #: Occlusion buckets of the aid-user table: [0, 0.25), [0.25, 0.5), [0.5, 0.75), [0.75, 1].
@@ -33,12 +33,20 @@ def occlusion_bucket(occlusion: float | None) -> str:
     raise AssertionError("unreachable")
 
 
-def _rig_key(record: ImageRecord) -> str:
-    return (record.get("camera") or {}).get("rig_type") or NO_RIG
+def _rig_key(record: DatasetRecord) -> str:
+    """The rig type of a rendered image's camera; a composite's photo has none."""
+    return NO_RIG if "composite" in record else record["camera"]["rig_type"] or NO_RIG
 
 
-def _condition_key(record: ImageRecord) -> str:
-    return condition_key((record.get("condition") or {}).get("name"))
+def _condition_key(record: DatasetRecord) -> str:
+    """The condition of a rendered image (the stage's own light when None); a composite has none."""
+    condition = None if "composite" in record else record["condition"]
+    return condition_key(None if condition is None else condition["name"])
+
+
+def _camera_path(record: DatasetRecord) -> str | None:
+    """The prim path of a rendered image's camera; None for a composite (a photo's camera is no prim)."""
+    return None if "composite" in record else record["camera"]["prim_path"]
 
 
 def _quota(name: str, key: str | None, asked: int, achieved: int, pool: int | None, what: str) -> tuple[dict, str | None]:
@@ -52,7 +60,7 @@ def _quota(name: str, key: str | None, asked: int, achieved: int, pool: int | No
     return entry, f"{label}: asked {asked}{what}, got {achieved}{why}"
 
 
-def coverage(records: Sequence[ImageRecord], config: GenerationConfig | None, targets: dict | None = None,
+def coverage(records: Sequence[DatasetRecord], config: GenerationConfig | None, targets: dict | None = None,
              pool: dict | None = None) -> dict:
     """The coverage report as a JSON-serialisable dict.
 
@@ -71,8 +79,8 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig | None, ta
     type × condition × occlusion bucket, with the images they appear in), ``quotas`` (asked, achieved,
     met per quota and key) and ``shortfalls`` (one sentence per unmet quota).
     """
-    verdicts = Counter((r.get("qa") or {}).get("verdict", "accepted") for r in records)
-    kept = [r for r in records if (r.get("qa") or {}).get("verdict") != "rejected"]
+    verdicts = Counter(r["qa"]["verdict"] for r in records)
+    kept = [r for r in records if not is_rejected(r)]
     quota_aid = None if config is None else config.quotas.aid_users
 
     per_condition = Counter(_condition_key(r) for r in kept)
@@ -80,7 +88,7 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig | None, ta
     cells: dict[tuple, list] = defaultdict(lambda: [0, set()])
     with_aid = qualifying = instances = 0
     for record in kept:
-        users = aid_users(record.get("instances", []))
+        users = aid_users(record["instances"])
         instances += len(users)
         with_aid += bool(users)
         qualifying += bool(quota_aid and any(quota_aid.qualifies(u.visible_pixels, u.occlusion) for u in users))
@@ -93,9 +101,9 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig | None, ta
 
     splits = {}
     for split in SPLITS:
-        members = [r for r in kept if r.get("split") == split]
+        members = [r for r in kept if r["split"] == split]
         splits[split] = {"images": len(members), "share": round(len(members) / len(kept), 6) if kept else 0.0,
-                         "cameras": len({(r.get("camera") or {}).get("prim_path") for r in members})}
+                         "cameras": len({_camera_path(r) for r in members})}
 
     if config is None:
         targets = {}
@@ -120,11 +128,11 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig | None, ta
 
     if config is not None:
         entry, short = _quota("images", None, config.images, len(kept), pool.get("candidates"), "")
-        if short and verdicts["rejected"]:
-            short = f"images: asked {config.images}, got {len(kept)} ({verdicts['rejected']} rejected by QA" + (
+        if short and verdicts[REJECTED]:
+            short = f"images: asked {config.images}, got {len(kept)} ({verdicts[REJECTED]} rejected by QA" + (
                 f"; the pool had {pool['candidates']})" if "candidates" in pool else ")")
         add((entry, short))
-    if targets.get("aid_users") is not None:
+    if quota_aid is not None and targets.get("aid_users") is not None:
         occl = "" if quota_aid.max_occlusion is None else f", occluded at most {quota_aid.max_occlusion:g}"
         add(_quota("aid_users", None, targets["aid_users"], qualifying, pool.get("aid_users"),
                    f" images with an aid user of >= {quota_aid.min_pixels} px{occl}"))
@@ -134,7 +142,7 @@ def coverage(records: Sequence[ImageRecord], config: GenerationConfig | None, ta
 
     return {
         "images": {"total": len(records), "kept": len(kept), **{v: verdicts.get(v, 0)
-                                                                for v in ("accepted", "flagged", "rejected")}},
+                                                                for v in ("accepted", "flagged", REJECTED)}},
         "splits": splits,
         "per_condition": dict(sorted(per_condition.items())),
         "per_rig_type": dict(sorted(per_rig.items())),

@@ -18,11 +18,12 @@ Measures (names as stored in the record's ``qa.measures``):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from synthua_usd.dataset.config import QAThresholds
+from synthua_usd.dataset.record import REJECTED
 
 UNKNOWN_AID = "unknown"
 LUMA = np.array([0.299, 0.587, 0.114])
@@ -49,7 +50,7 @@ class AidUser:
         return self.person_pixels + self.device_pixels
 
 
-def aid_users(instances: Sequence[dict]) -> list[AidUser]:
+def aid_users(instances: Sequence[Mapping[str, Any]]) -> list[AidUser]:
     """The aid users among a record's ``instances`` (dicts with ``class_name``, ``prim_path``, ``area``,
     optional ``amodal_area``, ``occlusion`` and ``relations``), in instance order. A device out of view
     takes its type from the person's ``relations.uses_class``."""
@@ -93,7 +94,7 @@ def clipped_shares(rgb: np.ndarray) -> tuple[float, float]:
             float(np.count_nonzero((r & g & b) == 255)) / pixels)
 
 
-def measure(rgb: np.ndarray, instances: Sequence[dict]) -> dict[str, float]:
+def measure(rgb: np.ndarray, instances: Sequence[Mapping[str, Any]]) -> dict[str, float]:
     """The QA measures of one image (see the module docstring) from its display RGB ((H, W, 3) uint8) and
     its record's instances."""
     shadows, highlights = clipped_shares(rgb)
@@ -133,5 +134,5 @@ def verdict(measures: dict[str, float], thresholds: QAThresholds) -> tuple[str, 
     failed = failures(measures, thresholds)
     if not failed:
         return "accepted", []
-    rejected = any(thresholds.action(check) == "rejected" for check, _ in failed)
-    return ("rejected" if rejected else "flagged"), [reason for _, reason in failed]
+    rejected = any(thresholds.action(check) == REJECTED for check, _ in failed)
+    return (REJECTED if rejected else "flagged"), [reason for _, reason in failed]

@@ -2,7 +2,7 @@
 
 Plain numpy: values keep the caller's float dtype, so a float32 texture decodes in float32 and an 8-bit
 colour divided by 255 in float64. Images meant for display go through OCIO instead
-(:func:`synthua_usd.backends.images.linear_to_display`).
+(:func:`synthua_usd.core.images.linear_to_display`).
 """
 
 from __future__ import annotations

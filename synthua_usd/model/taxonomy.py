@@ -43,6 +43,12 @@ class ClassMap:
         return cls.load(bundled_path("classmap.json"))
 
     @classmethod
+    def load_or_bundled(cls, path: str | Path | None) -> "ClassMap":
+        """The class map at ``path`` (a command's ``--class-map``), or the bundled one (:meth:`default`) when None:
+        the one rule of every command that takes a class map."""
+        return cls.load(path) if path else cls.default()
+
+    @classmethod
     def load(cls, path: str | Path) -> "ClassMap":
         """Read, schema-check and rule-check a class map file; unusable maps raise :class:`InputError`."""
         return cls.from_document(read_json(path, "a class map (schemas/classmap.schema.json)"), source=str(path))

@@ -32,7 +32,7 @@ def write_scenario_with_rigs(spec: ScenarioSpec, aimed: AimedRigs, out_dir: str 
     result (its report). A render camera that was rejected leaves the spec's own render camera in place."""
     out_dir = Path(out_dir)
     with output_set(out_dir) as staging:
-        written = write_scenario(spec, staging, ClassMap.load(class_map_path) if class_map_path else None)
+        written = write_scenario(spec, staging, ClassMap.load_or_bundled(class_map_path))
         images = [str(p.relative_to(staging)) for p in written if p.parent != staging]
         result = author_rigs(RigRequest(stage_path=staging / ROOT_FILE, out_path=staging / RIGS_FILE, rigs=aimed.rigs,
                                         width=spec.render.width, height=spec.render.height,

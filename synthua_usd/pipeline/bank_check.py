@@ -38,7 +38,7 @@ class BankCheck:
 def check_bank(bank: str | Path) -> BankCheck:
     """Check the bank folder ``bank`` (see the module); a ``bank.json`` that is not of this version's format, or
     malformed, is an :class:`InputError` (:func:`synthua_usd.dataset.cutout_bank.read_bank`)."""
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
     from synthua_usd.dataset.cutout_bank import BANK_FILE, FILE_KEYS, read_bank
     from synthua_usd.dataset.manifest import file_entry
 

@@ -97,7 +97,7 @@ class RigsResult:
 def author_rigs(request: RigRequest, show_progress: bool = False) -> RigsResult:
     """Place, score, verify and write every rig of ``request`` (see the module docstring)."""
     _check_request(request)
-    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(request.class_map_path)
     stage = open_stage(request.stage_path, request.allow_external_assets, request.layers)
     # the rigs layer states the stage's metadata
     meta = stage_metadata(stage)

@@ -38,6 +38,7 @@ from synthua_usd.dataset.composite_plan import eligible
 from synthua_usd.dataset.formats import cityscapes
 from synthua_usd.dataset.layout import Layout, cityscapes_city, composite_name
 from synthua_usd.dataset.manifest import document_digest
+from synthua_usd.dataset.record import is_rejected
 from synthua_usd.dataset.sampling import split_of
 from synthua_usd.pipeline.backgrounds import DEFAULT_SPLIT, BackgroundSet, read_backgrounds
 from synthua_usd.pipeline.composite_worker import CompositeJob, PlannedComposite
@@ -179,7 +180,7 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
         assemble(Layout(staging), records, bank.class_map, None, job_document, provenance=provenance)
     summary.images = len(records)
     summary.flagged = sum(r["qa"]["verdict"] == "flagged" for r in records)
-    summary.rejected = sum(r["qa"]["verdict"] == "rejected" for r in records)
+    summary.rejected = sum(is_rejected(r) for r in records)
     summary.pastes = sum(len(r["composite"]["pastes"]) for r in records)
     boxes = [b for r in records for b in r["composite"]["background_boxes"]]
     summary.boxes_kept = sum(b["kept"] for b in boxes)

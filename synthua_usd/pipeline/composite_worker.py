@@ -13,7 +13,6 @@ the record last. A composite depends on its plan entry, the inputs and the confi
 
 from __future__ import annotations
 
-import functools
 import time
 from collections import OrderedDict
 from dataclasses import dataclass, field
@@ -21,7 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from synthua_usd.analytics.detection_targets import background_boxes, image_boxes, targets_for
-from synthua_usd.backends import images
+from synthua_usd.core import images
+from synthua_usd.backends import frame_files
 from synthua_usd.backends.camera_effects import apply_effects
 from synthua_usd.backends.compositing import PasteInput, compose, composite_depth
 from synthua_usd.backends.cutout_pixels import CutoutPixels, read_cutout
@@ -32,12 +32,11 @@ from synthua_usd.dataset.composite_plan import draw_camera, eligible, plan_paste
 from synthua_usd.dataset.cutout_bank import BANK_FORMAT, read_bank
 from synthua_usd.dataset.formats import yolo
 from synthua_usd.dataset.layout import CityscapesName
-from synthua_usd.dataset.record import CompositeRecord, QAResult
+from synthua_usd.dataset.record import REJECTED, CompositeRecord, QAResult
 from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.background import BackgroundWriter
 from synthua_usd.pipeline.backgrounds import Background, BackgroundSet
-from synthua_usd.pipeline import dataset_worker
 from synthua_usd.pipeline.dataset_worker import FLUSH, ImageBuffers, label_files, write_image
 from synthua_usd.randomisation.effects import draw_effects
 from synthua_usd.randomisation.streams import stream
@@ -46,11 +45,7 @@ from synthua_usd.randomisation.streams import stream
 CUTOUT_CACHE = 128
 #: A composite's files are written as generate's, its PNGs at zlib level 1 (:data:`images.FAST_PNG`): writing is
 #: most of a composite's cost, and level 6 takes 3x as long for 6 % smaller files.
-_COLOUR, _IDS = (functools.partial(fn, compression=images.FAST_PNG) for fn in (images.write_color_png,
-                                                                              images.write_id_png))
-WRITERS = {**dataset_worker.WRITERS, "rgb_png": _COLOUR, "semantic": _COLOUR, "instance_preview": _COLOUR,
-           "panoptic": _COLOUR, "cs_color": _COLOUR, "class": _IDS, "instance": _IDS, "cs_labelIds": _IDS,
-           "cs_instanceIds": _IDS}
+WRITERS = frame_files.file_writers(png_compression=images.FAST_PNG)
 
 
 @dataclass(frozen=True)
@@ -242,7 +237,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
                                          "reason": b["reason"]} for b in boxes],
                    "effects": None if effects is None else effects.to_dict()})
     cs = CityscapesName(job.city, index, planned.id)
-    rejected = verdict == "rejected"
+    rejected = verdict == REJECTED
     files, arrays = label_files(planned.name, planned.split, cs, rejected, display, class_ids, instance_ids,
                                 painted.instances, ignored, panoptic_png,
                                 "" if rejected else composite_yolo_text(record, class_map, config.convention),

@@ -18,7 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from synthua_usd.backends.contact_sheet import class_overlay, compose, write_sheet
-from synthua_usd.backends.images import linear_to_display
+from synthua_usd.core.images import linear_to_display
 from synthua_usd.backends.mitsuba.session import RenderSession
 from synthua_usd.backends.mitsuba.weather_scene import scene_key
 from synthua_usd.core.errors import InputError, StageError
@@ -76,7 +76,7 @@ def make_contact_sheet(request: SheetRequest, show_progress: bool = False) -> Sh
     if request.out_path.suffix.lower() != ".png":
         raise InputError(f"{request.out_path}: the contact sheet is a PNG; expected a file name ending in .png")
     check_not_inputs([request.out_path], {"SCENARIO": request.stage_path, "--class-map": request.class_map_path})
-    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(request.class_map_path)
     stage = open_stage(request.stage_path, request.allow_external_assets)
     time_code = stage.GetStartTimeCode() if request.time_code is None else request.time_code
     check_time_code(stage, time_code)

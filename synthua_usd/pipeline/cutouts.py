@@ -183,7 +183,7 @@ def _aim(bounds: np.ndarray, heading_deg: float, view, frame) -> tuple[np.ndarra
 def render_cutout(session, snapshot, camera, condition, cast_prims, drawn: GroupDraw, config: CutoutsConfig,
                   seed: int, entry_id: str, folder: Path) -> dict:
     """Render one view of the studio's group, write its four images into ``folder`` and return its bank entry."""
-    from synthua_usd.backends import images
+    from synthua_usd.core import images
     from synthua_usd.backends.exposure import choose_exposure
     from synthua_usd.backends.mitsuba.cutout_passes import ground_light, ground_shadow, render_rgba
     from synthua_usd.dataset import annotations, keypoints
@@ -362,7 +362,7 @@ def make_bank(config_path: Path, out: Path, workers: int | None = None, class_ma
 
     started = time.perf_counter()
     config = CutoutsConfig.load(config_path)
-    class_map = ClassMap.load(class_map_path) if class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(class_map_path)
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise OutputError(f"{out}: exists and is not an empty folder; expected a new folder for the bank")

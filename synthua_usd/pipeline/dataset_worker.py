@@ -22,15 +22,15 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.backends import camera_effects, images, previews
-from synthua_usd.core.atomic import atomic_path, write_json_atomic, write_text_atomic
-from synthua_usd.core.outputs import DEPTH_DEFINITION
+from synthua_usd.backends import camera_effects, frame_files, previews
+from synthua_usd.core import images
+from synthua_usd.core.atomic import atomic_path, write_json_atomic
 from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
-from synthua_usd.dataset.formats import cityscapes, onehot, yolo
+from synthua_usd.dataset.formats import cityscapes, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
-from synthua_usd.dataset.record import (ImageRecord, InstanceEntry, QAResult, RecordCamera, RecordRender,
-                                         check_record, image_kind)
+from synthua_usd.dataset.record import (REJECTED, ImageRecord, InstanceEntry, QAResult, check_record, image_kind,
+                                         record_camera, record_render)
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.taxonomy import ClassMap
@@ -262,11 +262,11 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     name = image_name(planned.id, planned.camera_name, planned.time_code, planned.condition, planned.seed)
     split = planned.split
     cs = CityscapesName(job.city, job.camera_index.get(planned.camera_path, 0), planned.id)
-    yolo_text = (yolo.yolo_lines(instances, width, height, job.yolo_classes, instance_ids)
-                 if verdict != "rejected" else "")
-    files, arrays = label_files(name, split, cs, verdict == "rejected", display, class_ids, instance_ids,
+    rejected = verdict == REJECTED
+    yolo_text = "" if rejected else yolo.yolo_lines(instances, width, height, job.yolo_classes, instance_ids)
+    files, arrays = label_files(name, split, cs, rejected, display, class_ids, instance_ids,
                                 snapshot.instances, ignored, panoptic_png, yolo_text, class_map)
-    if verdict != "rejected":
+    if not rejected:
         outputs = job.config.outputs
         if outputs.depth:
             files["depth"] = Layout.frame_file(name, "depth")
@@ -276,21 +276,20 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
             arrays["rgb_exr"] = rgb
         if outputs.onehot:
             files["onehot"] = Layout.frame_file(name, "onehot")
-            arrays["onehot"] = class_ids
+            arrays["onehot"] = (class_ids, max(c.id for c in class_map.classes) + 1)
     record = ImageRecord(
         id=planned.id,
         name=name,
         split=split,
         width=width,
         height=height,
-        camera=camera_document(camera, planned, job.render.width, job.render.height, width, height),
+        camera=record_camera(camera, (job.render.width, job.render.height), (width, height),
+                             name=planned.camera_name, rig_type=planned.rig_type),
         time_code=planned.time_code,
         seed=planned.seed,
         condition=condition.to_dict() if condition is not None else None,
         exposure=rendered.exposure.to_dict() if rendered.exposure is not None else None,
-        render=RecordRender(variant=rendered.variant, spp=job.render.spp, pixel_filter=job.render.pixel_filter,
-                            max_depth=job.render.max_depth, width=job.render.width, height=job.render.height,
-                            denoise=rendered.denoised),
+        render=record_render(job.render, rendered.variant, rendered.denoised),
         layer_stack=job.layer_stack,
         files=files,
         class_pixel_counts={class_map.by_id(int(c)).name: int(n)
@@ -302,7 +301,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     if randomised is not None:
         record["randomisation"] = randomised.to_dict() | ({} if effects is None else {"effects": effects.to_dict()})
     seconds["annotate"] += time.perf_counter() - t0
-    return ImageBuffers(record, arrays, verdict == "rejected", seconds)
+    return ImageBuffers(record, arrays, rejected, seconds)
 
 
 def label_files(name: str, split: str, cs: CityscapesName, rejected: bool, display: np.ndarray, class_ids: np.ndarray,
@@ -330,40 +329,11 @@ def label_files(name: str, split: str, cs: CityscapesName, rejected: bool, displ
     return files, arrays
 
 
-def camera_document(camera, planned, render_w: int, render_h: int, width: int, height: int) -> RecordCamera:
-    """Intrinsics at the written size (K scaled from the render size) and extrinsics."""
-    K = camera.intrinsics(render_w, render_h).copy()
-    K[0] *= width / render_w
-    K[1] *= height / render_h
-    return RecordCamera(prim_path=camera.path, name=planned.camera_name, rig_type=planned.rig_type,
-                        K=K.tolist(), camera_to_world=camera.camera_to_world.tolist(),
-                        world_to_camera_opencv=camera.world_to_camera_opencv().tolist(),
-                        focal_length_mm=camera.focal_length_mm, horizontal_aperture_mm=camera.horizontal_aperture_mm,
-                        vertical_aperture_mm=camera.vertical_aperture_mm,
-                        clipping_range_m=[camera.clip_near_m, camera.clip_far_m],
-                        distortion=camera.distortion.to_dict() if camera.distortion is not None else None)
-
-
-WRITERS = {
-    "rgb_png": lambda path, data: images.write_color_png(path, data),
-    "class": images.write_id_png,
-    "semantic": images.write_color_png,
-    "instance": images.write_id_png,
-    "instance_preview": images.write_color_png,
-    "panoptic": images.write_color_png,
-    "cs_labelIds": images.write_id_png,
-    "cs_instanceIds": images.write_id_png,
-    "cs_color": images.write_color_png,
-    "depth": lambda path, data: images.write_depth_exr(path, data, DEPTH_DEFINITION),
-    "rgb_exr": images.write_linear_exr,
-}
-
-
 def write_image(state: WorkerState, image: ImageBuffers, writers: dict | None = None) -> dict:
     """Write every file of ``image`` (each atomically, by ``writers``: key -> function(path, data); default
-    :data:`WRITERS`), then its record; returns the worker's result. ``state`` needs ``job.out_dir``, ``writer`` and
-    ``class_map`` only (a composite worker's state has them too)."""
-    writers = WRITERS if writers is None else writers
+    :data:`synthua_usd.backends.frame_files.WRITERS`), then its record; returns the worker's result. ``state`` needs
+    ``job.out_dir`` and ``writer`` only (a composite worker's state has them too)."""
+    writers = frame_files.WRITERS if writers is None else writers
     t0 = time.perf_counter()
     layout = Layout(Path(state.job.out_dir))
     record = image.record
@@ -374,15 +344,7 @@ def write_image(state: WorkerState, image: ImageBuffers, writers: dict | None = 
     for key, path in targets.items():
         if key == "cs_leftImg8bit":
             continue  # a link to the RGB image, made once that exists
-        data = image.arrays[key]
-        if key == "yolo_label":
-            jobs.append(state.writer.encoders.submit(_timed, write_text_atomic, path, data))
-        elif key == "onehot":
-            num_classes = max(c.id for c in state.class_map.classes) + 1
-            jobs.append(state.writer.encoders.submit(
-                _timed, lambda p, d: onehot.write_onehot_npz(p, onehot.onehot(d, num_classes)), path, data))
-        else:
-            jobs.append(state.writer.encoders.submit(_timed, writers[key], path, data))
+        jobs.append(state.writer.encoders.submit(_timed, writers[key], path, image.arrays[key]))
     spent = {}
     for key, job in zip([k for k in targets if k != "cs_leftImg8bit"], jobs):
         spent[f"write_{key}"] = job.result()[1]  # seconds of an encoder thread (it overlaps the next render)

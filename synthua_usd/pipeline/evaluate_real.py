@@ -23,7 +23,7 @@ from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluati
 from synthua_usd.analytics.detection_report import REPORT_FILES, write_detection_report
 from synthua_usd.analytics.detection_sources import detect_format, manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets, targets_for
-from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
+from synthua_usd.pipeline.detector.runner import count_in, find_detector_python, run_job
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.input_guard import check_not_inputs

@@ -26,6 +26,7 @@ from synthua_usd.core.atomic import output_set
 from synthua_usd.core.errors import InputError, StageError, echo
 from synthua_usd.core.outputs import OUTPUT_NAMES, RenderOutput, select_outputs
 from synthua_usd.core.resources import check_frame_memory
+from synthua_usd.dataset.record import record_camera, record_render
 from synthua_usd.model.cameras import CONFORM_EXPAND, PinholeCamera
 from synthua_usd.model.render_config import RenderConfig, resolve_render
 from synthua_usd.model.scene import SceneSnapshot
@@ -112,7 +113,7 @@ def time_code_folder(time_code: float) -> str:
 
 def run_frames(request: FrameRequest, show_progress: bool = False) -> RenderRun:
     """Check every input, render every frame from one session, then move all files into place together."""
-    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(request.class_map_path)
     stage = open_stage(request.stage_path, request.allow_external_assets, request.layers)
     defaults = render_defaults(stage)
     unknown = [n for n in defaults.var_names if n not in OUTPUT_NAMES]
@@ -194,6 +195,7 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
     inst_counts = np.bincount(rendered.instance_ids.ravel(), minlength=len(snapshot.instances) + 1)
     class_counts = np.bincount(rendered.class_ids.ravel(), minlength=256)
     hap, vap = camera.conformed_aperture_mm(w, h)
+    view = record_camera(camera, (w, h), (w, h), name=camera.path.rsplit("/", 1)[-1], rig_type=None)
     instances = []
     for inst in snapshot.instances:
         entry = inst.to_dict()
@@ -205,25 +207,17 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
         "stage": str(stage_path),
         "time_code": time_code,
         "image": {"width": w, "height": h},
+        # a record's camera and render blocks (the same builders), with what only frame.json says
         "camera": {
-            "prim_path": camera.path,
-            "focal_length_mm": camera.focal_length_mm,
-            "horizontal_aperture_mm": camera.horizontal_aperture_mm,
-            "vertical_aperture_mm": camera.vertical_aperture_mm,
+            **{k: v for k, v in view.items() if k not in ("name", "rig_type", "distortion")},
             "conformed_aperture_mm": [hap, vap],
             "aspect_ratio_conform_policy": CONFORM_EXPAND,
             "fov_deg": list(camera.fov_deg(w, h)),
-            "clipping_range_m": [camera.clip_near_m, camera.clip_far_m],
-            "K": camera.intrinsics(w, h).tolist(),
-            "camera_to_world": camera.camera_to_world.tolist(),
-            "world_to_camera_opencv": camera.world_to_camera_opencv().tolist(),
             "conventions": "camera_to_world: column vectors, camera looks down -Z with +Y up (USD); "
                            "world_to_camera_opencv and K: x right, y down, z forward, pixel centres at +0.5",
         },
-        "render": {"renderer": "mitsuba", "variant": rendered.variant, "spp": config.spp,
-                   "max_depth": config.max_depth, "pixel_filter": config.pixel_filter, "seed": config.seed,
-                   "denoise": rendered.denoised,
-                   "labels": "one ray through each pixel centre", "seconds": rendered.seconds},
+        "render": {"renderer": "mitsuba", **record_render(config, rendered.variant, rendered.denoised),
+                   "seed": config.seed, "labels": "one ray through each pixel centre", "seconds": rendered.seconds},
         "files": {f.key: f.document() for o in outputs for f in o.files},
         "class_map": {"source": class_map.source, "taxonomy": class_map.taxonomy,
                       "classes": [c.to_dict() for c in class_map.classes]},
@@ -232,6 +226,6 @@ def frame_document(stage_path: Path, outputs: tuple[RenderOutput, ...], *, time_
         "condition": rendered.condition.to_dict() if rendered.condition is not None else None,
         "exposure": rendered.exposure.to_dict() if rendered.exposure is not None else None,
     }
-    if camera.distortion is not None:  # K is the ideal pinhole's; pixels went through this lens model
-        document["camera"]["distortion"] = camera.distortion.to_dict()
+    if view["distortion"] is not None:  # K is the ideal pinhole's; pixels went through this lens model
+        document["camera"]["distortion"] = view["distortion"]
     return document

@@ -37,10 +37,9 @@ from synthua_usd.core.resources import check_frame_memory
 from synthua_usd.dataset import coverage, sampling
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, coco, panoptic, tables, yolo
-from synthua_usd.dataset.formats.records import is_rejected
 from synthua_usd.dataset.layout import SPLITS, Layout, cityscapes_city
-from synthua_usd.dataset.manifest import document_digest, file_entry, manifest_document
-from synthua_usd.dataset.record import ImageRecord
+from synthua_usd.dataset.manifest import document_digest, file_entry, files_written, manifest_document
+from synthua_usd.dataset.record import IMAGE, ImageRecord, is_rejected, read_record
 from synthua_usd.model.render_config import RenderConfig, resolve_render
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline import view_scores
@@ -171,7 +170,7 @@ def generate(request: GenerateRequest, show_progress: bool = False) -> GenerateS
     check_not_inputs([request.out_dir], {"SCENARIO": request.scenario, "--config": request.config_path,
                                          "--class-map": request.class_map_path}, whole_folder=True)
     config = GenerationConfig.load(request.config_path)
-    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(request.class_map_path)
     stage, pool, cameras, render, stack = _stage_facts(request, config, class_map)
     output_size = config.output_size(render.width, render.height)  # a resample larger than the render is refused here
     check_frame_memory(render.width, render.height)
@@ -440,22 +439,18 @@ def _remove_partial_files(out: Path) -> None:
 
 
 def _complete_records(layout: Layout, plan) -> dict[int, ImageRecord]:
-    """Records of planned images already complete: a record that parses, names the planned image, and whose
-    files all exist with their recorded sizes (checksums are ``synthua verify``'s job)."""
+    """Records of planned images already complete: a record that validates (:func:`read_record`), names the planned
+    image, and whose files all exist with their recorded sizes (checksums are ``synthua verify``'s job)."""
     from synthua_usd.dataset.layout import image_name
 
     done = {}
     for p in plan:
         name = image_name(p.id, p.camera_name, p.time_code, p.condition, p.seed)
         try:
-            record = json.loads(layout.path(Layout.record(name)).read_text(encoding="utf-8"))
-            entries = record.get("checksums", {})
-            complete = record.get("id") == p.id and entries and all(
-                layout.path(e["path"]).is_file() and layout.path(e["path"]).stat().st_size == e["bytes"]
-                for e in entries.values())
-        except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError):
-            continue  # unreadable, or an edited record naming paths outside the dataset: render it again
-        if complete:
+            record = read_record(layout.path(Layout.record(name)), IMAGE)
+        except (InputError, OutputError):
+            continue  # not there, unreadable or not a record: render it again
+        if record["id"] == p.id and files_written(layout.root, record["checksums"]):
             done[p.id] = record
     return done
 

@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from synthua_usd.backends.detector.runner import run_job
+from synthua_usd.pipeline.detector.runner import run_job
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.schemas import read_json

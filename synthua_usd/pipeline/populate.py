@@ -37,7 +37,7 @@ def populate(request: PopulateRequest) -> tuple[Crowd, Path, float]:
     t0 = time.perf_counter()
     out = check_layer_path(request.out_path, "the agents layer")
     check_not_inputs([out], {"TWIN_OR_SCENARIO": request.stage_path, "--class-map": request.class_map_path})
-    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(request.class_map_path)
     unknown = [c for c in request.params.walkable if class_map.resolve(c) is None]
     if unknown:
         raise InputError(f"walkable classes {unknown} are not classes of {class_map.source}")

@@ -257,12 +257,9 @@ def _from_record(path: Path) -> tuple:
     from synthua_usd.core.errors import InputError
     from synthua_usd.core.schemas import read_json
     from synthua_usd.dataset.layout import Layout
-    from synthua_usd.dataset.record import IMAGE, ImageRecord, record_problem
+    from synthua_usd.dataset.record import IMAGE, read_record
 
-    record: ImageRecord = read_json(path, "an image record of a dataset (records/NAME.json)")
-    problem = record_problem(record, IMAGE)
-    if problem is not None:
-        raise InputError(f"{path}: not a dataset image record: {problem}")
+    record = read_record(path, IMAGE)
     job_path = Path(path).resolve().parent.parent / Layout.CONFIG
     job = read_json(job_path, "the generate.json of the record's dataset")
     try:
@@ -307,7 +304,7 @@ def randomise_image(request: RandomiseRequest) -> RandomiseResult:
     if config.randomise is None:
         raise InputError(f"{source}: has no randomise block; expected a config that randomises scenes (see "
                          f"schemas/generate.schema.json, randomise)")
-    class_map = ClassMap.load(request.class_map_path) if request.class_map_path else ClassMap.default()
+    class_map = ClassMap.load_or_bundled(request.class_map_path)
     scenario, key = Path(request.scenario), scene_of(config.randomise, seed)
     if key is not None:
         # the seed's scene lies in another scenario: the dataset's copy of it, or one written beside --out

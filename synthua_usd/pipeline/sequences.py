@@ -19,7 +19,6 @@ Scene randomisation does not apply to sequences: they render the scenario (and t
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -27,14 +26,15 @@ from pathlib import Path
 import numpy as np
 
 from synthua_usd.core.atomic import write_json_atomic, write_text_atomic
+from synthua_usd.core.errors import InputError, OutputError
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import mot
 from synthua_usd.dataset.layout import Layout
-from synthua_usd.dataset.manifest import file_entry
-from synthua_usd.dataset.record import SEQUENCE_FRAME, SequenceFrameRecord, check_record
+from synthua_usd.dataset.manifest import file_entry, files_written
+from synthua_usd.dataset.record import SEQUENCE_FRAME, SequenceFrameRecord, check_record, read_record, record_camera
 from synthua_usd.dataset.sequences import PlannedFrame, PlannedSequence
 from synthua_usd.model.taxonomy import ClassMap
-from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, camera_document, init_worker, render_annotated
+from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, render_annotated
 
 #: Where a sequence crowd's agents live (the scenario's stay under /World/Agents, deactivated).
 SEQUENCE_AGENTS = "/World/SequenceAgents"
@@ -125,7 +125,7 @@ def work_frame(state, item) -> list[dict]:
 
 
 def _write_frame(state, frame: PlannedFrame, annotated) -> dict:
-    from synthua_usd.backends import images
+    from synthua_usd.backends import frame_files
 
     t0 = time.perf_counter()
     job = state.sequence_job.worker
@@ -134,16 +134,16 @@ def _write_frame(state, frame: PlannedFrame, annotated) -> dict:
     files = {kind: Layout.sequence_frame(seq.name, frame.frame, kind) for kind in FRAME_KINDS[:2]}
     for rel in files.values():
         layout.path(rel).parent.mkdir(parents=True, exist_ok=True)
-    quality = job.config.sequences.jpeg_quality
-    images.write_color_jpeg(layout.path(files["img1"]), annotated.display(), quality)
-    images.write_id_png(layout.path(files["instances"]), annotated.instance_ids)
+    writers = frame_files.file_writers(jpeg_quality=job.config.sequences.jpeg_quality)
+    writers["img1"](layout.path(files["img1"]), annotated.display())
+    writers["instances"](layout.path(files["instances"]), annotated.instance_ids)
     tracked = set(mot.tracked(state.class_map))
     rendered = annotated.rendered
     record = SequenceFrameRecord(
         sequence=seq.name, frame=frame.frame, time_code=frame.time_code, seed=seq.seed,
         width=annotated.width, height=annotated.height,
-        camera=camera_document(annotated.camera, seq, job.render.width, job.render.height, annotated.width,
-                               annotated.height),
+        camera=record_camera(annotated.camera, (job.render.width, job.render.height),
+                             (annotated.width, annotated.height), name=seq.camera_name, rig_type=seq.rig_type),
         condition=annotated.condition.to_dict() if annotated.condition is not None else None,
         exposure=rendered.exposure.to_dict() if rendered.exposure is not None else None,
         files=files,
@@ -158,21 +158,17 @@ def _write_frame(state, frame: PlannedFrame, annotated) -> dict:
     return {"record": record, "seconds": seconds}
 
 
-def complete_frames(layout: Layout, sequences: list[PlannedSequence]) -> dict[tuple[str, int], dict]:
-    """Records of frames already complete: a record that parses, names its frame, and whose files exist with
-    their recorded sizes."""
+def complete_frames(layout: Layout, sequences: list[PlannedSequence]) -> dict[tuple[str, int], SequenceFrameRecord]:
+    """Records of frames already complete: a record that validates (:func:`read_record`), names its frame, and whose
+    files exist with their recorded sizes (:func:`synthua_usd.dataset.manifest.files_written`)."""
     done = {}
     for seq in sequences:
         for k in range(1, seq.frames + 1):
-            path = layout.path(Layout.sequence_frame(seq.name, k, "records"))
             try:
-                record = json.loads(path.read_text(encoding="utf-8"))
-                ok = record.get("frame") == k and record.get("sequence") == seq.name and all(
-                    layout.path(e["path"]).is_file() and layout.path(e["path"]).stat().st_size == e["bytes"]
-                    for e in record["checksums"].values())
-            except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError):
-                continue
-            if ok:
+                record = read_record(layout.path(Layout.sequence_frame(seq.name, k, "records")), SEQUENCE_FRAME)
+            except (InputError, OutputError):
+                continue  # not there, unreadable or not a frame's record: render it again
+            if record["frame"] == k and record["sequence"] == seq.name and files_written(layout.root, record["checksums"]):
                 done[(seq.name, k)] = record
     return done
 
@@ -219,13 +215,13 @@ def assemble_sequences(layout: Layout, sequences: list[PlannedSequence], records
 def boxed_frame(layout: Layout, record: dict, class_map: ClassMap) -> np.ndarray:
     """(H, W, 3) uint8: a sequence frame's image with the amodal box, id and class of every tracked object drawn,
     a device in its user's colour (what the preview video shows)."""
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
     from synthua_usd.backends.video import draw_boxes
 
     mot_classes = mot.tracked(class_map)
     instances = [e for e in record["instances"] if e["class_name"] in mot_classes]
-    user_of = {(e.get("relations") or {}).get("uses"): e["id"] for e in instances}
-    boxes = [(*(int(v) for v in (e.get("amodal_bbox") or e["bbox"])), user_of.get(e["prim_path"], e["id"]),
+    user_of = {e["relations"].get("uses"): e["id"] for e in instances}
+    boxes = [(*(int(v) for v in e["amodal_bbox"]), user_of.get(e["prim_path"], e["id"]),
               f"{e['id']} {e['class_name']}") for e in instances]
     return draw_boxes(read_image(layout.path(record["files"]["img1"]))[0][..., :3], boxes)
 

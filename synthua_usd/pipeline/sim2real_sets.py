@@ -15,7 +15,7 @@ from synthua_usd.analytics.class_mapping import build_mapping
 from synthua_usd.analytics.detection_sets import DetectionSet
 from synthua_usd.analytics.detection_sources import read_detection_set
 from synthua_usd.analytics.detection_targets import read_generated, targets_for
-from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
+from synthua_usd.pipeline.detector.yolo_data import write_yolo_boxes
 from synthua_usd.core.atomic import write_json_atomic
 from synthua_usd.core.errors import InputError
 

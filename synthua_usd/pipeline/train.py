@@ -36,8 +36,8 @@ from synthua_usd import __version__
 from synthua_usd.analytics.detection_sets import DetectionSet, MissingSplit
 from synthua_usd.analytics.detection_sources import manifest_sha256, read_detection_set, set_id
 from synthua_usd.analytics.detection_targets import DetectionTargets
-from synthua_usd.backends.detector.runner import count_in, find_detector_python, run_job
-from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
+from synthua_usd.pipeline.detector.runner import count_in, find_detector_python, run_job
+from synthua_usd.pipeline.detector.yolo_data import write_yolo_boxes
 from synthua_usd.core.atomic import output_set, write_json_atomic
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_guard import check_not_inputs

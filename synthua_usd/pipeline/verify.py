@@ -35,7 +35,7 @@ from synthua_usd.core.schemas import read_json, type_name
 from synthua_usd.dataset.annotations import rle_problem
 from synthua_usd.dataset.layout import SPLITS, Layout
 from synthua_usd.dataset.manifest import read_manifest, sha256_file
-from synthua_usd.dataset.record import SEQUENCE_FRAME, ImageRecord, image_kind, record_problem
+from synthua_usd.dataset.record import SEQUENCE_FRAME, ImageRecord, is_rejected, read_record
 
 #: Problems listed in full; beyond this many, verify counts the rest.
 MAX_LISTED = 50
@@ -81,6 +81,22 @@ def _document(layout: Layout, relative: str, what: str, result: Verification):
         return read_json(path, what) if path.exists() else None
     except (InputError, OutputError) as exc:
         result.add(f"{relative}: {echo(exc, 240)}")
+        return None
+
+
+def _record(layout: Layout, relative: str, result: Verification, kind: str | None = None):
+    """The record ``relative`` of the dataset read and validated (:func:`synthua_usd.dataset.record.read_record`; of
+    ``kind``, a dataset image's when None), or None when it is absent (the checksums report that) or is no such
+    record (a problem naming ``relative`` is added)."""
+    path = layout.path(relative)
+    if not path.exists():
+        return None
+    try:
+        return read_record(path, kind)
+    except (InputError, OutputError) as exc:
+        text = str(exc)
+        said = f"{shown(path)}: "
+        result.add(f"{relative}: {echo(text[len(said):] if text.startswith(said) else text, 240)}")
         return None
 
 
@@ -131,7 +147,6 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         result.files += 1
         if not _check_file(layout, entry, result):
             damaged.add(entry["path"])
-    from synthua_usd.dataset.formats.records import is_rejected
     from synthua_usd.dataset.formats.yolo import class_index
     from synthua_usd.model.taxonomy import ClassMap
 
@@ -143,17 +158,12 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         class_map, yolo_classes = None, {}
     records = []
     for img in manifest["images"]:
-        relative = Layout.record(img["name"])
-        record = _document(layout, relative, "an image record", result)
-        if record is None:
-            continue
-        problem = record_problem(record, image_kind(record))
-        if problem is None:
+        record = _record(layout, Layout.record(img["name"]), result)
+        if record is not None:
             records.append(record)
-        else:
-            result.add(f"{relative}: not an image record: {problem}")
     result.images = len(records)
-    coco_by_image, coco_images = {}, {}
+    coco_by_image: dict[int, list[dict]] = {}
+    coco_images: dict[int, str] = {}
     for split in SPLITS:
         relative = Layout.coco_instances(split)
         document = _document(layout, relative, "COCO instances", result)
@@ -172,9 +182,9 @@ def verify(root: Path, show_progress: bool = False) -> Verification:
         result.add(f"COCO annotations of image {echo(image_id)}: no such image kept in the dataset (unknown or "
                    f"rejected)")
     for image_id, record in kept.items():
-        if coco_images.get(image_id) != record.get("split"):
+        if coco_images.get(image_id) != record["split"]:
             result.add(f"image {image_id} ({record['name']}): not among the COCO images of its split "
-                       f"{echo(record.get('split'))}")
+                       f"{echo(record['split'])}")
     panoptic_by_image = {}
     for split in SPLITS:
         relative = Layout.coco_panoptic(split)
@@ -221,15 +231,12 @@ def _check_sequences(layout: Layout, planned: list, class_map, damaged: set, res
             result.add(f"{Layout.CONFIG}: sequences: {echo(exc)}; expected the sequences generate plans")
             continue
         result.sequences += 1
-        pairs, tracks = [], {}
+        pairs = []
+        tracks: dict[int, tuple] = {}
         for k in range(1, seq.frames + 1):
             relative = Layout.sequence_frame(seq.name, k, "records")
-            record = _document(layout, relative, "a sequence frame's record", result)
+            record = _record(layout, relative, result, SEQUENCE_FRAME)
             if record is None:
-                continue
-            problem = record_problem(record, SEQUENCE_FRAME)
-            if problem is not None:
-                result.add(f"{relative}: not a sequence frame's record: {problem}")
                 continue
             result.frames += 1
             try:
@@ -239,7 +246,7 @@ def _check_sequences(layout: Layout, planned: list, class_map, damaged: set, res
                 ids = None if ids_path in damaged else _read(layout, ids_path)
                 for entry in instances:
                     tid = int(entry["id"])
-                    seen = (entry["prim_path"], entry["class_name"], (entry.get("relations") or {}).get("uses"))
+                    seen = (entry["prim_path"], entry["class_name"], entry["relations"].get("uses"))
                     if tracks.setdefault(tid, seen) != seen:
                         result.add(f"sequence {seq.name} frame {k}: track {tid} is {echo(seen)}, earlier "
                                    f"{echo(tracks[tid])}; expected a track to keep its prim, class and link")
@@ -298,7 +305,7 @@ def _check_file(layout: Layout, entry: dict, result: Verification) -> bool:
 
 
 def _read(layout: Layout, relative: str) -> np.ndarray:
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
 
     pixels, _ = read_image(layout.path(relative))
     return pixels
@@ -467,7 +474,7 @@ def _check_cityscapes(layout: Layout, where: str, record: ImageRecord, instance_
     files = record["files"]
     instances = [Instance(int(i["id"]), str(i["prim_path"]), int(i["category_id"]), str(i["class_name"]),
                           bool(i["isthing"])) for i in record["instances"]]
-    ignored = {int(i["id"]) for i in record["instances"] if i.get("ignore")}
+    ignored = {int(i["id"]) for i in record["instances"] if i["ignore"]}
     try:
         _, expected_ids, expected_color = cityscapes_arrays(class_ids.astype(np.uint8), instance_ids.astype(np.uint16),
                                                             instances, class_map, ignored)
@@ -596,9 +603,8 @@ def _compare(root: Path, remake) -> Replay:
             record = remake(scratch)
         out = Replay(record["id"], record["name"])
         record_path = Layout.record(record["name"])
-        original = _document(layout, record_path, "an image record", Verification())
-        theirs = (set(original["files"].values()) if record_problem(original, image_kind(original)) is None
-                  else set())
+        original = _record(layout, record_path, Verification())
+        theirs = set() if original is None else set(original["files"].values())
         for rel in sorted(set(record["files"].values()) | theirs | {record_path}):
             ours = _sha256_or_none(scratch / rel)
             same = ours is not None and ours == _sha256_or_none(layout.path(rel))

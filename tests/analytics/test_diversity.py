@@ -12,7 +12,7 @@ import pytest
 from synthua_usd.analytics.dataset_index import load_index
 from synthua_usd.analytics.diversity import colour_name, diversity
 from synthua_usd.assets.bodies import load_bank
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 
 
 @pytest.mark.parametrize("rgb, name", [((0.0, 0.0, 0.0), "black"), ((1.0, 1.0, 1.0), "white"),

@@ -111,8 +111,11 @@ def test_a_folder_without_manifest_is_refused(tmp_path):
 def test_a_broken_record_is_one_error(tmp_path):
     root = tiny_dataset.write(tmp_path / "ds")
     (root / "records" / f"{tiny_dataset.NAMES[0]}.json").write_text('{"id": 1}')
-    with pytest.raises(InputError, match="expected an image record written by `synthua generate`"):
+    with pytest.raises(InputError, match=r"records/000001_CCTV_t0001_clear-day_s0\.json: not an image record: "
+                                         r"\(document\): 'camera' is a required property; expected a document "
+                                         r"matching \$defs/image of record\.schema\.json") as caught:
         load_index(root)
+    assert "\n" not in str(caught.value)
 
 
 def test_a_dataset_without_images_is_refused(tmp_path):

@@ -22,6 +22,7 @@ from PIL import Image
 from pycocotools import mask as mask_utils
 from scipy import ndimage
 
+from synthua_usd.model.conditions import shipped
 from synthua_usd.model.taxonomy import ClassMap
 
 H, W = 6, 8
@@ -53,6 +54,27 @@ def _rle(mask: np.ndarray) -> dict:
 def _bbox(mask: np.ndarray) -> list[int]:
     ys, xs = np.nonzero(mask)
     return [int(xs.min()), int(ys.min()), int(xs.max() - xs.min() + 1), int(ys.max() - ys.min() + 1)]
+
+
+#: What a record says the images were rendered with (read by none of the analytics: the schema requires it).
+_RENDER = {"variant": "scalar_rgb", "spp": 1, "pixel_filter": "box", "max_depth": 4, "width": W, "height": H,
+           "denoise": None}
+
+
+def _camera(name: str, rig_type: str) -> dict:
+    """A record's camera block (``$defs/camera``): a pinhole looking down -Z at the origin."""
+    return {"prim_path": f"/World/Cameras/{name}", "name": name, "rig_type": rig_type,
+            "K": [[10.0, 0.0, W / 2], [0.0, 10.0, H / 2], [0.0, 0.0, 1.0]], "camera_to_world": np.eye(4).tolist(),
+            "world_to_camera_opencv": np.diag([1.0, -1.0, -1.0, 1.0]).tolist(), "focal_length_mm": 35.0,
+            "horizontal_aperture_mm": 36.0, "vertical_aperture_mm": 27.0, "clipping_range_m": [0.1, 1000.0],
+            "distortion": None}
+
+
+def _files(name: str, split: str) -> dict:
+    """The files a record lists (the ones the schema requires; only rgb_png and class are written here)."""
+    return {"rgb_png": f"images/{split}/{name}.png", "class": f"frames/{name}/class.png",
+            "semantic": f"frames/{name}/semantic.png", "instance": f"frames/{name}/instance.png",
+            "instance_preview": f"frames/{name}/instance_preview.png"}
 
 
 def write(root: Path) -> Path:
@@ -88,7 +110,8 @@ def write(root: Path) -> Path:
                 cid, f"/World/Twin/Thing_{image_id}_{iid}")
             entry = {"id": iid, "category_id": cid, "class_name": c.name, "isthing": True, "area": int(mask.sum()),
                      "amodal_area": amodal, "occlusion": 1 - int(mask.sum()) / amodal, "bbox": _bbox(mask),
-                     "segmentation": _rle(mask), "prim_path": prim, "relations": relations}
+                     "segmentation": _rle(mask), "amodal_bbox": _bbox(mask), "amodal_segmentation": _rle(mask),
+                     "truncation": 0.0, "prim_path": prim, "relations": relations, "ignore": False}
             instances.append(entry)
             segments.append({"id": iid, "category_id": cid, "area": int(mask.sum()), "bbox": _bbox(mask), "iscrowd": 0})
             ann_id += 1
@@ -102,9 +125,11 @@ def write(root: Path) -> Path:
                                  "bbox": _bbox(mask), "iscrowd": 0})
         pixels = {cmap.by_id(int(v)).name: int((cls == v).sum()) for v in np.unique(cls)}
         record = {"id": image_id, "name": name, "split": split, "width": W, "height": H, "seed": 0,
-                  "time_code": 1.0, "camera": {"name": name.split("_")[1], "rig_type": rigs[k]},
-                  "condition": {"name": conditions[k]}, "class_pixel_counts": pixels, "instances": instances,
-                  "panoptic_segments": segments, "qa": {"verdict": verdicts[k], "reasons": [], "measures": {}}}
+                  "time_code": 1.0, "camera": _camera(name.split("_")[1], rigs[k]),
+                  "condition": shipped(conditions[k]).to_dict(), "exposure": None, "render": _RENDER,
+                  "layer_stack": "0" * 64, "files": _files(name, split), "class_pixel_counts": pixels,
+                  "instances": instances, "panoptic_segments": segments,
+                  "qa": {"verdict": verdicts[k], "reasons": [], "measures": {}}, "checksums": {}}
         (root / "records" / f"{name}.json").write_text(json.dumps(record))
         manifest["images"].append({"id": image_id, "name": name, "split": split, "seed": 0, "qa": verdicts[k],
                                    "files": []})

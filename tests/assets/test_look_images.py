@@ -9,7 +9,7 @@ import pytest
 
 from synthua_usd.assets.garments import EYE_HALF_SPACING_M, FACE_SPAN_M, SHOE_TILE_M
 from synthua_usd.assets.look_images import (FABRICS, FACE_OFFSET, SHOES, image_path, look_images, two_colour)
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import pytest
 
 from conftest import SCENARIO
 from synthua_usd.backends.contact_sheet import GAP_PX, HEADER_PX, SIDE_PX, TITLE_PX
-from synthua_usd.backends.images import linear_to_display, read_image
+from synthua_usd.core.images import linear_to_display, read_image
 from synthua_usd.core.schemas import validate_document
 
 TINY = ("--width", "32", "--height", "24", "--spp", "2")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import DATA, SCENARIO
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 from synthua_usd.core.outputs import file_names
 from synthua_usd.core.schemas import validate_document
 

@@ -145,7 +145,7 @@ def test_a_yolo_label_path_that_is_a_folder_is_refused(refuse, workdir):
 # --- train ------------------------------------------------------------------------------------------------------------
 
 def test_train_refuses_an_image_of_width_zero(refuse, workdir):
-    """ZeroDivisionError in backends/detector/yolo_data.py."""
+    """ZeroDivisionError in pipeline/detector/yolo_data.py."""
     coco = _coco(workdir / "photos", image_width=0)
     refuse("train", coco, "--epochs", "1", *NO_DETECTOR, "--out", workdir / "o", mentions=("images[0].width",))
 

@@ -14,7 +14,7 @@ import pytest
 
 from hostile import assert_refused, run_synthua
 from reference_raycast import meshes_hit, reference_labels
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 from synthua_usd.pipeline.bank_check import check_bank
 from synthua_usd.pipeline.cutouts import BANK_FILE, CutoutJob, CutoutWorker, make_bank
 from synthua_usd.randomisation.cutouts import CutoutsConfig

@@ -16,7 +16,7 @@ import pytest
 from conftest import SCENARIO, TINY_CONFIG, generate_dataset
 from dataset_runs import records, tree_bytes
 from hostile import assert_refused, run_synthua, tree_state
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.pipeline.verify import verify
 

@@ -13,7 +13,7 @@ import pytest
 from conftest import DATA, built_once, generate_dataset
 from dataset_runs import records
 from synthua_usd.backends.camera_effects import apply_effects
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 from synthua_usd.pipeline.verify import verify
 from synthua_usd.randomisation.config import EFFECTS
 from synthua_usd.randomisation.effects import EffectsDraw

@@ -13,7 +13,7 @@ import pytest
 
 from conftest import DATA, RANDOM_CONFIG, SCENARIO, generate_dataset
 from hostile import assert_refused, run_synthua
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 from synthua_usd.pipeline.verify import verify
 from dataset_runs import kill_when, records, tree_bytes
 

@@ -175,7 +175,7 @@ def test_randomise_refuses_a_malformed_record_with_one_line_naming_its_field(tmp
     record = tmp_path / "dataset" / "records" / "000001_x.json"
     record.parent.mkdir(parents=True)
     record.write_text(json.dumps({"id": 1, "seed": "zero"}))
-    with pytest.raises(InputError, match=r"000001_x\.json: not a dataset image record: \(document\): 'camera' is a "
+    with pytest.raises(InputError, match=r"000001_x\.json: not an image record: \(document\): 'camera' is a "
                                          r"required property; expected a document matching \$defs/image of "
                                          r"record\.schema\.json"):
         randomise_image(RandomiseRequest(scenario=SCENARIO, out=tmp_path / "layer.usda", record_path=record))
@@ -265,7 +265,7 @@ def _looked_up_albedo(snapshot, camera, W: int, H: int):
     has a base-colour texture, the texture's value there: the reader's st interpolated barycentrically, the image
     read by OpenImageIO (raw, 8-bit), bilinear with its wrap mode, times its scale plus its bias, clipped to [0, 1].
     Returns (H*W, 3) values and the (H*W,) mask of the pixels looked up."""
-    from synthua_usd.backends.images import read_image
+    from synthua_usd.core.images import read_image
     from trimesh.ray.ray_pyembree import RayMeshIntersector
     import trimesh
 

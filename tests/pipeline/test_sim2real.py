@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from synthua_usd.backends.detector.runner import DetectorUnavailable, find_detector_python
+from synthua_usd.pipeline.detector.runner import DetectorUnavailable, find_detector_python
 from synthua_usd.cli.main import main
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from synthua_usd.backends import images
+from synthua_usd.core import images
 from synthua_usd.core import json_text
 from synthua_usd.core.errors import SynthuaError
 

@@ -17,7 +17,7 @@ the three underscore-separated fields ``getCsFileInfo`` expects.
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import AbstractSet, Sequence
 
 import numpy as np
 
@@ -30,7 +30,7 @@ MAX_INSTANCES_PER_CLASS = 1000
 
 
 def cityscapes_arrays(class_ids: np.ndarray, instance_ids: np.ndarray, instances: Sequence[Instance],
-                      class_map: ClassMap, ignored: set[int] = frozenset()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                      class_map: ClassMap, ignored: AbstractSet[int] = frozenset()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The three gtFine images of one frame.
 
     Parameters

@@ -30,8 +30,8 @@ from __future__ import annotations
 from typing import Iterable
 
 from synthua_usd.core.errors import InputError
-from synthua_usd.dataset.formats.records import image_entry, is_rejected, ordered
-from synthua_usd.dataset.record import ImageRecord
+from synthua_usd.dataset.formats.records import image_entry, ordered
+from synthua_usd.dataset.record import DatasetRecord, InstanceEntry, is_rejected
 from synthua_usd.model.keypoint_classes import KEYPOINT_CLASSES
 from synthua_usd.model.taxonomy import ClassMap
 
@@ -49,7 +49,7 @@ def categories(class_map: ClassMap) -> list[dict]:
     return out
 
 
-def _keypoint_fields(record: ImageRecord, inst: dict, class_name: str) -> dict:
+def _keypoint_fields(record: DatasetRecord, inst: InstanceEntry, class_name: str) -> dict:
     """``keypoints`` and ``num_keypoints`` of an instance of ``class_name``, a class with keypoints (module
     docstring)."""
     names = KEYPOINT_CLASSES[class_name].names
@@ -62,7 +62,7 @@ def _keypoint_fields(record: ImageRecord, inst: dict, class_name: str) -> dict:
     return {"keypoints": list(found["keypoints"]), "num_keypoints": int(found["num_keypoints"])}
 
 
-def annotation_ids(records: Iterable[ImageRecord], class_map: ClassMap) -> dict[tuple[int, int], int]:
+def annotation_ids(records: Iterable[DatasetRecord], class_map: ClassMap) -> dict[tuple[int, int], int]:
     """(image id, instance id) -> annotation id, unique across the whole dataset (all splits): 1, 2, ... in
     image-id order, then in each record's instance order. Rejected images take no ids."""
     things = {c.id for c in class_map.classes if c.isthing and c.id >= 1}
@@ -76,7 +76,7 @@ def annotation_ids(records: Iterable[ImageRecord], class_map: ClassMap) -> dict[
     return out
 
 
-def coco_instances(records: Iterable[ImageRecord], class_map: ClassMap, split: str) -> dict:
+def coco_instances(records: Iterable[DatasetRecord], class_map: ClassMap, split: str) -> dict:
     """The COCO instances document of ``split``.
 
     Parameters
@@ -107,15 +107,15 @@ def coco_instances(records: Iterable[ImageRecord], class_map: ClassMap, split: s
             if ann_id is None:
                 continue
             name = class_map.by_id(int(inst["category_id"])).name
-            relations = dict(inst.get("relations") or {})
-            for relation, target in sorted(relations.items()):  # uses, pushes, accompanies -> annotated target
+            relations: dict[str, str | int] = dict(inst["relations"])
+            for relation, target in sorted(inst["relations"].items()):  # uses, pushes, accompanies -> annotated target
                 annotated = None if relation.endswith("_class") else by_path.get(target)
                 if annotated is not None:
                     relations[f"{relation}_annotation_id"] = annotated
             annotations.append({
                 "id": ann_id, "image_id": int(record["id"]), "category_id": int(inst["category_id"]),
                 "segmentation": inst["segmentation"], "area": int(inst["area"]),
-                "bbox": [float(v) for v in inst["bbox"]], "iscrowd": int(bool(inst.get("ignore"))),
+                "bbox": [float(v) for v in inst["bbox"]], "iscrowd": int(inst["ignore"]),
                 "amodal_segmentation": inst["amodal_segmentation"], "amodal_area": int(inst["amodal_area"]),
                 "amodal_bbox": [float(v) for v in inst["amodal_bbox"]],
                 "occlusion": float(inst["occlusion"]), "truncation": float(inst["truncation"]),

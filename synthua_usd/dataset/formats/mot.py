@@ -26,6 +26,7 @@ from __future__ import annotations
 import csv
 import io
 
+from synthua_usd.dataset.record import InstanceEntry
 from synthua_usd.model.taxonomy import ClassMap
 
 #: Class-map groups whose instances are tracked.
@@ -51,12 +52,12 @@ def tracked(class_map: ClassMap) -> dict[str, int]:
     return out
 
 
-def visibility(entry: dict) -> float:
+def visibility(entry: InstanceEntry) -> float:
     """1 - occlusion: the visible share of the amodal mask (0..1)."""
-    return max(0.0, min(1.0, 1.0 - float(entry.get("occlusion") or 0.0)))
+    return max(0.0, min(1.0, 1.0 - float(entry["occlusion"])))
 
 
-def gt_rows(frames: list[tuple[int, list[dict]]], class_map: ClassMap) -> list[tuple]:
+def gt_rows(frames: list[tuple[int, list[InstanceEntry]]], class_map: ClassMap) -> list[tuple]:
     """The rows of ``gt.txt`` from ``(frame, record instances)`` pairs, sorted by frame then id."""
     mot = tracked(class_map)
     rows = []
@@ -64,7 +65,7 @@ def gt_rows(frames: list[tuple[int, list[dict]]], class_map: ClassMap) -> list[t
         for entry in instances:
             if entry["class_name"] not in mot:
                 continue
-            x, y, w, h = entry.get("amodal_bbox") or entry["bbox"]
+            x, y, w, h = entry["amodal_bbox"]
             rows.append((int(frame), int(entry["id"]), int(x) + 1, int(y) + 1, int(w), int(h), 1,
                          mot[entry["class_name"]], round(visibility(entry), 6)))
     return sorted(rows)
@@ -74,17 +75,17 @@ def gt_text(rows: list[tuple]) -> str:
     return "".join(",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in row) + "\n" for row in rows)
 
 
-def tracks_text(frames: list[tuple[int, list[dict]]], class_map: ClassMap) -> str:
+def tracks_text(frames: list[tuple[int, list[InstanceEntry]]], class_map: ClassMap) -> str:
     """``tracks.csv``: each tracked instance once, with the tracks it uses and is used by (ids, or empty)."""
     mot = tracked(class_map)
-    seen: dict[int, dict] = {}
+    seen: dict[int, InstanceEntry] = {}
     by_path: dict[str, int] = {}
     for _, instances in frames:
         for entry in instances:
             if entry["class_name"] in mot and int(entry["id"]) not in seen:
                 seen[int(entry["id"])] = entry
                 by_path[entry["prim_path"]] = int(entry["id"])
-    uses = {tid: by_path.get((e.get("relations") or {}).get("uses", "")) for tid, e in seen.items()}
+    uses = {tid: by_path.get(e["relations"].get("uses", "")) for tid, e in seen.items()}
     used_by = {target: tid for tid, target in uses.items() if target is not None}
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
@@ -107,7 +108,8 @@ def coco_video(sequences: list[dict], class_map: ClassMap) -> dict:
     and ``frames``, a list of ``(frame, image file relative to the dataset, record instances)``."""
     mot = tracked(class_map)
     categories = [{"id": c.id, "name": c.name, "supercategory": c.group} for c in class_map.classes if c.name in mot]
-    videos, images, annotations, tracks = [], [], [], {}
+    videos, images, annotations = [], [], []
+    tracks: dict[int, dict] = {}
     image_id = ann_id = 0
     for video_id, seq in enumerate(sequences, start=1):
         videos.append({"id": video_id, "name": seq["name"], "width": seq["width"], "height": seq["height"],
@@ -125,7 +127,7 @@ def coco_video(sequences: list[dict], class_map: ClassMap) -> dict:
                 annotations.append({"id": ann_id, "image_id": image_id, "video_id": video_id, "track_id": track_id,
                                     "category_id": entry["category_id"], "bbox": entry["bbox"], "area": entry["area"],
                                     "segmentation": entry["segmentation"], "iscrowd": 0,
-                                    "amodal_bbox": entry.get("amodal_bbox"), "visibility": visibility(entry)})
+                                    "amodal_bbox": entry["amodal_bbox"], "visibility": visibility(entry)})
     return {"info": {"description": "synthua-usd tracking sequences (COCO video, TAO layout)"}, "videos": videos,
             "images": images, "annotations": annotations, "tracks": [tracks[k] for k in sorted(tracks)],
             "categories": categories}

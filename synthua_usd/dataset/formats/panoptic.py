@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import Iterable
 
 from synthua_usd.dataset.formats.records import image_entry, in_split
-from synthua_usd.dataset.record import ImageRecord
+from synthua_usd.dataset.record import DatasetRecord
 from synthua_usd.model.taxonomy import ClassMap
 
 
@@ -22,7 +22,7 @@ def panoptic_categories(class_map: ClassMap) -> list[dict]:
              "color": list(c.color)} for c in class_map.classes if c.id >= 1]
 
 
-def coco_panoptic(records: Iterable[ImageRecord], class_map: ClassMap, split: str) -> dict:
+def coco_panoptic(records: Iterable[DatasetRecord], class_map: ClassMap, split: str) -> dict:
     """The COCO panoptic document of ``split`` (rejected images left out).
 
     Returns

@@ -1,21 +1,15 @@
-"""Which records (:class:`synthua_usd.dataset.record.ImageRecord`) a dataset-level format holds: one rule for every
-format."""
+"""Which records (:data:`synthua_usd.dataset.record.DatasetRecord`) a dataset-level format holds: one rule for every
+format (QA's rejected images are left out: :func:`synthua_usd.dataset.record.is_rejected`)."""
 
 from __future__ import annotations
 
 from typing import Iterable
 
 from synthua_usd.core.errors import InputError
-from synthua_usd.dataset.record import ImageRecord
+from synthua_usd.dataset.record import DatasetRecord, is_rejected
 
 
-def is_rejected(record: ImageRecord) -> bool:
-    """True when QA rejected the image: it is listed in the metadata table and ``rejected.csv``, never in an
-    annotation format."""
-    return (record.get("qa") or {}).get("verdict") == "rejected"
-
-
-def ordered(records: Iterable[ImageRecord]) -> list[ImageRecord]:
+def ordered(records: Iterable[DatasetRecord]) -> list[DatasetRecord]:
     """All records sorted by image id (formats are then the same whatever order workers finished in);
     duplicate ids raise :class:`InputError`."""
     out = sorted(records, key=lambda r: r["id"])
@@ -26,12 +20,12 @@ def ordered(records: Iterable[ImageRecord]) -> list[ImageRecord]:
     return out
 
 
-def in_split(records: Iterable[ImageRecord], split: str) -> list[ImageRecord]:
+def in_split(records: Iterable[DatasetRecord], split: str) -> list[DatasetRecord]:
     """The accepted or flagged records of ``split``, by image id."""
     return [r for r in ordered(records) if r["split"] == split and not is_rejected(r)]
 
 
-def image_entry(record: ImageRecord) -> dict:
+def image_entry(record: DatasetRecord) -> dict:
     """A COCO ``images`` entry: ``file_name`` relative to ``images/{split}/``."""
     return {"id": int(record["id"]), "file_name": f"{record['name']}.png",
             "width": int(record["width"]), "height": int(record["height"])}

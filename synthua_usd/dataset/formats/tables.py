@@ -30,7 +30,7 @@ from synthua_usd.core import json_text
 from synthua_usd.core.atomic import atomic_path
 from synthua_usd.core.errors import OutputError
 from synthua_usd.dataset.formats.records import ordered
-from synthua_usd.dataset.record import ImageRecord
+from synthua_usd.dataset.record import DatasetRecord
 from synthua_usd.model.taxonomy import ClassMap
 
 
@@ -46,54 +46,67 @@ def _scalar(value):
     return value
 
 
-def metadata_rows(records: Iterable[ImageRecord], class_map: ClassMap) -> list[dict]:
+def _camera_columns(record: DatasetRecord) -> dict:
+    """The camera's columns: a rendered image's camera prim, intrinsics and extrinsics; a composite's intrinsics only
+    (its photo's camera has no prim, lens or pose: None there)."""
+    if "composite" in record:
+        K = record["camera"]["K"]
+        return {"camera_path": None, "camera_name": None, "rig_type": None, "fx": float(K[0][0]), "fy": float(K[1][1]),
+                "cx": float(K[0][2]), "cy": float(K[1][2]), "focal_length_mm": None, "horizontal_aperture_mm": None,
+                "vertical_aperture_mm": None} | _matrix("camera_to_world", None) | _matrix("world_to_camera_opencv", None)
+    cam = record["camera"]
+    K = cam["K"]
+    return ({"camera_path": cam["prim_path"], "camera_name": cam["name"], "rig_type": cam["rig_type"],
+             "fx": float(K[0][0]), "fy": float(K[1][1]), "cx": float(K[0][2]), "cy": float(K[1][2]),
+             "focal_length_mm": cam["focal_length_mm"], "horizontal_aperture_mm": cam["horizontal_aperture_mm"],
+             "vertical_aperture_mm": cam["vertical_aperture_mm"]}
+            | _matrix("camera_to_world", cam["camera_to_world"])
+            | _matrix("world_to_camera_opencv", cam["world_to_camera_opencv"]))
+
+
+def _condition(record: DatasetRecord) -> dict:
+    """The record's condition (its name and parameters); empty for a composite (a photo's light is not rendered)."""
+    return {} if "composite" in record else record["condition"] or {}
+
+
+def metadata_rows(records: Iterable[DatasetRecord], class_map: ClassMap) -> list[dict]:
     """One dict per record, by image id, every dict with the same keys in the same order (see module)."""
     records = ordered(records)
-    condition_keys = sorted({k for r in records for k in (r.get("condition") or {}) if k != "name"})
-    measure_keys = sorted({k for r in records for k in ((r.get("qa") or {}).get("measures") or {})})
+    condition_keys = sorted({k for r in records for k in _condition(r) if k != "name"})
+    measure_keys = sorted({k for r in records for k in r["qa"]["measures"]})
     composites = any("composite" in r for r in records)
     rows = []
     for r in records:
-        cam = r.get("camera") or {}
-        K = cam.get("K")
-        cond = r.get("condition") or {}
-        qa = r.get("qa") or {}
+        cond = _condition(r)
+        qa = r["qa"]
         row = {"image_id": int(r["id"]), "name": r["name"], "split": r["split"],
-               "width": int(r["width"]), "height": int(r["height"]),
-               "camera_path": cam.get("prim_path"), "camera_name": cam.get("name"), "rig_type": cam.get("rig_type"),
-               "fx": None if K is None else float(K[0][0]), "fy": None if K is None else float(K[1][1]),
-               "cx": None if K is None else float(K[0][2]), "cy": None if K is None else float(K[1][2]),
-               "focal_length_mm": cam.get("focal_length_mm"),
-               "horizontal_aperture_mm": cam.get("horizontal_aperture_mm"),
-               "vertical_aperture_mm": cam.get("vertical_aperture_mm")}
-        row |= _matrix("camera_to_world", cam.get("camera_to_world"))
-        row |= _matrix("world_to_camera_opencv", cam.get("world_to_camera_opencv"))
-        row |= {"time_code": None if r.get("time_code") is None else float(r["time_code"]), "seed": int(r["seed"]),
+               "width": int(r["width"]), "height": int(r["height"])} | _camera_columns(r)
+        row |= {"time_code": None if "composite" in r else float(r["time_code"]), "seed": int(r["seed"]),
                 "condition": cond.get("name")}
         row |= {f"condition.{k}": _scalar(cond.get(k)) for k in condition_keys}
         counts = {c.name: 0 for c in class_map.classes}
-        for inst in r.get("instances", ()):
+        for inst in r["instances"]:
             counts[class_map.by_id(inst["category_id"]).name] += 1
-        pixels = r.get("class_pixel_counts") or {}
+        pixels = r["class_pixel_counts"]
         row |= {f"instances.{c.name}": counts[c.name] for c in class_map.classes}
         row |= {f"pixels.{c.name}": int(pixels.get(c.name, 0)) for c in class_map.classes}
-        row |= {"qa_verdict": qa.get("verdict"), "qa_reasons": "; ".join(qa.get("reasons") or ())}
-        row |= {f"qa.{k}": (qa.get("measures") or {}).get(k) for k in measure_keys}
+        row |= {"qa_verdict": qa["verdict"], "qa_reasons": "; ".join(qa["reasons"])}
+        row |= {f"qa.{k}": qa["measures"].get(k) for k in measure_keys}
         if composites:
             row |= _composite_columns(r)
         rows.append(row)
     return rows
 
 
-def _composite_columns(record: ImageRecord) -> dict:
+def _composite_columns(record: DatasetRecord) -> dict:
     """The columns of a composite (None for a rendered image in the same table)."""
-    composite, camera = record.get("composite"), record.get("camera") or {}
-    if composite is None:
+    if "composite" not in record:
         return dict.fromkeys(("background", "background_labelled", "horizon_row_px", "camera_height_m", "pastes",
                               "boxes_kept", "boxes_dropped"))
+    composite, camera = record["composite"], record["camera"]
     boxes = composite["background_boxes"]
     return {"background": composite["background"]["path"], "background_labelled": composite["background"]["labelled"],
-            "horizon_row_px": camera.get("horizon_row_px"), "camera_height_m": camera.get("height_m"),
+            "horizon_row_px": camera["horizon_row_px"], "camera_height_m": camera["height_m"],
             "pastes": len(composite["pastes"]), "boxes_kept": sum(b["kept"] for b in boxes),
             "boxes_dropped": sum(not b["kept"] for b in boxes)}
 
@@ -133,7 +146,7 @@ def _column(values: list) -> pa.Array:
         return pa.array([None if v is None else _csv_text(v) for v in values], pa.string())
 
 
-def write_rejected(records: Iterable[ImageRecord], path: str | Path) -> Path:
+def write_rejected(records: Iterable[DatasetRecord], path: str | Path) -> Path:
     """``rejected.csv``: every image QA rejected or flagged, with its verdict and reasons, in image order
     (nothing is dropped silently), atomically."""
     import io

@@ -233,10 +233,10 @@ def yolo_lines(record_instances: Sequence[dict], width: int, height: int, class_
     # normalised coordinates are k / width and k / height for pixel corners k: each is formatted once
     columns, rows = ([f"{v:.{DECIMALS}f}".rstrip("0").rstrip(".") for v in (np.arange(n + 1) / np.float64(n)).tolist()]
                      for n in (width, height))
-    chosen = [inst for inst in record_instances if inst["category_id"] in class_index and not inst.get("ignore")]
+    chosen = [inst for inst in record_instances if inst["category_id"] in class_index and not inst["ignore"]]
     for inst in chosen:
         if list(inst["segmentation"]["size"]) != [height, width]:
-            raise InputError(f"instance {inst.get('id')}: mask size {inst['segmentation']['size']}; "
+            raise InputError(f"instance {inst['id']}: mask size {inst['segmentation']['size']}; "
                              f"expected [{height}, {width}]")
     outlines = None if instance_ids is None else label_outlines(instance_ids, [inst["id"] for inst in chosen])
     lines = []

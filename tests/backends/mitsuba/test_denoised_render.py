@@ -8,7 +8,7 @@ import pytest
 
 from conftest import activate_variant
 from reference_images import HEIGHT, WIDTH, reference_path, tiny_scene
-from synthua_usd.backends import images
+from synthua_usd.core import images
 from synthua_usd.backends.image_quality import psnr_db, ssim
 from synthua_usd.backends.mitsuba.render import render_rgb
 from synthua_usd.backends.mitsuba.session import RenderSession

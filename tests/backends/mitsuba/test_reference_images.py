@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from reference_images import HEIGHT, WIDTH, compare, reference_path, render_passes, tiny_scene
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 
 
 @pytest.fixture(scope="module")

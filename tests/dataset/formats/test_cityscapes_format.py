@@ -10,7 +10,7 @@ import pytest
 
 from format_readers import cityscapes_evaluation
 from label_scenes import INSTANCES, crowded_scene, scene
-from synthua_usd.backends.images import write_color_png, write_id_png
+from synthua_usd.core.images import write_color_png, write_id_png
 from synthua_usd.core.errors import OutputError
 from synthua_usd.dataset.formats.cityscapes import cityscapes_arrays
 from synthua_usd.dataset.layout import CityscapesName, Layout, cityscapes_city

@@ -15,7 +15,7 @@ from pycocotools.coco import COCO
 
 from format_readers import coco_self_evaluation
 from label_scenes import record
-from synthua_usd.backends.images import write_color_png
+from synthua_usd.core.images import write_color_png
 from synthua_usd.dataset.annotations import panoptic
 from synthua_usd.dataset.formats.coco import coco_instances
 from synthua_usd.dataset.formats.panoptic import coco_panoptic

@@ -7,8 +7,8 @@ import pytest
 from scipy import ndimage
 
 from label_scenes import W, H, crowded_scene, record, scene
-from synthua_usd.backends.images import write_color_png
-from synthua_usd.dataset.annotations import annotate
+from synthua_usd.core.images import write_color_png
+from synthua_usd.dataset.annotations import annotate, mark_ignored
 from synthua_usd.dataset.formats.yolo import (class_index, data_yaml, label_outlines, merge_parts, outer_outlines,
                                              yolo_lines)
 from synthua_usd.dataset.layout import Layout
@@ -138,6 +138,7 @@ def test_outlines_of_all_instances_at_once_and_lines_from_the_map_equal_those_of
         expected = outer_outlines(ins == inst_id)
         assert len(parts) == len(expected) and all(np.array_equal(a, b) for a, b in zip(parts, expected))
     entries = annotate(cls, ins, instances, amodal, trunc)
+    mark_ignored(entries, 0)  # as the worker does: every entry a record holds says whether it is ignored
     index = class_index(class_map)
     from_map = yolo_lines(entries, ins.shape[1], ins.shape[0], index, ins)
     assert from_map == yolo_lines(entries, ins.shape[1], ins.shape[0], index)  # masks decoded from the RLEs

@@ -1,6 +1,6 @@
 """Run one Ultralytics YOLO job inside the detector's interpreter (``.venv-train``): train, or predict.
 
-Started by :mod:`synthua_usd.backends.detector.runner` as ``python yolo_job.py JOB.json``; it imports only the
+Started by :mod:`synthua_usd.pipeline.detector.runner` as ``python yolo_job.py JOB.json``; it imports only the
 standard library, torch and Ultralytics (never synthua, whose dependencies that interpreter does not hold), reads
 the job, writes the result document the job names, and exits 0, or 1 with the reason as its last line of stderr.
 

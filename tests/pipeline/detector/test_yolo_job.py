@@ -1,4 +1,4 @@
-"""The detector job's guard against the network (synthua_usd/backends/detector/yolo_job.py imports only the standard
+"""The detector job's guard against the network (synthua_usd/pipeline/detector/yolo_job.py imports only the standard
 library at its top, so it loads here without Ultralytics): lookups and internet connections are refused and listed,
 local sockets keep working. That Ultralytics tries nothing during a real job is checked in test_sim2real.py."""
 
@@ -8,7 +8,7 @@ import socket
 
 import pytest
 
-from synthua_usd.backends.detector import yolo_job
+from synthua_usd.pipeline.detector import yolo_job
 
 
 @pytest.fixture

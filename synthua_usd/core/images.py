@@ -1,4 +1,8 @@
-"""Image files through OpenImageIO, colour-managed with explicitly named OCIO colour spaces.
+"""Image files through OpenImageIO, colour-managed with explicitly named OCIO colour spaces: every image file
+of pixels synthua writes (a frame's and a dataset's images and label maps, previews, a twin's texture images, contact
+sheets; not matplotlib's figures, nor the MP4 of a sequence) goes through the writers here, and :func:`read_image` reads them back (verify, analytics, tests). A user's photos are
+read by :mod:`synthua_usd.backends.photos` (Pillow: EXIF, HEIC), a stage's textures by
+:mod:`synthua_usd.core.texture_files` (USDZ members).
 
 Mitsuba's rgb variants render scene-linear Rec.709, which OCIO's built-in config calls
 ``lin_rec709_scene``; display PNGs are ``srgb_rec709_scene``. Names are always given explicitly: the
@@ -82,8 +86,9 @@ def _png(attributes: dict, compression: int | None) -> dict:
 
 
 def write_color_png(path: Path, rgb8: np.ndarray, compression: int | None = None) -> Path:
-    """(H, W, 3) uint8 sRGB values written as they are (class colours); ``compression`` the zlib level (None:
-    OpenImageIO's default)."""
+    """(H, W, 3) uint8 sRGB values written as they are (class colours, a display image; a texture image's (H, W, C),
+    C = 1 to 4, too: OpenImageIO tags every 8-bit PNG so); ``compression`` the zlib level (None: OpenImageIO's
+    default)."""
     return _write(path, rgb8.astype(np.uint8), "uint8", _png({"oiio:ColorSpace": DISPLAY_SPACE}, compression))
 
 

@@ -5,7 +5,7 @@ import warnings
 import numpy as np
 import pytest
 
-from synthua_usd.backends import images
+from synthua_usd.core import images
 
 
 def test_display_conversion_is_the_srgb_transfer_function():
@@ -68,7 +68,7 @@ def test_exr_files_depend_only_on_their_pixels(tmp_path, monkeypatch):
     """No capture date in EXR headers: the same pixels written at two moments give the same bytes."""
     import time as _time
 
-    from synthua_usd.backends import images as _images
+    from synthua_usd.core import images as _images
 
     pixels = np.random.default_rng(0).random((6, 8, 3)).astype(np.float32)
     _images.write_linear_exr(tmp_path / "a.exr", pixels)
@@ -83,7 +83,7 @@ def test_exr_files_depend_only_on_their_pixels(tmp_path, monkeypatch):
 
 
 def test_a_fast_png_holds_the_same_pixels(tmp_path):
-    from synthua_usd.backends.images import FAST_PNG, read_image, write_color_png, write_id_png
+    from synthua_usd.core.images import FAST_PNG, read_image, write_color_png, write_id_png
 
     rgb = np.random.default_rng(3).integers(0, 256, (12, 16, 3), dtype=np.uint8)
     ids = np.random.default_rng(4).integers(0, 2**16, (12, 16), dtype=np.uint16)

@@ -10,8 +10,8 @@ import pytest
 from PIL import Image
 
 from synthua_usd.analytics.detection_sets import Box, DetectionSet, SetImage, read_yolo
-from synthua_usd.backends.detector.runner import DetectorUnavailable, find_detector_python
-from synthua_usd.backends.detector.yolo_data import write_yolo_boxes
+from synthua_usd.pipeline.detector.runner import DetectorUnavailable, find_detector_python
+from synthua_usd.pipeline.detector.yolo_data import write_yolo_boxes
 
 
 def test_written_boxes_read_back(tmp_path):
