@@ -17,7 +17,7 @@ from conftest import DATA, RANDOM_CONFIG, SCENARIO, built_once, generate_dataset
 from dataset_runs import records
 from hostile import run_synthua
 from reference_raycast import reference_labels
-from synthua_usd.backends.images import read_image
+from synthua_usd.core.images import read_image
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.pipeline.scenes import SceneKey, scene_of
 from synthua_usd.pipeline.verify import replay, verify
