@@ -176,12 +176,15 @@ def generated_copy(generated, tmp_path) -> Path:
     return out
 
 
-#: The test files that take longest (pytest-xdist workers on 2 cores, 2026-12-04), run first: with ``--dist loadfile
+#: The test files that take longest (pytest-xdist workers on 2 cores, 2026-12-04; the Ray, view-score and settings
+#: files added 2026-12-06 from a fresh-clone run's --durations), run first: with ``--dist loadfile
 #: --no-loadscope-reorder`` (``make test``) pytest-xdist hands out files in collection order, and a long one handed
 #: out last keeps one worker busy while the others idle. (Without ``--no-loadscope-reorder`` xdist reorders the
 #: files by their number of tests, which put these few-test files last.)
 LONGEST_FIRST = ("pipeline/test_districts.py", "pipeline/test_sim2real.py", "test_quickstart.py", "demo/test_district.py",
-                 "test_wheel.py", "assets/test_bodies.py", "pipeline/test_generate_randomised.py",
+                 "test_wheel.py", "pipeline/test_generate_ray.py", "assets/test_bodies.py",
+                 "pipeline/test_generate_randomised.py", "pipeline/test_view_scores.py",
+                 "pipeline/test_generate_settings.py",
                  "pipeline/test_executors.py", "tools/test_bench_targets.py", "pipeline/test_generate.py",
                  "pipeline/test_randomiser.py", "backends/mitsuba/test_determinism.py", "pipeline/test_generate_resume.py",
                  "cli/test_hostile_subprocess.py", "pipeline/test_sequences.py", "backends/mitsuba/test_environment.py",
