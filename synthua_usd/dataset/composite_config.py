@@ -47,6 +47,10 @@ class CameraSettings:
         return out
 
 
+#: What a paste does that finds no column within its overlap limits (schema ``pastes.when_no_room``).
+WHEN_NO_ROOM = ("least_overlap", "skip")
+
+
 @dataclass(frozen=True)
 class PasteSettings:
     """How many cut-outs a composite gets, which and where (schema ``pastes``)."""
@@ -61,11 +65,18 @@ class PasteSettings:
     choose_among: int = 4
     max_overlap: float = 0.3
     placement_tries: int = 12
+    max_background_cover: float | None = None
+    when_no_room: str = "least_overlap"
 
     def __post_init__(self) -> None:
         lo, hi = _range("pastes.per_image", self.per_image, 0, 100)
         object.__setattr__(self, "per_image", (int(lo), int(hi)))
         object.__setattr__(self, "height_share", _range("pastes.height_share", self.height_share, 0.001, 1.0))
+        if self.when_no_room not in WHEN_NO_ROOM:
+            raise InputError(f"pastes.when_no_room: {self.when_no_room!r}; expected one of {', '.join(WHEN_NO_ROOM)}")
+        if self.max_background_cover is not None and not 0.0 <= self.max_background_cover <= 1.0:
+            raise InputError(f"pastes.max_background_cover: {self.max_background_cover}; expected null or a share "
+                             f"in [0, 1]")
         for name in ("aids", "groups"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, tuple(getattr(self, name)))

@@ -13,7 +13,9 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
 4. the anchor row again for the chosen cut-out's own height (the share kept), its scale
    ``(y_a - y_h) / (H scale_px_per_m)``, and a column where its box lies in the frame, tried ``placement_tries``
    times for one that covers at most ``max_overlap`` of each earlier paste's box and at most
-   ``drop_covered_share`` of each background box (else the least overlapping);
+   ``max_background_cover`` (default ``drop_covered_share``) of each labelled background box; where no column
+   does, the least overlapping one (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's
+   own labelled people stay in view);
 5. a blend mode by the config's weights (Poisson at most once a composite) and a shadow strength.
 
 Pastes are drawn far to near (by anchor row): ``order`` 0 is drawn first, and a nearer paste covers a farther one.
@@ -160,6 +162,8 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
     ``background_boxes`` (x0, y0, x1, y1, written px) are the labelled boxes a paste should not cover."""
     camera, settings = drawn.camera, config.pastes
     frame_w, frame_h = camera.width_px, camera.height_px
+    cover = (config.background_labels.drop_covered_share if settings.max_background_cover is None
+             else settings.max_background_cover)
     count = int(rng.integers(settings.per_image[0], settings.per_image[1] + 1))
     planned: list[dict] = []
     poisson_used = False
@@ -201,13 +205,14 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
             anchor = (float(lo + c * (hi - lo)), float(anchor_row))
             box = _box_in_frame(entry, anchor, scale)
             excess = max([covered_share(p["box"], box) - settings.max_overlap for p in planned]
-                         + [covered_share(b, box) - config.background_labels.drop_covered_share
-                            for b in background_boxes] + [0.0])
+                         + [covered_share(b, box) - cover for b in background_boxes] + [0.0])
             if best is None or excess < best[0]:
                 best = (excess, anchor, box)
             if excess <= 0:
                 break
         excess, anchor, box = best
+        if excess > 0 and settings.when_no_room == "skip":
+            continue
         poisson_used |= blend["mode"] == "poisson"
         overlap = max([covered_share(p["box"], box) for p in planned] + [0.0])
         planned.append(dict(

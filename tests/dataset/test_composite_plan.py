@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from bank_maker import default_cutouts, write_bank
+from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.composite_config import CameraSettings, CompositeConfig
 from synthua_usd.dataset.composite_plan import covered_share, draw_camera, eligible, plan_pastes
 from synthua_usd.dataset.cutout_bank import read_bank
@@ -96,6 +97,55 @@ def test_pastes_keep_off_earlier_ones_and_background_boxes_where_they_can(bank):
             for b in placements:
                 if a is not b:
                     assert covered_share(a.box, b.box) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_pastes_keep_off_labelled_people_entirely_or_are_skipped(bank):
+    """max_background_cover 0 with when_no_room skip: no paste covers any of a kept box; a photo whose labelled
+    people fill the ground gets no paste at all, where least_overlap would cover them."""
+    roomy = {"per_image": [3, 3], "height_share": [0.3, 0.3], "max_overlap": 1.0, "placement_tries": 50,
+             "max_background_cover": 0.0, "when_no_room": "skip"}
+    config = CompositeConfig.from_document({"pastes": roomy})
+    camera = PhotoCamera(640, 480, 100.0, 1.5, 500.0)
+    kept = [(0.0, 0.0, 250.0, 480.0)]
+    made = 0
+    for seed in range(6):
+        placements = plan_pastes(_drawn(camera), eligible(bank.entries, config), config, kept,
+                                 np.random.default_rng(seed))
+        made += len(placements)
+        for p in placements:                                 # independent: the box against the kept one
+            x0, y0, x1, y1 = p.box
+            assert x0 >= 250.0 - 1e-6 or x1 <= 0.0 or y1 <= 0.0
+    assert made > 0
+    full = [(0.0, 0.0, 640.0, 480.0)]
+    for seed in range(3):
+        assert plan_pastes(_drawn(camera), eligible(bank.entries, config), config, full,
+                           np.random.default_rng(seed)) == []
+        crowded = CompositeConfig.from_document({"pastes": {**roomy, "when_no_room": "least_overlap"}})
+        assert len(plan_pastes(_drawn(camera), eligible(bank.entries, crowded), crowded, full,
+                               np.random.default_rng(seed))) == 3
+
+
+def test_the_default_placement_limit_is_the_drop_threshold(bank):
+    """max_background_cover null is background_labels.drop_covered_share: the same plans as before the key."""
+    camera = PhotoCamera(640, 480, 100.0, 1.5, 500.0)
+    kept = [(100.0, 50.0, 400.0, 480.0)]
+    base = {"per_image": [3, 3], "max_overlap": 0.0, "placement_tries": 30}
+    implicit = CompositeConfig.from_document({"pastes": base, "background_labels": {"drop_covered_share": 0.2}})
+    explicit = CompositeConfig.from_document({"pastes": {**base, "max_background_cover": 0.2},
+                                              "background_labels": {"drop_covered_share": 0.2}})
+    for seed in range(3):
+        a = plan_pastes(_drawn(camera), eligible(bank.entries, implicit), implicit, kept, np.random.default_rng(seed))
+        b = plan_pastes(_drawn(camera), eligible(bank.entries, explicit), explicit, kept, np.random.default_rng(seed))
+        assert a == b
+
+
+@pytest.mark.parametrize("pastes, message", [
+    ({"when_no_room": "squeeze"}, "pastes.when_no_room"),
+    ({"max_background_cover": 1.5}, "pastes.max_background_cover"),
+])
+def test_placement_limits_are_checked(pastes, message):
+    with pytest.raises(InputError, match=message):
+        CompositeConfig.from_document({"pastes": pastes})
 
 
 def test_the_camera_draw_names_its_sources():
