@@ -10,7 +10,9 @@ rendered (RGB + OIDN) by one render session in this process, as a dataset worker
 kernel history on: per view the seconds of LLVM kernel compiles (cache misses: codegen + backend time), the largest
 kernel's operations (the path tracer's megakernel), the BSDFs and shapes of the loaded scene, and the seconds of one
 more render of the same view through a 4x4 film (tracing and launching the kernels: what every image pays before a
-ray is traced). Run it with an empty kernel cache (a fresh ``HOME``) to see a first run's compiles; run it with the
+ray is traced), and of tracing one full ``scene.ray_intersect`` of 16 rays (``si s``: the surface interaction is a
+call over every shape, traced once per shape, so it grows with the scene's shapes; the preliminary intersection of
+the label pass is not). Run it with an empty kernel cache (a fresh ``HOME``) to see a first run's compiles; run it with the
 code of another revision (``PYTHONPATH=<a worktree of REV>``) to compare. Not a test.
 """
 
@@ -66,7 +68,7 @@ def main() -> int:
     dr.set_flag(dr.JitFlag.KernelHistory, True)
     rows = []
     print(f"{'view':18} {'render s':>9} {'compile s':>10} {'misses':>7} {'kernel ops':>11} {'BSDFs':>6} "
-          f"{'shapes':>7} {'trace s':>8}")
+          f"{'shapes':>7} {'trace s':>8} {'si s':>6}")
     for view in args.views:
         seed, condition = view.split(":")
         randomiser.apply(int(seed), args.camera, 24.0, condition, None)
@@ -86,11 +88,16 @@ def main() -> int:
         dr.eval(mi.render(scene, sensor=small, spp=args.spp, seed=1))
         dr.sync_thread()
         trace_s = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        si = scene.ray_intersect(dr.zeros(mi.Ray3f, 16))
+        dr.eval(si.t, si.n, si.uv)
+        dr.sync_thread()
+        si_s = time.perf_counter() - t0
         rows.append({"view": view, "render_s": seconds, "compile_s": compile_s, "misses": len(misses),
                      "kernel_operations": operations, "bsdfs": bsdfs, "shapes": len(scene.shapes()),
-                     "trace_s": trace_s})
+                     "trace_s": trace_s, "surface_interaction_trace_s": si_s})
         print(f"{view:18} {seconds:9.2f} {compile_s:10.2f} {len(misses):7d} {operations:11,d} {bsdfs:6d} "
-              f"{len(scene.shapes()):7d} {trace_s:8.2f}", flush=True)
+              f"{len(scene.shapes()):7d} {trace_s:8.2f} {si_s:6.2f}", flush=True)
     if args.json is not None:
         args.json.write_text(json.dumps({"views": rows, "size": [args.width, args.height], "spp": args.spp},
                                         indent=1) + "\n", encoding="utf-8")
