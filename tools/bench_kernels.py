@@ -12,8 +12,8 @@ kernel's operations (the path tracer's megakernel), the BSDFs and shapes of the 
 more render of the same view through a 4x4 film (tracing and launching the kernels: what every image pays before a
 ray is traced), and of tracing one full ``scene.ray_intersect`` of 16 rays (``si s``: the surface interaction is a
 call over every shape, traced once per shape, so it grows with the scene's shapes; the preliminary intersection of
-the label pass is not). Run it with an empty kernel cache (a fresh ``HOME``) to see a first run's compiles; run it with the
-code of another revision (``PYTHONPATH=<a worktree of REV>``) to compare. Not a test.
+the label pass is not). Run it with an empty kernel cache (a fresh ``HOME``) to see a first run's compiles; run it
+with the code of another revision (``PYTHONPATH=<a worktree of REV>``) to compare. Not a test.
 """
 
 from __future__ import annotations
