@@ -132,6 +132,10 @@ class BackgroundLabels:
         return dict(self.classes).get(name, name)
 
 
+#: The composites' size (width, height) where the config gives no ``output``.
+DEFAULT_OUTPUT = (640, 480)
+
+
 @dataclass(frozen=True)
 class CompositeConfig:
     """The whole config; see ``schemas/composite.schema.json`` for every field."""
@@ -140,7 +144,7 @@ class CompositeConfig:
     seed: int = 0
     images_per_background: int = 2
     max_images: int | None = None
-    output: tuple[int, int] | None = (640, 480)
+    output: tuple[int, int] | None = DEFAULT_OUTPUT
     camera: CameraSettings = field(default_factory=CameraSettings)
     folders: tuple[tuple[str, dict], ...] = ()
     pastes: PasteSettings = field(default_factory=PasteSettings)
@@ -223,9 +227,9 @@ def _light(doc) -> Light | None:
                                           float(doc.get("sun_azimuth_deg", 0.0)))
 
 
-def _camera_fields(doc: dict) -> dict:
+def _camera_fields(doc: dict) -> dict[str, Any]:
     """A (partial) ``camera`` object of the schema as :class:`CameraSettings` keyword arguments."""
-    out = {}
+    out: dict[str, Any] = {}
     for key, value in doc.items():
         if key in ("horizon_row_share", "height_m", "focal_width_share"):
             out[key] = (value, value) if isinstance(value, (int, float)) else tuple(value)
@@ -236,19 +240,21 @@ def _camera_fields(doc: dict) -> dict:
     return out
 
 
+def _tuples(part: dict) -> dict[str, Any]:
+    """A schema object as dataclass keyword arguments: its lists (ranges, choices) as tuples."""
+    return {key: tuple(value) if isinstance(value, list) else value for key, value in part.items()}
+
+
 def _build(doc: dict) -> CompositeConfig:
     defaults = CompositeConfig()
-    output = doc.get("output", {"width": defaults.output[0], "height": defaults.output[1]})
+    output = doc.get("output", {"width": DEFAULT_OUTPUT[0], "height": DEFAULT_OUTPUT[1]})
     pastes = dict(doc.get("pastes", {}))
     for key in ("per_image", "height_share"):
         if key in pastes:
             pastes[key] = tuple(pastes[key])
     labels = doc.get("background_labels", {})
     qa = doc.get("qa", {})
-    effects = dict(doc.get("effects", {}))
-    for key, value in effects.items():
-        if isinstance(value, list):
-            effects[key] = tuple(value)
+    effects = _tuples(doc.get("effects", {}))
     folders = doc.get("folders", {})
     for folder, part in folders.items():  # each folder's fields checked as a camera of their own
         try:
@@ -263,9 +269,9 @@ def _build(doc: dict) -> CompositeConfig:
         camera=CameraSettings(**_camera_fields(doc.get("camera", {}))),
         folders=tuple(sorted((f.strip("/"), dict(part)) for f, part in folders.items())),
         pastes=PasteSettings(**pastes),
-        blend=BlendSettings(**{k: tuple(v) if isinstance(v, list) else v for k, v in doc.get("blend", {}).items()}),
+        blend=BlendSettings(**_tuples(doc.get("blend", {}))),
         shadow_strength=tuple(doc.get("shadow", {}).get("strength", defaults.shadow_strength)),
-        match=MatchSettings(**{k: tuple(v) if isinstance(v, list) else v for k, v in doc.get("match", {}).items()}),
+        match=MatchSettings(**_tuples(doc.get("match", {}))),
         effects=EffectsRandomisation(**effects),
         background_labels=BackgroundLabels(tuple(sorted(labels.get("classes", {}).items())),
                                            labels.get("drop_covered_share", 0.5),

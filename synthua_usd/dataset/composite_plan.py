@@ -32,6 +32,7 @@ import numpy as np
 
 from synthua_usd.dataset.composite_config import BLEND_MODES, CameraSettings, CompositeConfig
 from synthua_usd.dataset.cutout_bank import BankEntry, Light
+from synthua_usd.dataset.record import PhotoCameraEntry
 from synthua_usd.model.photo_camera import PhotoCamera, focal_px_from_35mm
 
 #: Least drop, in pixels, from the horizon to an anchor (a paste right at the horizon would be infinitely far).
@@ -48,9 +49,13 @@ class DrawnCamera:
     light: Light | None
     exif_focal_35mm: float | None
 
-    def to_dict(self) -> dict:
-        return {**self.camera.to_dict(), "K": self.camera.intrinsics().tolist(), "sources": dict(self.sources),
-                "exif_focal_35mm": self.exif_focal_35mm, "light": None if self.light is None else asdict(self.light)}
+    def to_dict(self) -> PhotoCameraEntry:
+        c = self.camera
+        return PhotoCameraEntry(width_px=c.width_px, height_px=c.height_px, horizon_row_px=c.horizon_row_px,
+                                height_m=c.height_m, focal_px=c.focal_px, pitch_deg=c.pitch_deg,
+                                K=c.intrinsics().tolist(), sources=dict(self.sources),
+                                exif_focal_35mm=self.exif_focal_35mm,
+                                light=None if self.light is None else asdict(self.light))
 
 
 def draw_camera(settings: CameraSettings, sources: dict, size: tuple[int, int], exif_focal_35mm: float | None,
@@ -200,7 +205,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         shadow = float(rng.uniform(*config.shadow_strength))
         if lo > hi:
             continue  # wider than the frame at this size
-        best = None
+        best: tuple[float, tuple[float, float], tuple[float, float, float, float]] | None = None
         for c in columns:
             anchor = (float(lo + c * (hi - lo)), float(anchor_row))
             box = _box_in_frame(entry, anchor, scale)
@@ -210,6 +215,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
                 best = (excess, anchor, box)
             if excess <= 0:
                 break
+        assert best is not None  # placement_tries >= 1 (the schema)
         excess, anchor, box = best
         if excess > 0 and settings.when_no_room == "skip":
             continue

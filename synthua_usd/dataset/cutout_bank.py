@@ -18,6 +18,7 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NoReturn
 
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.input_files import shown
@@ -142,7 +143,7 @@ class _Reader:
     def __init__(self, path: Path, class_map: ClassMap):
         self.where, self.class_map = shown(path), class_map
 
-    def fail(self, field: str, found, expected: str):
+    def fail(self, field: str, found, expected: str) -> NoReturn:
         raise InputError(f"{self.where}: {field}: {echo(str(found))}; expected {expected}")
 
     def number(self, doc, key: str, field: str, positive: bool = False) -> float:
@@ -151,6 +152,12 @@ class _Reader:
                 or (positive and value <= 0):
             self.fail(f"{field}.{key}", value, "a finite number" + (" > 0" if positive else ""))
         return float(value)
+
+    def pixels(self, doc: dict, key: str, field: str) -> int:
+        value = doc.get(key)
+        if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+            self.fail(f"{field}.{key}", value, "a pixel count >= 0")
+        return value
 
     def point(self, value, field: str) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2 or not all(
@@ -163,7 +170,8 @@ class _Reader:
                 isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value) \
                 or value[2] < 0 or value[3] < 0:
             self.fail(field, value, "[x, y, w, h], finite numbers with w, h >= 0 (crop pixels)")
-        return tuple(float(v) for v in value)
+        x, y, w, h = (float(v) for v in value)
+        return x, y, w, h
 
     def instance(self, doc, field: str, count: int) -> BankInstance:
         if not isinstance(doc, dict):
@@ -191,10 +199,7 @@ class _Reader:
                 self.fail(f"{field}.keypoints", f"{type(keypoints).__name__} of {len(keypoints) if isinstance(keypoints, list) else 0}",
                           f"null or {expected} keypoints [x, y, v] (v 0, 1 or 2) for class {name}")
             keypoints = tuple((float(x), float(y), int(v)) for x, y, v in keypoints)
-        area, amodal_area = doc.get("area"), doc.get("amodal_area")
-        for key, value in (("area", area), ("amodal_area", amodal_area)):
-            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-                self.fail(f"{field}.{key}", value, "a pixel count >= 0")
+        area, amodal_area = self.pixels(doc, "area", field), self.pixels(doc, "amodal_area", field)
         return BankInstance(index, name, doc["role"], tuple(sorted(relations.items())),
                             self.box(doc.get("bbox"), f"{field}.bbox"), area,
                             self.box(doc.get("amodal_bbox"), f"{field}.amodal_bbox"), amodal_area, keypoints)
@@ -281,7 +286,7 @@ def read_bank(root: str | Path) -> Bank:
     if doc.get("format") != BANK_FORMAT:
         raise InputError(f"{where}: format: {echo(str(doc.get('format')))!r}; expected {BANK_FORMAT!r} (a bank made by "
                          f"another version of synthua: make it again with `synthua cutouts`)")
-    class_map = ClassMap.from_document(doc.get("class_map"), source=f"{where}: class_map")
+    class_map = ClassMap.from_document(doc.get("class_map", {}), source=f"{where}: class_map")
     reader = _Reader(path, class_map)
     files = doc.get("files")
     if not isinstance(files, list) or not all(

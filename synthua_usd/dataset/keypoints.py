@@ -20,8 +20,11 @@ adult's trunk, so that a hip or shoulder seen on its own side counts as visible.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
+from synthua_usd.dataset.record import InstanceEntry
 from synthua_usd.model.cameras import PinholeCamera
 from synthua_usd.model.scene import Keypoints
 
@@ -86,7 +89,7 @@ def coco_keypoints(uv: np.ndarray, flags: np.ndarray) -> list[float]:
     return out
 
 
-def annotate_keypoints(entries: list[dict], keypoints: dict[int, Keypoints], camera: PinholeCamera,
+def annotate_keypoints(entries: Sequence[InstanceEntry], keypoints: dict[int, Keypoints], camera: PinholeCamera,
                        render_size: tuple[int, int], instance_ids: np.ndarray, z_depth: np.ndarray) -> None:
     """Add ``keypoints`` (``{"names", "keypoints": flat COCO list, "num_keypoints"}``) to every record entry
     (of :func:`synthua_usd.dataset.annotations.annotate`) whose instance has keypoints; ``instance_ids`` and

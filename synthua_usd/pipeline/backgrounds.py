@@ -125,13 +125,17 @@ def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: st
     path = Path(path)
     if not path.exists():
         raise InputError(f"{shown(path)}: not found; expected a folder of photos, a YOLO set or a COCO .json")
+    layout: str | None
     try:
         layout = detect_format(path)
     except InputError:
         layout = "folder" if path.is_dir() else None
-    if layout not in LAYOUTS:
+    if layout is None or layout not in LAYOUTS:
         raise InputError(f"{shown(path)}: {'a dataset written by synthua' if layout else 'not a folder'}; expected a "
                          f"folder of photos, a labelled YOLO set (data.yaml or images/ + labels/) or a COCO .json")
+    #: (photo, its boxes, the size its labels give; None for an unlabelled photo)
+    images: list[tuple[Path, tuple[Box, ...], tuple[int, int] | None]]
+    names: tuple[str, ...]
     if layout == "folder":
         folder = _absolute(path)
         paths = _photos_below(folder)
@@ -151,7 +155,7 @@ def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: st
     out = []
     for image, boxes, size in images:
         header = photo_header(image)
-        if layout != "folder":
+        if size is not None:  # a labelled photo
             if header.orientation != 1:
                 raise InputError(f"{shown(image)}: EXIF orientation {header.orientation}; expected labelled photos "
                                  f"stored upright (orientation 1), their boxes drawn on them as stored")

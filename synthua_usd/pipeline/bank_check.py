@@ -45,7 +45,7 @@ def check_bank(bank: str | Path) -> BankCheck:
     folder = Path(bank)
     read = read_bank(folder)
     out = BankCheck(cutouts=len(read.entries))
-    listed = set()
+    listed: set[str] = set()
     for entry in read.files:
         path = entry["path"]
         listed.add(path)
@@ -58,13 +58,13 @@ def check_bank(bank: str | Path) -> BankCheck:
     for path in sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()):
         if path != BANK_FILE and path not in listed:
             out.problems.append(f"{path}: not listed in {BANK_FILE}")
-    for entry in read.entries:
+    for cutout in read.entries:
         try:
-            arrays = {key: read_image(folder / entry.files[key])[0] for key in FILE_KEYS}
+            arrays = {key: read_image(folder / cutout.files[key])[0] for key in FILE_KEYS}
         except (OSError, KeyError) as exc:
-            out.problems.append(f"cut-out {entry.id}: its images cannot be read ({exc})")
+            out.problems.append(f"cut-out {cutout.id}: its images cannot be read ({exc})")
             continue
-        out.problems += [f"cut-out {entry.id}: {p}" for p in _entry_problems(entry, arrays)]
+        out.problems += [f"cut-out {cutout.id}: {p}" for p in _entry_problems(cutout, arrays)]
     return out
 
 

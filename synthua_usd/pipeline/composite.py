@@ -38,7 +38,7 @@ from synthua_usd.dataset.composite_plan import eligible
 from synthua_usd.dataset.formats import cityscapes
 from synthua_usd.dataset.layout import Layout, cityscapes_city, composite_name
 from synthua_usd.dataset.manifest import document_digest
-from synthua_usd.dataset.record import is_rejected
+from synthua_usd.dataset.record import CompositeRecord, is_rejected
 from synthua_usd.dataset.sampling import split_of
 from synthua_usd.pipeline.backgrounds import DEFAULT_SPLIT, BackgroundSet, read_backgrounds
 from synthua_usd.pipeline.composite_worker import CompositeJob, PlannedComposite
@@ -140,20 +140,21 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
     _check_classes(backgrounds, config, bank, str(request.config_path))
     plan = plan_composites(backgrounds, config)
     workers = request.workers or config.workers or default_workers()
-    job_key = {"config": config.to_document(), "class_map": bank.class_map.document(), "bank": bank.id,
+    config_document = config.to_document()
+    config_document.pop("workers")
+    job_key = {"config": config_document, "class_map": bank.class_map.document(), "bank": bank.id,
                "backgrounds": [[b.relative, b.width, b.height] for b in backgrounds.images]}
-    job_key["config"].pop("workers")
     job_document = {"synthua": __version__, "command": COMMAND, "job_key": job_key,
                     "job_key_digest": document_digest(job_key), "backgrounds": str(Path(request.backgrounds).resolve()),
                     "backgrounds_layout": backgrounds.layout, "backgrounds_split": request.split, "bank": str(Path(request.bank).resolve()),
                     "plan": [p.to_dict() for p in plan]}
     summary = CompositeSummary(out_dir=out, backgrounds=len(backgrounds.images), labelled=backgrounds.labelled,
                                workers=workers)
-    done: dict[int, dict] = {}
+    done: dict[int, CompositeRecord] = {}
     seconds: dict[str, float] = {}
     with output_set(out) as staging:
         write_json_atomic(staging / Layout.CONFIG, job_document, indent=1)
-        job = CompositeJob(out_dir=str(staging), config_document=job_key["config"],
+        job = CompositeJob(out_dir=str(staging), config_document=config_document,
                            class_map_document=bank.class_map.document(), bank_root=str(bank.root.resolve()),
                            backgrounds=backgrounds, city=cityscapes_city(config.name))
         bar = tqdm(total=len(plan), desc="composite", unit="img", disable=not show_progress)
@@ -173,8 +174,8 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
             raise OutputError(f"{shown(out)}: {len(missing)} composites were not written (e.g. id {missing[0]}); "
                               f"expected every planned composite's record")
         records = [done[p.id] for p in plan]
-        provenance = {**versions(), "command": COMMAND, "config": job_key["config"],
-                      "config_digest": document_digest(job_key["config"]), "bank": {"id": bank.id, "format": BANK_FORMAT},
+        provenance = {**versions(), "command": COMMAND, "config": config_document,
+                      "config_digest": document_digest(config_document), "bank": {"id": bank.id, "format": BANK_FORMAT},
                       "backgrounds": {"layout": backgrounds.layout, "labelled": backgrounds.labelled,
                                       "images": len(backgrounds.images)}}
         assemble(Layout(staging), records, bank.class_map, None, job_document, provenance=provenance)

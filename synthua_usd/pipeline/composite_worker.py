@@ -26,10 +26,11 @@ from synthua_usd.backends.camera_effects import apply_effects
 from synthua_usd.backends.compositing import PasteInput, compose, composite_depth
 from synthua_usd.backends.cutout_pixels import CutoutPixels, read_cutout
 from synthua_usd.backends.photos import read_photo
-from synthua_usd.dataset import annotations, keypoints, qa
+from synthua_usd.dataset import keypoints, qa
+from synthua_usd.dataset.annotations import annotate, mark_ignored, panoptic
 from synthua_usd.dataset.composite_config import CompositeConfig
 from synthua_usd.dataset.composite_plan import draw_camera, eligible, plan_pastes
-from synthua_usd.dataset.cutout_bank import BANK_FORMAT, read_bank
+from synthua_usd.dataset.cutout_bank import BANK_FORMAT, Bank, BankEntry, read_bank
 from synthua_usd.dataset.formats import yolo
 from synthua_usd.dataset.layout import CityscapesName
 from synthua_usd.dataset.record import REJECTED, CompositeRecord, QAResult
@@ -82,13 +83,13 @@ class CompositeState:
     job: CompositeJob
     config: CompositeConfig
     class_map: ClassMap
-    bank: object
+    bank: Bank
     pools: dict
     by_relative: dict
     writer: BackgroundWriter = field(default_factory=BackgroundWriter)
     cutouts: OrderedDict = field(default_factory=OrderedDict)
 
-    def cutout(self, entry) -> CutoutPixels:
+    def cutout(self, entry: BankEntry) -> CutoutPixels:
         pixels = self.cutouts.pop(entry.id, None)
         if pixels is None:
             pixels = read_cutout(self.bank.root, entry)
@@ -138,7 +139,7 @@ def covered_by_pastes(box: tuple[float, float, float, float], instance_ids: np.n
 def _background_entries(background: Background, labelled: bool, photo, config: CompositeConfig,
                         size) -> list[dict]:
     """The photo's boxes in the frame, before pasting: kept so far, or dropped as unmapped or cropped."""
-    out = []
+    out: list[dict] = []
     if not labelled:
         return out
     for box in background.boxes:
@@ -151,7 +152,7 @@ def _background_entries(background: Background, labelled: bool, photo, config: C
     return out
 
 
-def composite_yolo_text(record: dict, class_map: ClassMap, convention: str) -> str:
+def composite_yolo_text(record: CompositeRecord, class_map: ClassMap, convention: str) -> str:
     """The YOLO label file of a composite's record: the boxes of ``convention`` (its visible pasted instances that
     are not ignore regions, then the photo's kept boxes), one ``index cx cy w h`` line each, ignored boxes
     (below the detector's least height) left out."""
@@ -190,13 +191,13 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
 
     t0 = time.perf_counter()
     class_ids, instance_ids = painted.class_ids, painted.instance_ids
-    instances = annotations.annotate(class_ids, instance_ids, painted.instances, painted.amodal, painted.truncation)
-    ignored = annotations.mark_ignored(instances, config.min_instance_px)
-    for entry in instances:
-        points = painted.keypoints.get(entry["id"])
+    instances = annotate(class_ids, instance_ids, painted.instances, painted.amodal, painted.truncation)
+    ignored = mark_ignored(instances, config.min_instance_px)
+    for instance in instances:
+        points = painted.keypoints.get(instance["id"])
         if points is not None:
-            flags = keypoints.pasted_visibility(points, entry["id"], instance_ids)
-            entry["keypoints"] = {"names": list(KEYPOINT_CLASSES[entry["class_name"]].names),
+            flags = keypoints.pasted_visibility(points, instance["id"], instance_ids)
+            instance["keypoints"] = {"names": list(KEYPOINT_CLASSES[instance["class_name"]].names),
                                   "keypoints": keypoints.coco_keypoints(points[:, :2], flags),
                                   "num_keypoints": int((flags > 0).sum())}
     for box in boxes:
@@ -204,7 +205,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
             box["covered_share"] = covered_by_pastes(box["frame"], instance_ids)
             if box["covered_share"] > config.background_labels.drop_covered_share:
                 box["kept"], box["reason"] = False, "covered"
-    panoptic_png, segments = annotations.panoptic(class_ids, instance_ids, painted.instances, class_map, ignored)
+    panoptic_png, segments = panoptic(class_ids, instance_ids, painted.instances, class_map, ignored)
     measures = qa.measure(display, instances)
     verdict, reasons = qa.verdict(measures, config.qa)
     pastes = []

@@ -144,7 +144,7 @@ def _placements(rng: np.random.Generator, cast, drawn: GroupDraw) -> tuple:
     phase = float(rng.uniform(0.0, 2 * math.pi))
     amplitude = 0.0 if rng.random() < STANDING_SHARE else 1.0
     speed = PROFILES[cast[0].profile].speed_mps
-    placements = [None] * len(cast)
+    placements: list[Placement | None] = [None] * len(cast)
     for k, a, b in companion_offsets(cast, 0):
         xy = a * ahead + b * left
         own = phase if k == 0 else float(rng.uniform(0.0, 2 * math.pi))

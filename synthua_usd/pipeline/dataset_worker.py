@@ -29,7 +29,7 @@ from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
-from synthua_usd.dataset.record import (REJECTED, ImageRecord, InstanceEntry, QAResult, check_record, image_kind,
+from synthua_usd.dataset.record import (REJECTED, DatasetRecord, ImageRecord, InstanceEntry, QAResult, check_record, image_kind,
                                          record_camera, record_render)
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.render_config import RenderConfig
@@ -135,9 +135,9 @@ def work(state: WorkerState, item) -> list[dict]:
 
 @dataclass(eq=False)
 class ImageBuffers:
-    """One rendered and annotated image, ready to write."""
+    """One rendered and annotated image (or composite), ready to write."""
 
-    record: ImageRecord
+    record: DatasetRecord
     arrays: dict = field(repr=False)
     rejected: bool
     seconds: dict

@@ -26,7 +26,7 @@ import os
 import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 
 from synthua_usd import __version__
@@ -39,7 +39,7 @@ from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, coco, panoptic, tables, yolo
 from synthua_usd.dataset.layout import SPLITS, Layout, cityscapes_city
 from synthua_usd.dataset.manifest import document_digest, file_entry, files_written, manifest_document
-from synthua_usd.dataset.record import IMAGE, ImageRecord, is_rejected, read_record
+from synthua_usd.dataset.record import IMAGE, DatasetRecord, ImageRecord, is_rejected, read_record
 from synthua_usd.model.render_config import RenderConfig, resolve_render
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline import view_scores
@@ -455,7 +455,7 @@ def _complete_records(layout: Layout, plan) -> dict[int, ImageRecord]:
     return done
 
 
-def assemble(layout: Layout, records: list[ImageRecord], class_map: ClassMap, config: GenerationConfig | None,
+def assemble(layout: Layout, records: Sequence[DatasetRecord], class_map: ClassMap, config: GenerationConfig | None,
              job_document: dict, frames: dict | None = None, provenance: dict | None = None) -> None:
     """Every dataset-level file, from the records alone (the images', and the sequences' ``frames``: (sequence,
     frame) -> record); the manifest last. Another command's dataset (``synthua composite``) gives its own

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from contextlib import contextmanager
 from dataclasses import fields
+from typing import overload
 
 from pxr import Gf, Sdf, Usd, UsdLux
 
@@ -148,6 +149,14 @@ def condition_selected(stage: Usd.Stage, name: str | None):
                 _variant_set(stage).ClearVariantSelection()
             else:
                 _variant_set(stage).SetVariantSelection(before)
+
+
+@overload
+def read_condition(stage: Usd.Stage, name: str) -> Condition: ...
+
+
+@overload
+def read_condition(stage: Usd.Stage, name: str | None = None) -> Condition | None: ...
 
 
 def read_condition(stage: Usd.Stage, name: str | None = None) -> Condition | None:
