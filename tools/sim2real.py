@@ -17,7 +17,8 @@ photo lists, before any training: --plan-only stops there, e.g. to composite aid
 Every model is scored by `synthua evaluate-real` on each --test (its test split, else val; the first is the one of
 the plot), and (a) also on the generated dataset's held-out split. Outputs under --work: sim2real.md (per test set,
 arm and real size: AP50 and AP50-95 per class as the mean over seeds, min-max and sample standard deviation; every
-run), sim2real.json (every run's `synthua train` command, seed, epochs, image-steps, seconds, device and initial
+arm against (b): the difference of the AP50 means, seed by seed, its 95 % interval by Welch's t and whether that lies
+above zero, beyond the seeds' spread; every run), sim2real.json (every run's `synthua train` command, seed, epochs, image-steps, seconds, device and initial
 weights; every score) and sim2real.png (AP50 against real photos, one line per arm, the seeds' min-max shaded).
 Finished runs are kept: run the same command again to resume, or to score more test sets.
 
@@ -334,7 +335,7 @@ def plan_document(args, arms, seeds, got: Inputs, command: str, work: Path, note
                  "mix_images": {str(n): len(got.mixes[p].images) for n, p in got.mix_paths.items()},
                  "tests": [{k: v for k, v in t.items() if not k.startswith("_")} for t in got.tests]},
         "subsets": {str(n): list(got.subsets[n]) for n in got.sizes},
-        "notes": notes, "runs": [], "scores": [], "summary": [],
+        "notes": notes, "runs": [], "scores": [], "summary": [], "comparisons": [],
     }
 
 
@@ -435,6 +436,7 @@ def run(argv: list[str] | None) -> int:
         if planned.arm != "a" or "a" in arms:              # (a) only as (c)'s pretraining is not scored
             document["scores"] += score_one(planned, record, args, got.tests, work)
         document["summary"] = S.summarise(document["scores"])
+        document["comparisons"] = S.compare(document["scores"])
         document["seconds"] = round(time.perf_counter() - t0, 1)
         _write_outputs(document, work, args)              # after every run: a long experiment shows its progress
     print((work / "sim2real.md").read_text(encoding="utf-8"))

@@ -1,5 +1,6 @@
 """The sim-to-real experiment as data: its arms, budgets in image-steps, nested subsets of the real photos, the runs
-they make, and the spread of their scores over seeds (``tools/sim2real.py`` runs it; docs/statistics.md).
+they make, the spread of their scores over seeds, and each arm against (b) (:func:`compare`: the difference of the
+means and Welch's interval of it) (``tools/sim2real.py`` runs it; docs/statistics.md).
 
 Arms (each trained once per seed, each from the same initial weights):
 
@@ -206,3 +207,50 @@ def summarise(scores: Sequence[dict], measures: Sequence[str] = ("AP50", "AP50_9
     return [{"test": test, "arm": arm, "real_images": n, "class": name, "seeds": [r["seed"] for r in rows]}
             | {m: spread([r[m] for r in rows]) for m in measures}
             for (test, arm, n, name), rows in groups.items()]
+
+
+#: Confidence of :func:`compare`'s interval of a difference of means.
+CONFIDENCE = 0.95
+
+
+def compare(scores: Sequence[dict], baseline: str = "b", measure: str = "AP50",
+            confidence: float = CONFIDENCE) -> list[dict]:
+    """Every other arm against ``baseline`` at the same test set, real size and class, in ``measure``: the
+    difference of the means over seeds, the differences seed by seed (the seeds both arms have), the ranges, and
+    Welch's interval of the difference at ``confidence`` (unequal variances, Welch-Satterthwaite degrees of freedom;
+    None under 2 seeds on either side). ``beyond`` says whether the whole interval lies above zero: a difference
+    the seeds' spread does not explain (``df`` None where neither arm varies: the interval is the difference)."""
+    from scipy.stats import t as student_t
+
+    groups: dict[tuple, dict[str, dict[int, float]]] = {}
+    for row in scores:
+        if row[measure] is not None:
+            key = (row["test"], row["real_images"], row["class"])
+            groups.setdefault(key, {}).setdefault(row["arm"], {})[row["seed"]] = float(row[measure])
+    out = []
+    for (test, n, name), arms in groups.items():
+        base = arms.get(baseline)
+        if not base:
+            continue
+        for arm, values in arms.items():
+            if arm == baseline:
+                continue
+            x, y = np.asarray(list(values.values())), np.asarray(list(base.values()))
+            common = sorted(set(values) & set(base))
+            row = {"test": test, "real_images": n, "class": name, "arm": arm, "baseline": baseline,
+                   "measure": measure, "seeds": sorted(values), "baseline_seeds": sorted(base),
+                   "difference": float(x.mean() - y.mean()),
+                   "common_seeds": common, "per_seed": [values[s] - base[s] for s in common],
+                   "ranges_overlap": bool(max(x.min(), y.min()) <= min(x.max(), y.max())),
+                   "confidence": confidence, "df": None, "low": None, "high": None, "beyond": None}
+            if x.size > 1 and y.size > 1:
+                vx, vy = x.var(ddof=1) / x.size, y.var(ddof=1) / y.size
+                se = math.sqrt(vx + vy)
+                df, half = None, 0.0                              # no spread at all: the interval is the point
+                if se > 0:
+                    df = float((vx + vy) ** 2 / (vx ** 2 / (x.size - 1) + vy ** 2 / (y.size - 1)))
+                    half = float(student_t.ppf((1 + confidence) / 2, df)) * se
+                row |= {"df": df, "low": row["difference"] - half, "high": row["difference"] + half,
+                        "beyond": row["difference"] - half > 0}
+            out.append(row)
+    return out

@@ -1,5 +1,6 @@
 """The report of a sim-to-real experiment (``tools/sim2real.py``): its markdown tables and its low-data curve, both
-from the experiment's JSON document (``sim2real.json``: ``plan``, ``runs``, ``scores``, ``summary``, ``notes``).
+from the experiment's JSON document (``sim2real.json``: ``plan``, ``runs``, ``scores``, ``summary``, ``comparisons``,
+``notes``).
 
 Each score cell is the mean over seeds in %, then the seeds' min–max and sample standard deviation (n − 1):
 ``35.0 (31.0–39.0) sd 4.0``; one seed gives the value alone, no seed (no box of the class) ``–``.
@@ -63,6 +64,39 @@ def _score_tables(document: dict) -> list[str]:
     return lines
 
 
+def _signed(x: float) -> str:
+    return f"{100 * x:+.1f}"
+
+
+def _comparison_table(document: dict) -> list[str]:
+    """Each arm against (b): :func:`~synthua_usd.pipeline.sim2real.compare`'s rows, in points."""
+    rows = document.get("comparisons") or []
+    if not rows:
+        return []
+    first = rows[0]
+    lines = [f"**Against {arm_label(first['baseline'])}**, {first['measure']} in points (the arm minus "
+             f"({first['baseline']}); {100 * first['confidence']:.0f} % interval of the difference of the means by "
+             f"Welch's t, unequal variances):", "",
+             "| test | class | real images | arm | difference of the means | seed by seed | interval | beyond the "
+             "seeds' spread | seeds' ranges overlap |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        by_seed = (", ".join(map(_signed, r["per_seed"])) + f" (seeds {','.join(map(str, r['common_seeds']))})"
+                   if r["per_seed"] else "–")
+        if r["low"] is None:
+            interval, beyond = "– (under 2 seeds)", "–"
+        else:
+            interval = f"{_signed(r['low'])} to {_signed(r['high'])}" + (f" (df {r['df']:.1f})" if r["df"] else "")
+            beyond = "yes" if r["beyond"] else "no"
+        size = "–" if r["real_images"] is None else f"{r['real_images']:,}"
+        lines.append(f"| {r['test']} | {r['class']} | {size} | "
+                     f"{arm_label(r['arm'])} | {_signed(r['difference'])} | {by_seed} | {interval} | {beyond} | "
+                     f"{'yes' if r['ranges_overlap'] else 'no'} |")
+    return lines + ["", "Beyond the seeds' spread: the whole interval above zero, a difference the seeds' scatter "
+                    "does not explain. A difference of at least X beyond the spread, read strictly: the interval's "
+                    "lower end at X or above.", ""]
+
+
 def _run_table(document: dict) -> list[str]:
     lines = ["| run | trained on | images | epochs (last without mosaic) | image-steps | from | seconds | images/s | device |",
              "|---|---|---|---|---|---|---|---|---|"]
@@ -92,6 +126,7 @@ def markdown(document: dict) -> str:
     lines += _score_tables(document)
     lines += ["AP by pycocotools' COCOeval (bbox, area all, 100 detections an image), in %: the mean over seeds, "
               "(min–max) and sd, the sample standard deviation (n − 1).", ""]
+    lines += _comparison_table(document)
     lines += _run_table(document)
     if document.get("notes"):
         lines += [f"- {note}" for note in document["notes"]] + [""]

@@ -287,6 +287,15 @@ def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path,
     for row in doc["scores"]:
         s = next(s for s in doc["summary"] if (s["arm"], s["class"]) == (row["arm"], row["class"]))
         assert s["AP50"]["mean"] == row["AP50"] and s["AP50"]["std"] is None and s["seeds"] == [0]
+    # (c) and (d) against (b) class by class, from the same scores; one seed: no interval
+    ap = {(r["arm"], r["class"]): r["AP50"] for r in doc["scores"]}
+    scored = {c for (arm, c), v in ap.items() if arm == "b" and v is not None}
+    assert {(r["arm"], r["class"]) for r in doc["comparisons"]} == {(a, c) for a in "cd" for c in scored
+                                                                     if ap[(a, c)] is not None}
+    assert doc["comparisons"]
+    for r in doc["comparisons"]:
+        assert r["difference"] == pytest.approx(ap[(r["arm"], r["class"])] - ap[("b", r["class"])])
+        assert r["per_seed"] == [pytest.approx(r["difference"])] and r["low"] is None and r["beyond"] is None
     text = (work / "sim2real.md").read_text()
     assert "| (d) real + mixed set | 1 + 2 mixed | 0 | 1 × 3 = 3 |" in text
     assert "| (c) synthetic, then real | 1 | 0 | 4 × 1 = 4 after (a)'s 4 |" in text

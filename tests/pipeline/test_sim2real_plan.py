@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.stats
 from PIL import Image
 
 from conftest import REPO
@@ -130,6 +131,32 @@ def test_summaries_group_runs_over_seeds():
     assert cell(b["AP50"]) == "35.0 (31.0–39.0) sd 4.0"
 
 
+def test_arms_against_b_with_welchs_interval_as_scipy_computes_it():
+    rows = S.compare(_scores())
+    assert [(r["arm"], r["class"], r["real_images"]) for r in rows] == [("c", "wheelchair", 50)]  # (a): no (b) beside it
+    r, c, b = rows[0], [0.40, 0.46, 0.49], [0.35, 0.39, 0.31]
+    welch = scipy.stats.ttest_ind(c, b, equal_var=False)
+    interval = welch.confidence_interval(0.95)
+    assert r["difference"] == pytest.approx(np.mean(c) - np.mean(b))
+    assert (r["low"], r["high"], r["df"]) == pytest.approx((interval.low, interval.high, welch.df))
+    assert r["common_seeds"] == [0, 1, 2] and r["per_seed"] == pytest.approx([0.05, 0.07, 0.18])
+    assert r["beyond"] is True and r["ranges_overlap"] is False            # 40-49 against 31-39
+    # arms inside each other's spread: the interval holds zero
+    mixed = [x | {"AP50": v} for x, v in zip(_scores(), [0.35, 0.30, 0.39, 0.45, 0.31, 0.38, 0.1])]
+    near = S.compare(mixed)[0]
+    welch = scipy.stats.ttest_ind([0.30, 0.45, 0.38], b, equal_var=False)
+    assert near["low"] == pytest.approx(welch.confidence_interval(0.95).low) and near["low"] < 0 < near["high"]
+    assert near["beyond"] is False and near["ranges_overlap"] is True
+    # one seed of the arm: the difference, no interval; a seed without a box of the class (None) is left out
+    one = S.compare([x for x in _scores() if not (x["arm"] == "c" and x["seed"] > 0)])[0]
+    assert one["difference"] == pytest.approx(0.40 - np.mean(b)) and one["low"] is None and one["beyond"] is None
+    none = S.compare([x | {"AP50": None} if x["arm"] == "c" and x["seed"] == 2 else x for x in _scores()])[0]
+    assert none["seeds"] == [0, 1] and none["difference"] == pytest.approx(np.mean(c[:2]) - np.mean(b))
+    # no spread at all: the interval is the difference itself
+    flat = S.compare([x | {"AP50": 0.5 if x["arm"] == "c" else 0.3} for x in _scores() if x["arm"] != "a"])[0]
+    assert (flat["low"], flat["high"], flat["df"], flat["beyond"]) == pytest.approx((0.2, 0.2, None, True))
+
+
 def _document():
     runs = []
     for seed in range(3):
@@ -148,7 +175,8 @@ def _document():
                      "synthetic_budget_images": 8000, "imgsz": 320, "batch": 16, "init": None, "model": "yolo26n.yaml",
                      "subset_seed": 0, "real_photos": 449,
                      "tests": [{"label": "dev-val", "path": "real/", "split": "val", "images": 53}]},
-            "runs": runs, "scores": scores, "summary": S.summarise(scores), "notes": ["a note"]}
+            "runs": runs, "scores": scores, "summary": S.summarise(scores), "comparisons": S.compare(scores),
+            "notes": ["a note"]}
 
 
 def test_the_markdown_and_the_curve(tmp_path):
@@ -156,6 +184,8 @@ def test_the_markdown_and_the_curve(tmp_path):
     assert "| (b) real only | 50 | 0,1,2 | 150 × 50 = 7,500 | 35.0 (31.0–39.0) sd 4.0 |" in text
     assert "| (c) synthetic, then real | 50 | 0,1,2 | 150 × 50 = 7,500 after (a)'s 8,000 |" in text
     assert "every arm from scratch (yolo26n.yaml)" in text and "(8,000 for (a))" in text and "- a note" in text
+    assert ("| dev-val | wheelchair | 50 | (c) synthetic, then real | +10.0 | +5.0, +7.0, +18.0 (seeds 0,1,2) | "
+            "+0.2 to +19.8 (df 3.9) | yes | no |") in text
     png = curve(_document(), tmp_path / "curve.png", ["wheelchair", "person"])
     assert png.stat().st_size > 5000 and Image.open(png).size[0] > 300
     assert curve(_document(), tmp_path / "none.png", ["bicycle"]) is None
