@@ -18,8 +18,9 @@ Every model is scored by `synthua evaluate-real` on each --test (its test split,
 the plot), and (a) also on the generated dataset's held-out split. Outputs under --work: sim2real.md (per test set,
 arm and real size: AP50 and AP50-95 per class as the mean over seeds, min-max and sample standard deviation; every
 arm against (b): the difference of the AP50 means, seed by seed, its 95 % interval by Welch's t and whether that lies
-above zero, beyond the seeds' spread; every run), sim2real.json (every run's `synthua train` command, seed, epochs, image-steps, seconds, device and initial
-weights; every score) and sim2real.png (AP50 against real photos, one line per arm, the seeds' min-max shaded).
+above zero, beyond the seeds' spread; every run), sim2real.json (every run's `synthua train` command, seed, epochs,
+image-steps, seconds, device and initial weights; every score; the comparisons) and sim2real.png (AP50 against
+real photos, one line per arm, the seeds' min-max shaded).
 Finished runs are kept: run the same command again to resume, or to score more test sets.
 
 Examples:

@@ -29,8 +29,8 @@ from synthua_usd.dataset import annotations, keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
-from synthua_usd.dataset.record import (REJECTED, DatasetRecord, ImageRecord, InstanceEntry, QAResult, check_record, image_kind,
-                                         record_camera, record_render)
+from synthua_usd.dataset.record import (REJECTED, DatasetRecord, ImageRecord, InstanceEntry, QAResult, check_record,
+                                         image_kind, record_camera, record_render)
 from synthua_usd.dataset.manifest import file_entry
 from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.taxonomy import ClassMap

@@ -133,7 +133,8 @@ def test_summaries_group_runs_over_seeds():
 
 def test_arms_against_b_with_welchs_interval_as_scipy_computes_it():
     rows = S.compare(_scores())
-    assert [(r["arm"], r["class"], r["real_images"]) for r in rows] == [("c", "wheelchair", 50)]  # (a): no (b) beside it
+    # (a) has no real size, so no (b) beside it
+    assert [(r["arm"], r["class"], r["real_images"]) for r in rows] == [("c", "wheelchair", 50)]
     r, c, b = rows[0], [0.40, 0.46, 0.49], [0.35, 0.39, 0.31]
     welch = scipy.stats.ttest_ind(c, b, equal_var=False)
     interval = welch.confidence_interval(0.95)
