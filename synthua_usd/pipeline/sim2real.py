@@ -235,20 +235,20 @@ def compare(scores: Sequence[dict], baseline: str = "b", measure: str = "AP50",
         for arm, values in arms.items():
             if arm == baseline:
                 continue
-            x, y = np.asarray(list(values.values())), np.asarray(list(base.values()))
+            x, y = spread(list(values.values())), spread(list(base.values()))
             common = sorted(set(values) & set(base))
             row = {"test": test, "real_images": n, "class": name, "arm": arm, "baseline": baseline,
                    "measure": measure, "seeds": sorted(values), "baseline_seeds": sorted(base),
-                   "difference": float(x.mean() - y.mean()),
+                   "difference": x["mean"] - y["mean"],
                    "common_seeds": common, "per_seed": [values[s] - base[s] for s in common],
-                   "ranges_overlap": bool(max(x.min(), y.min()) <= min(x.max(), y.max())),
+                   "ranges_overlap": max(x["min"], y["min"]) <= min(x["max"], y["max"]),
                    "confidence": confidence, "df": None, "low": None, "high": None, "beyond": None}
-            if x.size > 1 and y.size > 1:
-                vx, vy = x.var(ddof=1) / x.size, y.var(ddof=1) / y.size
+            if x["n"] > 1 and y["n"] > 1:
+                vx, vy = x["std"] ** 2 / x["n"], y["std"] ** 2 / y["n"]
                 se = math.sqrt(vx + vy)
                 df, half = None, 0.0                              # no spread at all: the interval is the point
                 if se > 0:
-                    df = float((vx + vy) ** 2 / (vx ** 2 / (x.size - 1) + vy ** 2 / (y.size - 1)))
+                    df = (vx + vy) ** 2 / (vx ** 2 / (x["n"] - 1) + vy ** 2 / (y["n"] - 1))
                     half = float(student_t.ppf((1 + confidence) / 2, df)) * se
                 row |= {"df": df, "low": row["difference"] - half, "high": row["difference"] + half,
                         "beyond": row["difference"] - half > 0}
