@@ -15,12 +15,14 @@ image-steps do not. The real photos are drawn once (--subset-seed) in a seeded o
 first n of it, so the subsets are nested and the same for every arm and seed (written under WORK/subsets/, with their
 photo lists, before any training: --plan-only stops there, e.g. to composite aid users into a subset for arm d).
 Every model is scored by `synthua evaluate-real` on each --test (its test split, else val; the first is the one of
-the plot), and (a) also on the generated dataset's held-out split. Outputs under --work: sim2real.md (per test set,
-arm and real size: AP50 and AP50-95 per class as the mean over seeds, min-max and sample standard deviation; every
-arm against (b): the difference of the AP50 means, seed by seed, its 95 % interval by Welch's t and whether that lies
-above zero, beyond the seeds' spread; every run), sim2real.json (every run's `synthua train` command, seed, epochs,
-image-steps, seconds, device and initial weights; every score; the comparisons) and sim2real.png (AP50 against
-real photos, one line per arm, the seeds' min-max shaded).
+the plot), with --held-back also on the real training photos that no subset holds (WORK/held_back: with 50 of 449
+photos trained on, 399 more test photos), and (a) also on the generated dataset's held-out split. No test photo may
+be trained on: neither among the training photos or a --mix set, nor the background of a --mix set's composites.
+Outputs under --work: sim2real.md (per test set, arm and real size: AP50 and AP50-95 per class as the mean over
+seeds, min-max and sample standard deviation; every arm against (b): the difference of the AP50 means, seed by seed,
+its 95 % interval by Welch's t and whether that lies above zero, beyond the seeds' spread; every run), sim2real.json
+(every run's `synthua train` command, seed, epochs, image-steps, seconds, device and initial weights; every score;
+the comparisons) and sim2real.png (AP50 against real photos, one line per arm, the seeds' min-max shaded).
 Finished runs are kept: run the same command again to resume, or to score more test sets.
 
 Examples:
@@ -64,7 +66,9 @@ from synthua_usd.pipeline import sim2real as S  # noqa: E402
 from synthua_usd.pipeline.evaluate_real import EvaluateRequest, evaluate_real  # noqa: E402
 from synthua_usd.pipeline.init_weights import describe, inspect_checkpoint, locate_init  # noqa: E402
 from synthua_usd.pipeline.sim2real_report import curve, markdown  # noqa: E402
-from synthua_usd.pipeline.sim2real_sets import photo_names, renamed_mix, stand_in, write_training_folder  # noqa: E402
+from synthua_usd.dataset.manifest import sha256_file  # noqa: E402
+from synthua_usd.pipeline.sim2real_sets import (  # noqa: E402
+    composite_backgrounds, photo_names, renamed_mix, stand_in, write_test_folder, write_training_folder)
 from synthua_usd.pipeline.train import Budget, TrainRequest, train  # noqa: E402
 
 class _Parser(argparse.ArgumentParser):
@@ -123,6 +127,10 @@ def _parse(argv):
     data.add_argument("--test", type=Path, action="append", default=[], metavar="PATH",
                       help="real test set (YOLO folder: its test split, else val; or COCO .json); repeat for more; "
                            "the first is the plot's")
+    data.add_argument("--held-back", action="store_true",
+                      help="also score every run on the real training photos that no trained subset holds (those "
+                           "after the largest --real-sizes in the draw; written under WORK/held_back as a YOLO folder "
+                           "of links): a test set many times the val split's where labelled photos are few")
     data.add_argument("--mix", action="append", default=[], metavar="[SIZE=]PATH",
                       help="arm d's other labelled set (a `synthua composite` dataset or any YOLO set), mixed with "
                            "the real photos; SIZE= gives the set of one real size (e.g. 50=out/comp50), "
@@ -232,8 +240,44 @@ def _label(path: Path, split: str | None, taken: set[str]) -> str:
 def _no_overlap(test: dict, training: set[Path], what: str) -> None:
     shared = test["_paths"] & training
     if shared:
+        hint = (", or --held-back to score on the training photos no subset holds"
+                if what.startswith("the real training photos") else "")
         raise InputError(f"--test {test['path']}: {len(shared)} of its {test['images']} images are among {what} (e.g. "
-                         f"{sorted(shared)[0].name}); expected a held-out test set")
+                         f"{sorted(shared)[0].name}); expected a held-out test set{hint}")
+
+
+def _no_background(test: dict, backgrounds: dict[str, str], mix: Path) -> None:
+    """Refuse a mixed set whose composites were made into photos of a test set (the same bytes, by SHA-256)."""
+    if not backgrounds:
+        return
+    shared = sorted(backgrounds[h] for h in {sha256_file(p) for p in test["_paths"]} & backgrounds.keys())
+    if shared:
+        raise InputError(f"--mix {mix}: {len(shared)} of its composites' backgrounds are photos of the test set "
+                         f"{test['label']} (e.g. {shared[0]}); expected composites into training photos only")
+
+
+def _held_back(got: "Inputs", args, work: Path, taken: set[str]) -> dict:
+    """The real training photos after the largest subset in the draw, as a test entry still to be written
+    (:func:`_write_held_back`): its label, folder, photos and their paths, checked against the photos trained on."""
+    largest = got.sizes[-1]
+    names = list(S.draw_order(list(got.photos), args.subset_seed)[largest:])
+    if not names:
+        raise InputError(f"--held-back: all {len(got.photos)} real training photos are trained on (--real-sizes "
+                         f"{args.real_sizes}); expected a largest size below {len(got.photos)}")
+    base = args.real_train.parent.name if args.real_train.suffix.lower() in (".yaml", ".yml") else args.real_train.stem
+    entry = {"label": _label(Path(f"{base}-held-back"), None, taken), "path": str(work / "held_back"),
+             "images": len(names), "_names": names, "_paths": {Path(got.photos[p].path).resolve() for p in names}}
+    _no_overlap(entry, {Path(got.photos[p].path).resolve() for p in got.subsets[largest]}, "the photos trained on")
+    return entry
+
+
+def _write_held_back(entry: dict, got: "Inputs", args, targets) -> dict:
+    """Write the held-back photos' test folder (links) and read it back as every --test is read."""
+    names = entry["_names"]
+    about = {"real_train": str(args.real_train), "real_sha256": set_id(got.real), "subset_seed": args.subset_seed,
+             "held_back_after": got.sizes[-1], "photos": names}
+    folder = write_test_folder(Path(entry["path"]), [got.photos[p] for p in names], got.real.names, about)
+    return _test_entry(folder, None, entry["label"], targets)
 
 
 def _write_outputs(document: dict, work: Path, args) -> None:
@@ -268,8 +312,9 @@ class Inputs:
     init: object = None
 
 
-def read_inputs(args, arms: tuple[str, ...], targets) -> Inputs:
-    """Read and check every input (in one line on failure) before anything is written or trained."""
+def read_inputs(args, arms: tuple[str, ...], targets, work: Path) -> Inputs:
+    """Read and check every input (in one line on failure) before anything is written or trained (the held-back
+    photos' folder of links last, once every check has passed)."""
     got = Inputs()
     if any(a in arms for a in S.REAL_ARMS):
         got.real = read_detection_set(args.real_train, "auto", "train", targets=targets)
@@ -284,8 +329,13 @@ def read_inputs(args, arms: tuple[str, ...], targets) -> Inputs:
             _no_overlap(entry, {Path(im.path).resolve() for im in got.real.images},
                         f"the real training photos ({args.real_train})")
         got.tests.append(entry)
+    if args.held_back:
+        if got.real is None:
+            raise InputError("--held-back: no arm trains on real photos; expected arm b, c or d (--real-train)")
+        got.tests.append(_held_back(got, args, work, taken))
     if got.real is not None and not got.tests:
-        raise InputError("--test: none given; expected a real test set to score the arms trained on real photos")
+        raise InputError("--test: none given; expected a real test set (or --held-back) to score the arms trained "
+                         "on real photos")
     if "a" in arms or "c" in arms:
         got.synthetic_images = len(read_detection_set(args.synthetic, "auto", "train", targets=targets).images)
         if "a" in arms and args.synthetic_split != "none":
@@ -296,12 +346,17 @@ def read_inputs(args, arms: tuple[str, ...], targets) -> Inputs:
         got.mix_paths = _mix_paths(args.mix, got.sizes, len(got.photos))
         for path in dict.fromkeys(got.mix_paths.values()):
             got.mixes[path] = renamed_mix(path, args.mix_split, got.real.names, args.mix_map, args.convention)
+            backgrounds = composite_backgrounds(path, args.mix_split)
             for t in got.tests:
+                if t.get("only", "d") != "d":
+                    continue
                 _no_overlap(t, {Path(im.path).resolve() for im in got.mixes[path].images}, f"the mixed set {path}")
+                _no_background(t, backgrounds, path)
     got.init = locate_init(args.init)
     if got.init.kind == "checkpoint" and not args.plan_only:     # inspected once for every run
         with tempfile.TemporaryDirectory(prefix="sim2real-inspect-") as scratch:
             got.init = inspect_checkpoint(got.init, find_detector_python(args.python), Path(scratch))
+    got.tests = [_write_held_back(t, got, args, targets) if "_names" in t else t for t in got.tests]   # checks passed
     return got
 
 
@@ -411,7 +466,7 @@ def run(argv: list[str] | None) -> int:
     seeds = S.parse_seeds(args.seeds)
     Budget(minutes=None, epochs=1, imgsz=args.imgsz, batch=args.batch)           # checks imgsz and batch now
     targets = targets_for(args.convention)
-    got = read_inputs(args, arms, targets)
+    got = read_inputs(args, arms, targets, work)
     folders = write_folders(got, args, arms, work)
     runs = S.plan_runs(arms, got.sizes, seeds, args.budget_images, args.synthetic_budget_images or args.budget_images,
                        got.synthetic_images, {n: len(got.mixes[p].images) for n, p in got.mix_paths.items()},

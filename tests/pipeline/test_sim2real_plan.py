@@ -205,13 +205,15 @@ def tool():
 
 @pytest.fixture(scope="module")
 def real(tmp_path_factory) -> Path:
-    """A YOLO set of tiny images: train 20 (one person box each, every fourth a wheelchair too), val 3."""
+    """A YOLO set of tiny images: train 20 (one person box each, every fourth a wheelchair too), val 3 (greys no train
+    photo has)."""
     root = tmp_path_factory.mktemp("real")
     for split, count in (("train", 20), ("val", 3)):
         (root / "images" / split).mkdir(parents=True)
         (root / "labels" / split).mkdir(parents=True)
         for k in range(count):
-            Image.fromarray(np.full((48, 64, 3), 10 * k, np.uint8)).save(root / "images" / split / f"{split}{k:02d}.png")
+            grey = 10 * k + (5 if split == "val" else 0)           # no val photo the same as a train photo
+            Image.fromarray(np.full((48, 64, 3), grey, np.uint8)).save(root / "images" / split / f"{split}{k:02d}.png")
             lines = "0 0.5 0.5 0.25 0.5\n" + ("1 0.3 0.6 0.3 0.4\n" if k % 4 == 0 else "")
             (root / "labels" / split / f"{split}{k:02d}.txt").write_text(lines)
     (root / "data.yaml").write_text("path: .\ntrain: images/train\nval: images/val\nnames: [person, wheelchair]\n")
@@ -292,3 +294,58 @@ def test_every_arm_closes_mosaic_for_the_same_share_of_its_epochs(budget, images
     runs = S.plan_runs(("b", "d"), (50,), (0,), 7500, 7500, None, {50: 400})
     assert [(r.name, r.budget.epochs, r.budget.close_mosaic) for r in runs] == [("b_n0050_s0", 150, 10),
                                                                               ("d_n0050_s0", 17, 1)]
+
+
+def test_held_back_photos_are_the_draws_rest(tool, real, tmp_path, capsys):
+    """--held-back: the real training photos after the largest subset in the draw become a test set of links, read
+    and scored as every --test; all photos trained on leaves none and is refused."""
+    work = tmp_path / "work"
+    args = ["--real-train", str(real), "--test", str(real), "--held-back", "--real-sizes", "5,12", "--budget-images",
+            "30", "--plan-only", "--work", str(work)]
+    assert tool.main(args) == 0
+    doc = json.loads((work / "sim2real.json").read_text())
+    val, held = doc["plan"]["tests"]
+    trained = {Path(n).name for n in doc["subsets"]["12"]}
+    expected = sorted({p.name for p in (real / "images" / "train").iterdir()} - trained)
+    assert len(expected) == 8 and held["label"] == f"{real.name}-held-back" and held["split"] == "test"
+    links = sorted((work / "held_back" / "images" / "test").iterdir())
+    assert sorted(p.resolve().name for p in links) == expected and all(p.is_symlink() for p in links)
+    wheelchairs = sum(int(name[5:7]) % 4 == 0 for name in expected)          # the fixture: every fourth photo
+    assert held["images"] == 8 and held["boxes"] == {"person": 8, "wheelchair": wheelchairs}
+    assert val["label"] == f"{real.name}-val" and val["images"] == 3
+    capsys.readouterr()
+    assert tool.main([a if a != "5,12" else "5,all" for a in args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--held-back: all 20 real training photos are trained on" in err[0], err
+
+
+def test_no_composite_into_a_test_photo_is_trained_on(tool, real, tmp_path, run_cli, capsys):
+    """A --mix set of composites is refused when any of its backgrounds (by SHA-256) is a photo of a test set: the
+    --test's, or a held-back one; composites into the photos trained on are taken."""
+    from bank_maker import write_bank
+
+    write_bank(tmp_path / "bank")
+    (tmp_path / "config.json").write_text(json.dumps({
+        "output": {"width": 64, "height": 48}, "images_per_background": 1,
+        "background_labels": {"classes": {"wheelchair": "manual_wheelchair"}},
+        "split": {"train": 1.0, "val": 0.0, "test": 0.0}}))          # every composite trained on (--mix-split train)
+    for name, split in (("into_val", "val"), ("into_train", "train")):
+        code, out, err = run_cli("composite", real, "--bank", tmp_path / "bank", "--config", tmp_path / "config.json",
+                                 "--split", split, "--out", tmp_path / name, "--workers", "1")
+        assert code == 0, out + err
+    base = ["--real-train", str(real), "--test", str(real), "--arms", "d", "--budget-images", "10", "--plan-only"]
+    cases = [
+        (base + ["--mix", str(tmp_path / "into_val"), "--work", str(tmp_path / "w1")],
+         f"--mix {tmp_path / 'into_val'}: 3 of its composites' backgrounds are photos of the test set {real.name}-val"),
+        (base + ["--mix", str(tmp_path / "into_train"), "--real-sizes", "5", "--held-back", "--work",
+                 str(tmp_path / "w2")],
+         f"--mix {tmp_path / 'into_train'}: 15 of its composites' backgrounds are photos of the test set "
+         f"{real.name}-held-back"),
+    ]
+    for args, found in cases:
+        assert tool.main(args) == 2, args
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith(f"synthua: error: {found} (e.g. images/"), err
+        assert err[0].endswith("); expected composites into training photos only"), err
+    assert not (tmp_path / "w2" / "held_back").exists()          # refused before anything is written
+    assert tool.main(base + ["--mix", str(tmp_path / "into_train"), "--work", str(tmp_path / "w3")]) == 0
