@@ -39,13 +39,12 @@ import yaml
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.input_files import MAX_DOCUMENT_BYTES, read_input_text, shown
 from synthua_usd.core.schemas import read_json
+from synthua_usd.model.photo_sets import ALL_SPLITS
 
 #: File suffixes read as images (Ultralytics' own list, lower case, less the formats OpenImageIO cannot read).
 IMAGE_SUFFIXES = (".bmp", ".jpeg", ".jpg", ".png", ".tif", ".tiff", ".webp")
 #: Splits a set may name, in the order a test set is looked for when none is asked for.
 TEST_SPLITS = ("test", "val")
-#: The split that takes every split of a YOLO set.
-ALL_SPLITS = "all"
 #: Most images read from one set (a real benchmark holds thousands; this bounds a mistaken folder).
 MAX_IMAGES = 200_000
 #: Normalised coordinates may overshoot [0, 1] by this much (rounding of the tools that wrote them).

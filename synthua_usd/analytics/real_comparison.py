@@ -42,11 +42,12 @@ import numpy as np
 
 from synthua_usd.analytics.class_mapping import build_mapping
 from synthua_usd.analytics.dataset_index import DatasetIndex
-from synthua_usd.analytics.detection_sets import ALL_SPLITS, DetectionSet
+from synthua_usd.analytics.detection_sets import DetectionSet
 from synthua_usd.analytics.detection_sources import detect_format, read_detection_set
 from synthua_usd.analytics.detection_targets import read_generated, targets_for
 from synthua_usd.analytics.image_contrast import SPREAD, photo_measures, spread
 from synthua_usd.model.detection_limits import DEFAULT_MIN_HEIGHT_PX
+from synthua_usd.model.photo_sets import ALL_SPLITS
 
 log = logging.getLogger(__name__)
 

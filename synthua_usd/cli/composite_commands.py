@@ -9,6 +9,7 @@ import click
 
 from synthua_usd.cli.common import EXIT_OK, say
 from synthua_usd.cli.dataset_commands import worker_time_shares
+from synthua_usd.model.photo_sets import DEFAULT_SPLIT, SPLIT_CHOICES
 
 
 @click.command()
@@ -21,7 +22,7 @@ from synthua_usd.cli.dataset_commands import worker_time_shares
               help="Dataset folder: created (an existing one must be empty).")
 @click.option("--workers", type=click.IntRange(1, 1024),
               help="Worker processes [default: the config's, else one per CPU core].")
-@click.option("--split", type=click.Choice(["default", "train", "val", "test", "all"]), default="default",
+@click.option("--split", type=click.Choice(SPLIT_CHOICES), default=DEFAULT_SPLIT,
               show_default=True,
               help="Which photos of a labelled YOLO set: default is its train split where it names one (its val and "
                    "test photos are what a detector trained on the composites is scored on: pasting into them "

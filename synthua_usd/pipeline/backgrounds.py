@@ -25,11 +25,11 @@ from pathlib import Path
 
 from synthua_usd.analytics.detection_sets import IMAGE_SUFFIXES, MAX_IMAGES, TOLERANCE, Box, label_path, read_coco, \
     read_data_yaml, read_yolo
-from synthua_usd.analytics.detection_sets import ALL_SPLITS
 from synthua_usd.analytics.detection_sources import detect_format
 from synthua_usd.backends.photos import HEIC_SUFFIXES, cover_region, photo_header
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
+from synthua_usd.model.photo_sets import ALL_SPLITS, DEFAULT_SPLIT
 
 LAYOUTS = ("folder", "yolo", "coco")
 
@@ -103,13 +103,9 @@ def _check_boxes(image: Path, boxes: tuple[Box, ...], width: int, height: int) -
                              f"a box inside the {width}x{height} image")
 
 
-#: ``split`` of :func:`read_backgrounds`: a labelled YOLO set's train split where it names one, else all its photos.
-DEFAULT_SPLIT = "default"
-SPLIT_CHOICES = (DEFAULT_SPLIT, "train", "val", "test", ALL_SPLITS)
-
-
 def _yolo_split(path: Path, split: str) -> str:
-    """The split of the YOLO set at ``path`` that ``split`` (:data:`SPLIT_CHOICES`) reads."""
+    """The split of the YOLO set at ``path`` that ``split`` (one of
+    :data:`synthua_usd.model.photo_sets.SPLIT_CHOICES`) reads."""
     if split != DEFAULT_SPLIT:
         return split
     yaml = path if path.is_file() else path / "data.yaml"
@@ -120,8 +116,8 @@ def _yolo_split(path: Path, split: str) -> str:
 
 def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: str = DEFAULT_SPLIT) -> BackgroundSet:
     """The background set at ``path`` (see the module docstring), every photo's header checked against
-    ``output`` (W, H; None: any size); of a labelled YOLO set, the photos of ``split`` (:data:`SPLIT_CHOICES`;
-    the default: its train split where it names one, else all)."""
+    ``output`` (W, H; None: any size); of a labelled YOLO set, the photos of ``split`` (one of
+    :data:`synthua_usd.model.photo_sets.SPLIT_CHOICES`; the default: its train split where it names one, else all)."""
     path = Path(path)
     if not path.exists():
         raise InputError(f"{shown(path)}: not found; expected a folder of photos, a YOLO set or a COCO .json")

@@ -56,7 +56,7 @@ class CompositeRequest:
     config_path: Path
     out_dir: Path
     workers: int | None = None
-    #: Which photos of a labelled YOLO set (backgrounds.SPLIT_CHOICES; default: its train split where it has one).
+    #: Which photos of a labelled YOLO set (model.photo_sets.SPLIT_CHOICES; default: its train split where it has one).
     split: str = DEFAULT_SPLIT
 
 
