@@ -313,7 +313,7 @@ class GenerationConfig:
             raise InputError(f"{source}: {', '.join(map(echo, unknown))} is not a class group or class; expected "
                              f"among the groups {', '.join(sorted(set(groups)))} or a class name")
 
-    def amodal_wanted(self, class_name: str, group: str) -> bool:
+    def amodal_wanted(self, class_name: str, group: str | None) -> bool:
         """Whether instances of ``class_name`` (in ``group``) get amodal masks."""
         return class_name in self.amodal_groups or group in self.amodal_groups
 

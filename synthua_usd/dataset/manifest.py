@@ -50,10 +50,10 @@ def sha256_file(path: str | Path) -> str:
     return digest.hexdigest()
 
 
-def file_entry(root: Path, relative: str) -> dict:
+def file_entry(root: Path, relative: str) -> FileEntry:
     """``{"path", "sha256", "bytes"}`` of the file ``root / relative``."""
     path = Path(root) / relative
-    return {"path": relative, "sha256": sha256_file(path), "bytes": path.stat().st_size}
+    return FileEntry(path=relative, sha256=sha256_file(path), bytes=path.stat().st_size)
 
 
 def files_written(root: Path, checksums: dict[str, FileEntry]) -> bool:
@@ -68,7 +68,7 @@ def files_written(root: Path, checksums: dict[str, FileEntry]) -> bool:
         return False
 
 
-def manifest_document(*, provenance: dict, images: list[dict], dataset_files: list[dict]) -> dict:
+def manifest_document(*, provenance: dict, images: list[dict], dataset_files: list[FileEntry]) -> dict:
     """The manifest: ``provenance`` (software versions, variant, config and its hash, layer stack digest),
     one entry per image (``id``, ``name``, ``split``, ``seed``, ``layer_stack``, ``files``: a list of file
     entries) and the dataset-level files."""

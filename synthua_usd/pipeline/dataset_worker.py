@@ -19,13 +19,15 @@ import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from synthua_usd.backends import camera_effects, frame_files, previews
 from synthua_usd.core import images
 from synthua_usd.core.atomic import atomic_path, write_json_atomic
-from synthua_usd.dataset import annotations, keypoints, qa, resample
+from synthua_usd.dataset import annotations as instance_annotations
+from synthua_usd.dataset import keypoints, qa, resample
 from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import cityscapes, yolo
 from synthua_usd.dataset.layout import CityscapesName, Layout, image_name
@@ -36,6 +38,16 @@ from synthua_usd.model.render_config import RenderConfig
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.background import BackgroundWriter
 from synthua_usd.randomisation.effects import draw_image_effects
+
+if TYPE_CHECKING:      # the heavy modules a worker loads when it starts, not when it is imported
+    from synthua_usd.backends.mitsuba.render import RenderedFrame
+    from synthua_usd.backends.mitsuba.session import RenderSession
+    from synthua_usd.model.cameras import PinholeCamera
+    from synthua_usd.model.conditions import Condition
+    from synthua_usd.model.scene import SceneSnapshot
+    from synthua_usd.pipeline.randomiser import ImageRandomisation, Randomiser
+    from synthua_usd.pipeline.scenes import SceneKey
+    from synthua_usd.usd.reader import StageReader
 
 #: The item that ends a shard: the worker finishes its pending write and returns that record.
 FLUSH = "flush"
@@ -68,20 +80,21 @@ class WorkerJob:
 @dataclass
 class WorkerState:
     job: WorkerJob
-    stage: object
-    reader: object
-    session: object
+    #: The open pxr ``Usd.Stage`` (typed Any: only synthua_usd.usd imports OpenUSD, type hints included).
+    stage: Any
+    reader: StageReader
+    session: RenderSession
     class_map: ClassMap
-    conditions: dict = field(default_factory=dict)
+    conditions: dict[str | None, Condition | None] = field(default_factory=dict)
     #: Gives each image its randomisation layers (None when the config randomises nothing).
-    randomiser: object = None
+    randomiser: Randomiser | None = None
     #: The scene key whose scenario ``stage`` is (None: the job's scenario).
-    scene: object = None
+    scene: SceneKey | None = None
     #: Writes the previous image (its files, then its record) while the next one renders.
     writer: BackgroundWriter = field(default_factory=BackgroundWriter)
     seconds: dict = field(default_factory=lambda: {"render": 0.0, "annotate": 0.0, "write": 0.0})
 
-    def condition(self, name: str | None):
+    def condition(self, name: str | None) -> Condition | None:
         """The condition ``name`` as the stage composes it: read once, or for every image when randomised (the
         view layer moves its sun)."""
         from synthua_usd.usd.conditions import read_condition
@@ -98,29 +111,37 @@ def init_worker(job: WorkerJob) -> WorkerState:
     from synthua_usd.backends.mitsuba.session import RenderSession
 
     class_map = ClassMap.from_document(job.class_map_document, source="class_map.json")
-    state = WorkerState(job=job, stage=None, reader=None, session=RenderSession(job.render, job.count_compiles),
-                        class_map=class_map)
-    _open(state, job.scenario, None)
-    return state
+    stage, reader = _opened(job, job.scenario, None, class_map)
+    return WorkerState(job=job, stage=stage, reader=reader, session=RenderSession(job.render, job.count_compiles),
+                       class_map=class_map, randomiser=_randomiser(job, stage, class_map))
 
 
-def _open(state: WorkerState, scenario: str, scene) -> None:
-    """Make ``scenario`` (the job's, or a scene's of the dataset) the stage the worker renders."""
+def _opened(job: WorkerJob, scenario: str, scene: SceneKey | None, class_map: ClassMap) -> tuple[Any, StageReader]:
+    """The stage of ``scenario`` (the job's, or a scene's of the dataset) and its reader."""
     from synthua_usd.usd.reader import StageReader
     from synthua_usd.usd.stage_io import open_stage
 
-    job = state.job
-    if state.randomiser is not None:
-        state.randomiser.close()
     # a scene's scenario is the dataset's own, checked when it was written
     stage = open_stage(scenario, job.allow_external_assets or scene is not None)
-    state.stage, state.reader, state.scene, state.conditions = stage, StageReader(stage, state.class_map), scene, {}
-    state.randomiser = None
-    if job.config.randomise is not None:
-        from synthua_usd.pipeline.randomiser import Randomiser
+    return stage, StageReader(stage, class_map)
 
-        state.randomiser = Randomiser(stage, job.config.randomise, state.class_map,
-                                      (job.render.width, job.render.height))
+
+def _randomiser(job: WorkerJob, stage: Any, class_map: ClassMap) -> Randomiser | None:
+    """What gives each image of ``stage`` its randomisation layers, or None when the config randomises nothing."""
+    if job.config.randomise is None:
+        return None
+    from synthua_usd.pipeline.randomiser import Randomiser
+
+    return Randomiser(stage, job.config.randomise, class_map, (job.render.width, job.render.height))
+
+
+def _open(state: WorkerState, scenario: str, scene: SceneKey | None) -> None:
+    """Make ``scenario`` (the job's, or a scene's of the dataset) the stage the worker renders."""
+    if state.randomiser is not None:
+        state.randomiser.close()
+    state.stage, state.reader = _opened(state.job, scenario, scene, state.class_map)
+    state.scene, state.conditions = scene, {}
+    state.randomiser = _randomiser(state.job, state.stage, state.class_map)
 
 
 def work(state: WorkerState, item) -> list[dict]:
@@ -150,10 +171,10 @@ class AnnotatedFrame:
     size ``width`` x ``height``; ``instances`` the annotation entries (:func:`annotations.annotate`, with keypoints
     and the class of what a person uses); ``seconds`` where the time went."""
 
-    snapshot: object
-    camera: object
-    condition: object
-    rendered: object
+    snapshot: SceneSnapshot
+    camera: PinholeCamera
+    condition: Condition | None
+    rendered: RenderedFrame
     rgb: np.ndarray = field(repr=False)
     class_ids: np.ndarray = field(repr=False)
     instance_ids: np.ndarray = field(repr=False)
@@ -162,7 +183,7 @@ class AnnotatedFrame:
     width: int
     height: int
     seconds: dict
-    randomised: object = None
+    randomised: ImageRandomisation | None = None
 
     def display(self) -> np.ndarray:
         """The exposed display-referred sRGB image, (H, W, 3) uint8."""
@@ -230,8 +251,8 @@ def render_annotated(state: WorkerState, camera_path: str, time_code: float, con
         depth = resample.gather(depth, index)
         amodal = {i: resample.resample_pixel_set(pixels, (height, width), index) for i, pixels in amodal.items()}
         width, height = out_w, out_h
-    instances = annotations.annotate(class_ids, instance_ids, snapshot.instances, amodal, truncated)
-    annotations.mark_ignored(instances, job.config.min_instance_px)
+    instances = instance_annotations.annotate(class_ids, instance_ids, snapshot.instances, amodal, truncated)
+    instance_annotations.mark_ignored(instances, job.config.min_instance_px)
     keypoints.annotate_keypoints(instances, snapshot.keypoints, camera, (job.render.width, job.render.height),
                                  instance_ids, depth)
     seconds["annotate"] = time.perf_counter() - t0
@@ -250,7 +271,7 @@ def render_image(state: WorkerState, planned) -> ImageBuffers:
     instances, width, height, seconds, randomised = (frame.instances, frame.width, frame.height, frame.seconds,
                                                      frame.randomised)
     ignored = {entry["id"] for entry in instances if entry["ignore"]}
-    panoptic_png, segments = annotations.panoptic(class_ids, instance_ids, snapshot.instances, class_map, ignored)
+    panoptic_png, segments = instance_annotations.panoptic(class_ids, instance_ids, snapshot.instances, class_map, ignored)
     display = frame.display()
     effects = draw_image_effects(job.config.randomise, planned.seed, planned.camera_path, planned.time_code,
                                  planned.condition)

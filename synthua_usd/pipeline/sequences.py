@@ -31,7 +31,8 @@ from synthua_usd.dataset.config import GenerationConfig
 from synthua_usd.dataset.formats import mot
 from synthua_usd.dataset.layout import Layout
 from synthua_usd.dataset.manifest import file_entry, files_written
-from synthua_usd.dataset.record import SEQUENCE_FRAME, SequenceFrameRecord, check_record, read_record, record_camera
+from synthua_usd.dataset.record import (SEQUENCE_FRAME, FileEntry, SequenceFrameRecord, check_record, read_record,
+                                         record_camera)
 from synthua_usd.dataset.sequences import PlannedFrame, PlannedSequence
 from synthua_usd.model.taxonomy import ClassMap
 from synthua_usd.pipeline.dataset_worker import FLUSH, WorkerJob, init_worker, render_annotated
@@ -233,7 +234,7 @@ def _preview(layout: Layout, seq: PlannedSequence, frames: list[dict], fps: floa
     return write_preview(layout.path(Layout.sequence_file(seq.name, "preview.mp4")), images, fps)
 
 
-def sequence_files(layout: Layout, sequences: list[PlannedSequence], records: dict) -> list[dict]:
+def sequence_files(layout: Layout, sequences: list[PlannedSequence], records: dict) -> list[FileEntry]:
     """Manifest entries of every file of every sequence (frames, their records, the sequence files), sorted."""
     entries = []
     for seq in sequences:

@@ -23,6 +23,7 @@ from pycocotools import mask as mask_utils
 
 from synthua_usd.core.errors import InputError
 from synthua_usd.dataset.layout import SPLITS
+from synthua_usd.dataset.record import InstanceEntry
 from synthua_usd.model.taxonomy import ClassMap
 
 #: Decimals of normalised coordinates: 1e-9 of the image size, far below a pixel at any resolution.
@@ -214,7 +215,7 @@ def _merged(parts: list[np.ndarray], offset: np.ndarray | int, size) -> np.ndarr
     return merge_parts([part + offset for part in parts])
 
 
-def yolo_lines(record_instances: Sequence[dict], width: int, height: int, class_index: dict[int, int],
+def yolo_lines(record_instances: Sequence[InstanceEntry], width: int, height: int, class_index: dict[int, int],
                instance_ids: np.ndarray | None = None) -> str:
     """The label file's text for one image: one line per instance whose class is in ``class_index`` and that is
     not an ignore region (``ignore`` True: too small to annotate; YOLO has no ignore flag, so no line).
