@@ -18,6 +18,7 @@ from typing import Any
 
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.core.schemas import unknown_key
+from synthua_usd.assets.devices import DEVICE_MODELS
 from synthua_usd.assets.hair import HAIR_STYLES
 from synthua_usd.assets.look_images import LOWER_FABRICS, SHOES, UPPER_FABRICS
 from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES
@@ -30,6 +31,8 @@ AID_CLASSES = ("manual_wheelchair", "electric_wheelchair", "walker", "crutch", "
                "orthopedic_cane", "tripod_cane")
 #: Finishes a device frame can take.
 DEVICE_FINISH_NAMES = tuple(DEVICE_FINISHES)
+#: The models every aid class has (:data:`synthua_usd.assets.devices.DEVICE_MODELS`), in the order they are drawn.
+DEVICE_MODEL_NAMES = tuple(sorted(set.intersection(*(set(m) for m in DEVICE_MODELS.values()))))
 #: Twin classes whose objects can get their own variant of their material ("within its class": a building
 #: keeps a façade colour, a car a car paint); all of them by default.
 RECOLOURED_CLASSES = tuple(RECOLOUR_PALETTES)
@@ -121,19 +124,22 @@ class CrowdRandomisation:
 
 @dataclass(frozen=True)
 class DeviceRandomisation:
-    """Each aid user's device: a model among those available for its type, a frame finish and colour, a
-    seat or grip fabric colour."""
+    """Each aid user's device: a model among ``models`` of those its type has (standard low-poly, detailed), a
+    frame finish and colour, a seat or grip fabric colour."""
 
     enabled: bool = True
     finishes: tuple[str, ...] = DEVICE_FINISH_NAMES
+    models: tuple[str, ...] = DEVICE_MODEL_NAMES
 
     def __post_init__(self) -> None:
-        finishes = tuple(self.finishes)
-        unknown = [f for f in finishes if f not in DEVICE_FINISH_NAMES]
-        if unknown or not finishes:
-            raise InputError(f"devices.finishes: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
-                             f"{', '.join(DEVICE_FINISH_NAMES)}")
-        object.__setattr__(self, "finishes", finishes)
+        for name, known in (("finishes", DEVICE_FINISH_NAMES), ("models", DEVICE_MODEL_NAMES)):
+            chosen = tuple(getattr(self, name))
+            unknown = [f for f in chosen if f not in known]
+            if unknown or not chosen:
+                raise InputError(f"devices.{name}: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
+                                 f"{', '.join(known)}")
+            # models in their drawing order (the order they are given in changes nothing drawn); finishes as given
+            object.__setattr__(self, name, tuple(sorted(chosen)) if name == "models" else chosen)
 
 
 @dataclass(frozen=True)
@@ -359,6 +365,8 @@ _PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "hair": H
 #: so that a config that does not ask for them keeps its generate.json and job key.
 _LATER_PARTS = {"effects": EffectsRandomisation, "framing": FramingRandomisation, "settings": SettingsRandomisation,
                 "distractors": DistractorRandomisation}
+#: Fields of a part that came after datasets were made: left out of the document while they are their default.
+_LATER_FIELDS = {"devices": {"models": DEVICE_MODEL_NAMES}}
 
 
 @dataclass(frozen=True)
@@ -383,7 +391,7 @@ class RandomisationConfig:
     def __post_init__(self) -> None:
         if self.devices.enabled and not self.crowd.enabled:
             # devices belong to the randomised crowd's aid users
-            object.__setattr__(self, "devices", DeviceRandomisation(enabled=False, finishes=self.devices.finishes))
+            object.__setattr__(self, "devices", replace(self.devices, enabled=False))
         if self.hair.enabled and not self.crowd.enabled:  # hair belongs to the randomised crowd's people
             object.__setattr__(self, "hair", HairRandomisation(False, self.hair.styles, self.hair.colours))
         if self.looks.enabled and not self.crowd.enabled:  # so do looks
@@ -425,7 +433,11 @@ class RandomisationConfig:
                 # left out as before the part existed: a config that does not ask for it keeps its generate.json
                 # and job key (and with them resumption of datasets written before)
                 continue
-            out[name] = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(getattr(self, name)).items()}
+            part = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(getattr(self, name)).items()}
+            for key, default in _LATER_FIELDS.get(name, {}).items():
+                if part[key] == list(default):
+                    del part[key]          # as before the field existed, for the same reason
+            out[name] = part
         return out
 
     @property

@@ -157,10 +157,10 @@ class SceneDraw:
 
 
 def _device_look(rng: np.random.Generator, aid: str, config: RandomisationConfig) -> DeviceLook:
-    """The model (uniform over the class's models, drawn from a child stream of ``rng``: ``rng`` itself draws
-    as many numbers whatever the number of models, so adding a model changes no other draw of the scene),
-    then the finishes."""
-    model = pick(rng.spawn(1)[0], sorted(DEVICE_MODELS[aid]))
+    """The model (uniform over the class's models that ``devices.models`` allows, drawn from a child stream of
+    ``rng``: ``rng`` itself draws as many numbers whatever the number of models, so adding a model, or allowing
+    fewer, changes no other draw of the scene), then the finishes."""
+    model = pick(rng.spawn(1)[0], [m for m in sorted(DEVICE_MODELS[aid]) if m in config.devices.models])
     if not config.devices.enabled:
         base = PALETTE["Frame"]
         seat = PALETTE["Seat"]

@@ -93,3 +93,20 @@ def test_companions_push_chairs_and_walk_beside_aid_users():
     alone = draw_cast(np.random.default_rng(5), none, 4000.0, [])[2]
     assert not any(m.pushes is not None or m.accompanies is not None or m.pushed_by is not None for m in alone)
     assert abs(len(alone) - len(cast)) < 0.1 * len(cast)  # the same Poisson draw of people, companions among them
+
+
+def test_devices_models_narrow_the_model_draw_and_shift_no_other_draw():
+    """devices.models ["detailed"]: every device detailed, everything else as drawn with both models; the document
+    leaves the field out while it is its default (datasets written before keep their generate.json and job key)."""
+    cast = _cast(3)
+    detailed_config = dataclasses.replace(CONFIG, devices=dataclasses.replace(CONFIG.devices, models=("detailed",)))
+    detailed = draw_cast(np.random.default_rng(3), detailed_config, 4000.0, [])[2]
+    assert len(detailed) == len(cast) > 100
+    assert {m.device.model for m in detailed if m.device} == {"detailed"}
+    same = [dataclasses.replace(m, device=dataclasses.replace(m.device, model="detailed")) if m.device else m for m in cast]
+    assert same == list(detailed)
+    assert "models" not in CONFIG.to_document()["devices"]
+    assert detailed_config.to_document()["devices"]["models"] == ["detailed"]
+    assert RandomisationConfig.from_document(detailed_config.to_document()) == detailed_config
+    both = RandomisationConfig.from_document({"devices": {"models": ["standard", "detailed"]}})
+    assert both.devices.models == ("detailed", "standard") and "models" not in both.to_document()["devices"]
