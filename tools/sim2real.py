@@ -250,25 +250,24 @@ def _no_background(test: dict, backgrounds: dict[str, str], mix: Path) -> None:
     """Refuse a mixed set whose composites were made into photos of a test set (the same bytes, by SHA-256)."""
     if not backgrounds:
         return
-    shared = sorted(backgrounds[h] for h in {sha256_file(p) for p in test["_paths"]} & backgrounds.keys())
+    if "_sha256" not in test:                 # hashed once, whatever the number of mixed sets
+        test["_sha256"] = {sha256_file(p) for p in test["_paths"]}
+    shared = sorted(backgrounds[h] for h in test["_sha256"] & backgrounds.keys())
     if shared:
         raise InputError(f"--mix {mix}: {len(shared)} of its composites' backgrounds are photos of the test set "
                          f"{test['label']} (e.g. {shared[0]}); expected composites into training photos only")
 
 
 def _held_back(got: "Inputs", args, work: Path, taken: set[str]) -> dict:
-    """The real training photos after the largest subset in the draw, as a test entry still to be written
-    (:func:`_write_held_back`): its label, folder, photos and their paths, checked against the photos trained on."""
+    """The real training photos after the largest subset in the draw (none of them trained on), as a test entry
+    still to be written (:func:`_write_held_back`): its label, folder, photos and their paths."""
     largest = got.sizes[-1]
     names = list(S.draw_order(list(got.photos), args.subset_seed)[largest:])
     if not names:
         raise InputError(f"--held-back: all {len(got.photos)} real training photos are trained on (--real-sizes "
                          f"{args.real_sizes}); expected a largest size below {len(got.photos)}")
-    base = args.real_train.parent.name if args.real_train.suffix.lower() in (".yaml", ".yml") else args.real_train.stem
-    entry = {"label": _label(Path(f"{base}-held-back"), None, taken), "path": str(work / "held_back"),
-             "images": len(names), "_names": names, "_paths": {Path(got.photos[p].path).resolve() for p in names}}
-    _no_overlap(entry, {Path(got.photos[p].path).resolve() for p in got.subsets[largest]}, "the photos trained on")
-    return entry
+    return {"label": _label(args.real_train, "held-back", taken), "path": str(work / "held_back"),
+            "images": len(names), "_names": names, "_paths": {Path(got.photos[p].path).resolve() for p in names}}
 
 
 def _write_held_back(entry: dict, got: "Inputs", args, targets) -> dict:
