@@ -13,6 +13,15 @@ step):
    photo around the paste (grey world: the cast of its light, (1, 1, 1) for a neutral one), normalised to keep
    luminance, then clipped: the paste takes part of the photo's colour cast (the cut-out's own colours, a red
    coat, say nothing of its light, so they are not compared). Y is Rec. 709 luminance.
+   **Sharpness** (where ``sharpness_strength`` > 0): the blur of an image part's edges is estimated by re-blurring
+   (after Zhuo and Sim, "Defocus map estimation from a single image", 2011, with two Gaussians for noise): at its
+   edges (local maxima, the strongest tenth, of the gradient of its sRGB luminance smoothed by s2), the ratio R of
+   the gradient smoothed by s1 to that smoothed by s2 (``EDGE_REBLUR_PX``) gives a Gaussian edge of blur b with
+   b^2 = (s2^2 - R^2 s1^2) / (R^2 - 1); the part's blur is the median. Gaussians here are normalised convolutions
+   (weighted by the pixels that belong to the part: the photo's around the paste, the cut-out's alpha), so a
+   silhouette's edge is not an edge. A paste whose edges are sharper than the photo's (blur b_paste < b_photo) has
+   its colour blurred, within its own pixels, by a Gaussian of ``sqrt(b^2 - b_paste^2)``, ``b = b_paste + strength x
+   (b_photo - b_paste)``, at most ``sharpness_sigma_px``; never sharpened. Its labelled pixels and alpha stay as they are (the silhouette's edge is the blend mode's).
 2. **Shadows** of every paste on the photo: each pixel times ``1 - strength x (1 - shadow)``, the shadows of all
    pastes multiplied (they fall on the ground, under every paste).
 3. **Pastes**, far to near (their ``order``), each with its mode: ``hard`` (the paste covers exactly its labelled
@@ -44,6 +53,12 @@ from synthua_usd.model.srgb import from_linear
 from synthua_usd.model.taxonomy import ClassMap
 
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722], np.float64)
+#: The two Gaussians (px) of the edge-blur estimate.
+EDGE_REBLUR_PX = (0.75, 1.5)
+#: Edges: local gradient maxima in this top share of a part's gradients, and at least this many of them.
+EDGE_TOP_SHARE, EDGE_MIN_COUNT = 0.1, 12
+#: The least gradient (sRGB luminance per px, after the re-blur) an edge has: flat parts have no edges.
+EDGE_MIN_GRADIENT = 0.01
 #: Pixels the Poisson domain reaches beyond the labelled ones.
 POISSON_MARGIN_PX = 2
 
@@ -84,17 +99,8 @@ class Composite:
 def paste_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSettings) -> tuple[float, list[float]]:
     """(exposure gain, [r, g, b] white-balance gains) of one paste over ``photo`` (H, W, 3) uint8 (see the module
     docstring, step 1)."""
-    height, width = photo.shape[:2]
-    x0, y0, x1, y1 = box
-    grow_x, grow_y = settings.surround_share * (x1 - x0), settings.surround_share * (y1 - y0)
-    wx0, wy0 = max(0, int(np.floor(x0 - grow_x))), max(0, int(np.floor(y0 - grow_y)))
-    wx1, wy1 = min(width, int(np.ceil(x1 + grow_x))), min(height, int(np.ceil(y1 + grow_y)))
-    keep = np.ones((wy1 - wy0, wx1 - wx0), bool)
-    rx0, ry0, rx1, ry1 = placed.region
-    ox0, oy0, ox1, oy1 = max(rx0, wx0), max(ry0, wy0), min(rx1, wx1), min(ry1, wy1)
-    if ox0 < ox1 and oy0 < oy1:
-        keep[oy0 - wy0:oy1 - wy0, ox0 - wx0:ox1 - wx0] &= placed.premultiplied[oy0 - ry0:oy1 - ry0,
-                                                                               ox0 - rx0:ox1 - rx0, 3] <= 0
+    wx0, wy0, wx1, wy1 = window = _window(photo.shape, box, settings.surround_share)
+    keep = _photo_only(placed, window)
     # every other pixel of every other row: the mean of a few thousand pixels, at a quarter of the cost
     around = LINEAR_LUT[photo[wy0:wy1:2, wx0:wx1:2]][keep[::2, ::2]].astype(np.float64)
     weight = float(placed.premultiplied[..., 3].sum())
@@ -109,6 +115,92 @@ def paste_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSet
     balance = (m_photo / y_photo) ** settings.white_balance_strength
     balance = np.clip(balance / float(balance @ LUMINANCE), *settings.white_balance_gain)
     return exposure, [float(v) for v in balance]
+
+
+def _smooth(values: np.ndarray, weight: np.ndarray, sigma: float) -> np.ndarray:
+    """``values`` (h, w) smoothed by a Gaussian of ``sigma`` px weighted by ``weight`` (a normalised convolution:
+    pixels of weight 0 neither count nor are written; they come out 0)."""
+    num = ndimage.gaussian_filter(values * weight, sigma, mode="constant")
+    den = ndimage.gaussian_filter(weight, sigma, mode="constant")
+    return np.where(den > 1e-6, num / np.maximum(den, 1e-6), 0.0).astype(np.float32)
+
+
+def edge_blur(luma: np.ndarray, weight: np.ndarray, mask: np.ndarray) -> float | None:
+    """The Gaussian blur (px) of the edges of ``luma`` (h, w) within ``mask`` (module docstring, step 1), the
+    smoothing weighted by ``weight``; None where the part has fewer than ``EDGE_MIN_COUNT`` edges."""
+    inner = ndimage.binary_erosion(mask, iterations=2)
+    if int(inner.sum()) < EDGE_MIN_COUNT:
+        return None
+    first, second = EDGE_REBLUR_PX
+    sharp = np.hypot(*np.gradient(_smooth(luma, weight, first)))
+    soft = np.hypot(*np.gradient(_smooth(luma, weight, second)))
+    candidates = inner & (soft >= EDGE_MIN_GRADIENT)
+    if int(candidates.sum()) < EDGE_MIN_COUNT:
+        return None
+    floor = float(np.quantile(soft[candidates], 1.0 - EDGE_TOP_SHARE))
+    edges = candidates & (soft >= floor) & (soft >= ndimage.maximum_filter(soft, size=3))
+    ratio = sharp[edges] / soft[edges]
+    ratio = ratio[ratio > 1.0 + 1e-3]
+    if ratio.size < EDGE_MIN_COUNT:
+        return None
+    squared = (second * second - ratio * ratio * first * first) / (ratio * ratio - 1.0)
+    return float(np.sqrt(max(float(np.median(squared)), 0.0)))
+
+
+def _luma(srgb: np.ndarray) -> np.ndarray:
+    """Rec. 709 luminance of sRGB-coded values in [0, 1] (h, w, 3) -> (h, w) float32."""
+    return (srgb.astype(np.float32) @ LUMINANCE.astype(np.float32)).astype(np.float32)
+
+
+def _window(shape: tuple[int, ...], box, share: float) -> tuple[int, int, int, int]:
+    """The paste's box widened by ``share`` of its size on every side, clipped to the frame: x0, y0, x1, y1."""
+    height, width = shape[:2]
+    x0, y0, x1, y1 = box
+    grow_x, grow_y = share * (x1 - x0), share * (y1 - y0)
+    return (max(0, int(np.floor(x0 - grow_x))), max(0, int(np.floor(y0 - grow_y))),
+            min(width, int(np.ceil(x1 + grow_x))), min(height, int(np.ceil(y1 + grow_y))))
+
+
+def _photo_only(placed: PlacedCutout, window: tuple[int, int, int, int]) -> np.ndarray:
+    """(h, w) bool over ``window``: the photo's pixels there, the paste's own (alpha > 0) left out."""
+    wx0, wy0, wx1, wy1 = window
+    keep = np.ones((wy1 - wy0, wx1 - wx0), bool)
+    rx0, ry0, rx1, ry1 = placed.region
+    ox0, oy0, ox1, oy1 = max(rx0, wx0), max(ry0, wy0), min(rx1, wx1), min(ry1, wy1)
+    if ox0 < ox1 and oy0 < oy1:
+        keep[oy0 - wy0:oy1 - wy0, ox0 - wx0:ox1 - wx0] &= placed.premultiplied[oy0 - ry0:oy1 - ry0,
+                                                                               ox0 - rx0:ox1 - rx0, 3] <= 0
+    return keep
+
+
+def sharpness_sigma(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSettings) -> float:
+    """The Gaussian sigma (px) that softens one paste's colour toward the edge blur of the photo around it (module
+    docstring, step 1); 0 where matching is off, the paste is no sharper than the photo, or either part has too
+    few edges to measure."""
+    strength = settings.sharpness_strength
+    if strength <= 0 or settings.sharpness_sigma_px <= 0:
+        return 0.0
+    wx0, wy0, wx1, wy1 = window = _window(photo.shape, box, settings.surround_share)
+    keep = _photo_only(placed, window)
+    blur_photo = edge_blur(_luma(photo[wy0:wy1, wx0:wx1] / 255.0), keep.astype(np.float32), keep)
+    alpha = placed.premultiplied[..., 3]
+    straight = np.clip(placed.premultiplied[..., :3] / np.maximum(alpha, 1e-6)[..., None], 0.0, 1.0)
+    blur_paste = edge_blur(_luma(from_linear(straight)), alpha, alpha >= 0.999)
+    if blur_photo is None or blur_paste is None or blur_paste >= blur_photo:
+        return 0.0
+    wanted = blur_paste + strength * (blur_photo - blur_paste)
+    return round(min(float(np.sqrt(wanted * wanted - blur_paste * blur_paste)), settings.sharpness_sigma_px), 3)
+
+
+def soften(premultiplied: np.ndarray, sigma: float) -> np.ndarray:
+    """Premultiplied linear RGB (h, w, 3) of a cut-out blurred within its own pixels by a Gaussian of ``sigma``
+    (the straight colour smoothed by alpha-weighted normalised convolution, times alpha again): alpha and the
+    silhouette stay as they are; nothing transparent bleeds in."""
+    if sigma <= 0:
+        return premultiplied[..., :3]
+    alpha = premultiplied[..., 3]
+    straight = premultiplied[..., :3] / np.maximum(alpha, 1e-6)[..., None]
+    return np.stack([_smooth(straight[..., c], alpha, sigma) * alpha for c in range(3)], axis=-1)
 
 
 def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: dict) -> np.ndarray:
@@ -149,6 +241,8 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
     placed = [place(p.pixels, p.entry, p.placement.anchor_px, p.placement.scale, (width, height)) for p in pastes]
     gains = [paste_gains(photo, pc, p.placement.box, settings) if pc is not None else (1.0, [1.0, 1.0, 1.0])
              for p, pc in zip(pastes, placed)]
+    sigmas = [sharpness_sigma(photo, pc, p.placement.box, settings) if pc is not None else 0.0
+              for p, pc in zip(pastes, placed)]
     rgb = photo.copy()
     light = np.ones((height, width), np.float32)
     for p, pc in zip(pastes, placed):
@@ -162,7 +256,7 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
     instance_ids = np.zeros((height, width), np.uint16)
     instances, amodal, truncation, keypoints, records = [], {}, {}, {}, []
     next_id = 1
-    for p, pc, (exposure, balance) in zip(pastes, placed, gains):
+    for p, pc, (exposure, balance), sigma in zip(pastes, placed, gains, sigmas):
         entry, order = p.entry, p.placement.order
         ids = {inst.index: next_id + k for k, inst in enumerate(entry.instances)}
         next_id += len(entry.instances)
@@ -179,12 +273,14 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
                 keypoints[ids[inst.index]] = points
         records.append({"order": order, "instance_ids": sorted(ids.values()), "exposure_gain": exposure,
                         "white_balance_gains": balance, "in_frame": pc is not None})
+        if settings.sharpness_strength > 0:
+            records[-1]["sharpness_sigma_px"] = sigma
         if pc is None:
             for index, gid in ids.items():
                 amodal[gid], truncation[gid] = np.zeros(0, np.int64), 1.0
             continue
         rows, cols = pc.slices
-        colour = pc.premultiplied[..., :3] * np.float32(exposure) * np.asarray(balance, np.float32)
+        colour = soften(pc.premultiplied, sigma) * np.float32(exposure) * np.asarray(balance, np.float32)
         region = LINEAR_LUT[rgb[rows, cols]]
         rgb[rows, cols] = encode(_blend(region, pc, colour, p.placement.blend))
         table = np.zeros(256, np.uint16)

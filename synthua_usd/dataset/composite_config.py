@@ -113,6 +113,8 @@ class MatchSettings:
     white_balance_strength: float = 0.5
     white_balance_gain: Range = (0.8, 1.25)
     surround_share: float = 0.5
+    sharpness_strength: float = 0.0
+    sharpness_sigma_px: float = 3.0
 
     def __post_init__(self) -> None:
         for name in ("exposure_gain", "white_balance_gain"):
@@ -210,8 +212,7 @@ class CompositeConfig:
             "blend": {**asdict(self.blend), "feather_px": list(self.blend.feather_px),
                       "blur_sigma_px": list(self.blend.blur_sigma_px)},
             "shadow": {"strength": list(self.shadow_strength)},
-            "match": {**asdict(self.match), "exposure_gain": list(self.match.exposure_gain),
-                      "white_balance_gain": list(self.match.white_balance_gain)},
+            "match": _match_document(self.match),
             "effects": {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self.effects).items()},
             "background_labels": {"classes": dict(self.background_labels.classes),
                                   "drop_covered_share": self.background_labels.drop_covered_share,
@@ -220,6 +221,20 @@ class CompositeConfig:
             "qa": {**asdict(self.qa), "reject": list(self.qa.reject)},
             "min_instance_px": self.min_instance_px, "workers": self.workers,
         }
+
+
+#: Fields of ``match`` that came after datasets were made: written only where they differ from their default, so
+#: the config documents (and job keys) of datasets made before them stay as they were.
+LATER_MATCH_FIELDS = ("sharpness_strength", "sharpness_sigma_px")
+
+
+def _match_document(match: MatchSettings) -> dict:
+    out = {**asdict(match), "exposure_gain": list(match.exposure_gain),
+           "white_balance_gain": list(match.white_balance_gain)}
+    for name in LATER_MATCH_FIELDS:
+        if out[name] == getattr(MatchSettings, name):
+            del out[name]
+    return out
 
 
 def _light(doc) -> Light | None:

@@ -1,7 +1,7 @@
 """Painting a composite: label maps by the painter's rule (checked with labels resampled here pixel by pixel), the
 photo untouched outside pastes and shadows, shadows darkening by the factor the shadow layer gives, hard edges
 showing the cut-out's own colours, soft edges soft, the gains of exposure and white balance as defined, and Poisson
-blending solving its equation."""
+blending solving its equation; sharpness matching reading a known blur and giving it to a sharper paste."""
 
 from __future__ import annotations
 
@@ -10,8 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from bank_maker import write_bank
-from synthua_usd.backends.compositing import PasteInput, compose, composite_depth, paste_gains
+from scipy import ndimage
+
+from bank_maker import aid_user, write_bank
+from synthua_usd.backends.compositing import PasteInput, compose, composite_depth, edge_blur, paste_gains
 from synthua_usd.backends.cutout_pixels import LINEAR_LUT, place, read_cutout
 from synthua_usd.backends.poisson_blend import poisson_blend
 from synthua_usd.dataset.composite_config import MatchSettings
@@ -210,3 +212,85 @@ def test_a_labelled_pixel_no_sample_covered_keeps_the_photo(bank):
     assert (painted.instance_ids[18, 36:44] == 1).all()          # still labelled the person
     np.testing.assert_array_equal(painted.rgb[18, 36:44], photo[18, 36:44])
     assert np.abs(painted.rgb[18, 34].astype(int) - [200, 40, 40]).max() <= 1
+
+
+def _bands(height: int, width: int, period: int, low: float, high: float, sigma: float = 0.0) -> np.ndarray:
+    """Horizontal grey bands (half a period each), sRGB values in [0, 1], blurred by a Gaussian of ``sigma``."""
+    rows = (np.arange(height) // (period // 2)) % 2
+    grey = np.where(rows[:, None] == 1, high, low) * np.ones((1, width))
+    return ndimage.gaussian_filter(grey, sigma) if sigma else grey
+
+
+def test_edge_blur_reads_a_known_gaussian_and_ignores_what_its_weight_leaves_out():
+    rng = np.random.default_rng(3)
+    blocks = np.kron(rng.random((10, 12)), np.ones((16, 16))).astype(np.float32)
+    everywhere = np.ones(blocks.shape, bool)
+    for sigma in (1.0, 2.0, 3.0):
+        blurred = ndimage.gaussian_filter(blocks, sigma).astype(np.float32)
+        assert edge_blur(blurred, everywhere.astype(np.float32), everywhere) == pytest.approx(sigma, abs=0.35)
+    # a part that covers the left half: sharp junk on the right, left out by the weight, changes nothing
+    blurred = ndimage.gaussian_filter(blocks, 2.0).astype(np.float32)
+    part = np.zeros(blocks.shape, bool)
+    part[:, :96] = True
+    junk = np.where(part, blurred, rng.random(blocks.shape).astype(np.float32))
+    clean = np.where(part, blurred, 0.0).astype(np.float32)
+    assert edge_blur(junk, part.astype(np.float32), part) == pytest.approx(
+        edge_blur(clean, part.astype(np.float32), part), abs=1e-6)
+    assert edge_blur(np.full((40, 40), 0.5, np.float32), np.ones((40, 40), np.float32),
+                     np.ones((40, 40), bool)) is None  # flat: no edges to read
+
+
+def _banded_bank(tmp_path, sigma: float):
+    """A bank of one aid user whose person is drawn in grey bands 12 px high (blurred by ``sigma`` within it)."""
+    cutout = aid_user("c000000", 15.0)
+    person = cutout["ids"] == 1
+    bands = np.round(_bands(66, 48, 12, 0.35, 0.7, sigma) * 255).astype(np.uint8)
+    cutout["rgba"][person, :3] = bands[person][:, None]
+    return read_bank(write_bank(tmp_path / f"bank{sigma}", [cutout]))
+
+
+def _slope_sigma(column: np.ndarray, low: float, high: float) -> float:
+    """The Gaussian blur of the steps in a column of sRGB values in [0, 1], read from its steepest step: a step of
+    contrast C blurred by s rises at most C / (s sqrt(2 pi)) a pixel."""
+    return (high - low) / (np.abs(np.diff(column)).max() * math.sqrt(2 * math.pi))
+
+
+def test_sharpness_matching_softens_a_sharp_paste_to_the_photos_blur_and_leaves_labels_alone(tmp_path):
+    bank = _banded_bank(tmp_path, 0.0)
+    entry = bank.entries[0]
+    photo_sigma, scale, anchor = 2.0, 3.0, (160.0, 230.0)
+    photo = np.round(np.repeat(_bands(260, 320, 36, 0.3, 0.75, photo_sigma)[..., None], 3, axis=2) * 255
+                     ).astype(np.uint8)
+    paste = [PasteInput(entry, read_cutout(bank.root, entry), _placement(entry, anchor, scale, 0))]
+    as_rendered = compose(photo, paste, ClassMap.default(), NO_MATCH)
+    matched = compose(photo, paste, ClassMap.default(), MatchSettings(exposure_strength=0.0,
+                                                                        white_balance_strength=0.0,
+                                                                        sharpness_strength=1.0))
+    np.testing.assert_array_equal(matched.instance_ids, as_rendered.instance_ids)
+    np.testing.assert_array_equal(matched.class_ids, as_rendered.class_ids)
+    outside = as_rendered.instance_ids == 0
+    np.testing.assert_array_equal(matched.rgb[outside], as_rendered.rgb[outside])  # only the paste changes
+    assert "sharpness_sigma_px" not in as_rendered.pastes[0]
+    assert matched.pastes[0]["sharpness_sigma_px"] > 1.0
+    # the torso's middle column, rows of the person only (the head and the chair left out): its steps' blur
+    column = int(anchor[0])
+    rows = np.flatnonzero(as_rendered.instance_ids[:, column] == 1)
+    torso = rows[(rows >= anchor[1] - scale * (62 - 14)) & (rows < anchor[1] - scale * (62 - 37))]
+    low, high = 0.35, 0.7
+    before = _slope_sigma(as_rendered.rgb[torso, column, 1] / 255.0, low, high)
+    after = _slope_sigma(matched.rgb[torso, column, 1] / 255.0, low, high)
+    assert before < 1.1  # the resampling's own ramp
+    assert after == pytest.approx(photo_sigma, abs=0.5)
+
+
+def test_a_paste_no_sharper_than_the_photo_is_left_as_rendered(tmp_path):
+    bank = _banded_bank(tmp_path, 2.5)
+    entry = bank.entries[0]
+    photo = np.round(np.repeat(_bands(260, 320, 36, 0.3, 0.75)[..., None], 3, axis=2) * 255).astype(np.uint8)
+    paste = [PasteInput(entry, read_cutout(bank.root, entry), _placement(entry, (160.0, 230.0), 3.0, 0))]
+    as_rendered = compose(photo, paste, ClassMap.default(), NO_MATCH)
+    matched = compose(photo, paste, ClassMap.default(), MatchSettings(exposure_strength=0.0,
+                                                                        white_balance_strength=0.0,
+                                                                        sharpness_strength=1.0))
+    assert matched.pastes[0]["sharpness_sigma_px"] == 0.0
+    np.testing.assert_array_equal(matched.rgb, as_rendered.rgb)

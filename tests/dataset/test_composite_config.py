@@ -10,7 +10,7 @@ import pytest
 from conftest import REPO
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.schemas import load_schema
-from synthua_usd.dataset.composite_config import CompositeConfig
+from synthua_usd.dataset.composite_config import LATER_MATCH_FIELDS, CompositeConfig, MatchSettings
 
 
 def _defaults(node, schema) -> dict:
@@ -36,12 +36,23 @@ def test_the_schema_documents_the_dataclass_defaults():
     for path, default in documented.items():
         if path == "shadow":
             continue
+        if path.startswith("match.") and path.split(".")[1] in LATER_MATCH_FIELDS:
+            assert default == getattr(MatchSettings, path.split(".")[1]), path  # left out of the document
+            continue
         value = written
         for part in path.split("."):
             value = value[part]
         if isinstance(default, dict) and not default:
             continue  # an empty object: its fields' own defaults are checked one by one
         assert value == default, path
+
+
+def test_later_match_fields_are_written_only_where_set_so_earlier_job_keys_hold():
+    assert not set(LATER_MATCH_FIELDS) & set(CompositeConfig().to_document()["match"])
+    config = CompositeConfig.from_document({"match": {"sharpness_strength": 0.5}})
+    document = config.to_document()
+    assert document["match"]["sharpness_strength"] == 0.5 and "sharpness_sigma_px" not in document["match"]
+    assert CompositeConfig.from_document(document) == config
 
 
 def test_an_empty_document_is_the_defaults_and_a_document_round_trips():

@@ -295,3 +295,21 @@ def test_a_coco_set_is_a_labelled_background_too(inputs, tmp_path):
     box = boxed[0]["composite"]["background_boxes"][0]
     # the 96x72 photo covers 64x48 at scale 2/3: x (20 - 0) * 2/3, y 30 * 2/3 - 0 (no cut), sizes * 2/3
     assert box["label"] == "person" and box["bbox"] == pytest.approx([13.3333, 20.0, 8.0, 20.0], abs=1e-4)
+
+
+def test_sharpness_matching_is_recorded_per_paste_verifies_and_replays(inputs, unlabelled, tmp_path, run_cli):
+    config = tmp_path / "sharp.json"
+    config.write_text(json.dumps({**CONFIG, "match": {"sharpness_strength": 1.0}}))
+    out = tmp_path / "sharp"
+    assert main([str(a) for a in ("composite", inputs / "photos", "--bank", inputs / "bank", "--config", config,
+                                  "--out", out, "--workers", 1)]) == 0
+    pastes = [p for r in _records(out) for p in r["composite"]["pastes"]]
+    assert pastes and all(p["sharpness_sigma_px"] >= 0.0 for p in pastes)
+    job = json.loads((out / "generate.json").read_text())
+    assert job["job_key"]["config"]["match"]["sharpness_strength"] == 1.0
+    code, text, _ = run_cli("verify", out)
+    assert code == 0 and text.strip().endswith("ok"), text
+    code, text, _ = run_cli("replay", out, "2")
+    assert code == 0 and "byte-identical" in text, text
+    off = [p for r in _records(unlabelled) for p in r["composite"]["pastes"]]
+    assert off and all("sharpness_sigma_px" not in p for p in off)
