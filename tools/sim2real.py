@@ -418,13 +418,17 @@ def train_one(planned: S.PlannedRun, args, got: Inputs, folders: dict, work: Pat
         about = train(TrainRequest(train_set, out, budget, targets, init=start, device=args.device,
                                    seed=planned.seed, python=args.python))
         wall = round(time.perf_counter() - t, 1)
-    generated = detect_format(Path(train_set)) == "synthua"
+    # what the run was trained on, as its train.json says: for a run linked from another work folder, that folder's
+    # set, not this one's (and its command writes where the run is)
+    source = Path(about["train_set"]["source"])
+    trained_on = source.parent if source.name == "data.yaml" else source
+    generated = detect_format(trained_on) == "synthua"
     b = planned.budget
     return {"name": planned.name, "arm": planned.arm, "real_images": planned.real_images,
-            "mixed_images": planned.mixed_images, "seed": planned.seed, "train_set": str(train_set),
+            "mixed_images": planned.mixed_images, "seed": planned.seed, "train_set": str(trained_on),
             "images": b.images, "epochs": b.epochs, "close_mosaic": b.close_mosaic, "image_steps": b.image_steps, "budget_images": b.budget_images,
             "rounding": b.note(), "pretraining": planned.pretraining,
-            "command": _train_command(Path(train_set), out, budget, planned.seed, args.device,
+            "command": _train_command(trained_on, out.resolve() if out.is_symlink() else out, budget, planned.seed, args.device,
                                       start.weights if start.kind != "scratch" else None,
                                       args.convention if generated else None),
             "init": about["init"], "model": about["model"], "epochs_done": about["epochs_done"],

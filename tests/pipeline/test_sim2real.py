@@ -312,3 +312,14 @@ def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path,
     assert tool.main([a if a != "4" else "8" for a in args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "a_synthetic_s0: kept from an earlier run with epochs 2 (planned 4)" in err[0], err
+    # a report over those runs linked into another work folder names the sets they were trained on, not its own
+    other = tmp_path / "other"
+    (other / "runs").mkdir(parents=True)
+    for name, r in runs.items():
+        (other / "runs" / name).symlink_to(Path(r["run"]))
+    assert tool.main(args[:-1] + [str(other)]) == 0
+    linked = {r["name"]: r for r in json.loads((other / "sim2real.json").read_text())["runs"]}
+    assert linked["d_n0001_s0"]["train_set"] == str(work / "mixed" / "n0001")
+    assert linked["b_n0001_s0"]["train_set"] == str(work / "subsets" / "n0001")
+    assert linked["d_n0001_s0"]["command"] == runs["d_n0001_s0"]["command"]
+    assert f"`{work / 'mixed' / 'n0001'}`" in (other / "sim2real.md").read_text()
