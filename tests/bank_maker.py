@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 from PIL import Image
+from scipy import ndimage
 
 from synthua_usd.model.taxonomy import ClassMap
 
@@ -126,6 +127,36 @@ def _entry(entry_id, kind, group, aid, rgba, ids, amodal, shadow, instances, gro
              "light": {"sun_elevation_deg": 35.0, "sun_azimuth_deg": sun_azimuth_deg, "overcast": overcast,
                        "condition": "clear_day"}, "seed": 0}
     return {"entry": entry, "rgba": rgba, "ids": ids, "amodal": amodal.astype(np.uint16), "shadow": shadow}
+
+
+def bands(height: int, width: int, period: int, low: float, high: float, sigma: float = 0.0) -> np.ndarray:
+    """Horizontal grey bands (half a period each), sRGB values in [0, 1] (h, w), blurred by a Gaussian of
+    ``sigma`` px."""
+    rows = (np.arange(height) // (period // 2)) % 2
+    grey = np.where(rows[:, None] == 1, high, low) * np.ones((1, width))
+    return ndimage.gaussian_filter(grey, sigma) if sigma else grey
+
+
+def banded_aid_user(entry_id: str, sigma: float = 0.0) -> dict:
+    """:func:`aid_user` whose person is drawn in grey bands 12 px high (0.35 and 0.7; blurred by ``sigma`` within
+    the drawing): a cut-out with edges inside it, for sharpness matching."""
+    cutout = aid_user(entry_id, 15.0)
+    person = cutout["ids"] == 1
+    grey = np.round(bands(66, 48, 12, 0.35, 0.7, sigma) * 255).astype(np.uint8)
+    cutout["rgba"][person, :3] = grey[person][:, None]
+    return cutout
+
+
+def write_band_photos(folder: Path, count: int, size, sigma: float) -> list[Path]:
+    """``count`` photos (W, H) ``size`` of grey bands 18 px high blurred by ``sigma`` px: a soft photo."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for k in range(count):
+        grey = np.round(bands(size[1], size[0], 36, 0.3 + 0.05 * k, 0.75, sigma) * 255).astype(np.uint8)
+        out.append(folder / f"bands_{k:02d}.png")
+        Image.fromarray(np.repeat(grey[..., None], 3, axis=2)).save(out[-1])
+    return out
 
 
 def default_cutouts() -> list[dict]:

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shlex
 import shutil
 import sys
@@ -394,6 +395,23 @@ def plan_document(args, arms, seeds, got: Inputs, command: str, work: Path, note
     }
 
 
+def _trained_on(train_set: dict) -> tuple[Path, bool]:
+    """The set a run was trained on, as its train.json records it (for a run linked from another work folder, that
+    folder's set, not this one's), and whether it was read as a generated dataset. A YOLO data.yaml is named by its
+    folder, unless that folder is a generated dataset (read another way)."""
+    source = Path(train_set["source"])
+    if train_set["layout"] == "yolo" and source.name == "data.yaml" and not (source.parent / "manifest.json").is_file():
+        source = source.parent
+    return source, train_set["layout"] == "synthua"
+
+
+def _where(path: Path) -> Path:
+    """``path`` where it really is when links lead there (a run linked from another work folder, or a linked runs
+    folder), else as given. (Start weights are resolved already: :func:`locate_init`.)"""
+    real = Path(os.path.realpath(path))
+    return real if real != Path(os.path.abspath(path)) else path
+
+
 def train_one(planned: S.PlannedRun, args, got: Inputs, folders: dict, work: Path, targets) -> dict:
     """Train one planned run (or keep it when trained before with the same plan); its record."""
     out = work / "runs" / planned.name
@@ -418,17 +436,13 @@ def train_one(planned: S.PlannedRun, args, got: Inputs, folders: dict, work: Pat
         about = train(TrainRequest(train_set, out, budget, targets, init=start, device=args.device,
                                    seed=planned.seed, python=args.python))
         wall = round(time.perf_counter() - t, 1)
-    # what the run was trained on, as its train.json says: for a run linked from another work folder, that folder's
-    # set, not this one's (and its command writes where the run is)
-    source = Path(about["train_set"]["source"])
-    trained_on = source.parent if source.name == "data.yaml" else source
-    generated = detect_format(trained_on) == "synthua"
+    trained_on, generated = _trained_on(about["train_set"])
     b = planned.budget
     return {"name": planned.name, "arm": planned.arm, "real_images": planned.real_images,
             "mixed_images": planned.mixed_images, "seed": planned.seed, "train_set": str(trained_on),
             "images": b.images, "epochs": b.epochs, "close_mosaic": b.close_mosaic, "image_steps": b.image_steps, "budget_images": b.budget_images,
             "rounding": b.note(), "pretraining": planned.pretraining,
-            "command": _train_command(trained_on, out.resolve() if out.is_symlink() else out, budget, planned.seed, args.device,
+            "command": _train_command(trained_on, _where(out), budget, planned.seed, args.device,
                                       start.weights if start.kind != "scratch" else None,
                                       args.convention if generated else None),
             "init": about["init"], "model": about["model"], "epochs_done": about["epochs_done"],

@@ -1,6 +1,6 @@
-"""One composite painted: cut-outs placed on a photo with their shadows, matched exposure and white balance, and
-their blend edges, with the label maps that follow from them. Pixel work only: where each paste goes is planned in
-:mod:`synthua_usd.dataset.composite_plan`.
+"""One composite painted: cut-outs placed on a photo with their shadows, matched exposure, white balance and
+(where asked) sharpness, and their blend edges, with the label maps that follow from them. Pixel work only: where
+each paste goes is planned in :mod:`synthua_usd.dataset.composite_plan`.
 
 Order of operations, all in linear light (8-bit sRGB decoded by the sRGB curve, encoded back and rounded once per
 step):
@@ -14,14 +14,16 @@ step):
    luminance, then clipped: the paste takes part of the photo's colour cast (the cut-out's own colours, a red
    coat, say nothing of its light, so they are not compared). Y is Rec. 709 luminance.
    **Sharpness** (where ``sharpness_strength`` > 0): the blur of an image part's edges is estimated by re-blurring
-   (after Zhuo and Sim, "Defocus map estimation from a single image", 2011, with two Gaussians for noise): at its
-   edges (local maxima, the strongest tenth, of the gradient of its sRGB luminance smoothed by s2), the ratio R of
-   the gradient smoothed by s1 to that smoothed by s2 (``EDGE_REBLUR_PX``) gives a Gaussian edge of blur b with
-   b^2 = (s2^2 - R^2 s1^2) / (R^2 - 1); the part's blur is the median. Gaussians here are normalised convolutions
-   (weighted by the pixels that belong to the part: the photo's around the paste, the cut-out's alpha), so a
-   silhouette's edge is not an edge. A paste whose edges are sharper than the photo's (blur b_paste < b_photo) has
-   its colour blurred, within its own pixels, by a Gaussian of ``sqrt(b^2 - b_paste^2)``, ``b = b_paste + strength x
-   (b_photo - b_paste)``, at most ``sharpness_sigma_px``; never sharpened. Its labelled pixels and alpha stay as they are (the silhouette's edge is the blend mode's).
+   (after Zhuo and Sim, "Defocus map estimation from a single image", 2011, with two Gaussians for noise): the
+   gradient of its sRGB luminance is taken by derivative-of-Gaussian filters at two scales s1 < s2
+   (``EDGE_SCALES_PX``); at its edges (local maxima, the strongest tenth, of the gradient at s2) the ratio R of the
+   two gradient magnitudes gives a Gaussian edge of blur b with b^2 = (s2^2 - R^2 s1^2) / (R^2 - 1); the part's
+   blur is the median (a pixel-sampled sharp edge reads about 0.3-0.45 px, whatever its direction). The filters
+   are normalised convolutions, weighted by the pixels that belong to the part (the photo's around the paste, the
+   cut-out's alpha), so a silhouette's edge is not an edge. A paste whose edges are sharper than the photo's
+   (b_paste < b_photo) has its colour blurred, within its own pixels, by a Gaussian of ``sqrt(b^2 - b_paste^2)``,
+   ``b = b_paste + strength x (b_photo - b_paste)``, at most ``sharpness_sigma_px``; never sharpened. Its labelled
+   pixels and alpha stay as they are (the silhouette's edge is the blend mode's).
 2. **Shadows** of every paste on the photo: each pixel times ``1 - strength x (1 - shadow)``, the shadows of all
    pastes multiplied (they fall on the ground, under every paste).
 3. **Pastes**, far to near (their ``order``), each with its mode: ``hard`` (the paste covers exactly its labelled
@@ -53,11 +55,11 @@ from synthua_usd.model.srgb import from_linear
 from synthua_usd.model.taxonomy import ClassMap
 
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722], np.float64)
-#: The two Gaussians (px) of the edge-blur estimate.
-EDGE_REBLUR_PX = (0.75, 1.5)
+#: The two scales (px) of the edge-blur estimate's derivative-of-Gaussian filters.
+EDGE_SCALES_PX = (1.0, 2.0)
 #: Edges: local gradient maxima in this top share of a part's gradients, and at least this many of them.
 EDGE_TOP_SHARE, EDGE_MIN_COUNT = 0.1, 12
-#: The least gradient (sRGB luminance per px, after the re-blur) an edge has: flat parts have no edges.
+#: The least gradient (sRGB luminance per px, at the larger scale) an edge has: flat parts have no edges.
 EDGE_MIN_GRADIENT = 0.01
 #: Pixels the Poisson domain reaches beyond the labelled ones.
 POISSON_MARGIN_PX = 2
@@ -119,10 +121,26 @@ def paste_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSet
 
 def _smooth(values: np.ndarray, weight: np.ndarray, sigma: float) -> np.ndarray:
     """``values`` (h, w) smoothed by a Gaussian of ``sigma`` px weighted by ``weight`` (a normalised convolution:
-    pixels of weight 0 neither count nor are written; they come out 0)."""
+    pixels of weight 0 do not count; a pixel with no weighted pixel within reach comes out 0)."""
     num = ndimage.gaussian_filter(values * weight, sigma, mode="constant")
     den = ndimage.gaussian_filter(weight, sigma, mode="constant")
     return np.where(den > 1e-6, num / np.maximum(den, 1e-6), 0.0).astype(np.float32)
+
+
+def _gradient(values: np.ndarray, weight: np.ndarray, sigma: float) -> np.ndarray:
+    """The gradient magnitude (h, w) of ``values`` smoothed by the normalised convolution of :func:`_smooth`,
+    taken analytically with derivative-of-Gaussian filters: grad(N / D) = (D grad N - N grad D) / D^2."""
+    weighted = values * weight
+    num = ndimage.gaussian_filter(weighted, sigma, mode="constant")
+    den = ndimage.gaussian_filter(weight, sigma, mode="constant")
+    reached = den > 1e-3
+    square = np.where(reached, den * den, 1.0)
+    parts = []
+    for order in ((1, 0), (0, 1)):
+        d_num = ndimage.gaussian_filter(weighted, sigma, order=order, mode="constant")
+        d_den = ndimage.gaussian_filter(weight, sigma, order=order, mode="constant")
+        parts.append(np.where(reached, (d_num * den - num * d_den) / square, 0.0))
+    return np.hypot(*parts).astype(np.float32)
 
 
 def edge_blur(luma: np.ndarray, weight: np.ndarray, mask: np.ndarray) -> float | None:
@@ -131,9 +149,8 @@ def edge_blur(luma: np.ndarray, weight: np.ndarray, mask: np.ndarray) -> float |
     inner = ndimage.binary_erosion(mask, iterations=2)
     if int(inner.sum()) < EDGE_MIN_COUNT:
         return None
-    first, second = EDGE_REBLUR_PX
-    sharp = np.hypot(*np.gradient(_smooth(luma, weight, first)))
-    soft = np.hypot(*np.gradient(_smooth(luma, weight, second)))
+    first, second = EDGE_SCALES_PX
+    sharp, soft = _gradient(luma, weight, first), _gradient(luma, weight, second)
     candidates = inner & (soft >= EDGE_MIN_GRADIENT)
     if int(candidates.sum()) < EDGE_MIN_COUNT:
         return None

@@ -106,7 +106,8 @@ class BlendSettings:
 
 @dataclass(frozen=True)
 class MatchSettings:
-    """Exposure and white balance of a paste matched to its surroundings (schema ``match``)."""
+    """Exposure, white balance and (where ``sharpness_strength`` > 0) sharpness of a paste matched to its
+    surroundings (schema ``match``)."""
 
     exposure_strength: float = 0.5
     exposure_gain: Range = (0.5, 2.0)
@@ -119,6 +120,10 @@ class MatchSettings:
     def __post_init__(self) -> None:
         for name in ("exposure_gain", "white_balance_gain"):
             object.__setattr__(self, name, _range(f"match.{name}", getattr(self, name), 1e-3, 1e3))
+        if not 0.0 <= self.sharpness_strength <= 1.0:
+            raise InputError(f"match.sharpness_strength: {self.sharpness_strength}; expected a share in [0, 1]")
+        if not 0.0 <= self.sharpness_sigma_px <= 50.0:
+            raise InputError(f"match.sharpness_sigma_px: {self.sharpness_sigma_px}; expected px in [0, 50]")
 
 
 @dataclass(frozen=True)
@@ -223,16 +228,17 @@ class CompositeConfig:
         }
 
 
-#: Fields of ``match`` that came after datasets were made: written only where they differ from their default, so
-#: the config documents (and job keys) of datasets made before them stay as they were.
+#: Fields of ``match`` that came after datasets were made: left out of the document while all of them hold their
+#: defaults (written together otherwise), so the config documents (and job keys) of datasets made before them stay
+#: as they were.
 LATER_MATCH_FIELDS = ("sharpness_strength", "sharpness_sigma_px")
 
 
 def _match_document(match: MatchSettings) -> dict:
     out = {**asdict(match), "exposure_gain": list(match.exposure_gain),
            "white_balance_gain": list(match.white_balance_gain)}
-    for name in LATER_MATCH_FIELDS:
-        if out[name] == getattr(MatchSettings, name):
+    if all(out[name] == getattr(MatchSettings, name) for name in LATER_MATCH_FIELDS):
+        for name in LATER_MATCH_FIELDS:
             del out[name]
     return out
 

@@ -12,7 +12,7 @@ import pytest
 
 from scipy import ndimage
 
-from bank_maker import aid_user, write_bank
+from bank_maker import banded_aid_user, bands, write_bank
 from synthua_usd.backends.compositing import PasteInput, compose, composite_depth, edge_blur, paste_gains
 from synthua_usd.backends.cutout_pixels import LINEAR_LUT, place, read_cutout
 from synthua_usd.backends.poisson_blend import poisson_blend
@@ -214,13 +214,6 @@ def test_a_labelled_pixel_no_sample_covered_keeps_the_photo(bank):
     assert np.abs(painted.rgb[18, 34].astype(int) - [200, 40, 40]).max() <= 1
 
 
-def _bands(height: int, width: int, period: int, low: float, high: float, sigma: float = 0.0) -> np.ndarray:
-    """Horizontal grey bands (half a period each), sRGB values in [0, 1], blurred by a Gaussian of ``sigma``."""
-    rows = (np.arange(height) // (period // 2)) % 2
-    grey = np.where(rows[:, None] == 1, high, low) * np.ones((1, width))
-    return ndimage.gaussian_filter(grey, sigma) if sigma else grey
-
-
 def test_edge_blur_reads_a_known_gaussian_and_ignores_what_its_weight_leaves_out():
     rng = np.random.default_rng(3)
     blocks = np.kron(rng.random((10, 12)), np.ones((16, 16))).astype(np.float32)
@@ -234,19 +227,41 @@ def test_edge_blur_reads_a_known_gaussian_and_ignores_what_its_weight_leaves_out
     part[:, :96] = True
     junk = np.where(part, blurred, rng.random(blocks.shape).astype(np.float32))
     clean = np.where(part, blurred, 0.0).astype(np.float32)
-    assert edge_blur(junk, part.astype(np.float32), part) == pytest.approx(
-        edge_blur(clean, part.astype(np.float32), part), abs=1e-6)
+    read = edge_blur(clean, part.astype(np.float32), part)
+    assert read is not None and read == pytest.approx(2.0, abs=0.35)
+    assert edge_blur(junk, part.astype(np.float32), part) == pytest.approx(read, abs=1e-6)
     assert edge_blur(np.full((40, 40), 0.5, np.float32), np.ones((40, 40), np.float32),
                      np.ones((40, 40), bool)) is None  # flat: no edges to read
 
 
+def _edges_at(angle_deg: float, sigma: float, size: int = 128) -> np.ndarray:
+    """Straight stripes 16 px wide at ``angle_deg``, each pixel the mean of 8 x 8 samples (a rendered edge's own
+    0.29 px of box blur), then blurred by a Gaussian of ``sigma``."""
+    samples = 8
+    yy, xx = np.mgrid[0:size * samples, 0:size * samples] / samples
+    theta = math.radians(angle_deg)
+    across = (xx - size / 2) * math.cos(theta) + (yy - size / 2) * math.sin(theta)
+    image = (np.floor(across / 16) % 2 == 0) * 0.5 + 0.2
+    image = image.reshape(size, samples, size, samples).mean(axis=(1, 3))
+    return (ndimage.gaussian_filter(image, sigma) if sigma else image).astype(np.float32)
+
+
+def test_edge_blur_is_near_zero_for_sharp_edges_in_every_direction_and_reads_small_blurs():
+    everywhere = np.ones((128, 128), bool)
+    weight = everywhere.astype(np.float32)
+    sharp = [edge_blur(_edges_at(angle, 0.0), weight, everywhere) for angle in (0.0, 22.5, 45.0)]
+    assert all(b is not None and b < 0.5 for b in sharp), sharp  # the 0.29 px box blur of the samples, and a bit
+    assert max(sharp) - min(sharp) < 0.2, sharp
+    for sigma in (0.75, 1.0, 1.5):
+        for angle in (0.0, 30.0):
+            read = edge_blur(_edges_at(angle, sigma), weight, everywhere)
+            truth = math.hypot(sigma, 1 / math.sqrt(12))  # the Gaussian and the sampling's box, combined
+            assert read == pytest.approx(truth, abs=0.15), (sigma, angle, read)
+
+
 def _banded_bank(tmp_path, sigma: float):
-    """A bank of one aid user whose person is drawn in grey bands 12 px high (blurred by ``sigma`` within it)."""
-    cutout = aid_user("c000000", 15.0)
-    person = cutout["ids"] == 1
-    bands = np.round(_bands(66, 48, 12, 0.35, 0.7, sigma) * 255).astype(np.uint8)
-    cutout["rgba"][person, :3] = bands[person][:, None]
-    return read_bank(write_bank(tmp_path / f"bank{sigma}", [cutout]))
+    """A bank of one aid user whose person is drawn in grey bands (blurred by ``sigma`` within it)."""
+    return read_bank(write_bank(tmp_path / f"bank{sigma}", [banded_aid_user("c000000", sigma)]))
 
 
 def _slope_sigma(column: np.ndarray, low: float, high: float) -> float:
@@ -259,7 +274,7 @@ def test_sharpness_matching_softens_a_sharp_paste_to_the_photos_blur_and_leaves_
     bank = _banded_bank(tmp_path, 0.0)
     entry = bank.entries[0]
     photo_sigma, scale, anchor = 2.0, 3.0, (160.0, 230.0)
-    photo = np.round(np.repeat(_bands(260, 320, 36, 0.3, 0.75, photo_sigma)[..., None], 3, axis=2) * 255
+    photo = np.round(np.repeat(bands(260, 320, 36, 0.3, 0.75, photo_sigma)[..., None], 3, axis=2) * 255
                      ).astype(np.uint8)
     paste = [PasteInput(entry, read_cutout(bank.root, entry), _placement(entry, anchor, scale, 0))]
     as_rendered = compose(photo, paste, ClassMap.default(), NO_MATCH)
@@ -286,11 +301,19 @@ def test_sharpness_matching_softens_a_sharp_paste_to_the_photos_blur_and_leaves_
 def test_a_paste_no_sharper_than_the_photo_is_left_as_rendered(tmp_path):
     bank = _banded_bank(tmp_path, 2.5)
     entry = bank.entries[0]
-    photo = np.round(np.repeat(_bands(260, 320, 36, 0.3, 0.75)[..., None], 3, axis=2) * 255).astype(np.uint8)
+    photo = np.round(np.repeat(bands(260, 320, 36, 0.3, 0.75)[..., None], 3, axis=2) * 255).astype(np.uint8)
     paste = [PasteInput(entry, read_cutout(bank.root, entry), _placement(entry, (160.0, 230.0), 3.0, 0))]
     as_rendered = compose(photo, paste, ClassMap.default(), NO_MATCH)
     matched = compose(photo, paste, ClassMap.default(), MatchSettings(exposure_strength=0.0,
                                                                         white_balance_strength=0.0,
                                                                         sharpness_strength=1.0))
+    # both parts are measured (the sigma is 0 because the paste is softer, not because nothing could be read)
+    placed = place(read_cutout(bank.root, entry), entry, (160.0, 230.0), 3.0, (320, 260))
+    alpha = placed.premultiplied[..., 3]
+    grey = from_linear(placed.premultiplied[..., 1] / np.maximum(alpha, 1e-6)).astype(np.float32)
+    paste_blur = edge_blur(grey, alpha, alpha >= 0.999)
+    photo_blur = edge_blur(photo[..., 1] / np.float32(255), np.ones(photo.shape[:2], np.float32),
+                           np.ones(photo.shape[:2], bool))
+    assert paste_blur is not None and photo_blur is not None and paste_blur > photo_blur
     assert matched.pastes[0]["sharpness_sigma_px"] == 0.0
     np.testing.assert_array_equal(matched.rgb, as_rendered.rgb)

@@ -49,10 +49,19 @@ def test_the_schema_documents_the_dataclass_defaults():
 
 def test_later_match_fields_are_written_only_where_set_so_earlier_job_keys_hold():
     assert not set(LATER_MATCH_FIELDS) & set(CompositeConfig().to_document()["match"])
-    config = CompositeConfig.from_document({"match": {"sharpness_strength": 0.5}})
-    document = config.to_document()
-    assert document["match"]["sharpness_strength"] == 0.5 and "sharpness_sigma_px" not in document["match"]
-    assert CompositeConfig.from_document(document) == config
+    for part in ({"sharpness_strength": 0.5}, {"sharpness_sigma_px": 5.0}):
+        config = CompositeConfig.from_document({"match": part})
+        document = config.to_document()
+        assert {k: document["match"][k] for k in LATER_MATCH_FIELDS} == {
+            "sharpness_strength": 0.0, "sharpness_sigma_px": 3.0, **part}  # written together
+        assert CompositeConfig.from_document(document) == config
+
+
+def test_match_settings_made_in_code_are_checked():
+    with pytest.raises(InputError, match=r"match\.sharpness_strength: nan; expected a share in \[0, 1\]"):
+        MatchSettings(sharpness_strength=float("nan"))
+    with pytest.raises(InputError, match=r"match\.sharpness_sigma_px: -1\.0; expected px in \[0, 50\]"):
+        MatchSettings(sharpness_sigma_px=-1.0)
 
 
 def test_an_empty_document_is_the_defaults_and_a_document_round_trips():
@@ -70,6 +79,7 @@ def test_the_shipped_config_is_valid():
 
 @pytest.mark.parametrize("document, message", [
     ({"bogus": 1}, r"x\.json: bogus: not a key of the document; expected one of \$schema, background_labels"),
+    ({"match": {"sharpness_strength": 1.5}}, r"x\.json: match\.sharpness_strength: 1\.5"),
     ({"pastes": {"height_share": [0.9, 0.2]}}, r"x\.json: pastes\.height_share: \[0\.9, 0\.2\]; expected two finite "
                                                r"numbers with low <= high"),
     ({"split": {"train": 0.5, "val": 0.1, "test": 0.1}}, r"x\.json: split: train \+ val \+ test = 0\.7; expected"),

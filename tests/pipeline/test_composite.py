@@ -16,7 +16,7 @@ import pytest
 import yaml
 from PIL import Image
 
-from bank_maker import write_bank, write_photos
+from bank_maker import banded_aid_user, write_band_photos, write_bank, write_photos
 from synthua_usd.cli.main import main
 from synthua_usd.dataset.cutout_bank import read_bank
 
@@ -297,19 +297,25 @@ def test_a_coco_set_is_a_labelled_background_too(inputs, tmp_path):
     assert box["label"] == "person" and box["bbox"] == pytest.approx([13.3333, 20.0, 8.0, 20.0], abs=1e-4)
 
 
-def test_sharpness_matching_is_recorded_per_paste_verifies_and_replays(inputs, unlabelled, tmp_path, run_cli):
+def test_sharpness_matching_is_recorded_per_paste_verifies_and_replays(unlabelled, tmp_path, run_cli):
+    """Banded cut-outs over soft banded photos: pastes are softened, recorded, verified and replayed."""
+    write_bank(tmp_path / "bank", [banded_aid_user("c000000"), banded_aid_user("c000001")])
+    write_band_photos(tmp_path / "photos", 2, (256, 192), 2.5)
     config = tmp_path / "sharp.json"
-    config.write_text(json.dumps({**CONFIG, "match": {"sharpness_strength": 1.0}}))
+    config.write_text(json.dumps({**CONFIG, "output": {"width": 192, "height": 144}, "match": {"sharpness_strength": 1.0},
+                                  "pastes": {**CONFIG["pastes"], "per_image": [1, 1], "height_share": [0.7, 0.9]}}))
     out = tmp_path / "sharp"
-    assert main([str(a) for a in ("composite", inputs / "photos", "--bank", inputs / "bank", "--config", config,
+    assert main([str(a) for a in ("composite", tmp_path / "photos", "--bank", tmp_path / "bank", "--config", config,
                                   "--out", out, "--workers", 1)]) == 0
     pastes = [p for r in _records(out) for p in r["composite"]["pastes"]]
     assert pastes and all(p["sharpness_sigma_px"] >= 0.0 for p in pastes)
+    assert any(p["sharpness_sigma_px"] > 0.5 for p in pastes), [p["sharpness_sigma_px"] for p in pastes]
     job = json.loads((out / "generate.json").read_text())
     assert job["job_key"]["config"]["match"]["sharpness_strength"] == 1.0
     code, text, _ = run_cli("verify", out)
     assert code == 0 and text.strip().endswith("ok"), text
-    code, text, _ = run_cli("replay", out, "2")
+    softened = next(r["id"] for r in _records(out) if any(p["sharpness_sigma_px"] > 0.5 for p in r["composite"]["pastes"]))
+    code, text, _ = run_cli("replay", out, str(softened))
     assert code == 0 and "byte-identical" in text, text
     off = [p for r in _records(unlabelled) for p in r["composite"]["pastes"]]
     assert off and all("sharpness_sigma_px" not in p for p in off)
