@@ -106,8 +106,8 @@ class BlendSettings:
 
 @dataclass(frozen=True)
 class MatchSettings:
-    """Exposure, white balance and (where ``sharpness_strength`` > 0) sharpness of a paste matched to its
-    surroundings (schema ``match``)."""
+    """Exposure, white balance and (where their strengths are > 0) sharpness, contrast and saturation of a paste
+    matched to its surroundings (schema ``match``)."""
 
     exposure_strength: float = 0.5
     exposure_gain: Range = (0.5, 2.0)
@@ -116,10 +116,19 @@ class MatchSettings:
     surround_share: float = 0.5
     sharpness_strength: float = 0.0
     sharpness_sigma_px: float = 3.0
+    contrast_strength: float = 0.0
+    contrast_gain: Range = (0.67, 1.5)
+    saturation_strength: float = 0.0
+    saturation_gain: Range = (0.5, 1.5)
 
     def __post_init__(self) -> None:
         for name in ("exposure_gain", "white_balance_gain"):
             object.__setattr__(self, name, _range(f"match.{name}", getattr(self, name), 1e-3, 1e3))
+        for name in ("contrast_gain", "saturation_gain"):
+            object.__setattr__(self, name, _range(f"match.{name}", getattr(self, name), 0.1, 10.0))
+        for name in ("contrast_strength", "saturation_strength"):
+            if not 0.0 <= getattr(self, name) <= 1.0:
+                raise InputError(f"match.{name}: {getattr(self, name)}; expected a share in [0, 1]")
         if not 0.0 <= self.sharpness_strength <= 1.0:
             raise InputError(f"match.sharpness_strength: {self.sharpness_strength}; expected a share in [0, 1]")
         if not 0.0 <= self.sharpness_sigma_px <= 50.0:
@@ -228,18 +237,20 @@ class CompositeConfig:
         }
 
 
-#: Fields of ``match`` that came after datasets were made: left out of the document while all of them hold their
-#: defaults (written together otherwise), so the config documents (and job keys) of datasets made before them stay
-#: as they were.
-LATER_MATCH_FIELDS = ("sharpness_strength", "sharpness_sigma_px")
+#: Groups of fields of ``match`` that came after datasets were made: a group is left out of the document while all of
+#: its fields hold their defaults (written together otherwise), so the config documents (and job keys) of datasets
+#: made before them stay as they were.
+LATER_MATCH_GROUPS = (("sharpness_strength", "sharpness_sigma_px"),
+                      ("contrast_strength", "contrast_gain", "saturation_strength", "saturation_gain"))
+LATER_MATCH_FIELDS = tuple(name for group in LATER_MATCH_GROUPS for name in group)
 
 
 def _match_document(match: MatchSettings) -> dict:
-    out = {**asdict(match), "exposure_gain": list(match.exposure_gain),
-           "white_balance_gain": list(match.white_balance_gain)}
-    if all(out[name] == getattr(MatchSettings, name) for name in LATER_MATCH_FIELDS):
-        for name in LATER_MATCH_FIELDS:
-            del out[name]
+    out = {name: list(value) if isinstance(value, tuple) else value for name, value in asdict(match).items()}
+    for group in LATER_MATCH_GROUPS:
+        if all(getattr(match, name) == getattr(MatchSettings, name) for name in group):
+            for name in group:
+                del out[name]
     return out
 
 

@@ -217,8 +217,9 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
                        "aid": entry.aid, "exposure_gain": painted_paste["exposure_gain"],
                        "white_balance_gains": painted_paste["white_balance_gains"],
                        "instance_ids": painted_paste["instance_ids"], "ground_points": ground})
-        if "sharpness_sigma_px" in painted_paste:
-            pastes[-1]["sharpness_sigma_px"] = painted_paste["sharpness_sigma_px"]
+        for name in ("sharpness_sigma_px", "contrast_gain", "saturation_gain"):  # written where matching is on
+            if name in painted_paste:
+                pastes[-1][name] = painted_paste[name]
         del pastes[-1]["entry_id"]
     record = CompositeRecord(
         id=planned.id, name=planned.name, split=planned.split, width=width, height=height, seed=planned.seed,

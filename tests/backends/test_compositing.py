@@ -13,8 +13,9 @@ import pytest
 from scipy import ndimage
 
 from bank_maker import banded_aid_user, bands, write_bank
-from synthua_usd.backends.compositing import PasteInput, compose, composite_depth, edge_blur, paste_gains
-from synthua_usd.backends.cutout_pixels import LINEAR_LUT, place, read_cutout
+from synthua_usd.backends.compositing import (PasteInput, compose, composite_depth, edge_blur, paste_gains, retone,
+                                              tone_gains)
+from synthua_usd.backends.cutout_pixels import LINEAR_LUT, PlacedCutout, place, read_cutout
 from synthua_usd.backends.poisson_blend import poisson_blend
 from synthua_usd.dataset.composite_config import MatchSettings
 from synthua_usd.dataset.composite_plan import Placement
@@ -317,3 +318,129 @@ def test_a_paste_no_sharper_than_the_photo_is_left_as_rendered(tmp_path):
     assert paste_blur is not None and photo_blur is not None and paste_blur > photo_blur
     assert matched.pastes[0]["sharpness_sigma_px"] == 0.0
     np.testing.assert_array_equal(matched.rgb, as_rendered.rgb)
+
+
+REC709 = np.array([0.2126, 0.7152, 0.0722])
+
+
+def _log_spread_and_chroma(rgb: np.ndarray, weight: np.ndarray) -> tuple[float, float]:
+    """Contrast and saturation as the schema defines them, written out again: the weighted standard deviation of
+    ln Y and the weighted mean of |rgb - Y| / Y over pixels of weight > 0."""
+    y = rgb @ REC709
+    w = weight / weight.sum()
+    mean = np.sum(w * np.log(y))
+    spread = math.sqrt(np.sum(w * (np.log(y) - mean) ** 2))
+    chroma = np.sum(w * np.sqrt(((rgb - y[:, None]) ** 2).sum(axis=1)) / y)
+    return spread, chroma
+
+
+def _placed(rgb: np.ndarray, alpha: np.ndarray) -> PlacedCutout:
+    """A placed cut-out made directly: straight linear ``rgb`` (h, w, 3) and ``alpha`` (h, w) at the frame's
+    origin."""
+    h, w = alpha.shape
+    premultiplied = np.concatenate([rgb * alpha[..., None], alpha[..., None]], axis=-1).astype(np.float32)
+    return PlacedCutout((w, h), (0, 0, w, h), premultiplied, (alpha > 0).astype(np.uint8),
+                        np.zeros((h, w), np.uint16), np.ones((h, w), np.float32), {1: 0})
+
+
+def _colourful(h=30, w=20, seed=0):
+    """Straight linear colours of luminance 0.05-0.4 with chroma up to half their luminance (no channel below 0),
+    alpha 1 but for a transparent first row and a half-transparent last one."""
+    rng = np.random.default_rng(seed)
+    y = np.exp(rng.uniform(np.log(0.05), np.log(0.4), (h, w)))
+    hue = rng.uniform(0, 2 * np.pi, (h, w))
+    u = np.array([REC709[1], -REC709[0], 0.0]) / np.linalg.norm([REC709[1], -REC709[0], 0.0])
+    v = np.cross(REC709, u)
+    v = v - (v @ REC709) / (REC709 @ REC709) * REC709
+    v /= np.linalg.norm(v)
+    direction = np.cos(hue)[..., None] * u + np.sin(hue)[..., None] * v
+    rgb = y[..., None] * (1.0 + rng.uniform(0.0, 0.5, (h, w))[..., None] * direction)
+    rgb = np.maximum(rgb, y[..., None] * 0.2)        # no channel at 0 (the chroma direction may point below it)
+    alpha = np.ones((h, w))
+    alpha[0], alpha[-1] = 0.0, 0.5
+    return rgb, alpha
+
+
+def test_retone_scales_contrast_and_saturation_by_its_gains_and_keeps_alpha():
+    rgb, alpha = _colourful()
+    placed = _placed(rgb, alpha)
+    counted = alpha.reshape(-1) > 0.5
+
+    def measures(p):
+        a = p.premultiplied[..., 3].reshape(-1).astype(np.float64)
+        straight = p.premultiplied[..., :3].reshape(-1, 3).astype(np.float64) / np.maximum(a, 1e-6)[:, None]
+        return _log_spread_and_chroma(straight[counted], a[counted])
+
+    spread, chroma = measures(placed)
+    toned = retone(placed, 1.3, 0.6)
+    np.testing.assert_array_equal(toned.premultiplied[..., 3], placed.premultiplied[..., 3])
+    np.testing.assert_array_equal(toned.ids, placed.ids)
+    assert measures(toned) == pytest.approx((1.3 * spread, 0.6 * chroma), rel=1e-4)
+    only_saturation = retone(placed, 1.0, 0.6)
+    y0 = placed.premultiplied[..., :3] @ REC709.astype(np.float32)
+    np.testing.assert_allclose(only_saturation.premultiplied[..., :3] @ REC709.astype(np.float32), y0, rtol=1e-5)
+    only_contrast = retone(placed, 1.3, 1.0)
+    inside = alpha > 0
+    ratio_before = placed.premultiplied[..., :3][inside] / y0[inside][:, None]
+    y1 = only_contrast.premultiplied[..., :3] @ REC709.astype(np.float32)
+    np.testing.assert_allclose(only_contrast.premultiplied[..., :3][inside] / y1[inside][:, None], ratio_before,
+                               rtol=1e-4)          # the colour's chromaticity kept
+    assert retone(placed, 1.0, 1.0) is placed
+
+
+def _checker_photo(bright, dark, h=120, w=160):
+    """A photo of 2 x 2-pixel blocks in a checkerboard of two sRGB colours (every other pixel of every other row
+    samples both equally)."""
+    blocks = ((np.arange(h)[:, None] // 2 + np.arange(w)[None, :] // 2) % 2).astype(bool)
+    return np.where(blocks[..., None], np.array(bright, np.uint8), np.array(dark, np.uint8))
+
+
+def test_tone_gains_take_the_photos_measures_partly_and_clamp(bank):
+    entry = bank.entries[0]
+    placement = _placement(entry, (80.0, 100.0), 1.2, 0)
+    placed = place(read_cutout(bank.root, entry), entry, placement.anchor_px, placement.scale, (160, 120))
+    bright, dark = (230, 180, 120), (40, 60, 70)
+    photo = _checker_photo(bright, dark)
+    colours = LINEAR_LUT[np.array([bright, dark], np.uint8)].astype(np.float64)
+    photo_spread, photo_chroma = _log_spread_and_chroma(colours, np.ones(2))
+    a = placed.premultiplied[..., 3].reshape(-1).astype(np.float64)
+    straight = placed.premultiplied[..., :3].reshape(-1, 3).astype(np.float64) / np.maximum(a, 1e-6)[:, None]
+    counted = (a > 0.5) & (straight @ REC709 > 0.005)
+    paste_spread, paste_chroma = _log_spread_and_chroma(straight[counted], a[counted])
+    wide = {"contrast_gain": (0.1, 10.0), "saturation_gain": (0.1, 10.0)}
+    full = tone_gains(photo, placed, placement.box, MatchSettings(contrast_strength=1.0, saturation_strength=1.0,
+                                                                  **wide))
+    assert full == pytest.approx((photo_spread / paste_spread, photo_chroma / paste_chroma), rel=0.03)
+    half = tone_gains(photo, placed, placement.box, MatchSettings(contrast_strength=0.5, saturation_strength=0.5,
+                                                                  **wide))
+    assert half == pytest.approx((math.sqrt(full[0]), math.sqrt(full[1])), rel=0.01)
+    clamped = tone_gains(photo, placed, placement.box, MatchSettings(contrast_strength=1.0, saturation_strength=1.0,
+                                                                     contrast_gain=(0.9, 1.1),
+                                                                     saturation_gain=(0.9, 1.1)))
+    assert clamped == (min(max(full[0], 0.9), 1.1), min(max(full[1], 0.9), 1.1))
+    assert tone_gains(photo, placed, placement.box, MatchSettings()) == (1.0, 1.0)          # off by default
+    flat = np.full_like(photo, 128)           # no spread to match, and no chroma: contrast left alone
+    assert tone_gains(flat, placed, placement.box, MatchSettings(contrast_strength=1.0, **wide))[0] == 1.0
+
+
+def test_tone_matching_changes_the_pastes_colour_only_and_is_recorded(bank):
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    photo = _checker_photo((150, 140, 130), (60, 58, 56))      # a greyish, contrasty surround
+    paste = [PasteInput(entry, pixels, _placement(entry, (80.0, 100.0), 1.2, 0))]
+    as_rendered = compose(photo, paste, ClassMap.default(), NO_MATCH)
+    settings = MatchSettings(exposure_strength=0.0, white_balance_strength=0.0, contrast_strength=1.0,
+                             saturation_strength=1.0)
+    toned = compose(photo, paste, ClassMap.default(), settings)
+    np.testing.assert_array_equal(toned.instance_ids, as_rendered.instance_ids)
+    np.testing.assert_array_equal(toned.class_ids, as_rendered.class_ids)
+    outside = (as_rendered.instance_ids == 0) & (as_rendered.rgb == photo).all(axis=-1)
+    np.testing.assert_array_equal(toned.rgb[outside], photo[outside])
+    record = toned.pastes[0]
+    assert record["saturation_gain"] < 1.0 and record["contrast_gain"] != 1.0
+    assert "contrast_gain" not in as_rendered.pastes[0] and "saturation_gain" not in as_rendered.pastes[0]
+    person = as_rendered.instance_ids == 1
+    assert (toned.rgb[person] != as_rendered.rgb[person]).any(axis=1).mean() > 0.9
+    # the red person (200, 40, 40 in sRGB) comes out greyer: its channels closer together
+    spread_before = np.ptp(as_rendered.rgb[person].astype(int), axis=1).mean()
+    assert np.ptp(toned.rgb[person].astype(int), axis=1).mean() < 0.8 * spread_before

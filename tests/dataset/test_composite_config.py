@@ -10,7 +10,7 @@ import pytest
 from conftest import REPO
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.schemas import load_schema
-from synthua_usd.dataset.composite_config import LATER_MATCH_FIELDS, CompositeConfig, MatchSettings
+from synthua_usd.dataset.composite_config import LATER_MATCH_FIELDS, LATER_MATCH_GROUPS, CompositeConfig, MatchSettings
 
 
 def _defaults(node, schema) -> dict:
@@ -37,7 +37,8 @@ def test_the_schema_documents_the_dataclass_defaults():
         if path == "shadow":
             continue
         if path.startswith("match.") and path.split(".")[1] in LATER_MATCH_FIELDS:
-            assert default == getattr(MatchSettings, path.split(".")[1]), path  # left out of the document
+            field = getattr(MatchSettings, path.split(".")[1])
+            assert default == (list(field) if isinstance(field, tuple) else field), path  # left out of the document
             continue
         value = written
         for part in path.split("."):
@@ -49,11 +50,18 @@ def test_the_schema_documents_the_dataclass_defaults():
 
 def test_later_match_fields_are_written_only_where_set_so_earlier_job_keys_hold():
     assert not set(LATER_MATCH_FIELDS) & set(CompositeConfig().to_document()["match"])
-    for part in ({"sharpness_strength": 0.5}, {"sharpness_sigma_px": 5.0}):
+    sharpness = {"sharpness_strength": 0.0, "sharpness_sigma_px": 3.0}
+    tone = {"contrast_strength": 0.0, "contrast_gain": [0.67, 1.5], "saturation_strength": 0.0,
+            "saturation_gain": [0.5, 1.5]}
+    assert [set(group) for group in LATER_MATCH_GROUPS] == [set(sharpness), set(tone)]
+    for part, group, other in (({"sharpness_strength": 0.5}, sharpness, tone),
+                               ({"sharpness_sigma_px": 5.0}, sharpness, tone),
+                               ({"saturation_strength": 1.0}, tone, sharpness),
+                               ({"contrast_gain": [0.8, 1.2]}, tone, sharpness)):
         config = CompositeConfig.from_document({"match": part})
         document = config.to_document()
-        assert {k: document["match"][k] for k in LATER_MATCH_FIELDS} == {
-            "sharpness_strength": 0.0, "sharpness_sigma_px": 3.0, **part}  # written together
+        assert {k: document["match"][k] for k in group} == {**group, **part}  # written together
+        assert not set(other) & set(document["match"])                       # the other group still left out
         assert CompositeConfig.from_document(document) == config
 
 
@@ -62,6 +70,12 @@ def test_match_settings_made_in_code_are_checked():
         MatchSettings(sharpness_strength=float("nan"))
     with pytest.raises(InputError, match=r"match\.sharpness_sigma_px: -1\.0; expected px in \[0, 50\]"):
         MatchSettings(sharpness_sigma_px=-1.0)
+    with pytest.raises(InputError, match=r"match\.saturation_strength: 1\.5; expected a share in \[0, 1\]"):
+        MatchSettings(saturation_strength=1.5)
+    with pytest.raises(InputError, match=r"match\.contrast_strength: nan; expected a share in \[0, 1\]"):
+        MatchSettings(contrast_strength=float("nan"))
+    with pytest.raises(InputError, match=r"match\.contrast_gain: \[0\.05, 2\]; expected a range within \[0\.1, 10\]"):
+        MatchSettings(contrast_gain=(0.05, 2.0))
 
 
 def test_an_empty_document_is_the_defaults_and_a_document_round_trips():

@@ -319,3 +319,25 @@ def test_sharpness_matching_is_recorded_per_paste_verifies_and_replays(unlabelle
     assert code == 0 and "byte-identical" in text, text
     off = [p for r in _records(unlabelled) for p in r["composite"]["pastes"]]
     assert off and all("sharpness_sigma_px" not in p for p in off)
+
+
+def test_tone_matching_is_recorded_per_paste_verifies_and_replays(inputs, unlabelled, tmp_path, run_cli):
+    config = tmp_path / "tone.json"
+    config.write_text(json.dumps({**CONFIG, "match": {"contrast_strength": 1.0, "saturation_strength": 0.5}}))
+    out = tmp_path / "tone"
+    assert main([str(a) for a in ("composite", inputs / "photos", "--bank", inputs / "bank", "--config", config,
+                                  "--out", out, "--workers", 1)]) == 0
+    pastes = [p for r in _records(out) for p in r["composite"]["pastes"]]
+    assert pastes and all(0.67 <= p["contrast_gain"] <= 1.5 and 0.5 <= p["saturation_gain"] <= 1.5 for p in pastes)
+    assert any(p["saturation_gain"] != 1.0 for p in pastes)
+    match = json.loads((out / "generate.json").read_text())["job_key"]["config"]["match"]
+    assert (match["contrast_strength"], match["saturation_strength"]) == (1.0, 0.5) and "sharpness_strength" not in match
+    code, text, _ = run_cli("verify", out)
+    assert code == 0 and text.strip().endswith("ok"), text
+    toned = next(r for r in _records(out) if any(p["saturation_gain"] != 1.0 for p in r["composite"]["pastes"]))
+    code, text, _ = run_cli("replay", out, str(toned["id"]))
+    assert code == 0 and "byte-identical" in text, text
+    # the same draws as without tone matching (placements, blends, effects): only the pastes' pixels differ
+    plain = next(r for r in _records(unlabelled) if r["id"] == toned["id"])
+    assert [p["box"] for p in plain["composite"]["pastes"]] == [p["box"] for p in toned["composite"]["pastes"]]
+    assert all("contrast_gain" not in p for r in _records(unlabelled) for p in r["composite"]["pastes"])
