@@ -137,30 +137,37 @@ def _tone_measures(linear: np.ndarray, weight: np.ndarray) -> tuple[float | None
     natural log of luminance, and the mean chroma ``|rgb - Y| / Y`` (Euclidean over the channels), over the pixels
     brighter than ``TONE_MIN_LUMINANCE``; None for a measure with fewer than ``TONE_MIN_PIXELS`` of them (or no
     spread: a flat part has no contrast to match)."""
-    luminance = linear @ LUMINANCE
+    luminance = linear @ LUMINANCE.astype(linear.dtype)
     bright = (luminance > TONE_MIN_LUMINANCE) & (weight > 0)
     if int(bright.sum()) < TONE_MIN_PIXELS:
         return None, None
-    y, w = luminance[bright], weight[bright] / float(weight[bright].sum())
+    y, w = luminance[bright].astype(np.float64), weight[bright].astype(np.float64)
+    w = w / w.sum()
     log_y = np.log(y)
     contrast = float(np.sqrt(w @ (log_y - w @ log_y) ** 2))
     chroma = np.linalg.norm(linear[bright] - y[:, None], axis=1) / y
     return (contrast if contrast > 1e-6 else None), float(w @ chroma)
 
 
+def _straight(premultiplied: np.ndarray) -> np.ndarray:
+    """Straight (un-premultiplied) linear RGB of premultiplied RGBA pixels (..., 4)."""
+    return premultiplied[..., :3] / np.maximum(premultiplied[..., 3:], 1e-6)
+
+
 def tone_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSettings) -> tuple[float, float]:
     """(contrast gain, saturation gain) of one paste over ``photo`` (module docstring, step 0): 1.0 where matching
-    is off or either part cannot be measured."""
+    is off or either part cannot be measured. Both parts are measured on every other pixel of every other row."""
     contrast, saturation = 1.0, 1.0
     if settings.contrast_strength <= 0 and settings.saturation_strength <= 0:
         return contrast, saturation
     wx0, wy0, wx1, wy1 = window = _window(photo.shape, box, settings.surround_share)
     keep = _photo_only(placed, window)[::2, ::2]
-    around = LINEAR_LUT[photo[wy0:wy1:2, wx0:wx1:2]][keep].astype(np.float64)
-    photo_c, photo_s = _tone_measures(around, np.ones(len(around)))
-    alpha = placed.premultiplied[..., 3].reshape(-1).astype(np.float64)
-    straight = placed.premultiplied[..., :3].reshape(-1, 3) / np.maximum(alpha, 1e-6)[:, None]
-    paste_c, paste_s = _tone_measures(straight.astype(np.float64), np.where(alpha > 0.5, alpha, 0.0))
+    around = LINEAR_LUT[photo[wy0:wy1:2, wx0:wx1:2]][keep]
+    photo_c, photo_s = _tone_measures(around, np.ones(len(around), np.float32))
+    sampled = placed.premultiplied[::2, ::2]
+    alpha = sampled[..., 3]
+    inside = alpha > 0.5
+    paste_c, paste_s = _tone_measures(_straight(sampled[inside]), alpha[inside])
     if settings.contrast_strength > 0 and photo_c is not None and paste_c is not None:
         contrast = float(np.clip((photo_c / paste_c) ** settings.contrast_strength, *settings.contrast_gain))
     if settings.saturation_strength > 0 and photo_s and paste_s:
@@ -171,25 +178,28 @@ def tone_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSett
 def retone(placed: PlacedCutout, contrast: float, saturation: float) -> PlacedCutout:
     """``placed`` with its colour's contrast and saturation scaled (module docstring, step 0): each pixel's chroma
     ``rgb - Y`` times ``saturation`` (luminance kept), then its log luminance moved from the paste's mean log
-    luminance (alpha-weighted, over the pixels the measure counts) by ``contrast`` (chroma ratios kept); alpha,
-    silhouette and labels unchanged. Negative channels a saturation above 1 makes are clipped to 0."""
+    luminance (alpha-weighted over its pixels of alpha > 0.5 brighter than ``TONE_MIN_LUMINANCE``) by ``contrast``
+    (chroma ratios kept); alpha, silhouette and labels unchanged. Negative channels a saturation above 1 makes are
+    clipped to 0."""
     if contrast == 1.0 and saturation == 1.0:
         return placed
-    alpha = placed.premultiplied[..., 3:].astype(np.float64)
-    straight = placed.premultiplied[..., :3].astype(np.float64) / np.maximum(alpha, 1e-6)
-    luminance = straight @ LUMINANCE
+    out = placed.premultiplied.copy()
+    shown = out[..., 3] > 0
+    alpha = out[..., 3][shown]
+    straight = _straight(out[shown])
+    weights = LUMINANCE.astype(np.float32)
+    luminance = straight @ weights
     if saturation != 1.0:
-        straight = np.maximum(luminance[..., None] + saturation * (straight - luminance[..., None]), 0.0)
-        luminance = straight @ LUMINANCE
+        straight = np.maximum(luminance[:, None] + np.float32(saturation) * (straight - luminance[:, None]), 0.0)
+        luminance = straight @ weights
     if contrast != 1.0:
-        counted = (luminance > TONE_MIN_LUMINANCE) & (alpha[..., 0] > 0.5)
         log_y = np.log(np.maximum(luminance, TONE_MIN_LUMINANCE))
-        w = alpha[..., 0][counted]
-        mean = float(w @ log_y[counted] / w.sum()) if counted.any() else 0.0
-        factor = np.exp((contrast - 1.0) * (log_y - mean))
-        straight = straight * np.where(luminance > 0, factor, 1.0)[..., None]
-    colour = (straight * alpha).astype(np.float32)
-    return replace(placed, premultiplied=np.concatenate([colour, placed.premultiplied[..., 3:]], axis=-1))
+        counted = (luminance > TONE_MIN_LUMINANCE) & (alpha > 0.5)
+        mean = float(alpha[counted] @ log_y[counted] / alpha[counted].sum()) if counted.any() else 0.0
+        factor = np.exp(np.float32(contrast - 1.0) * (log_y - np.float32(mean)))
+        straight = straight * np.where(luminance > 0, factor, np.float32(1.0))[:, None]
+    out[..., :3][shown] = straight * alpha[:, None]
+    return replace(placed, premultiplied=out)
 
 
 def _smooth(values: np.ndarray, weight: np.ndarray, sigma: float) -> np.ndarray:
