@@ -8,13 +8,18 @@ step):
 0. **Tone** of each paste (where ``contrast_strength`` or ``saturation_strength`` > 0), a partial transfer of colour
    statistics from the photo around the paste (as Reinhard et al., "Color transfer between images", 2001, transfer
    a spread; Xue et al., "Understanding and improving the realism of image composites", 2012, found such statistics
-   of foreground and background to decide whether a composite looks real). Over the pixels brighter than
-   ``TONE_MIN_LUMINANCE`` (the photo's around the paste as in step 1, the paste's own weighted by alpha):
-   contrast is the standard deviation of ln Y, saturation the mean of ``|rgb - Y| / Y``. The paste's chroma
-   ``rgb - Y`` is scaled by ``clip((s_photo / s_paste) ^ saturation_strength)`` (Y kept), then its ln Y is scaled
-   about its mean by ``clip((c_photo / c_paste) ^ contrast_strength)`` (chroma ratios kept): the two measures move
-   independently, and steps 1-3 work on the paste so toned. Renders are more colourful and flatter than the photos
-   they are pasted into (their palettes and light, not a camera's tone curve, set them).
+   of foreground and background to decide whether a composite looks real). Both parts are sampled as in step 1
+   (every other pixel of every other row; the photo's pixels around the paste, the paste's own of alpha > 0.5,
+   weighted by alpha), and only pixels brighter than ``TONE_MIN_LUMINANCE`` count: contrast is the standard
+   deviation of ln Y, saturation the mean of ``||rgb - Y|| / Y`` (Euclidean over the channels). The paste's chroma
+   ``rgb - Y`` is scaled by ``clip((s_photo / s_paste) ^ saturation_strength)``, Y kept (a pixel whose channel would
+   go below 0 is scaled only until that channel reaches 0); then its ln Y is scaled about its mean (over the
+   pixels measured) by ``clip((c_photo / c_paste) ^ contrast_strength)``, chromaticity kept (pixels darker than the
+   threshold take the threshold's factor). A photo with no spread or chroma asks for the gain's lower clamp; a paste
+   with none, or either part with too few pixels to measure, gets 1. The two measures move independently, and
+   steps 1-3 work on the paste so toned (a contrast above 1 raises its mean linear luminance, which exposure
+   matching then answers). Renders are more colourful and flatter than the photos they are pasted into (their
+   palettes and light, not a camera's tone curve, set them).
 1. **Gains** of each paste, measured on the photo as it came: the mean linear RGB of the photo in the paste's box
    widened by ``surround_share`` of its size on every side (every other pixel of every other row; the paste's own
    pixels, alpha > 0, left out) against
@@ -72,7 +77,7 @@ EDGE_TOP_SHARE, EDGE_MIN_COUNT = 0.1, 12
 #: The least gradient (sRGB luminance per px, at the larger scale) an edge has: flat parts have no edges.
 EDGE_MIN_GRADIENT = 0.01
 #: Contrast and saturation are measured over pixels brighter than this linear luminance (darker ones carry sensor
-#: noise and quantisation, not tone), and only where at least this many pixels are left.
+#: noise and quantisation, not tone), and only where at least this many sampled pixels are left.
 TONE_MIN_LUMINANCE, TONE_MIN_PIXELS = 0.005, 64
 #: Pixels the Poisson domain reaches beyond the labelled ones.
 POISSON_MARGIN_PX = 2
@@ -111,13 +116,19 @@ class Composite:
     pastes: list[dict]
 
 
+def _around(photo: np.ndarray, placed: PlacedCutout, box, share: float) -> np.ndarray:
+    """The photo's linear RGB around a paste (n, 3) float32: its box widened by ``share`` of its size on every side,
+    every other pixel of every other row, the paste's own pixels (alpha > 0) left out."""
+    wx0, wy0, wx1, wy1 = window = _window(photo.shape, box, share)
+    keep = _photo_only(placed, window)
+    return LINEAR_LUT[photo[wy0:wy1:2, wx0:wx1:2]][keep[::2, ::2]]
+
+
 def paste_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSettings) -> tuple[float, list[float]]:
     """(exposure gain, [r, g, b] white-balance gains) of one paste over ``photo`` (H, W, 3) uint8 (see the module
     docstring, step 1)."""
-    wx0, wy0, wx1, wy1 = window = _window(photo.shape, box, settings.surround_share)
-    keep = _photo_only(placed, window)
     # every other pixel of every other row: the mean of a few thousand pixels, at a quarter of the cost
-    around = LINEAR_LUT[photo[wy0:wy1:2, wx0:wx1:2]][keep[::2, ::2]].astype(np.float64)
+    around = _around(photo, placed, box, settings.surround_share).astype(np.float64)
     weight = float(placed.premultiplied[..., 3].sum())
     if around.size == 0 or weight <= 0:
         return 1.0, [1.0, 1.0, 1.0]
@@ -133,20 +144,21 @@ def paste_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSet
 
 
 def _tone_measures(linear: np.ndarray, weight: np.ndarray) -> tuple[float | None, float | None]:
-    """(contrast, saturation) of linear RGB pixels (n, 3) weighted by ``weight`` (n,): the standard deviation of the
-    natural log of luminance, and the mean chroma ``|rgb - Y| / Y`` (Euclidean over the channels), over the pixels
-    brighter than ``TONE_MIN_LUMINANCE``; None for a measure with fewer than ``TONE_MIN_PIXELS`` of them (or no
-    spread: a flat part has no contrast to match)."""
-    luminance = linear @ LUMINANCE.astype(linear.dtype)
+    """(contrast, saturation) of linear RGB pixels (n, 3) weighted by ``weight`` (n,), in float64: the standard
+    deviation of the natural log of luminance, and the mean chroma ``||rgb - Y|| / Y`` (Euclidean over the
+    channels), over the pixels of weight > 0 brighter than ``TONE_MIN_LUMINANCE``; (None, None) where fewer than
+    ``TONE_MIN_PIXELS`` of them are left."""
+    linear = linear.astype(np.float64)
+    luminance = linear @ LUMINANCE
     bright = (luminance > TONE_MIN_LUMINANCE) & (weight > 0)
     if int(bright.sum()) < TONE_MIN_PIXELS:
         return None, None
-    y, w = luminance[bright].astype(np.float64), weight[bright].astype(np.float64)
+    y, w = luminance[bright], weight[bright].astype(np.float64)
     w = w / w.sum()
     log_y = np.log(y)
     contrast = float(np.sqrt(w @ (log_y - w @ log_y) ** 2))
     chroma = np.linalg.norm(linear[bright] - y[:, None], axis=1) / y
-    return (contrast if contrast > 1e-6 else None), float(w @ chroma)
+    return contrast, float(w @ chroma)
 
 
 def _straight(premultiplied: np.ndarray) -> np.ndarray:
@@ -154,33 +166,33 @@ def _straight(premultiplied: np.ndarray) -> np.ndarray:
     return premultiplied[..., :3] / np.maximum(premultiplied[..., 3:], 1e-6)
 
 
+def _tone_gain(photo: float | None, paste: float | None, strength: float, clamp) -> float:
+    """(photo / paste) ^ strength, clamped; 1 where matching is off or the paste has nothing to scale (a photo with
+    nothing asks for the clamp's low end)."""
+    if strength <= 0 or photo is None or paste is None or paste <= 1e-9:
+        return 1.0
+    return round(float(np.clip((photo / paste) ** strength, *clamp)), 4)
+
+
 def tone_gains(photo: np.ndarray, placed: PlacedCutout, box, settings: MatchSettings) -> tuple[float, float]:
-    """(contrast gain, saturation gain) of one paste over ``photo`` (module docstring, step 0): 1.0 where matching
-    is off or either part cannot be measured. Both parts are measured on every other pixel of every other row."""
-    contrast, saturation = 1.0, 1.0
+    """(contrast gain, saturation gain) of one paste over ``photo`` (module docstring, step 0)."""
     if settings.contrast_strength <= 0 and settings.saturation_strength <= 0:
-        return contrast, saturation
-    wx0, wy0, wx1, wy1 = window = _window(photo.shape, box, settings.surround_share)
-    keep = _photo_only(placed, window)[::2, ::2]
-    around = LINEAR_LUT[photo[wy0:wy1:2, wx0:wx1:2]][keep]
-    photo_c, photo_s = _tone_measures(around, np.ones(len(around), np.float32))
+        return 1.0, 1.0
+    around = _around(photo, placed, box, settings.surround_share)
+    photo_c, photo_s = _tone_measures(around, np.ones(len(around)))
     sampled = placed.premultiplied[::2, ::2]
-    alpha = sampled[..., 3]
-    inside = alpha > 0.5
-    paste_c, paste_s = _tone_measures(_straight(sampled[inside]), alpha[inside])
-    if settings.contrast_strength > 0 and photo_c is not None and paste_c is not None:
-        contrast = float(np.clip((photo_c / paste_c) ** settings.contrast_strength, *settings.contrast_gain))
-    if settings.saturation_strength > 0 and photo_s and paste_s:
-        saturation = float(np.clip((photo_s / paste_s) ** settings.saturation_strength, *settings.saturation_gain))
-    return round(contrast, 4), round(saturation, 4)
+    inside = sampled[..., 3] > 0.5
+    paste_c, paste_s = _tone_measures(_straight(sampled[inside]), sampled[..., 3][inside])
+    return (_tone_gain(photo_c, paste_c, settings.contrast_strength, settings.contrast_gain),
+            _tone_gain(photo_s, paste_s, settings.saturation_strength, settings.saturation_gain))
 
 
 def retone(placed: PlacedCutout, contrast: float, saturation: float) -> PlacedCutout:
     """``placed`` with its colour's contrast and saturation scaled (module docstring, step 0): each pixel's chroma
-    ``rgb - Y`` times ``saturation`` (luminance kept), then its log luminance moved from the paste's mean log
-    luminance (alpha-weighted over its pixels of alpha > 0.5 brighter than ``TONE_MIN_LUMINANCE``) by ``contrast``
-    (chroma ratios kept); alpha, silhouette and labels unchanged. Negative channels a saturation above 1 makes are
-    clipped to 0."""
+    ``rgb - Y`` times ``saturation`` (Y kept; where a channel would go below 0, only as far as it reaching 0), then
+    its ln Y moved from the paste's mean ln Y (alpha-weighted over its pixels of alpha > 0.5 brighter than
+    ``TONE_MIN_LUMINANCE``, summed in float64) by ``contrast``, chromaticity kept; alpha, silhouette and labels
+    unchanged."""
     if contrast == 1.0 and saturation == 1.0:
         return placed
     out = placed.premultiplied.copy()
@@ -190,12 +202,16 @@ def retone(placed: PlacedCutout, contrast: float, saturation: float) -> PlacedCu
     weights = LUMINANCE.astype(np.float32)
     luminance = straight @ weights
     if saturation != 1.0:
-        straight = np.maximum(luminance[:, None] + np.float32(saturation) * (straight - luminance[:, None]), 0.0)
-        luminance = straight @ weights
+        chroma = straight - luminance[:, None]
+        lowest = chroma.min(axis=1)                      # the most a channel may lose is its share of Y
+        room = np.where(lowest < 0, luminance / np.maximum(-lowest, 1e-12), np.inf)
+        factor = np.minimum(np.float32(saturation), room).astype(np.float32)
+        straight = np.maximum(luminance[:, None] + factor[:, None] * chroma, 0.0)
     if contrast != 1.0:
         log_y = np.log(np.maximum(luminance, TONE_MIN_LUMINANCE))
         counted = (luminance > TONE_MIN_LUMINANCE) & (alpha > 0.5)
-        mean = float(alpha[counted] @ log_y[counted] / alpha[counted].sum()) if counted.any() else 0.0
+        w = alpha[counted].astype(np.float64)
+        mean = float(w @ log_y[counted].astype(np.float64) / w.sum()) if counted.any() else 0.0
         factor = np.exp(np.float32(contrast - 1.0) * (log_y - np.float32(mean)))
         straight = straight * np.where(luminance > 0, factor, np.float32(1.0))[:, None]
     out[..., :3][shown] = straight * alpha[:, None]
@@ -284,7 +300,7 @@ def sharpness_sigma(photo: np.ndarray, placed: PlacedCutout, box, settings: Matc
     keep = _photo_only(placed, window)
     blur_photo = edge_blur(_luma(photo[wy0:wy1, wx0:wx1] / 255.0), keep.astype(np.float32), keep)
     alpha = placed.premultiplied[..., 3]
-    straight = np.clip(placed.premultiplied[..., :3] / np.maximum(alpha, 1e-6)[..., None], 0.0, 1.0)
+    straight = np.clip(_straight(placed.premultiplied), 0.0, 1.0)
     blur_paste = edge_blur(_luma(from_linear(straight)), alpha, alpha >= 0.999)
     if blur_photo is None or blur_paste is None or blur_paste >= blur_photo:
         return 0.0
@@ -299,7 +315,7 @@ def soften(premultiplied: np.ndarray, sigma: float) -> np.ndarray:
     if sigma <= 0:
         return premultiplied[..., :3]
     alpha = premultiplied[..., 3]
-    straight = premultiplied[..., :3] / np.maximum(alpha, 1e-6)[..., None]
+    straight = _straight(premultiplied)
     return np.stack([_smooth(straight[..., c], alpha, sigma) * alpha for c in range(3)], axis=-1)
 
 

@@ -325,7 +325,7 @@ REC709 = np.array([0.2126, 0.7152, 0.0722])
 
 def _log_spread_and_chroma(rgb: np.ndarray, weight: np.ndarray) -> tuple[float, float]:
     """Contrast and saturation as the schema defines them, written out again: the weighted standard deviation of
-    ln Y and the weighted mean of |rgb - Y| / Y over pixels of weight > 0."""
+    ln Y and the weighted mean of ||rgb - Y|| / Y over the pixels given (the caller picks them)."""
     y = rgb @ REC709
     w = weight / weight.sum()
     mean = np.sum(w * np.log(y))
@@ -419,8 +419,78 @@ def test_tone_gains_take_the_photos_measures_partly_and_clamp(bank):
                                                                      saturation_gain=(0.9, 1.1)))
     assert clamped == (min(max(full[0], 0.9), 1.1), min(max(full[1], 0.9), 1.1))
     assert tone_gains(photo, placed, placement.box, MatchSettings()) == (1.0, 1.0)          # off by default
-    flat = np.full_like(photo, 128)           # no spread to match, and no chroma: contrast left alone
-    assert tone_gains(flat, placed, placement.box, MatchSettings(contrast_strength=1.0, **wide))[0] == 1.0
+    both = MatchSettings(contrast_strength=1.0, saturation_strength=1.0, contrast_gain=(0.25, 4.0),
+                         saturation_gain=(0.25, 4.0))
+    # a grey photo (every grey level, in random order: no chroma, some spread) asks for the least saturation; a flat
+    # one for the least contrast too, however its levels round
+    grey = np.repeat(np.random.default_rng(3).integers(20, 256, (120, 160, 1), dtype=np.uint8), 3, axis=2)
+    assert tone_gains(grey, placed, placement.box, both)[1] == 0.25
+    for level in (128, 200, 77):
+        assert tone_gains(np.full_like(photo, level), placed, placement.box, both) == (0.25, 0.25)
+    # too few pixels bright enough to measure: nothing asked
+    assert tone_gains(np.full_like(photo, 3), placed, placement.box, both) == (1.0, 1.0)
+
+
+def test_tone_gains_weigh_the_paste_by_alpha_and_skip_dark_photo_pixels():
+    # the paste: two halves in 2 x 2 blocks (its sampling reads each once), a greyish one opaque and a colourful one
+    # at alpha 0.6; the photo: three colours in 2 x 2 blocks, one too dark to count
+    h, w = 40, 40
+    greyish, colourful = np.array([0.30, 0.29, 0.27]), np.array([0.25, 0.04, 0.01])
+    rgb = np.where((np.arange(w) < w // 2)[None, :, None], greyish, colourful) * np.ones((h, w, 3))
+    alpha = np.where(np.arange(w) < w // 2, 1.0, 0.6)[None, :] * np.ones((h, w))
+    placed = _placed(rgb, alpha)
+    colours = np.array([(230, 180, 120), (40, 60, 70), (4, 2, 1)], np.uint8)
+    cycle = (np.arange(300)[:, None] // 2 + np.arange(400)[None, :] // 2) % 3
+    photo = colours[cycle]
+    counted = LINEAR_LUT[colours[:2]].astype(np.float64)
+    assert LINEAR_LUT[colours[2]].astype(np.float64) @ REC709 < 0.005
+    photo_spread, photo_chroma = _log_spread_and_chroma(counted, np.ones(2))
+    paste_spread, paste_chroma = _log_spread_and_chroma(np.array([greyish, colourful]), np.array([1.0, 0.6]))
+    unweighted = _log_spread_and_chroma(np.array([greyish, colourful]), np.ones(2))
+    assert abs(unweighted[1] / paste_chroma - 1) > 0.1        # weighting matters here, beyond the tolerance below
+    settings = MatchSettings(contrast_strength=1.0, saturation_strength=1.0, contrast_gain=(0.1, 10.0),
+                             saturation_gain=(0.1, 10.0), surround_share=3.0)
+    gains = tone_gains(photo, placed, (0, 0, w, h), settings)
+    assert gains == pytest.approx((photo_spread / paste_spread, photo_chroma / paste_chroma), rel=0.02)
+
+
+def test_retone_keeps_the_mean_log_luminance_and_clips_no_channel():
+    rgb, alpha = _colourful()
+    rgb[5, :4] = 0.0                                   # black: left black
+    rgb[6, :4] = 0.002                                 # darker than the measure's threshold: not counted
+    placed = _placed(rgb, alpha)
+    counted = (alpha > 0.5) & (rgb @ REC709 > 0.005)
+
+    def mean_log(p):
+        a = p.premultiplied[..., 3].astype(np.float64)
+        y = (p.premultiplied[..., :3].astype(np.float64) / np.maximum(a, 1e-6)[..., None]) @ REC709
+        return np.sum(a[counted] * np.log(y[counted])) / a[counted].sum()
+
+    toned = retone(placed, 1.4, 1.0)
+    assert mean_log(toned) == pytest.approx(mean_log(placed), abs=1e-5)       # scaled about its mean, not about 0
+    np.testing.assert_array_equal(toned.premultiplied[5, :4, :3], 0.0)
+    # darker than the threshold: the threshold's factor
+    threshold = math.exp(0.4 * (math.log(0.005) - mean_log(placed)))
+    np.testing.assert_allclose(toned.premultiplied[6, :4, :3], placed.premultiplied[6, :4, :3] * threshold, rtol=1e-4)
+    assert np.isfinite(toned.premultiplied).all()
+    # a saturation gain of 3 pushes most pixels' smallest channel below 0: those stop at 0, their luminance and hue
+    # kept; the others take the whole gain
+    vivid = retone(placed, 1.0, 3.0)
+    inside = alpha > 0
+    before = placed.premultiplied[..., :3][inside].astype(np.float64) / alpha[inside][:, None]
+    after = vivid.premultiplied[..., :3][inside].astype(np.float64) / alpha[inside][:, None]
+    assert after.min() >= 0.0
+    np.testing.assert_allclose(after @ REC709, before @ REC709, rtol=1e-4, atol=1e-7)
+    y = (before @ REC709)[:, None]
+    gain = np.linalg.norm(after - y, axis=1) / np.maximum(np.linalg.norm(before - y, axis=1), 1e-12)
+    stopped = after.min(axis=1) < 1e-6
+    moved = np.linalg.norm(before - y, axis=1) > 1e-4         # pixels with a chroma to scale (not the greys)
+    assert 0 < stopped[moved].mean() < 1
+    np.testing.assert_allclose(gain[moved & ~stopped], 3.0, rtol=1e-3)
+    assert np.all(gain[moved & stopped] < 3.0 + 1e-3)
+    unit = (after - y) / np.maximum(np.linalg.norm(after - y, axis=1, keepdims=True), 1e-12)
+    unit_before = (before - y) / np.maximum(np.linalg.norm(before - y, axis=1, keepdims=True), 1e-12)
+    np.testing.assert_allclose(unit[moved], unit_before[moved], atol=1e-3)     # the hue kept
 
 
 def test_tone_matching_changes_the_pastes_colour_only_and_is_recorded(bank):
@@ -438,6 +508,14 @@ def test_tone_matching_changes_the_pastes_colour_only_and_is_recorded(bank):
     np.testing.assert_array_equal(toned.rgb[outside], photo[outside])
     record = toned.pastes[0]
     assert record["saturation_gain"] < 1.0 and record["contrast_gain"] != 1.0
+    # exposure and white balance are matched to the paste as toned, not as rendered
+    lit = MatchSettings(contrast_strength=1.0, saturation_strength=1.0)
+    placed = place(pixels, entry, (80.0, 100.0), 1.2, (160, 120))
+    as_toned = paste_gains(photo, retone(placed, record["contrast_gain"], record["saturation_gain"]),
+                           paste[0].placement.box, lit)
+    assert as_toned != paste_gains(photo, placed, paste[0].placement.box, lit)
+    painted = compose(photo, paste, ClassMap.default(), lit).pastes[0]
+    assert (painted["exposure_gain"], painted["white_balance_gains"]) == as_toned
     assert "contrast_gain" not in as_rendered.pastes[0] and "saturation_gain" not in as_rendered.pastes[0]
     person = as_rendered.instance_ids == 1
     assert (toned.rgb[person] != as_rendered.rgb[person]).any(axis=1).mean() > 0.9

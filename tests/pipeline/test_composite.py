@@ -331,7 +331,8 @@ def test_tone_matching_is_recorded_per_paste_verifies_and_replays(inputs, unlabe
     assert pastes and all(0.67 <= p["contrast_gain"] <= 1.5 and 0.5 <= p["saturation_gain"] <= 1.5 for p in pastes)
     assert any(p["saturation_gain"] != 1.0 for p in pastes)
     match = json.loads((out / "generate.json").read_text())["job_key"]["config"]["match"]
-    assert (match["contrast_strength"], match["saturation_strength"]) == (1.0, 0.5) and "sharpness_strength" not in match
+    assert (match["contrast_strength"], match["saturation_strength"]) == (1.0, 0.5)
+    assert "sharpness_strength" not in match
     code, text, _ = run_cli("verify", out)
     assert code == 0 and text.strip().endswith("ok"), text
     toned = next(r for r in _records(out) if any(p["saturation_gain"] != 1.0 for p in r["composite"]["pastes"]))
