@@ -351,6 +351,14 @@ def _prim_path(order: int, entry: BankEntry, index: int) -> str:
     return f"/pastes/p{order}/{entry.id}/{role}{index}"
 
 
+def _class_id(class_map: ClassMap, name: str) -> int:
+    """The id of a pasted instance's class; the bank's reader has checked that its class map names it."""
+    found = class_map.resolve(name)
+    if found is None:
+        raise ValueError(f"class '{name}' of a cut-out is not in the class map it was read with")
+    return found.id
+
+
 def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, settings: MatchSettings) -> Composite:
     """Paint ``pastes`` (sorted by their placement's ``order``) over ``photo`` (H, W, 3) uint8 sRGB."""
     height, width = photo.shape[:2]
@@ -380,8 +388,9 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
         ids = {inst.index: next_id + k for k, inst in enumerate(entry.instances)}
         next_id += len(entry.instances)
         paths = {index: _prim_path(order, entry, index) for index in ids}
+        class_of = {inst.index: _class_id(class_map, inst.class_name) for inst in entry.instances}
         for inst in entry.instances:
-            instances.append(Instance(ids[inst.index], paths[inst.index], class_map.resolve(inst.class_name).id,
+            instances.append(Instance(ids[inst.index], paths[inst.index], class_of[inst.index],
                                       inst.class_name, True, tuple((name, paths[target])
                                                                    for name, target in inst.relations)))
             if inst.keypoints is not None:
@@ -410,7 +419,7 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
         classes = np.zeros(256, np.uint8)
         for index, gid in ids.items():
             table[index] = gid
-            classes[index] = class_map.resolve(next(i.class_name for i in entry.instances if i.index == index)).id
+            classes[index] = class_of[index]
         labelled = pc.ids > 0
         instance_ids[rows, cols] = np.where(labelled, table[pc.ids], instance_ids[rows, cols])
         class_ids[rows, cols] = np.where(labelled, classes[pc.ids], class_ids[rows, cols])

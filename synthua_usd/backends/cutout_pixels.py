@@ -103,7 +103,7 @@ class PlacedCutout:
 
 
 def preimage(anchor_crop: tuple[float, float], anchor_px: tuple[float, float], scale: float,
-             frame_coordinate: np.ndarray, axis: int) -> np.ndarray:
+             frame_coordinate: np.ndarray | float, axis: int) -> np.ndarray | float:
     """Cut-out coordinates (continuous) of frame coordinates along ``axis`` (0: x, 1: y)."""
     return anchor_crop[axis] + (frame_coordinate - anchor_px[axis]) / scale
 
@@ -151,10 +151,10 @@ def place(pixels: CutoutPixels, entry: BankEntry, anchor_px: tuple[float, float]
         bit = np.uint16(1 << (inst.index - 1))
         total = int(np.count_nonzero(full_amodal & bit))
         outside[inst.index] = total - int(np.count_nonzero(full_amodal[inside] & bit))
-    box = (float(preimage(entry.anchor, anchor_px, scale, np.float64(x0), 0)),
-           float(preimage(entry.anchor, anchor_px, scale, np.float64(y0), 1)),
-           float(preimage(entry.anchor, anchor_px, scale, np.float64(x1), 0)),
-           float(preimage(entry.anchor, anchor_px, scale, np.float64(y1), 1)))
+    box = (float(preimage(entry.anchor, anchor_px, scale, float(x0), 0)),
+           float(preimage(entry.anchor, anchor_px, scale, float(y0), 1)),
+           float(preimage(entry.anchor, anchor_px, scale, float(x1), 0)),
+           float(preimage(entry.anchor, anchor_px, scale, float(y1), 1)))
     size = (x1 - x0, y1 - y0)
     colour = _resize(pixels.premultiplied, box, size, 0.0)
     np.clip(colour, 0.0, None, out=colour)

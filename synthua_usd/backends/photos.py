@@ -78,7 +78,8 @@ def photo_header(path: str | Path) -> PhotoHeader:
         return _header(image)
 
 
-def cover_region(size: tuple[int, int], output: tuple[int, int] | None, path: Path) -> tuple[tuple[float, ...], float]:
+def cover_region(size: tuple[int, int], output: tuple[int, int] | None,
+                 path: Path) -> tuple[tuple[float, float, float, float], float]:
     """The photo ``region`` (x0, y0, x1, y1, photo pixels) that covers ``output`` (W, H) at the centre, and the
     ``scale`` (written px per photo px, <= 1); ``output`` None: the whole photo at scale 1. A photo smaller than the
     output raises :class:`InputError`."""
