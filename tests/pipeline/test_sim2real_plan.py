@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import shlex
 import sys
 from pathlib import Path
 
@@ -248,6 +249,17 @@ def test_plan_only_writes_nested_subsets_of_links(tool, real, tmp_path, capsys):
     assert tool.main([a if a != "3" else "4" for a in args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "holds another draw" in err[0]
+
+
+def test_the_help_examples_plan_only_command_runs_as_written(tool, real, tmp_path):
+    """The --help's example that writes the subsets for composites (issue 45), with its paths pointed at the
+    hand-made set: it once lacked --budget-images and was refused."""
+    text = tool.__doc__.replace("\\\n", " ")
+    line = next(line for line in text.splitlines() if "python tools/sim2real.py" in line and "--plan-only" in line)
+    args = shlex.split(line.split("tools/sim2real.py", 1)[1])
+    paths = {"real/": str(real), "out/s2r_45": str(tmp_path / "w"), "50": "12"}     # the set holds 20 photos
+    assert tool.main([paths.get(a, a) for a in args]) == 0
+    assert (tmp_path / "w" / "subsets" / "n0012" / "subset.json").is_file()
 
 
 def test_refusals_are_one_line(tool, real, tmp_path, capsys):
