@@ -4,7 +4,10 @@ written size, through Pillow (which reads EXIF, and HEIC when its plugin pillow-
 The written image *covers* the output size: the photo is scaled by ``max(W / w, H / h)`` (never above 1: a photo
 smaller than the output is refused) and its centre cut out, ``region`` in photo pixels. A photo with an EXIF
 orientation other than 1 is turned upright first (as viewers and Ultralytics' loader do); its size and boxes are
-then the upright photo's. Colours are taken as 8-bit sRGB (an embedded ICC profile is not applied).
+then the upright photo's. Colours are taken as 8-bit sRGB (an embedded ICC profile is not applied); a 16-bit
+photo is scaled to 8 bits (x / 257), one of floating-point pixels refused. An EXIF orientation or 35 mm focal length
+that is no such value (damaged, out of range) is taken as absent. Photos of up to :data:`MAX_PHOTO_PIXELS` are read
+(Pillow's own guard against decompression bombs stops at about 179 megapixels, below a 200-megapixel phone's).
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ from __future__ import annotations
 import hashlib
 import io
 import math
+import numbers
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +30,10 @@ from synthua_usd.core.input_files import shown
 HEIC_SUFFIXES = (".heic", ".heif")
 #: Pillow's orientation tag.
 _ORIENTATION = 0x0112
+#: The most pixels a photo may have: a 200-megapixel phone's 16320 x 12240 with room to spare.
+MAX_PHOTO_PIXELS = 250_000_000
+#: EXIF 35 mm equivalent focal lengths taken as stated (mm), a fisheye's to a superzoom's; others are taken as absent.
+FOCAL_35MM_RANGE = (8.0, 3000.0)
 
 
 def heic_decoder() -> bool:
@@ -43,11 +51,24 @@ def _open(path: Path, data: bytes | None = None) -> Image.Image:
     if path.suffix.lower() in HEIC_SUFFIXES and not heic_decoder():
         raise InputError(f"{shown(path)}: a HEIC image, and no HEIC decoder is installed; expected a JPEG, PNG, TIFF, "
                          f"BMP or WebP photo, or `pip install pillow-heif` to read HEIC")
+    limit, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, None     # MAX_PHOTO_PIXELS is checked below instead
     try:
-        return Image.open(io.BytesIO(data) if data is not None else path)
-    except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError) as exc:
+        image = Image.open(io.BytesIO(data) if data is not None else path)
+    except (UnidentifiedImageError, OSError, ValueError, SyntaxError) as exc:
         raise InputError(f"{shown(path)}: not an image Pillow can read ({type(exc).__name__}); expected a photo "
                          f"(JPEG, PNG, TIFF, BMP, WebP)") from None
+    finally:
+        Image.MAX_IMAGE_PIXELS = limit
+    width, height = image.size
+    if width * height > MAX_PHOTO_PIXELS:
+        image.close()
+        raise InputError(f"{shown(path)}: {width}x{height} pixels ({width * height / 1e6:.0f} megapixels); expected "
+                         f"a photo of at most {MAX_PHOTO_PIXELS / 1e6:.0f} megapixels")
+    return image
+
+
+def _damaged(path: Path, exc: Exception) -> InputError:
+    return InputError(f"{shown(path)}: truncated or damaged ({str(exc)[:60]}); expected a complete image")
 
 
 @dataclass(frozen=True)
@@ -61,21 +82,50 @@ class PhotoHeader:
     orientation: int
 
 
-def _header(image: Image.Image) -> PhotoHeader:
-    exif = image.getexif()
-    orientation = int(exif.get(_ORIENTATION, 1) or 1)
-    focal = exif.get_ifd(IFD.Exif).get(Base.FocalLengthIn35mmFilm)
+def _number(value) -> float | None:
+    """An EXIF value as a finite number (an int, float or rational; a rational 0/0, text or a tuple: None)."""
+    if not isinstance(value, numbers.Real):
+        return None
+    try:
+        number = float(value)
+    except (ValueError, OverflowError, ZeroDivisionError):
+        return None
+    return number if math.isfinite(number) else None
+
+
+def _header(path: Path, image: Image.Image) -> PhotoHeader:
+    try:    # a PNG's EXIF may follow its pixels: reading it decodes them
+        exif = image.getexif()
+        orientation, focal = _number(exif.get(_ORIENTATION)), _number(exif.get_ifd(IFD.Exif).get(
+            Base.FocalLengthIn35mmFilm))
+    except (OSError, ValueError, SyntaxError) as exc:
+        raise _damaged(path, exc) from None
+    orientation = int(orientation) if orientation is not None and orientation in range(1, 9) else 1
     width, height = image.size
     if orientation in (5, 6, 7, 8):  # turned a quarter: the upright photo's sides swap
         width, height = height, width
-    focal = float(focal) if isinstance(focal, (int, float)) and focal > 0 else None
+    focal = focal if focal is not None and FOCAL_35MM_RANGE[0] <= focal <= FOCAL_35MM_RANGE[1] else None
     return PhotoHeader(width, height, focal, orientation)
 
 
 def photo_header(path: str | Path) -> PhotoHeader:
-    """The header of the photo at ``path`` (no pixels decoded)."""
-    with _open(Path(path)) as image:
-        return _header(image)
+    """The header of the photo at ``path`` (no pixels decoded where the format allows)."""
+    path = Path(path)
+    with _open(path) as image:
+        return _header(path, image)
+
+
+def _rgb(path: Path, image: Image.Image) -> Image.Image:
+    """8-bit RGB of a decoded photo: 16-bit grey scaled (x / 257, rounded), floating-point pixels refused."""
+    if image.mode.startswith("I;16") or image.mode == "I":
+        values = np.asarray(image).astype(np.float64)
+        if values.size and (values.min() < 0 or values.max() > 65535):
+            raise InputError(f"{shown(path)}: 32-bit integer pixels from {values.min():g} to {values.max():g}; "
+                             f"expected an 8- or 16-bit photo")
+        return Image.fromarray(np.rint(values / 257.0).astype(np.uint8), "L").convert("RGB")
+    if image.mode == "F":
+        raise InputError(f"{shown(path)}: floating-point pixels; expected an 8- or 16-bit photo")
+    return image.convert("RGB")
 
 
 def cover_region(size: tuple[int, int], output: tuple[int, int] | None,
@@ -117,14 +167,13 @@ def read_photo(path: str | Path, output: tuple[int, int] | None) -> Photo:
     except OSError as exc:
         raise InputError(f"{shown(path)}: cannot be read ({exc.strerror}); expected a readable photo") from None
     with _open(path, data) as image:
-        header = _header(image)
+        header = _header(path, image)
         try:
             image.load()
             upright = ImageOps.exif_transpose(image) if header.orientation != 1 else image
-            rgb = upright.convert("RGB")
+            rgb = _rgb(path, upright)
         except (OSError, ValueError, SyntaxError) as exc:
-            raise InputError(f"{shown(path)}: truncated or damaged ({str(exc)[:60]}); expected a complete "
-                             f"image") from None
+            raise _damaged(path, exc) from None
     region, scale = cover_region(rgb.size, output, path)
     x0, y0, x1, y1 = region
     size = output or rgb.size

@@ -4,11 +4,13 @@ read (35 mm focal length, orientation), and what cannot serve refused in one lin
 from __future__ import annotations
 
 import hashlib
+import struct
 
 import numpy as np
 import pytest
 from PIL import Image
 from PIL.ExifTags import IFD
+from PIL.TiffImagePlugin import IFDRational
 
 from synthua_usd.backends.photos import cover_region, photo_header, read_photo
 from synthua_usd.core.errors import InputError
@@ -79,3 +81,69 @@ def test_truncated_unreadable_and_heic_photos_are_refused(tmp_path, pixels):
     except ImportError:
         with pytest.raises(InputError, match=r"c\.heic: a HEIC image, and no HEIC decoder is installed"):
             photo_header(tmp_path / "c.heic")
+
+
+def test_a_16_bit_photo_is_scaled_to_8_bits_and_floating_point_pixels_are_refused(tmp_path):
+    grey = np.random.default_rng(1).integers(0, 65536, (40, 60), dtype=np.uint16)
+    path = tmp_path / "deep.png"
+    Image.fromarray(grey).save(path)                              # a 16-bit grey PNG (was clipped to white)
+    assert Image.open(path).mode in ("I;16", "I")
+    expected = np.floor(grey.astype(np.float64) / 257.0 + 0.5)    # rounded half up: x / 257 is never a half
+    np.testing.assert_array_equal(read_photo(path, None).pixels, np.repeat(expected[..., None], 3, axis=2))
+    Image.fromarray(grey.astype(np.float32) / 65535.0).save(tmp_path / "float.tif")
+    with pytest.raises(InputError, match=r"float\.tif: floating-point pixels; expected an 8- or 16-bit photo"):
+        read_photo(tmp_path / "float.tif", None)
+
+
+def test_a_damaged_png_is_named_when_its_header_is_read(tmp_path, pixels):
+    """A PNG's EXIF may follow its pixels, so reading its header decodes them: damage is the photo's, one line."""
+    path = tmp_path / "cut.png"
+    Image.fromarray(pixels).save(path)
+    path.write_bytes(path.read_bytes()[:len(path.read_bytes()) // 2])
+    with pytest.raises(InputError, match=r"cut\.png: truncated or damaged .*; expected a complete image"):
+        photo_header(path)
+
+
+def _exif_with(tag: int, kind: int, count: int, data: bytes) -> bytes:
+    """EXIF (APP1 payload) of one IFD0 entry written as given, type and all: what Pillow's writer would not make."""
+    inline = len(data) <= 4
+    entry = struct.pack("<HHI", tag, kind, count) + (data.ljust(4, b"\0") if inline else struct.pack("<I", 26))
+    return b"Exif\0\0" + b"II*\0" + struct.pack("<IH", 8, 1) + entry + struct.pack("<I", 0) + (b"" if inline else data)
+
+
+@pytest.mark.parametrize("kind, count, data", [(2, 4, b"abc\0"),                       # text
+                                               (5, 1, struct.pack("<II", 0, 0)),        # the rational 0/0
+                                               (8, 1, struct.pack("<h", -3)),           # a signed short
+                                               (3, 1, struct.pack("<H", 0)), (3, 1, struct.pack("<H", 9))])
+def test_an_orientation_that_is_no_such_value_is_taken_as_upright(tmp_path, pixels, kind, count, data):
+    path = tmp_path / "a.jpg"
+    Image.fromarray(pixels).save(path, exif=_exif_with(0x0112, kind, count, data), quality=95)
+    assert photo_header(path).orientation == 1
+    assert read_photo(path, None).pixels.shape == (40, 60, 3)
+
+
+@pytest.mark.parametrize("value, read", [(28, 28.0), (IFDRational(55, 2), 27.5), (8, 8.0), (3000, 3000.0),
+                                         (1, None), (7, None), (65535, None), (0, None), ("28", None)])
+def test_a_35mm_focal_length_outside_a_lens_range_is_taken_as_absent(tmp_path, pixels, value, read):
+    """EXIF FocalLengthIn35mmFilm from a fisheye's 8 mm to a superzoom's 3,000 mm is used; 1 mm would put the
+    camera model 77 degrees down, 65,535 mm (a damaged tag) kilometres away: such values are taken as absent."""
+    path = _save(tmp_path / "a.jpg", pixels, focal_35mm=value, quality=95)
+    assert photo_header(path).focal_35mm == read
+
+
+def test_photos_above_pillows_bomb_guard_are_read_up_to_the_stated_limit(tmp_path, pixels, monkeypatch):
+    """Pillow refuses images above twice its MAX_IMAGE_PIXELS (about 179 MP, below a 200 MP phone's photo) and warns
+    above it; photos are held to MAX_PHOTO_PIXELS instead, and Pillow's setting is left as it was."""
+    import warnings
+
+    from synthua_usd.backends import photos
+
+    path = _save(tmp_path / "a.png", pixels)
+    monkeypatch.setattr(Image, "MAX_IMAGE_PIXELS", 100)          # 2,400 pixels: a "bomb" to Pillow
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert read_photo(path, None).pixels.shape == (40, 60, 3)
+    assert Image.MAX_IMAGE_PIXELS == 100
+    monkeypatch.setattr(photos, "MAX_PHOTO_PIXELS", 2399)
+    with pytest.raises(InputError, match=r"a\.png: 60x40 pixels \(0 megapixels\); expected a photo of at most 0 mega"):
+        photo_header(path)
