@@ -268,7 +268,7 @@ def read_yolo_folder(root: str | Path, split: str | None = None) -> DetectionSet
     where = shown(folder)
     if not folder.is_dir():
         raise InputError(f"{where}: not a folder; expected the images of the split below images/")
-    paths = _split_images(root, str(folder), where)
+    paths = _split_images(root, folder.relative_to(root).as_posix(), where)
     if not paths:
         raise InputError(f"{where}: no images; expected images in a format OpenImageIO reads ({', '.join(IMAGE_SUFFIXES)})")
     texts = [read_input_text(label_path(p), MAX_DOCUMENT_BYTES, "a YOLO label file")
@@ -295,6 +295,23 @@ def read_yolo_folder(root: str | Path, split: str | None = None) -> DetectionSet
     return DetectionSet(names, _set_images(paths, names, texts), "yolo", str(root), split)
 
 
+def _yolo_base(data_yaml: Path, doc: dict) -> Path:
+    """The folder a data.yaml's splits are relative to: its ``path`` (relative to the file's folder), else the
+    file's folder."""
+    if isinstance(doc.get("path"), str) and doc["path"]:
+        p = Path(doc["path"])
+        return p if p.is_absolute() else data_yaml.parent / p
+    return data_yaml.parent
+
+
+def yolo_root(path: str | Path) -> Path:
+    """The folder of the YOLO set at ``path`` (a data.yaml, or a folder with or without one) that its images'
+    paths start from: a data.yaml's ``path`` where it names one."""
+    path = Path(path)
+    data_yaml = path / "data.yaml" if path.is_dir() else path
+    return _yolo_base(data_yaml, read_data_yaml(data_yaml)) if data_yaml.is_file() else path
+
+
 def read_yolo(data_yaml: str | Path, split: str | None = None) -> DetectionSet:
     """The images and boxes of one split of an Ultralytics YOLO dataset (``split`` default: ``test``, else
     ``val``; :data:`ALL_SPLITS`: every split); a folder without ``data.yaml`` is :func:`read_yolo_folder`'s."""
@@ -306,10 +323,7 @@ def read_yolo(data_yaml: str | Path, split: str | None = None) -> DetectionSet:
     where = shown(data_yaml)
     doc = read_data_yaml(data_yaml)
     names = yolo_names(doc, where)
-    base = data_yaml.parent
-    if isinstance(doc.get("path"), str) and doc["path"]:
-        p = Path(doc["path"])
-        base = p if p.is_absolute() else base / p
+    base = _yolo_base(data_yaml, doc)
     present = [s for s in ("train", "val", "test") if doc.get(s)]
     if split == ALL_SPLITS:
         wanted = present

@@ -24,11 +24,16 @@ FORMATS = {
 FORMAT_NAMES = ("auto",) + tuple(FORMATS)
 
 
+def is_synthua_dataset(path: Path) -> bool:
+    """Whether ``path`` is a dataset `synthua generate` or `synthua composite` wrote (a manifest and records)."""
+    return path.is_dir() and (path / "manifest.json").is_file() and (path / "records").is_dir()
+
+
 def detect_format(path: Path) -> str:
     """The format ``auto`` reads ``path`` as; a path that is none of them raises :class:`InputError`."""
     if path.is_file() and path.suffix.lower() == ".json":
         return "coco"
-    if path.is_dir() and (path / "manifest.json").is_file() and (path / "records").is_dir():
+    if is_synthua_dataset(path):
         return "synthua"
     if (path.is_file() and path.suffix.lower() in (".yaml", ".yml")) or (path / "data.yaml").is_file() \
             or ((path / "images").is_dir() and (path / "labels").is_dir()):

@@ -27,8 +27,11 @@ from synthua_usd.model.photo_sets import DEFAULT_SPLIT, SPLIT_CHOICES
               help="Which photos of a labelled YOLO set: default is its train split where it names one (its val and "
                    "test photos are what a detector trained on the composites is scored on: pasting into them "
                    "would leak), else all.")
+@click.option("--images", "images_dir", type=click.Path(path_type=Path),
+              help="The folder of a COCO .json's photos, its file_name paths relative to it [default: the .json's "
+                   "folder], e.g. train2017/ beside annotations/instances_train2017.json.")
 def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, workers: int | None,
-              split: str) -> int:
+              split: str, images_dir: Path | None) -> int:
     """Paste the cut-outs of --bank onto the photos of BACKGROUNDS, as --config says, into the dataset --out.
 
     \b
@@ -41,7 +44,8 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     \b
     BACKGROUNDS is a folder of photos without labels (empty streets, corridors, CCTV frames), or a labelled
     YOLO set (data.yaml, or images/ + labels/: its train split unless --split says otherwise) or COCO .json
-    whose boxes are kept. Photos are read in place.
+    (its photos beside it or in --images) whose boxes are kept. Photos are read in place; below a folder of
+    photos, hidden files and the datasets synthua wrote there are left out, linked folders followed.
     \b
     Per composite: the photo scaled down and cut to the config's output size; a camera model (horizon row,
     camera height, focal length: from the config, its per-folder defaults, or the photo's EXIF); cut-outs
@@ -60,14 +64,17 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     from synthua_usd.pipeline.composite import CompositeRequest, composite as run_composite
 
     s = run_composite(CompositeRequest(backgrounds=backgrounds, bank=bank, config_path=config_path,
-                                       out_dir=out_dir, workers=workers, split=split),
+                                       out_dir=out_dir, workers=workers, split=split, images=images_dir),
                      show_progress=sys.stderr.isatty())
     kind = "labelled" if s.labelled else "unlabelled (their pixels void, no boxes of their own)"
     say(f"dataset {s.out_dir}: {s.images - s.rejected} composites ({s.flagged} flagged by QA) and {s.rejected} "
         f"rejected by QA, from {s.backgrounds} {kind} photos; {s.pastes} pastes")
+    if s.skipped:
+        say(f"left out {len(s.skipped)} dataset{'s' * (len(s.skipped) > 1)} written by synthua below BACKGROUNDS "
+            f"({', '.join(s.skipped[:3])}{', ...' * (len(s.skipped) > 3)}): their images are no photos")
     if s.labelled:
         say(f"the photos' boxes: {s.boxes_kept} kept, {s.boxes_dropped} dropped (covered by pastes, cut off by the "
-            f"output size or unmapped: see each record's composite.background_boxes)")
+            f"output size, unmapped or crowd regions: see each record's composite.background_boxes)")
     if s.images:
         say(f"{s.images / s.wall_seconds * 60:.0f} images/min over {s.wall_seconds:.1f} s on {s.workers} workers; "
             f"worker time: {worker_time_shares(s.seconds)}")

@@ -35,12 +35,13 @@ class OutputError(SynthuaError):
 ECHO_LIMIT = 120
 
 
-_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+_CONTROL = re.compile(r"[\x00-\x1f\x7f\ud800-\udfff]")
 
 
 def escape_controls(text: str) -> str:
-    """``text`` with newlines and other control characters escaped (``\\n``, ``\\x1b``); other characters,
-    accented letters included, kept as they are."""
+    """``text`` with newlines and other control characters escaped (``\\n``, ``\\x1b``), and the lone surrogates
+    that stand for the bytes of a file name that is not UTF-8 (``\\udce9``); other characters, accented letters
+    included, kept as they are."""
     return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), str(text))
 
 

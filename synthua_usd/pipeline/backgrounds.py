@@ -2,15 +2,18 @@
 
 BACKGROUNDS is one of:
 
-* a folder of photos without labels (every JPEG, PNG, TIFF, BMP, WebP and HEIC file below it, in path order);
+* a folder of photos without labels (every JPEG, PNG, TIFF, BMP, WebP and HEIC file below it, in path order;
+  linked folders followed, hidden files and folders and the datasets synthua wrote there left out);
 * a labelled Ultralytics YOLO set (a ``data.yaml``, or a folder holding one or ``images/`` + ``labels/``): its
   ``train`` split where it has one (a set's val and test photos are what a detector trained on its composites is
   scored on: pasting into them would leak), another split or all of them when asked, read by
   :func:`synthua_usd.analytics.detection_sets.read_yolo`;
-* a COCO instances ``.json`` (its images in the file's folder): :func:`synthua_usd.analytics.detection_sets.read_coco`.
+* a COCO instances ``.json`` (its images in the file's folder, or in ``images``):
+  :func:`synthua_usd.analytics.detection_sets.read_coco`; crowd regions (``iscrowd``) are kept as boxes to ignore.
 
 Photos are read in place, never copied: a background is named by its path relative to the set's folder (the
-folder itself, a ``data.yaml``'s or a ``.json``'s folder). Checked here, each failure one :class:`InputError`: a
+folder itself, a ``data.yaml``'s ``path`` or folder, a ``.json``'s images folder), which must be UTF-8. Checked
+here, each failure one :class:`InputError`: a
 folder without photos, a photo Pillow cannot open (a HEIC without its decoder included) or smaller than the output
 size, a YOLO label file whose image is missing, a box outside its image (the YOLO reader refuses coordinates outside
 [0, 1]; COCO boxes are checked here against the image's size), a labelled photo not stored upright. A truncated
@@ -24,8 +27,8 @@ import os
 from pathlib import Path
 
 from synthua_usd.analytics.detection_sets import IMAGE_SUFFIXES, MAX_IMAGES, TOLERANCE, Box, label_path, read_coco, \
-    read_data_yaml, read_yolo
-from synthua_usd.analytics.detection_sources import detect_format
+    read_data_yaml, read_yolo, yolo_root
+from synthua_usd.analytics.detection_sources import detect_format, is_synthua_dataset
 from synthua_usd.backends.photos import HEIC_SUFFIXES, cover_region, photo_header
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
@@ -50,7 +53,8 @@ class Background:
 @dataclass(frozen=True)
 class BackgroundSet:
     """The photos of BACKGROUNDS: ``folder`` (absolute) that ``relative`` paths start from, ``layout`` (one of
-    :data:`LAYOUTS`), ``labelled`` (whether its photos' people are labelled), ``names`` the set's class names."""
+    :data:`LAYOUTS`), ``labelled`` (whether its photos' people are labelled), ``names`` the set's class names;
+    ``skipped`` the datasets synthua wrote below a folder of photos, left out (paths relative to ``folder``)."""
 
     source: str
     folder: Path
@@ -58,6 +62,7 @@ class BackgroundSet:
     labelled: bool
     names: tuple[str, ...]
     images: tuple[Background, ...]
+    skipped: tuple[str, ...] = ()
 
     def path(self, background: Background) -> Path:
         return self.folder / background.relative
@@ -69,16 +74,31 @@ def _absolute(path: Path) -> Path:
     return Path(os.path.abspath(path))
 
 
-def _photos_below(folder: Path) -> list[Path]:
+def _photos_below(folder: Path) -> tuple[list[Path], list[Path]]:
+    """The photos below ``folder`` in path order, and the datasets synthua wrote there (left out: their images
+    and label maps are no photos). Linked folders are followed, each real folder once; hidden ones are not."""
     suffixes = IMAGE_SUFFIXES + HEIC_SUFFIXES
-    found = []
-    for path in sorted(folder.rglob("*")):
-        if path.suffix.lower() in suffixes and path.is_file() and not any(p.startswith(".") for p in
-                                                                           path.relative_to(folder).parts):
-            found.append(path)
-            if len(found) > MAX_IMAGES:
-                raise InputError(f"{shown(folder)}: more than {MAX_IMAGES} photos; expected at most that many")
-    return found
+    found: list[Path] = []
+    skipped: list[Path] = []
+    seen: set[str] = set()
+    for top, dirs, files in os.walk(folder, followlinks=True):
+        real = os.path.realpath(top)
+        if real in seen:        # a link back to a folder already walked
+            dirs[:] = []
+            continue
+        seen.add(real)
+        kept: list[Path] = []
+        for name in sorted(dirs):
+            if not name.startswith("."):
+                (skipped if is_synthua_dataset(Path(top, name)) else kept).append(Path(top, name))
+        dirs[:] = [p.name for p in kept]
+        for name in files:
+            path = Path(top, name)
+            if not name.startswith(".") and path.suffix.lower() in suffixes and path.is_file():
+                found.append(path)
+                if len(found) > MAX_IMAGES:
+                    raise InputError(f"{shown(folder)}: more than {MAX_IMAGES} photos; expected at most that many")
+    return sorted(found), sorted(skipped)
 
 
 def _check_yolo_labels(root: Path, images: list[Path], whole: bool = True) -> None:
@@ -114,10 +134,12 @@ def _yolo_split(path: Path, split: str) -> str:
     return "train" if (path / "images" / "train").is_dir() else ALL_SPLITS
 
 
-def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: str = DEFAULT_SPLIT) -> BackgroundSet:
+def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: str = DEFAULT_SPLIT,
+                     images_dir: str | Path | None = None) -> BackgroundSet:
     """The background set at ``path`` (see the module docstring), every photo's header checked against
     ``output`` (W, H; None: any size); of a labelled YOLO set, the photos of ``split`` (one of
-    :data:`synthua_usd.model.photo_sets.SPLIT_CHOICES`; the default: its train split where it names one, else all)."""
+    :data:`synthua_usd.model.photo_sets.SPLIT_CHOICES`; the default: its train split where it names one, else all);
+    of a COCO .json, the photos in ``images_dir`` (default: the file's folder)."""
     path = Path(path)
     if not path.exists():
         raise InputError(f"{shown(path)}: not found; expected a folder of photos, a YOLO set or a COCO .json")
@@ -126,27 +148,31 @@ def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: st
         layout = detect_format(path)
     except InputError:
         layout = "folder" if path.is_dir() else None
+    if images_dir is not None and layout != "coco":
+        raise InputError(f"--images: {shown(images_dir)}; expected only with a COCO .json (a folder or YOLO set "
+                         f"names its own photos)")
     if layout is None or layout not in LAYOUTS:
         raise InputError(f"{shown(path)}: {'a dataset written by synthua' if layout else 'not a folder'}; expected a "
                          f"folder of photos, a labelled YOLO set (data.yaml or images/ + labels/) or a COCO .json")
     #: (photo, its boxes, the size its labels give; None for an unlabelled photo)
     images: list[tuple[Path, tuple[Box, ...], tuple[int, int] | None]]
     names: tuple[str, ...]
+    skipped: list[Path] = []
     if layout == "folder":
         folder = _absolute(path)
-        paths = _photos_below(folder)
+        paths, skipped = _photos_below(folder)
         if not paths:
             raise InputError(f"{shown(path)}: no photos; expected JPEG, PNG, TIFF, BMP, WebP or HEIC files below it")
         images, names = [(p, (), None) for p in paths], ()
     elif layout == "yolo":
         chosen = _yolo_split(path, split)
         found = read_yolo(path, chosen)
-        folder = _absolute(path if path.is_dir() else path.parent)
+        folder = _absolute(yolo_root(path))
         _check_yolo_labels(folder, [Path(i.path) for i in found.images], whole=chosen == ALL_SPLITS)
         images, names = [(Path(i.path), i.boxes, (i.width, i.height)) for i in found.images], found.names
     else:
-        found = read_coco(path)
-        folder = _absolute(path.parent)
+        found = read_coco(path, images_dir)
+        folder = _absolute(Path(images_dir) if images_dir is not None else path.parent)
         images, names = [(Path(i.path), i.boxes, (i.width, i.height)) for i in found.images], found.names
     out = []
     for image, boxes, size in images:
@@ -165,7 +191,13 @@ def read_backgrounds(path: str | Path, output: tuple[int, int] | None, split: st
         except ValueError:
             raise InputError(f"{shown(image)}: outside {shown(folder)}; expected the set's photos below its "
                              f"folder") from None
+        try:
+            relative.encode("utf-8")
+        except UnicodeEncodeError:
+            raise InputError(f"{shown(image)}: a file name that is not UTF-8; expected UTF-8 names (rename it, "
+                             f"e.g. with convmv)") from None
         out.append(Background(relative, header.width, header.height, tuple(boxes), header.focal_35mm))
     if len({b.relative for b in out}) != len(out):
         raise InputError(f"{shown(path)}: a photo listed twice; expected each photo once")
-    return BackgroundSet(str(path), folder, layout, layout != "folder", tuple(names), tuple(out))
+    return BackgroundSet(str(path), folder, layout, layout != "folder", tuple(names), tuple(out),
+                         tuple(p.relative_to(folder).as_posix() for p in skipped))

@@ -58,6 +58,8 @@ class CompositeRequest:
     workers: int | None = None
     #: Which photos of a labelled YOLO set (model.photo_sets.SPLIT_CHOICES; default: its train split where it has one).
     split: str = DEFAULT_SPLIT
+    #: The folder of a COCO .json's photos (default: the file's folder).
+    images: Path | None = None
 
 
 @dataclass
@@ -74,6 +76,8 @@ class CompositeSummary:
     boxes_dropped: int = 0
     backgrounds: int = 0
     labelled: bool = False
+    #: Datasets synthua wrote below a folder of photos, left out (paths relative to it).
+    skipped: tuple[str, ...] = ()
     workers: int = 1
     seconds: dict = field(default_factory=dict)
     wall_seconds: float = 0.0
@@ -136,7 +140,7 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
     cityscapes.check_class_map(bank.class_map)
     out = Path(request.out_dir)
     _check_out(out)
-    backgrounds = read_backgrounds(request.backgrounds, config.output, request.split)
+    backgrounds = read_backgrounds(request.backgrounds, config.output, request.split, request.images)
     _check_classes(backgrounds, config, bank, str(request.config_path))
     plan = plan_composites(backgrounds, config)
     workers = request.workers or config.workers or default_workers()
@@ -146,10 +150,12 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
                "backgrounds": [[b.relative, b.width, b.height] for b in backgrounds.images]}
     job_document = {"synthua": __version__, "command": COMMAND, "job_key": job_key,
                     "job_key_digest": document_digest(job_key), "backgrounds": str(Path(request.backgrounds).resolve()),
-                    "backgrounds_layout": backgrounds.layout, "backgrounds_split": request.split, "bank": str(Path(request.bank).resolve()),
+                    "backgrounds_layout": backgrounds.layout, "backgrounds_split": request.split,
+                    "backgrounds_images": None if request.images is None else str(Path(request.images).resolve()),
+                    "bank": str(Path(request.bank).resolve()),
                     "plan": [p.to_dict() for p in plan]}
     summary = CompositeSummary(out_dir=out, backgrounds=len(backgrounds.images), labelled=backgrounds.labelled,
-                               workers=workers)
+                               skipped=backgrounds.skipped, workers=workers)
     done: dict[int, CompositeRecord] = {}
     seconds: dict[str, float] = {}
     with output_set(out) as staging:
@@ -204,7 +210,8 @@ def remake(job_document: dict, planned: dict, out_dir: Path) -> dict:
     try:
         config = CompositeConfig.from_document(job_document["job_key"]["config"], source="generate.json")
         backgrounds = read_backgrounds(job_document["backgrounds"], config.output,
-                                       job_document.get("backgrounds_split", DEFAULT_SPLIT))
+                                       job_document.get("backgrounds_split", DEFAULT_SPLIT),
+                                       job_document.get("backgrounds_images"))
         item = PlannedComposite(**planned)
         job = CompositeJob(out_dir=str(out_dir), config_document=job_document["job_key"]["config"],
                            class_map_document=job_document["job_key"]["class_map"], bank_root=job_document["bank"],

@@ -138,14 +138,15 @@ def covered_by_pastes(box: tuple[float, float, float, float], instance_ids: np.n
 
 def _background_entries(background: Background, labelled: bool, photo, config: CompositeConfig,
                         size) -> list[dict]:
-    """The photo's boxes in the frame, before pasting: kept so far, or dropped as unmapped or cropped."""
+    """The photo's boxes in the frame, before pasting: kept so far, or dropped as a crowd region (COCO's
+    ``iscrowd``: no one object), unmapped or cropped."""
     out: list[dict] = []
     if not labelled:
         return out
     for box in background.boxes:
         ours = config.background_labels.our_class(box.label)
         frame, kept_share = _frame_box(box, photo.region, photo.scale, size)
-        reason = "unmapped" if ours is None else (
+        reason = "crowd" if box.ignore else "unmapped" if ours is None else (
             "cropped" if kept_share < config.background_labels.drop_cropped_share else None)
         out.append({"label": box.label, "class_name": ours, "frame": frame, "covered_share": None,
                     "kept": reason is None, "reason": reason})
@@ -177,7 +178,8 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
     drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
                         (photo.header.width, photo.header.height), photo.scale, camera_rng)
     boxes = _background_entries(background, job.backgrounds.labelled, photo, config, (width, height))
-    placements = plan_pastes(drawn, state.pools, config, [b["frame"] for b in boxes if b["kept"]], paste_rng)
+    placements = plan_pastes(drawn, state.pools, config,      # pastes keep off crowds as off the kept boxes
+                             [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng)
     entries = [bank.entry(p.entry_id) for p in placements]
     painted = compose(photo.pixels, [PasteInput(e, state.cutout(e), p) for e, p in zip(entries, placements)],
                       class_map, config.match)

@@ -342,3 +342,44 @@ def test_tone_matching_is_recorded_per_paste_verifies_and_replays(inputs, unlabe
     plain = next(r for r in _records(unlabelled) if r["id"] == toned["id"])
     assert [p["box"] for p in plain["composite"]["pastes"]] == [p["box"] for p in toned["composite"]["pastes"]]
     assert all("contrast_gain" not in p for r in _records(unlabelled) for p in r["composite"]["pastes"])
+
+
+def test_a_coco_set_with_its_photos_elsewhere_keeps_pastes_off_its_crowd_regions(inputs, tmp_path, run_cli):
+    """COCO's own layout (annotations/instances_*.json, the photos in a folder beside it: --images) read in place;
+    a crowd region (iscrowd 1: no one object) is no box to train on, recorded as dropped (crowd), and pastes keep
+    off it as off the kept boxes when the config says so; replay finds the photos where the job did."""
+    photos = sorted((inputs / "photos").glob("*.png"))
+    coco = {"images": [{"id": k + 1, "file_name": p.name, "width": 96, "height": 72} for k, p in enumerate(photos)],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 7, "bbox": [0.0, 0.0, 40.0, 72.0], "iscrowd": 1},
+                            {"id": 2, "image_id": 1, "category_id": 7, "bbox": [60.0, 30.0, 12.0, 30.0],
+                             "iscrowd": 0}],
+            "categories": [{"id": 7, "name": "person"}]}
+    (tmp_path / "annotations").mkdir()
+    (tmp_path / "annotations" / "instances_train.json").write_text(json.dumps(coco))
+    config = {**CONFIG, "pastes": {**CONFIG["pastes"], "max_background_cover": 0.0, "when_no_room": "skip",
+                                   "placement_tries": 40}}
+    (tmp_path / "config.json").write_text(json.dumps(config))
+    out = tmp_path / "out"
+    code, said, err = run_cli("composite", tmp_path / "annotations" / "instances_train.json", "--images",
+                              inputs / "photos", "--bank", inputs / "bank", "--config", tmp_path / "config.json",
+                              "--out", out, "--workers", "1")
+    assert code == 0, said + err
+    boxed = [r for r in _records(out) if r["composite"]["background"]["path"] == photos[0].name]
+    assert len(boxed) == 2
+    pasted = 0
+    for record in boxed:
+        crowd, person = record["composite"]["background_boxes"]
+        assert (crowd["reason"], crowd["kept"], person["kept"]) == ("crowd", False, True)
+        # the 96x72 photo at scale 2/3: the crowd region covers x < 26.67 of the 64x48 image
+        assert crowd["bbox"] == pytest.approx([0.0, 0.0, 26.6667, 48.0], abs=1e-4)
+        for instance in record["instances"]:
+            pasted += 1
+            assert instance["bbox"][0] >= 26.6667 - 1e-6, instance["bbox"]       # off the crowd region
+        lines = (out / record["files"]["yolo_label"]).read_text().splitlines()
+        # the person at [60, 30, 12, 30] in the photo: [40, 20, 8, 20] in the image
+        rows = [[float(v) for v in line.split()[1:]] for line in lines]
+        assert sum(row == pytest.approx([0.6875, 0.625, 0.125, 0.416667], abs=1e-6) for row in rows) == 1
+        assert all(cx - w / 2 >= 26.6667 / 64 - 1e-6 for cx, _, w, _ in rows)
+    assert pasted
+    code, said, err = run_cli("replay", out, str(boxed[0]["id"]))
+    assert code == 0 and "byte-identical" in said + err, said + err

@@ -164,3 +164,59 @@ def test_a_set_of_links_to_photos_elsewhere_is_read_and_a_split_outside_it_is_re
     _yolo_set(climbing / "inner", train="../../whole/images/train")
     with pytest.raises(InputError, match="outside"):
         read_backgrounds(climbing / "inner", (64, 48))
+
+
+def test_a_file_name_that_is_not_utf8(case, run_cli):
+    """A Latin-1 name (old zips, SMB shares) cannot be recorded in UTF-8 JSON: refused, the name escaped."""
+    import os
+
+    (case / "photos" / "photo_00.jpg").rename(case / "photos" / os.fsdecode(b"caf\xe9.jpg"))
+    _refused(run_cli, case, case / "photos", "caf\\udce9.jpg: a file name that is not UTF-8", "expected UTF-8 names")
+
+
+def test_images_is_for_a_coco_json_only(case, run_cli):
+    code, _, err = run_cli("composite", case / "photos", "--bank", case / "bank", "--config", case / "config.json",
+                           "--out", case / "out", "--images", case / "photos")
+    assert code == 2 and err.strip().splitlines()[-1].startswith("synthua: error: --images: ")
+    assert "expected only with a COCO .json" in err and not (case / "out").exists()
+
+
+def test_backgrounds_below_a_folder_links_followed_hidden_files_and_datasets_left_out(tmp_path):
+    """Every photo below a folder: linked folders followed (each real folder once, a link back to an ancestor
+    walked no further), hidden files and folders and the datasets synthua wrote there (a manifest and records:
+    their images and label maps are no photos) left out and the datasets named."""
+    from synthua_usd.pipeline.backgrounds import read_backgrounds
+
+    root, elsewhere = tmp_path / "photos", tmp_path / "elsewhere"
+    write_photos(root, 1, (96, 72))
+    write_photos(elsewhere, 2, (96, 72), suffix=".jpg")
+    (root / "linked").symlink_to(elsewhere, target_is_directory=True)
+    (root / "again").symlink_to(elsewhere, target_is_directory=True)     # the same real folder: walked once
+    (root / "loop").symlink_to(root, target_is_directory=True)
+    write_photos(root / ".hidden", 1, (96, 72))
+    (root / "._photo_00.png").write_bytes(b"AppleDouble")
+    dataset = root / "composites"
+    write_photos(dataset / "images" / "train", 1, (96, 72))
+    (dataset / "records").mkdir()
+    (dataset / "manifest.json").write_text("{}")
+    read = read_backgrounds(root, (64, 48))
+    assert [b.relative for b in read.images] == ["again/photo_00.jpg", "again/photo_01.jpg", "photo_00.png"]
+    assert read.skipped == ("composites",)
+
+
+def test_a_yolo_folder_given_by_a_relative_path_and_a_data_yaml_whose_path_points_elsewhere(tmp_path, monkeypatch):
+    """A YOLO folder without data.yaml (classes.txt) given as a relative path (its images' paths were joined to it
+    twice); a data.yaml whose ``path`` names the set's folder elsewhere (Ultralytics' own layout): the photos are
+    named below that folder."""
+    from synthua_usd.pipeline.backgrounds import read_backgrounds
+
+    _yolo_set(tmp_path / "set")
+    (tmp_path / "set" / "data.yaml").unlink()
+    (tmp_path / "set" / "classes.txt").write_text("person\n")
+    monkeypatch.chdir(tmp_path)
+    read = read_backgrounds(Path("set"), (64, 48))
+    assert [(b.relative, b.boxes[0].label) for b in read.images] == [("images/train/a.png", "person")]
+    (tmp_path / "cfg").mkdir()
+    (tmp_path / "cfg" / "set.yaml").write_text("path: ../set\ntrain: images/train\nnames:\n  0: person\n")
+    read = read_backgrounds(tmp_path / "cfg" / "set.yaml", (64, 48))
+    assert read.folder == tmp_path / "set" and [b.relative for b in read.images] == ["images/train/a.png"]
