@@ -4,18 +4,22 @@ written size, through Pillow (which reads EXIF, and HEIC when its plugin pillow-
 The written image *covers* the output size: the photo is scaled by ``max(W / w, H / h)`` (never above 1: a photo
 smaller than the output is refused) and its centre cut out, ``region`` in photo pixels. A photo with an EXIF
 orientation other than 1 is turned upright first (as viewers and Ultralytics' loader do); its size and boxes are
-then the upright photo's. Colours are taken as 8-bit sRGB (an embedded ICC profile is not applied); a 16-bit
-photo is scaled to 8 bits (x / 257), one of floating-point pixels refused. An EXIF orientation or 35 mm focal length
-that is no such value (damaged, out of range) is taken as absent. Photos of up to :data:`MAX_PHOTO_PIXELS` are read
-(Pillow's own guard against decompression bombs stops at about 179 megapixels, below a 200-megapixel phone's).
+then the upright photo's. Colours are taken as 8-bit sRGB (an embedded ICC profile is not applied); a 16-bit photo
+is scaled to 8 bits (x / 257), one of 32-bit integer or floating-point pixels refused. An EXIF orientation or 35 mm
+focal length that is no such value (damaged, out of range) is taken as absent. Photos of up to
+:data:`MAX_PHOTO_PIXELS` are read (Pillow's own guard against decompression bombs stops at about 179 megapixels,
+below a 200-megapixel phone's).
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import io
 import math
 import numbers
+import threading
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,25 +50,34 @@ def heic_decoder() -> bool:
     return True
 
 
-def _open(path: Path, data: bytes | None = None) -> Image.Image:
+#: Pillow's guard against decompression bombs is a global: photos move it under this lock.
+_PILLOW_GUARD = threading.Lock()
+
+
+@contextlib.contextmanager
+def _opened(path: Path, data: bytes | None = None) -> Iterator[Image.Image]:
+    """The photo at ``path`` (its bytes ``data`` where read) open, and held to :data:`MAX_PHOTO_PIXELS` instead of
+    Pillow's guard (about 179 megapixels, checked again by its TIFF reader while decoding) until it is closed."""
     path = Path(path)
     if path.suffix.lower() in HEIC_SUFFIXES and not heic_decoder():
         raise InputError(f"{shown(path)}: a HEIC image, and no HEIC decoder is installed; expected a JPEG, PNG, TIFF, "
                          f"BMP or WebP photo, or `pip install pillow-heif` to read HEIC")
-    limit, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, None     # MAX_PHOTO_PIXELS is checked below instead
-    try:
-        image = Image.open(io.BytesIO(data) if data is not None else path)
-    except (UnidentifiedImageError, OSError, ValueError, SyntaxError) as exc:
-        raise InputError(f"{shown(path)}: not an image Pillow can read ({type(exc).__name__}); expected a photo "
-                         f"(JPEG, PNG, TIFF, BMP, WebP)") from None
-    finally:
-        Image.MAX_IMAGE_PIXELS = limit
-    width, height = image.size
-    if width * height > MAX_PHOTO_PIXELS:
-        image.close()
-        raise InputError(f"{shown(path)}: {width}x{height} pixels ({width * height / 1e6:.0f} megapixels); expected "
-                         f"a photo of at most {MAX_PHOTO_PIXELS / 1e6:.0f} megapixels")
-    return image
+    with _PILLOW_GUARD:
+        limit, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, None
+        try:
+            try:
+                image = Image.open(io.BytesIO(data) if data is not None else path)
+            except (UnidentifiedImageError, OSError, ValueError, SyntaxError) as exc:
+                raise InputError(f"{shown(path)}: not an image Pillow can read ({type(exc).__name__}); expected a "
+                                 f"photo (JPEG, PNG, TIFF, BMP, WebP)") from None
+            with image:
+                width, height = image.size
+                if width * height > MAX_PHOTO_PIXELS:
+                    raise InputError(f"{shown(path)}: {width}x{height} pixels ({width * height / 1e6:.0f} megapixels); "
+                                     f"expected a photo of at most {MAX_PHOTO_PIXELS / 1e6:.0f} megapixels")
+                yield image
+        finally:
+            Image.MAX_IMAGE_PIXELS = limit
 
 
 def _damaged(path: Path, exc: Exception) -> InputError:
@@ -111,20 +124,19 @@ def _header(path: Path, image: Image.Image) -> PhotoHeader:
 def photo_header(path: str | Path) -> PhotoHeader:
     """The header of the photo at ``path`` (no pixels decoded where the format allows)."""
     path = Path(path)
-    with _open(path) as image:
+    with _opened(path) as image:
         return _header(path, image)
 
 
 def _rgb(path: Path, image: Image.Image) -> Image.Image:
-    """8-bit RGB of a decoded photo: 16-bit grey scaled (x / 257, rounded), floating-point pixels refused."""
-    if image.mode.startswith("I;16") or image.mode == "I":
-        values = np.asarray(image).astype(np.float64)
-        if values.size and (values.min() < 0 or values.max() > 65535):
-            raise InputError(f"{shown(path)}: 32-bit integer pixels from {values.min():g} to {values.max():g}; "
-                             f"expected an 8- or 16-bit photo")
-        return Image.fromarray(np.rint(values / 257.0).astype(np.uint8), "L").convert("RGB")
-    if image.mode == "F":
-        raise InputError(f"{shown(path)}: floating-point pixels; expected an 8- or 16-bit photo")
+    """8-bit RGB of a decoded photo: 16-bit grey scaled (x / 257, rounded: never a half), 32-bit integer and
+    floating-point pixels refused (their range is the writer's choice)."""
+    if image.mode.startswith("I;16"):
+        values = np.asarray(image).astype(np.uint32)
+        return Image.fromarray(((values + 128) // 257).astype(np.uint8), "L").convert("RGB")
+    if image.mode in ("I", "F"):
+        kind = "32-bit integer" if image.mode == "I" else "floating-point"
+        raise InputError(f"{shown(path)}: {kind} pixels; expected an 8- or 16-bit photo")
     return image.convert("RGB")
 
 
@@ -166,7 +178,7 @@ def read_photo(path: str | Path, output: tuple[int, int] | None) -> Photo:
         data = path.read_bytes()
     except OSError as exc:
         raise InputError(f"{shown(path)}: cannot be read ({exc.strerror}); expected a readable photo") from None
-    with _open(path, data) as image:
+    with _opened(path, data) as image:
         header = _header(path, image)
         try:
             image.load()

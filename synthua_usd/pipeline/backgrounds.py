@@ -22,7 +22,7 @@ photo's pixels fail when its composite decodes them (the run then stops and writ
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import os
 from pathlib import Path
 
@@ -76,21 +76,25 @@ def _absolute(path: Path) -> Path:
 
 def _photos_below(folder: Path) -> tuple[list[Path], list[Path]]:
     """The photos below ``folder`` in path order, and the datasets synthua wrote there (left out: their images
-    and label maps are no photos). Linked folders are followed, each real folder once; hidden ones are not."""
+    and label maps are no photos). Hidden files and folders are left out; a linked folder is followed where it
+    leads out of ``folder`` (one leading into it is walked under its own name), each real folder once."""
     suffixes = IMAGE_SUFFIXES + HEIC_SUFFIXES
+    root = os.path.realpath(folder)
     found: list[Path] = []
     skipped: list[Path] = []
     seen: set[str] = set()
     for top, dirs, files in os.walk(folder, followlinks=True):
         real = os.path.realpath(top)
-        if real in seen:        # a link back to a folder already walked
+        if real in seen:        # two links to one folder outside, or a link back up
             dirs[:] = []
             continue
         seen.add(real)
         kept: list[Path] = []
         for name in sorted(dirs):
-            if not name.startswith("."):
-                (skipped if is_synthua_dataset(Path(top, name)) else kept).append(Path(top, name))
+            path = Path(top, name)
+            if name.startswith(".") or (path.is_symlink() and _inside(os.path.realpath(path), root)):
+                continue
+            (skipped if is_synthua_dataset(path) else kept).append(path)
         dirs[:] = [p.name for p in kept]
         for name in files:
             path = Path(top, name)
@@ -99,6 +103,31 @@ def _photos_below(folder: Path) -> tuple[list[Path], list[Path]]:
                 if len(found) > MAX_IMAGES:
                     raise InputError(f"{shown(folder)}: more than {MAX_IMAGES} photos; expected at most that many")
     return sorted(found), sorted(skipped)
+
+
+def _inside(path: str, root: str) -> bool:
+    return path == root or path.startswith(root.rstrip(os.sep) + os.sep)
+
+
+def listed_backgrounds(backgrounds: BackgroundSet, listed: list) -> BackgroundSet:
+    """``backgrounds`` as a job listed them (``job_key.backgrounds``: ``[relative, width, height]`` each; a
+    composite's names count photos in that list): for replay, when the folder is walked otherwise now (a photo
+    left out today, e.g. in a dataset synthua wrote there, is read by its recorded name)."""
+    found = {b.relative: b for b in backgrounds.images}
+    images = []
+    for item in listed:
+        relative = item[0] if isinstance(item, list) and item and isinstance(item[0], str) else None
+        if relative is None or Path(relative).is_absolute() or ".." in Path(relative).parts:
+            raise InputError(f"generate.json: job_key.backgrounds: {str(item)[:80]!r}; expected [path below "
+                             f"BACKGROUNDS, width, height]")
+        if relative not in found:
+            if backgrounds.labelled:
+                raise InputError(f"{shown(backgrounds.folder / relative)}: not among the photos of "
+                                 f"{shown(backgrounds.source)}; expected the photos the dataset was made from")
+            header = photo_header(backgrounds.folder / relative)
+            found[relative] = Background(relative, header.width, header.height, (), header.focal_35mm)
+        images.append(found[relative])
+    return replace(backgrounds, images=tuple(images))
 
 
 def _check_yolo_labels(root: Path, images: list[Path], whole: bool = True) -> None:

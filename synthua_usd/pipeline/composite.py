@@ -40,7 +40,7 @@ from synthua_usd.dataset.layout import Layout, cityscapes_city, composite_name
 from synthua_usd.dataset.manifest import document_digest
 from synthua_usd.dataset.record import CompositeRecord, is_rejected
 from synthua_usd.dataset.sampling import split_of
-from synthua_usd.pipeline.backgrounds import DEFAULT_SPLIT, BackgroundSet, read_backgrounds
+from synthua_usd.pipeline.backgrounds import DEFAULT_SPLIT, BackgroundSet, listed_backgrounds, read_backgrounds
 from synthua_usd.pipeline.composite_worker import CompositeJob, PlannedComposite
 
 #: Composites a worker makes before its shard ends and it takes the next.
@@ -209,9 +209,10 @@ def remake(job_document: dict, planned: dict, out_dir: Path) -> dict:
 
     try:
         config = CompositeConfig.from_document(job_document["job_key"]["config"], source="generate.json")
-        backgrounds = read_backgrounds(job_document["backgrounds"], config.output,
-                                       job_document.get("backgrounds_split", DEFAULT_SPLIT),
-                                       job_document.get("backgrounds_images"))
+        backgrounds = listed_backgrounds(read_backgrounds(job_document["backgrounds"], config.output,
+                                                          job_document.get("backgrounds_split", DEFAULT_SPLIT),
+                                                          job_document.get("backgrounds_images")),
+                                         job_document["job_key"]["backgrounds"])
         item = PlannedComposite(**planned)
         job = CompositeJob(out_dir=str(out_dir), config_document=job_document["job_key"]["config"],
                            class_map_document=job_document["job_key"]["class_map"], bank_root=job_document["bank"],

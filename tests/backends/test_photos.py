@@ -93,6 +93,9 @@ def test_a_16_bit_photo_is_scaled_to_8_bits_and_floating_point_pixels_are_refuse
     Image.fromarray(grey.astype(np.float32) / 65535.0).save(tmp_path / "float.tif")
     with pytest.raises(InputError, match=r"float\.tif: floating-point pixels; expected an 8- or 16-bit photo"):
         read_photo(tmp_path / "float.tif", None)
+    Image.fromarray((grey // 257).astype(np.int32)).save(tmp_path / "int32.tif")       # 0..255 or 0..65535? unsaid
+    with pytest.raises(InputError, match=r"int32\.tif: 32-bit integer pixels; expected an 8- or 16-bit photo"):
+        read_photo(tmp_path / "int32.tif", None)
 
 
 def test_a_damaged_png_is_named_when_its_header_is_read(tmp_path, pixels):
@@ -131,19 +134,26 @@ def test_a_35mm_focal_length_outside_a_lens_range_is_taken_as_absent(tmp_path, p
     assert photo_header(path).focal_35mm == read
 
 
-def test_photos_above_pillows_bomb_guard_are_read_up_to_the_stated_limit(tmp_path, pixels, monkeypatch):
+@pytest.mark.parametrize("suffix", [".png", ".jpg", ".tif"])
+@pytest.mark.parametrize("output", [None, (30, 16)])
+def test_photos_above_pillows_bomb_guard_are_read_up_to_the_stated_limit(tmp_path, pixels, monkeypatch, suffix,
+                                                                         output):
     """Pillow refuses images above twice its MAX_IMAGE_PIXELS (about 179 MP, below a 200 MP phone's photo) and warns
-    above it; photos are held to MAX_PHOTO_PIXELS instead, and Pillow's setting is left as it was."""
+    above it, at opening and (TIFF) again while decoding; photos are held to MAX_PHOTO_PIXELS instead, and Pillow's
+    setting is left as it was, after a refusal too."""
     import warnings
 
     from synthua_usd.backends import photos
 
-    path = _save(tmp_path / "a.png", pixels)
+    path = _save(tmp_path / f"a{suffix}", pixels)
     monkeypatch.setattr(Image, "MAX_IMAGE_PIXELS", 100)          # 2,400 pixels: a "bomb" to Pillow
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        assert read_photo(path, None).pixels.shape == (40, 60, 3)
+        assert read_photo(path, output).pixels.shape == ((40, 60, 3) if output is None else (16, 30, 3))
     assert Image.MAX_IMAGE_PIXELS == 100
     monkeypatch.setattr(photos, "MAX_PHOTO_PIXELS", 2399)
-    with pytest.raises(InputError, match=r"a\.png: 60x40 pixels \(0 megapixels\); expected a photo of at most 0 mega"):
-        photo_header(path)
+    for read in (photo_header, lambda p: read_photo(p, output)):
+        with pytest.raises(InputError, match=rf"a\{suffix}: 60x40 pixels \(0 megapixels\); expected a photo of at "
+                                             rf"most 0 megapixels"):
+            read(path)
+        assert Image.MAX_IMAGE_PIXELS == 100

@@ -193,6 +193,8 @@ def test_backgrounds_below_a_folder_links_followed_hidden_files_and_datasets_lef
     (root / "linked").symlink_to(elsewhere, target_is_directory=True)
     (root / "again").symlink_to(elsewhere, target_is_directory=True)     # the same real folder: walked once
     (root / "loop").symlink_to(root, target_is_directory=True)
+    write_photos(root / "z_real", 1, (96, 72))
+    (root / "a_link").symlink_to(root / "z_real", target_is_directory=True)   # into the folder: walked as z_real
     write_photos(root / ".hidden", 1, (96, 72))
     (root / "._photo_00.png").write_bytes(b"AppleDouble")
     dataset = root / "composites"
@@ -200,8 +202,35 @@ def test_backgrounds_below_a_folder_links_followed_hidden_files_and_datasets_lef
     (dataset / "records").mkdir()
     (dataset / "manifest.json").write_text("{}")
     read = read_backgrounds(root, (64, 48))
-    assert [b.relative for b in read.images] == ["again/photo_00.jpg", "again/photo_01.jpg", "photo_00.png"]
+    assert [b.relative for b in read.images] == ["again/photo_00.jpg", "again/photo_01.jpg", "photo_00.png",
+                                                 "z_real/photo_00.png"]
     assert read.skipped == ("composites",)
+
+
+def test_replay_reads_the_photos_as_the_job_listed_them(tmp_path):
+    """A composite's names count the photos of its job's list (generate.json: job_key.backgrounds): replay takes
+    that list, reading a photo the folder's walk leaves out today (a dataset made before the walk left out the
+    datasets synthua wrote) by its recorded name; a labelled set's photo must still be in the set, and a listed
+    name may not climb out of the folder."""
+    from synthua_usd.core.errors import InputError
+    from synthua_usd.pipeline.backgrounds import listed_backgrounds, read_backgrounds
+
+    root = tmp_path / "photos"
+    write_photos(root, 2, (96, 72))
+    write_photos(root / "old" / "images", 1, (80, 60))
+    (root / "old" / "records").mkdir()
+    (root / "old" / "manifest.json").write_text("{}")
+    now = read_backgrounds(root, (64, 48))
+    assert [b.relative for b in now.images] == ["photo_00.png", "photo_01.png"]
+    listed = [["old/images/photo_00.png", 80, 60], ["photo_00.png", 96, 72], ["photo_01.png", 96, 72]]
+    then = listed_backgrounds(now, listed)
+    assert [(b.relative, b.width, b.height) for b in then.images] == [tuple(item) for item in listed]
+    for hostile in (["../photos/photo_00.png", 96, 72], ["/etc/passwd", 1, 1], "photo_00.png"):
+        with pytest.raises(InputError, match="job_key.backgrounds"):
+            listed_backgrounds(now, [hostile])
+    _yolo_set(tmp_path / "set")
+    with pytest.raises(InputError, match="not among the photos of"):
+        listed_backgrounds(read_backgrounds(tmp_path / "set", (64, 48)), [["images/train/b.png", 96, 72]])
 
 
 def test_a_yolo_folder_given_by_a_relative_path_and_a_data_yaml_whose_path_points_elsewhere(tmp_path, monkeypatch):
