@@ -5,12 +5,13 @@ Each group (:mod:`synthua_usd.randomisation.cutouts`) is authored into a :class:
 once and seen from ``views_per_group`` cameras and lights; per view one label pass gives the exact instance ids of
 every pixel centre and the amodal masks (as a dataset image's), the path tracer the group's colour and coverage
 (:func:`~synthua_usd.backends.mitsuba.cutout_passes.render_rgba`), shadow rays the shadow it casts on the ground
-(:func:`~synthua_usd.backends.mitsuba.cutout_passes.ground_shadow`). The crop holding the group and its shadow is
-written as four PNGs and an entry of ``bank.json`` (the format: docs/cutouts.md, read by
-:mod:`synthua_usd.dataset.cutout_bank`):
-instances with visible and amodal boxes, keypoints, the ground points, the camera, the light. Groups run on
-worker processes (:func:`synthua_usd.pipeline.executors.run_shards`); the bank is written as a set (a staging
-folder renamed into place when complete) with a manifest of checksums. The same config gives the same bytes.
+(:func:`~synthua_usd.backends.mitsuba.cutout_passes.ground_shadow`) over the frame and the ground around it (a low
+sun's shadow goes on beyond the frame; one longer still fades out). The crop holding the group and its shadow (it
+may reach beyond the frame: the colour, ids and masks are empty there) is written as four PNGs and an entry of
+``bank.json`` (the format: docs/cutouts.md, read by :mod:`synthua_usd.dataset.cutout_bank`): instances with visible
+and amodal boxes, keypoints, the ground points, the camera, the light. Groups run on worker processes
+(:func:`synthua_usd.pipeline.executors.run_shards`); the bank is written as a set (a staging folder renamed into
+place when complete) with a manifest of checksums. The same config gives the same bytes.
 """
 
 from __future__ import annotations
@@ -42,6 +43,11 @@ GROUND_TOUCH_M = 0.02
 SKY_REACH = 1.5
 #: The shadow factor below which the ground counts as shadowed (for the crop).
 SHADOWED = 0.98
+#: The ground around the frame the shadow layer covers, a share of the frame's longer side on each side: a low sun's
+#: shadow goes on beyond the frame (cut at the frame's edge, it ended in a straight line where it was pasted).
+SHADOW_PAD_SHARE = 0.25
+#: A shadow that reaches beyond that fades out over this share of the pad, outermost (no straight edge either).
+SHADOW_FADE_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -201,7 +207,9 @@ def render_cutout(session, snapshot, camera, condition, cast_prims, drawn: Group
     bounds = _bounds(snapshot)
     # the sky's occlusion matters within about one and a half heights of the group
     reach = float(np.hypot(*(bounds[1, :2] - bounds[0, :2])) / 2 + SKY_REACH * bounds[1, 2])
-    shadow = ground_shadow(session, camera, light, (*((bounds[0, :2] + bounds[1, :2]) / 2), reach))
+    pad = shadow_pad(frame.width, frame.height)
+    shadow = _faded(ground_shadow(session, camera, light, (*((bounds[0, :2] + bounds[1, :2]) / 2), reach), pad,
+                                  bounds), max(1, int(round(SHADOW_FADE_SHARE * pad))))
     exposure = choose_exposure(light.grey_card())
     alpha = rgba[..., 3]
     colour = rgba[..., :3] / np.maximum(alpha, 1e-6)[..., None]
@@ -223,18 +231,19 @@ def render_cutout(session, snapshot, camera, condition, cast_prims, drawn: Group
     group_box = _box(alpha8 > 0)
     if group_box is None:
         raise RuntimeError(f"cut-out {entry_id}: the group is not in its frame (a bug in aiming the camera)")
-    shadow_box = _box(shadow < SHADOWED)
+    shadow_box = _box(shadow < SHADOWED)      # in the padded grid: frame pixels + pad
     x0, y0, x1, y1 = group_box if shadow_box is None else (
-        min(group_box[0], shadow_box[0]), min(group_box[1], shadow_box[1]),
-        max(group_box[2], shadow_box[2]), max(group_box[3], shadow_box[3]))
-    x0, y0 = max(0, x0 - MARGIN_PX), max(0, y0 - MARGIN_PX)
-    x1, y1 = min(frame.width, x1 + MARGIN_PX), min(frame.height, y1 + MARGIN_PX)
-    crop = (slice(y0, y1), slice(x0, x1))
+        min(group_box[0], shadow_box[0] - pad), min(group_box[1], shadow_box[1] - pad),
+        max(group_box[2], shadow_box[2] - pad), max(group_box[3], shadow_box[3] - pad))
+    # frame pixels: the crop may reach beyond the frame (by the shadow alone: the group is inside it)
+    x0, y0 = max(-pad, x0 - MARGIN_PX), max(-pad, y0 - MARGIN_PX)
+    x1, y1 = min(frame.width + pad, x1 + MARGIN_PX), min(frame.height + pad, y1 + MARGIN_PX)
     files = {key: f"{FOLDER}/{entry_id}.{suffix}" for key, suffix in FILES.items()}
-    images.write_rgba_png(folder / files["rgba"], np.dstack([display, alpha8])[crop])
-    images.write_id_png(folder / files["ids"], ids[crop])
-    images.write_id_png(folder / files["amodal"], bits[crop])
-    images.write_id_png(folder / files["shadow"], np.round(np.clip(shadow, 0, 1) * 255).astype(np.uint8)[crop])
+    images.write_rgba_png(folder / files["rgba"], _cut(np.dstack([display, alpha8]), x0, y0, x1, y1))
+    images.write_id_png(folder / files["ids"], _cut(ids, x0, y0, x1, y1))
+    images.write_id_png(folder / files["amodal"], _cut(bits, x0, y0, x1, y1))
+    images.write_id_png(folder / files["shadow"], np.round(np.clip(shadow[y0 + pad:y1 + pad, x0 + pad:x1 + pad], 0, 1)
+                                                           * 255).astype(np.uint8))
 
     instances = []
     for member in members:
@@ -292,6 +301,30 @@ def render_cutout(session, snapshot, camera, condition, cast_prims, drawn: Group
         "exposure": exposure.to_dict(),
         "seed": seed,
     }
+
+
+def shadow_pad(width: int, height: int) -> int:
+    """Pixels of ground on each side of a frame the shadow layer covers: :data:`SHADOW_PAD_SHARE` of its longer
+    side, a multiple of 4."""
+    return 4 * int(round(SHADOW_PAD_SHARE * max(width, height) / 4))
+
+
+def _faded(shadow: np.ndarray, fade_px: int) -> np.ndarray:
+    """``shadow`` (1: unshadowed) with its darkening faded out linearly over the outermost ``fade_px`` pixels: a
+    shadow longer than the layer ends softly, not in a straight line."""
+    h, w = shadow.shape
+    rows, cols = np.arange(h), np.arange(w)
+    to_edge = np.minimum.outer(np.minimum(rows, h - 1 - rows), np.minimum(cols, w - 1 - cols))
+    ramp = np.clip((to_edge + 0.5) / fade_px, 0.0, 1.0).astype(np.float32)
+    return 1.0 - (1.0 - shadow) * ramp
+
+
+def _cut(array: np.ndarray, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+    """``array`` (H, W, ...) of the frame cut to x0..x1, y0..y1 (frame pixels, beyond the frame: zeros)."""
+    h, w = array.shape[:2]
+    out = np.zeros((y1 - y0, x1 - x0) + array.shape[2:], array.dtype)
+    out[max(0, -y0):min(h, y1) - y0, max(0, -x0):min(w, x1) - x0] = array[max(0, y0):min(h, y1), max(0, x0):min(w, x1)]
+    return out
 
 
 def _members(cast_prims, snapshot) -> list[dict]:

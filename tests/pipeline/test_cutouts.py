@@ -61,6 +61,17 @@ def test_a_bank_holds_every_cut_out_whole_and_verifies(bank, run_cli):
         assert not rgba[[0, -1], :, 3].any() and not rgba[:, [0, -1], 3].any()
 
 
+def _in_crop(frame_array: np.ndarray, entry: dict) -> np.ndarray:
+    """A frame-sized array cut to the entry's crop, zeros where the crop reaches beyond the frame (by its shadow)."""
+    x0, y0 = entry["camera"]["crop_origin"]
+    w, h = entry["size"]
+    fh, fw = frame_array.shape[:2]
+    out = np.zeros((h, w) + frame_array.shape[2:], frame_array.dtype)
+    out[max(0, -y0):min(fh, y0 + h) - y0, max(0, -x0):min(fw, x0 + w) - x0] = \
+        frame_array[max(0, y0):min(fh, y0 + h), max(0, x0):min(fw, x0 + w)]
+    return out
+
+
 def test_ids_are_those_of_an_independent_ray_cast(bank):
     """Rebuild a view's studio scene and cast its pixel-centre rays with Embree (trimesh): every pixel of the crop
     names the instance Embree hits first (the cut-out's index of it, by prim path)."""
@@ -80,9 +91,7 @@ def test_ids_are_those_of_an_independent_ray_cast(bank):
             lut = np.zeros(int(instance_ids.max()) + 1, np.uint8)
             for inst in entry["instances"]:
                 lut[by_path[inst["prim_path"]]] = inst["index"]
-            x0, y0 = entry["camera"]["crop_origin"]
-            w, h = entry["size"]
-            expected = lut[instance_ids][y0:y0 + h, x0:x0 + w]
+            expected = _in_crop(lut[instance_ids], entry)
             ids = read_image(folder / entry["files"]["ids"])[0][..., 0]
             assert np.mean(ids == expected) >= 0.999, entry["id"]  # float32 against float64 rays: edge pixels
             assert np.count_nonzero(expected) == np.count_nonzero(lut[instance_ids])  # nothing outside the crop
@@ -108,16 +117,16 @@ def test_the_shadow_layer_is_where_independent_rays_to_the_sun_are_blocked(bank)
     x0, y0 = entry["camera"]["crop_origin"]
     w, h = entry["size"]
     frame_w, frame_h = entry["camera"]["frame"]
-    origins, directions = camera.pixel_center_rays(frame_w, frame_h)
-    crop = np.zeros((frame_h, frame_w), bool)
-    crop[y0:y0 + h, x0:x0 + w] = True
-    ground = (directions[:, 2] < 0) & crop.ravel() & (meshes_hit(snapshot, origins, directions) < 0)
+    # every pixel centre of the crop, inside the frame or beyond it
+    px, py = np.meshgrid(np.arange(x0, x0 + w) + 0.5, np.arange(y0, y0 + h) + 0.5)
+    origins, directions = camera.pixel_rays(px.ravel(), py.ravel(), frame_w, frame_h)
+    ground = (directions[:, 2] < 0) & (meshes_hit(snapshot, origins, directions) < 0)
     t = -origins[ground, 2] / directions[ground, 2]
     points = origins[ground] + directions[ground] * t[:, None]
     sun = np.asarray(worker.session.lighting.sun_direction, float)
     assert math.isclose(math.degrees(math.asin(sun[2])), math.degrees(elevation), abs_tol=0.5)
     blocked = meshes_hit(snapshot, points + sun * 1e-3, np.broadcast_to(sun, points.shape).copy()) >= 0
-    values = shadow[(np.flatnonzero(ground) // frame_w) - y0, (np.flatnonzero(ground) % frame_w) - x0]
+    values = shadow.ravel()[ground]
     # away from the shadow's edge (the layer is smoothed by SMOOTHING_PX)
     assert blocked.sum() > 20 and (~blocked).sum() > 20
     assert np.median(values[blocked]) < np.median(values[~blocked]) - 0.2
@@ -205,3 +214,45 @@ def test_an_existing_folder_is_not_written_into(tmp_path):
     (tmp_path / "bank" / "keep.txt").write_text("mine", encoding="utf-8")
     assert_refused(run_synthua("cutouts", "--config", str(config), "--out", str(tmp_path / "bank")), "not an empty")
     assert [p.name for p in (tmp_path / "bank").iterdir()] == ["keep.txt"]
+
+
+def test_no_shadow_ends_at_its_crops_border(bank):
+    """The shadow layer covers the ground around the frame (a low sun's shadow goes on beyond it) and fades a longer
+    one out: no cut-out's shadow is cut off in a straight line at its crop's border (where it would be pasted)."""
+    from synthua_usd.pipeline.cutouts import SHADOWED
+
+    folder, _ = bank
+    beyond = 0
+    for entry in entries(folder):
+        shadow = read_image(folder / entry["files"]["shadow"])[0][..., 0] / 255.0
+        border = np.concatenate([shadow[0], shadow[-1], shadow[:, 0], shadow[:, -1]])
+        assert border.min() >= SHADOWED - 1 / 255, entry["id"]
+        x0, y0 = entry["camera"]["crop_origin"]
+        (w, h), (frame_w, frame_h) = entry["size"], entry["camera"]["frame"]
+        beyond += x0 < 0 or y0 < 0 or x0 + w > frame_w or y0 + h > frame_h
+    assert beyond, "some shadow of the bank reaches beyond its frame"
+
+
+def test_the_shadow_traced_where_it_can_fall_is_the_shadow_traced_everywhere(bank):
+    """The shadow layer traces only the pixels where the group's box can shadow the ground (or the sky's occlusion
+    is measured) and only the sun rays that meet the box: the same layer, to the bit, as every pixel of the frame
+    and its pad traced, for every view of a group (the sun from several sides, one close camera)."""
+    from synthua_usd.backends.mitsuba.cutout_passes import ground_light, ground_shadow
+    from synthua_usd.model.taxonomy import ClassMap
+    from synthua_usd.pipeline.cutouts import _bounds, shadow_pad
+
+    folder, config = bank
+    worker = CutoutWorker(CutoutJob(CutoutsConfig.load(config), ClassMap.default().document(), str(folder)))
+    drawn, placements = worker.set_group(1)
+    shadowed = 0
+    for view in range(3):
+        _, _, snapshot, camera, condition = worker.set_view(drawn, placements, view)
+        worker.session.render(snapshot, camera, rgb=False, condition=condition)
+        light, bounds = ground_light(worker.session), _bounds(snapshot)
+        near = (*((bounds[0, :2] + bounds[1, :2]) / 2), float(np.hypot(*(bounds[1, :2] - bounds[0, :2])) / 2 + 1.5
+                                                            * bounds[1, 2]))
+        pad = shadow_pad(TINY["frame"]["width"], TINY["frame"]["height"])
+        everywhere = ground_shadow(worker.session, camera, light, near, pad)
+        np.testing.assert_array_equal(ground_shadow(worker.session, camera, light, near, pad, bounds), everywhere)
+        shadowed += everywhere.min() < 0.9
+    assert shadowed, "a shadow was cast"

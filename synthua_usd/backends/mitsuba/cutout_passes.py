@@ -111,23 +111,68 @@ def ground_light(session) -> GroundLight:
     return GroundLight(sun, sun_lux, sky, radiance, float(np.pi * radiance.mean()))
 
 
-def ground_shadow(session, camera: PinholeCamera, light: GroundLight, near: tuple[float, float, float]) -> np.ndarray:
-    """(H, W) float32 shadow factor of the ground plane z = 0 seen by ``camera`` (1: unshadowed; pixels whose ray
-    misses the plane are 1) under ``light`` (:func:`ground_light`): see the module's docstring. The sky's occlusion
-    is measured within ``near`` (x, y, radius: metres) of the group, where it is not negligible; the sun's
-    shadow everywhere."""
+def _meets_box(origins: np.ndarray, direction: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+    """Whether each ray ``origins`` (n, 3) + t ``direction`` (t >= 0) meets the box ``bounds`` (2, 3: lowest and
+    highest corner) widened by a millimetre (the slab test)."""
+    lo, hi = bounds[0] - 1e-3, bounds[1] + 1e-3
+    d = np.where(np.abs(direction) < 1e-12, 1e-12, direction)
+    t0, t1 = (lo - origins) / d, (hi - origins) / d
+    near, far = np.minimum(t0, t1).max(axis=1), np.maximum(t0, t1).min(axis=1)
+    return far >= np.maximum(near, 0.0)
+
+
+def _window(camera: PinholeCamera, frame_w: int, frame_h: int, pad: int, light: GroundLight,
+            near: tuple[float, float, float], bounds: np.ndarray) -> tuple[int, int, int, int]:
+    """The pixels (x0, y0, x1, y1) of the grid of the frame and ``pad`` around it outside which the ground keeps
+    all its light: the image of the box ``bounds``'s shadow on the ground (its corners moved along the sun) and of
+    the square about ``near`` (the sky's occlusion); the whole grid where one of those points is behind the camera
+    or the sun is at the horizon."""
+    w, h = frame_w + 2 * pad, frame_h + 2 * pad
+    cx, cy, r = near
+    points = [np.array([[cx + sx * r, cy + sy * r, 0.0] for sx in (-1, 1) for sy in (-1, 1)])]
+    if light.sun is not None:
+        if light.sun[2] <= 1e-6:
+            return 0, 0, w, h
+        corners = np.array([[x, y, z] for x in bounds[:, 0] for y in bounds[:, 1] for z in bounds[:, 2]])
+        points.append(corners - corners[:, 2:3] / light.sun[2] * light.sun)
+    uv, depth = camera.project(np.vstack(points), frame_w, frame_h)
+    if not (depth > 1e-9).all():
+        return 0, 0, w, h
+    # two pixels wider (a pixel whose centre lies just outside is still shadowed in part), from a multiple of 4 (the
+    # corner of the sky's block of a pixel inside is inside)
+    x0, y0 = ((int(np.floor(v)) + pad - 2) // 4 * 4 for v in uv.min(axis=0))
+    x1, y1 = (int(np.ceil(v)) + pad + 2 for v in uv.max(axis=0))
+    x0, y0, x1, y1 = min(max(x0, 0), w), min(max(y0, 0), h), min(max(x1, 0), w), min(max(y1, 0), h)
+    return x0, y0, max(x0, x1), max(y0, y1)
+
+
+def ground_shadow(session, camera: PinholeCamera, light: GroundLight, near: tuple[float, float, float],
+                  pad: int = 0, bounds: np.ndarray | None = None) -> np.ndarray:
+    """(H + 2 pad, W + 2 pad) float32 shadow factor of the ground plane z = 0 seen by ``camera`` over the frame
+    and ``pad`` pixels around it (a multiple of 4) (the ground a long shadow reaches beyond the frame), 1: unshadowed; pixels whose
+    ray misses the plane are 1; under ``light`` (:func:`ground_light`): see the module's docstring. The sky's
+    occlusion is measured within ``near`` (x, y, radius: metres) of the group, where it is not negligible; the
+    sun's shadow everywhere. Where ``bounds`` (2, 3), a box holding every mesh of the scene, is given, only the
+    pixels where the box's shadow or the sky's occlusion can fall are traced (:func:`_window`), and of them only
+    the rays towards the sun that meet the box: the others keep all their light, as a trace of them would find."""
+    if pad % 4:
+        raise ValueError(f"pad {pad}: expected a multiple of 4 (the sky's blocks beyond the frame)")
     mi = session.mi
     scene = session.mitsuba_scene
-    w, h = session.config.width, session.config.height
-    origins, directions = camera.pixel_center_rays(w, h)
+    frame_w, frame_h = session.config.width, session.config.height
+    w, h = frame_w + 2 * pad, frame_h + 2 * pad
+    x0, y0, x1, y1 = (0, 0, w, h) if bounds is None else _window(camera, frame_w, frame_h, pad, light, near, bounds)
+    gx, gy = np.meshgrid(np.arange(x0, x1), np.arange(y0, y1))
+    origins, directions = camera.pixel_rays(gx.ravel() - pad + 0.5, gy.ravel() - pad + 0.5, frame_w, frame_h)
     factor = np.ones(w * h, np.float32)
     down = directions[:, 2] < -1e-6
     t = np.where(down, -origins[:, 2] / np.where(down, directions[:, 2], -1.0), -1.0)
-    hit = np.flatnonzero(down & (t > 0))
+    on_ground = np.flatnonzero(down & (t > 0))
     total = light.sun_lux + light.sky_lux
-    if not len(hit) or total <= 0:
+    if not len(on_ground) or total <= 0:
         return factor.reshape(h, w)
-    points = origins[hit] + directions[hit] * t[hit, None]
+    points = origins[on_ground] + directions[on_ground] * t[on_ground, None]
+    hit = (gy.ravel() * w + gx.ravel())[on_ground]         # the pixels' indices in the whole grid
 
     def visible(origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         rays = mi.Ray3f(mi.Point3f(*(origins + directions * 1e-4).T.astype(np.float32)),
@@ -136,7 +181,11 @@ def ground_shadow(session, camera: PinholeCamera, light: GroundLight, near: tupl
 
     lit = np.zeros(len(points))
     if light.sun is not None:
-        lit += light.sun_lux * visible(points, np.broadcast_to(light.sun, points.shape))
+        # a ray that misses the box holding every mesh sees the sun: only the others are traced
+        sun_seen = np.ones(len(points), bool)
+        near_box = np.flatnonzero(_meets_box(points, light.sun, bounds)) if bounds is not None else slice(None)
+        sun_seen[near_box] = visible(points[near_box], np.broadcast_to(light.sun, points[near_box].shape))
+        lit += light.sun_lux * sun_seen
     # the sky's directions turned about the vertical by an angle of each pixel's own (a fixed hash of its index):
     # the same turn everywhere would draw the group's occlusion as streaks; here it is fine noise, then smoothed
     turn = (hit * 0.6180339887498949) % 1.0 * 2 * np.pi
@@ -145,11 +194,13 @@ def ground_shadow(session, camera: PinholeCamera, light: GroundLight, near: tupl
     weights = light.sky_radiance / max(light.sky_radiance.sum(), 1e-12)
     close = np.hypot(points[:, 0] - near[0], points[:, 1] - near[1]) <= near[2]
     lit[~close] += light.sky_lux
-    # the sky's occlusion varies slowly: traced at every other pixel of every other row, each pixel taking its
-    # block's value
+    # the sky's occlusion varies slowly: traced at one pixel of each block of 2 x 2 (beyond the frame, of 4 x 4:
+    # the ground nearest the camera is many pixels there), each pixel taking its block's value
     rows, cols = np.divmod(hit, w)
-    block = (rows // 2) * ((w + 1) // 2) + cols // 2
-    traced = close & (rows % 2 == 0) & (cols % 2 == 0)
+    inside = (rows >= pad) & (rows < pad + frame_h) & (cols >= pad) & (cols < pad + frame_w)
+    size = np.where(inside, 2, 4)
+    corner = (rows // size * size) * w + cols // size * size        # a 4 x 4 block's corner is a 2 x 2 block's
+    traced = close & (hit == corner)
     inner, cos, sin = points[traced], cos[traced], sin[traced]
     sky_seen = np.zeros(len(points))
     for start in range(0, len(sky), SKY_BATCH):
@@ -159,9 +210,10 @@ def ground_shadow(session, camera: PinholeCamera, light: GroundLight, near: tupl
         seen = visible(np.repeat(inner, len(part), axis=0), dirs.reshape(-1, 3)).reshape(len(inner), len(part))
         sky_seen[traced] += (seen * weights[start:start + SKY_BATCH]).sum(axis=1)
     # a pixel of a block whose traced corner missed the plane (or lay too far) keeps the whole sky
-    share = np.ones(((h + 1) // 2) * ((w + 1) // 2))
-    share[block[traced]] = sky_seen[traced]
-    lit[close] += light.sky_lux * share[block[close]]
+    corners, seen_there = hit[traced], sky_seen[traced]          # ascending, as hit
+    at = np.minimum(np.searchsorted(corners, corner[close]), max(len(corners) - 1, 0))
+    found = corners[at] == corner[close] if len(corners) else np.zeros(int(close.sum()), bool)
+    lit[close] += light.sky_lux * np.where(found, seen_there[at] if len(corners) else 1.0, 1.0)
     factor[hit] = np.clip(lit / total, 0.0, 1.0)
     from scipy.ndimage import gaussian_filter
 
