@@ -149,8 +149,9 @@ def _window(camera: PinholeCamera, frame_w: int, frame_h: int, pad: int, light: 
 def ground_shadow(session, camera: PinholeCamera, light: GroundLight, near: tuple[float, float, float],
                   pad: int = 0, bounds: np.ndarray | None = None) -> np.ndarray:
     """(H + 2 pad, W + 2 pad) float32 shadow factor of the ground plane z = 0 seen by ``camera`` over the frame
-    and ``pad`` pixels around it (a multiple of 4) (the ground a long shadow reaches beyond the frame), 1: unshadowed; pixels whose
-    ray misses the plane are 1; under ``light`` (:func:`ground_light`): see the module's docstring. The sky's
+    and ``pad`` pixels (a multiple of 4) around it, the ground a long shadow reaches beyond the frame (1:
+    unshadowed; pixels whose ray misses the plane are 1), under ``light`` (:func:`ground_light`): see the module's
+    docstring. The sky's
     occlusion is measured within ``near`` (x, y, radius: metres) of the group, where it is not negligible; the
     sun's shadow everywhere. Where ``bounds`` (2, 3), a box holding every mesh of the scene, is given, only the
     pixels where the box's shadow or the sky's occlusion can fall are traced (:func:`_window`), and of them only
@@ -210,10 +211,9 @@ def ground_shadow(session, camera: PinholeCamera, light: GroundLight, near: tupl
         seen = visible(np.repeat(inner, len(part), axis=0), dirs.reshape(-1, 3)).reshape(len(inner), len(part))
         sky_seen[traced] += (seen * weights[start:start + SKY_BATCH]).sum(axis=1)
     # a pixel of a block whose traced corner missed the plane (or lay too far) keeps the whole sky
-    corners, seen_there = hit[traced], sky_seen[traced]          # ascending, as hit
-    at = np.minimum(np.searchsorted(corners, corner[close]), max(len(corners) - 1, 0))
-    found = corners[at] == corner[close] if len(corners) else np.zeros(int(close.sum()), bool)
-    lit[close] += light.sky_lux * np.where(found, seen_there[at] if len(corners) else 1.0, 1.0)
+    share = np.ones(w * h)
+    share[hit[traced]] = sky_seen[traced]
+    lit[close] += light.sky_lux * share[corner[close]]
     factor[hit] = np.clip(lit / total, 0.0, 1.0)
     from scipy.ndimage import gaussian_filter
 
