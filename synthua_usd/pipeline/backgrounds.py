@@ -92,7 +92,7 @@ def _photos_below(folder: Path) -> tuple[list[Path], list[Path]]:
         kept: list[Path] = []
         for name in sorted(dirs):
             path = Path(top, name)
-            if name.startswith(".") or (path.is_symlink() and _inside(os.path.realpath(path), root)):
+            if name.startswith(".") or (path.is_symlink() and Path(os.path.realpath(path)).is_relative_to(root)):
                 continue
             (skipped if is_synthua_dataset(path) else kept).append(path)
         dirs[:] = [p.name for p in kept]
@@ -103,10 +103,6 @@ def _photos_below(folder: Path) -> tuple[list[Path], list[Path]]:
                 if len(found) > MAX_IMAGES:
                     raise InputError(f"{shown(folder)}: more than {MAX_IMAGES} photos; expected at most that many")
     return sorted(found), sorted(skipped)
-
-
-def _inside(path: str, root: str) -> bool:
-    return path == root or path.startswith(root.rstrip(os.sep) + os.sep)
 
 
 def listed_backgrounds(backgrounds: BackgroundSet, listed: list) -> BackgroundSet:
