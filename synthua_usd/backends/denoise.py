@@ -42,6 +42,9 @@ FIREFLY_RATIO = 4.0
 #: OIDN's memory limit per filter: it denoises larger images in overlapping tiles. Measured at 1280x960: peak
 #: memory 531 MiB against 787 MiB without a limit, the same bytes out, no slower.
 MAX_MEMORY_MB = 512
+#: OIDN measures an HDR image's exposure over bins of this many pixels a side: a box denoised alone starts on
+#: a multiple of it (:meth:`Denoiser.denoise_pass`'s ``margin``).
+BIN_PX = 16
 
 
 class DenoiserError(RuntimeError):
@@ -104,6 +107,21 @@ def _import_pyoidn():
     finally:
         del sys.modules["torch"]
     return pyoidn
+
+
+def _hit_box(hit: np.ndarray, margin: int) -> tuple[int, int, int, int] | None:
+    """(y0, y1, x0, x1) of the pixels ``hit`` (H, W) widened by ``margin``, from a multiple of :data:`BIN_PX` and
+    a multiple of it long (or to the image's edge); None where nothing is hit or the box is the whole image."""
+    rows, cols = np.flatnonzero(hit.any(axis=1)), np.flatnonzero(hit.any(axis=0))
+    if not len(rows):
+        return None
+    h, w = hit.shape
+    box = []
+    for first, last, size in ((rows[0], rows[-1], h), (cols[0], cols[-1], w)):
+        start = max(0, first - margin) // BIN_PX * BIN_PX
+        end = min(size, start + -(-(last + 1 + margin - start) // BIN_PX) * BIN_PX)
+        box += [start, end]
+    return None if box == [0, h, 0, w] else (box[0], box[1], box[2], box[3])
 
 
 class Denoiser:
@@ -169,15 +187,29 @@ class Denoiser:
             flt.release()
         return output
 
-    def denoise_pass(self, color: np.ndarray, albedo: np.ndarray,
-                     normal: np.ndarray) -> tuple[np.ndarray, FireflyReport]:
+    def denoise_pass(self, color: np.ndarray, albedo: np.ndarray, normal: np.ndarray,
+                     margin: int | None = None) -> tuple[np.ndarray, FireflyReport]:
         """A path-traced pass, (H, W, 3) float32 each, denoised: :func:`suppress_fireflies`, then OIDN; pixels
         whose every sample escaped to the environment (normal guide exactly 0) keep their value, since the sky
         seen straight has no Monte Carlo noise and OIDN would only add its own small error to it (measured:
-        about 1.5 % on a constant sky)."""
+        about 1.5 % on a constant sky).
+
+        With ``margin`` (pixels), OIDN sees only the box of the pixels something was hit in, widened by
+        ``margin`` and from a multiple of :data:`BIN_PX` (OIDN's exposure bins then fall as in the whole
+        image): for a small subject on an empty frame (a cut-out), where the rest keeps its value anyway. The
+        hit pixels then differ from the whole image's by what OIDN's view beyond the margin would have added
+        (64 pixels: at most 3e-5 of their mean and 0.2 % of the brightest, on frames of the cut-out bank)."""
         cleaned, report = suppress_fireflies(color)
-        out = self(cleaned, albedo, normal)
-        sky = ~np.asarray(normal).any(axis=2)
+        normal = np.asarray(normal)
+        sky = (normal[..., 0] == 0) & (normal[..., 1] == 0) & (normal[..., 2] == 0)    # ~any(axis=2), faster
+        box = _hit_box(~sky, margin) if margin is not None else None
+        if box is None:
+            out = self(cleaned, albedo, normal)
+        else:
+            y0, y1, x0, x1 = box
+            out = cleaned.copy()
+            out[y0:y1, x0:x1] = self(*(np.ascontiguousarray(np.asarray(image, np.float32)[y0:y1, x0:x1])
+                                       for image in (cleaned, albedo, normal)))
         out[sky] = np.asarray(color, np.float32)[sky]
         return out, report
 

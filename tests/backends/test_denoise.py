@@ -89,3 +89,37 @@ def test_the_denoiser_does_not_load_torch_and_leaves_it_importable():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip().endswith("ok")
+
+
+def subject_on_empty_frame(size=(160, 192), box=(70, 100, 90, 130), seed=2):
+    """(colour, albedo, normal): a noisy lit patch (rows and columns of ``box``: y0, y1, x0, x1) on a frame where
+    nothing was hit (all three zero), as a cut-out's render is."""
+    h, w = size
+    y0, y1, x0, x1 = box
+    colour, albedo, normal, _ = noisy_scene(seed, (y1 - y0, x1 - x0))
+    frames = [np.zeros((h, w, 3), np.float32) for _ in range(3)]
+    for frame, part in zip(frames, (colour, albedo, normal)):
+        frame[y0:y1, x0:x1] = part
+    return frames
+
+
+def test_a_subject_denoised_in_its_box_keeps_the_rest_and_matches_the_whole_frame():
+    """``margin``: OIDN sees the hit pixels' box widened by the margin, from a multiple of 16; every pixel
+    outside keeps its input (zero), and the subject's pixels match denoising the whole frame closely."""
+    from synthua_usd.backends.denoise import BIN_PX, _hit_box
+
+    colour, albedo, normal = subject_on_empty_frame()
+    hit = normal.any(axis=2)
+    assert _hit_box(hit, 8) == (48, 112, 80, 144)           # 70-8 -> 48, 100+8 -> 112 (4 bins); 90-8 -> 80, ...
+    assert all(v % BIN_PX == 0 for v in _hit_box(hit, 8))
+    assert _hit_box(hit, 500) is None and _hit_box(np.zeros_like(hit), 8) is None
+    with Denoiser() as denoise:
+        whole, _ = denoise.denoise_pass(colour, albedo, normal)
+        boxed, report = denoise.denoise_pass(colour, albedo, normal, margin=64)
+        wide, _ = denoise.denoise_pass(colour, albedo, normal, margin=500)     # the box is the frame
+    assert np.array_equal(wide, whole)
+    assert report.pixels == 0
+    assert np.array_equal(boxed[~hit], colour[~hit])
+    error = np.abs(boxed[hit] - whole[hit])
+    assert error.max() <= 3e-3 * whole[hit].max() and error.mean() <= 1e-4 * whole[hit].mean()
+    assert not np.array_equal(boxed[hit], colour[hit])       # denoised, not passed through

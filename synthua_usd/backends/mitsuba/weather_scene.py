@@ -42,6 +42,7 @@ ground's roughness halves. Snow: a white (albedo 0.85) rough BSDF.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -243,14 +244,22 @@ def environment_texels(mi) -> tuple[int, int]:
 
 def texel_directions(mi, up_axis: str) -> np.ndarray:
     """(H, W, 3) unit world directions of the environment map's texel centres (Mitsuba's ``envmap``
-    convention: u = φ / 2π, v = θ / π, local direction (sin φ sin θ, cos θ, −cos φ sin θ))."""
-    w, h = environment_texels(mi)
+    convention: u = φ / 2π, v = θ / π, local direction (sin φ sin θ, cos θ, −cos φ sin θ)); read-only, computed
+    once per map size and up axis (every new sky evaluates itself at them)."""
+    return _texel_directions(mi, environment_texels(mi), up_axis)
+
+
+@functools.lru_cache(maxsize=4)
+def _texel_directions(mi, size: tuple[int, int], up_axis: str) -> np.ndarray:
+    w, h = size
     theta = (np.arange(h) + 0.5) / h * math.pi
     phi = (np.arange(w) + 0.5) / w * 2.0 * math.pi
     t, p = np.meshgrid(theta, phi, indexing="ij")
     local = np.stack([np.sin(p) * np.sin(t), np.cos(t), -np.cos(p) * np.sin(t)], axis=-1)
     rotation = np.array(environment_to_world(mi, up_axis).matrix, np.float64)[:3, :3]
-    return local @ rotation.T
+    directions = local @ rotation.T
+    directions.setflags(write=False)
+    return directions
 
 
 def sky_emitter(mi, up_axis: str) -> dict:

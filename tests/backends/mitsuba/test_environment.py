@@ -63,6 +63,22 @@ def test_the_environment_is_the_sunsky_above_the_horizon(variant, name, up_axis)
     np.testing.assert_allclose(got, expected, rtol=0.1 if mi.variant().startswith("scalar") else 0.03)
 
 
+def test_texel_directions_are_computed_once_per_up_axis_and_read_only(variant):
+    """Every new sky is evaluated at the map's texel directions: they are cached per map size and up axis (a
+    Y-up stage after a Z-up one gets its own), unit length, the first row at the zenith, and cannot be changed."""
+    import mitsuba as mi
+
+    z, y = weather_scene.texel_directions(mi, "Z"), weather_scene.texel_directions(mi, "Y")
+    assert weather_scene.texel_directions(mi, "Z") is z and weather_scene.texel_directions(mi, "Y") is y
+    w, h = weather_scene.environment_texels(mi)
+    assert z.shape == y.shape == (h, w, 3)
+    np.testing.assert_allclose(np.linalg.norm(z, axis=2), 1.0, atol=1e-12)
+    assert (z[0, :, 2] > 0.999).all() and (y[0, :, 1] > 0.999).all()       # the first row: the zenith
+    np.testing.assert_allclose(y[..., 1], z[..., 2], atol=1e-6)              # the same map, turned
+    with pytest.raises(ValueError):
+        z[0, 0, 0] = 1.0
+
+
 @pytest.mark.parametrize("name", ["clear_day", "sunset", "day_fog", "snow", "clear_night"])
 def test_below_the_horizon_is_the_ground_a_real_plain_would_show(variant, name):
     import mitsuba as mi
