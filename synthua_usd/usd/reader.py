@@ -502,11 +502,11 @@ class StageReader:
         """``local`` in world metres with ``prim``'s transform at ``t``."""
         m = np.array(xcache.GetLocalToWorldTransform(prim), float)  # row-vector convention
         world = (local.points @ m[:3, :3] + m[3, :3]) * self.meters_per_unit
-        tris = local.triangles
-        if np.linalg.det(m[:3, :3]) < 0:  # a mirroring transform flips the winding
-            tris = tris[:, ::-1]
         if not np.all(np.isfinite(world)):
             raise StageError(f"{prim.GetPath()}: has non-finite point coordinates at time {t.GetValue():g}")
+        tris = local.triangles
+        if np.all(np.isfinite(m[:3, :3])) and np.linalg.det(m[:3, :3]) < 0:  # a mirroring transform flips the winding
+            tris = tris[:, ::-1]
         return MeshItem(prim_path=str(prim.GetPath()), points=world, triangles=np.ascontiguousarray(tris),
                         material_key=local.material_key, instance_id=local.instance_id, class_id=local.class_id,
                         lamp=local.lamp, uvs=local.uvs, double_sided=local.double_sided,
