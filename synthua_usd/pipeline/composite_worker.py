@@ -139,14 +139,14 @@ def covered_by_pastes(box: tuple[float, float, float, float], instance_ids: np.n
 def _background_entries(background: Background, labelled: bool, photo, config: CompositeConfig,
                         size) -> list[dict]:
     """The photo's boxes in the frame, before pasting: kept so far, or dropped as a crowd region (COCO's
-    ``iscrowd``: no one object), unmapped or cropped."""
+    ``iscrowd``: no one object), unmapped, empty (no width or no height in the photo) or cropped."""
     out: list[dict] = []
     if not labelled:
         return out
     for box in background.boxes:
         ours = config.background_labels.our_class(box.label)
         frame, kept_share = _frame_box(box, photo.region, photo.scale, size)
-        reason = "crowd" if box.ignore else "unmapped" if ours is None else (
+        reason = "crowd" if box.ignore else "unmapped" if ours is None else "empty" if min(box.w, box.h) <= 0 else (
             "cropped" if kept_share < config.background_labels.drop_cropped_share else None)
         out.append({"label": box.label, "class_name": ours, "frame": frame, "covered_share": None,
                     "kept": reason is None, "reason": reason})

@@ -352,7 +352,9 @@ def test_a_coco_set_with_its_photos_elsewhere_keeps_pastes_off_its_crowd_regions
     coco = {"images": [{"id": k + 1, "file_name": p.name, "width": 96, "height": 72} for k, p in enumerate(photos)],
             "annotations": [{"id": 1, "image_id": 1, "category_id": 7, "bbox": [0.0, 0.0, 40.0, 72.0], "iscrowd": 1},
                             {"id": 2, "image_id": 1, "category_id": 7, "bbox": [60.0, 30.0, 12.0, 30.0],
-                             "iscrowd": 0}],
+                             "iscrowd": 0},
+                            {"id": 3, "image_id": 1, "category_id": 7, "bbox": [80.0, 10.0, 0.0, 20.0],
+                             "iscrowd": 0}],        # a stray click of a label tool: no width
             "categories": [{"id": 7, "name": "person"}]}
     (tmp_path / "annotations").mkdir()
     (tmp_path / "annotations" / "instances_train.json").write_text(json.dumps(coco))
@@ -368,8 +370,9 @@ def test_a_coco_set_with_its_photos_elsewhere_keeps_pastes_off_its_crowd_regions
     assert len(boxed) == 2
     pasted = 0
     for record in boxed:
-        crowd, person = record["composite"]["background_boxes"]
+        crowd, person, empty = record["composite"]["background_boxes"]
         assert (crowd["reason"], crowd["kept"], person["kept"]) == ("crowd", False, True)
+        assert (empty["reason"], empty["kept"]) == ("empty", False)
         # the 96x72 photo at scale 2/3: the crowd region covers x < 26.67 of the 64x48 image
         assert crowd["bbox"] == pytest.approx([0.0, 0.0, 26.6667, 48.0], abs=1e-4)
         for instance in record["instances"]:
