@@ -1,14 +1,18 @@
 #!/usr/bin/env python
-"""Benchmark: ``synthua composite`` images/min beside ``synthua generate`` on the same machine, in one run.
+"""Benchmark: ``synthua composite`` images/min (and ``synthua cutouts`` cut-outs/min) beside ``synthua generate``
+on the same machine, in one run.
 
 Usage:
   python tools/bench_composite.py --bank BANK [--backgrounds PHOTOS] [--config configs/composite.json]
          [--images 600] [--workers 2] [--gen-images 6] [--json OUT.json] [--keep DIR]
+  python tools/bench_composite.py --cutouts 24 [...]      # makes the bank too (configs/cutouts.json), timed
   python tools/bench_composite.py --drawn-bank [...]      # tests/bank_maker.py's drawn bank (a stand-in)
 
 Runs, one after the other on the same machine: (1) ``synthua generate`` of the demo street
 (``stages/scenario.usda``) with ``configs/demo.json`` at 640x480 (``--gen-images`` images, its other settings as
-shipped), (2) ``synthua composite`` of BACKGROUNDS (default: ``../shared/data/real_photos/wheelchair_dev`` when
+shipped), with ``--cutouts N`` then ``synthua cutouts`` of ``--cutouts-config`` (default ``configs/cutouts.json``)
+with its ``count`` N on the command's default workers (the bank the composites then use), (2) ``synthua composite``
+of BACKGROUNDS (default: ``../shared/data/real_photos/wheelchair_dev`` when
 present, else 40 synthetic 640x480 photos) with ``--config`` (a temporary copy whose ``max_images`` is
 ``--images`` and output 640x480), and prints each one's images/min end to end (checks, workers' start, assembly
 included) and over its make phase (the workers' run), their ratio, where the composite workers' time went, and the
@@ -95,6 +99,25 @@ def run_generate(work: Path, images: int, workers: int) -> dict:
             "render": f"640x480 {doc['render'].get('spp')} spp, configs/demo.json"}
 
 
+def run_cutouts(work: Path, base: Path, count: int) -> dict:
+    from synthua_usd.pipeline.cutouts import CutoutsConfig, default_workers, make_bank
+
+    doc = json.loads(base.read_text(encoding="utf-8"))
+    doc.pop("$schema", None)
+    doc["count"] = count
+    config = work / "cutouts.bench.json"
+    config.write_text(json.dumps(doc), encoding="utf-8")
+    frame = CutoutsConfig.load(config).frame
+    workers = CutoutsConfig.load(config).workers or default_workers()
+    t0, cpu0 = time.perf_counter(), cpu_seconds()
+    summary = make_bank(config, work / "bank", workers=workers)
+    wall, cpu = time.perf_counter() - t0, cpu_seconds() - cpu0
+    return {"cutouts": summary.cutouts, "workers": workers, "wall_s": wall, "cpu_s": cpu,
+            "cpu_s_per_cutout": cpu / max(1, summary.cutouts), "cutouts_per_min": 60 * summary.cutouts / wall,
+            "frame": f"{frame.width}x{frame.height} {frame.spp} spp" + (" + OIDN" if frame.denoise else ""),
+            "bank": str(work / "bank")}
+
+
 def run_composite(work: Path, backgrounds: Path, bank: Path, base: Path, images: int, workers: int) -> dict:
     from synthua_usd.pipeline.composite import CompositeRequest, composite
 
@@ -118,11 +141,13 @@ def run_composite(work: Path, backgrounds: Path, bank: Path, base: Path, images:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0],
-                                     formatter_class=argparse.RawDescriptionHelpFormatter,
-                                     epilog="\n".join(__doc__.splitlines()[2:6]))
+    lines = __doc__.splitlines()
+    parser = argparse.ArgumentParser(description=" ".join(lines[:2]), epilog="\n".join(lines[3:8]),
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--bank", type=Path, help="a bank written by `synthua cutouts`")
     parser.add_argument("--drawn-bank", action="store_true", help="use tests/bank_maker.py's drawn bank (a stand-in)")
+    parser.add_argument("--cutouts", type=int, metavar="N", help="make a bank of N cut-outs first, timed, and use it")
+    parser.add_argument("--cutouts-config", type=Path, default=REPO / "configs" / "cutouts.json")
     parser.add_argument("--backgrounds", type=Path, default=None)
     parser.add_argument("--config", type=Path, default=REPO / "configs" / "composite.json")
     parser.add_argument("--images", type=int, default=600, help="composites to make [600]")
@@ -131,8 +156,10 @@ def main() -> int:
     parser.add_argument("--json", type=Path, help="write the figures here too")
     parser.add_argument("--keep", type=Path, help="keep the datasets in this folder (must not exist)")
     args = parser.parse_args()
-    if (args.bank is None) == (not args.drawn_bank):
-        parser.error("give --bank BANK or --drawn-bank")
+    if sum([args.bank is not None, args.drawn_bank, args.cutouts is not None]) != 1:
+        parser.error("give one of --bank BANK, --cutouts N or --drawn-bank")
+    if args.cutouts is not None and args.cutouts < 1:
+        parser.error(f"--cutouts {args.cutouts}: expected at least 1")
     work = args.keep or Path(tempfile.mkdtemp(prefix="bench_composite_"))
     work.mkdir(parents=True, exist_ok=args.keep is None)
     try:
@@ -145,6 +172,10 @@ def main() -> int:
         backgrounds = args.backgrounds or (DEV_PHOTOS if DEV_PHOTOS.is_dir() else synthetic_photos(work / "photos"))
         load_before = os.getloadavg()
         generated = run_generate(work, args.gen_images, args.workers)
+        cut = None
+        if args.cutouts is not None:
+            cut = run_cutouts(work, args.cutouts_config, args.cutouts)
+            bank = Path(cut["bank"])
         composited = run_composite(work, backgrounds, bank, args.config, args.images, args.workers)
         load_after = os.getloadavg()
     finally:
@@ -153,7 +184,8 @@ def main() -> int:
     ratio = composited["images_per_min"] / generated["images_per_min"]
     cpu_ratio = generated["cpu_s_per_image"] / composited["cpu_s_per_image"]
     result = {"cpus": os.cpu_count(), "workers": args.workers, "load_before": load_before, "load_after": load_after,
-              "bank": "drawn (tests/bank_maker.py)" if args.drawn_bank else str(args.bank),
+              "bank": "drawn (tests/bank_maker.py)" if args.drawn_bank else (
+                  f"made: {args.cutouts} cut-outs" if cut else str(args.bank)), "cutouts": cut,
               "backgrounds": str(backgrounds), "config": str(args.config), "generate": generated,
               "composite": composited, "ratio": ratio, "cpu_ratio": cpu_ratio,
               "composite_images_per_min_on_idle_cores": 60 * os.cpu_count() / composited["cpu_s_per_image"]}
@@ -162,6 +194,12 @@ def main() -> int:
     print(f"synthua generate (demo street, {generated['render']}): {generated['images']} images, "
           f"{generated['images_per_min']:.1f} images/min end to end, {generated['make_images_per_min']:.1f} over "
           f"rendering")
+    if cut:
+        result["cutouts_ratio"] = cut["cutouts_per_min"] / generated["images_per_min"]
+        print(f"synthua cutouts ({args.cutouts_config.name}, {cut['frame']}, {cut['workers']} worker"
+              f"{'s' if cut['workers'] > 1 else ''}): {cut['cutouts']} cut-outs, {cut['cutouts_per_min']:.1f} a minute "
+              f"end to end ({cut['wall_s']:.1f} s), {cut['cpu_s_per_cutout']:.2f} CPU seconds a cut-out; "
+              f"{result['cutouts_ratio']:.1f}x generate's images a minute")
     print(f"synthua composite ({result['bank']}, {backgrounds}, {args.config.name}): {composited['images']} "
           f"composites of 640x480 with {composited['pastes']} pastes, {composited['images_per_min']:.0f} images/min "
           f"end to end ({composited['wall_s']:.1f} s), {composited['make_images_per_min']:.0f} over the workers' run; "
