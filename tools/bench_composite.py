@@ -95,18 +95,29 @@ def run_generate(work: Path, images: int, workers: int) -> dict:
     wall, cpu = time.perf_counter() - t0, cpu_seconds() - cpu0
     return {"images": summary.rendered, "wall_s": wall, "make_s": timer.seconds, "cpu_s": cpu,
             "cpu_s_per_image": cpu / max(1, summary.rendered),
-            "images_per_min": 60 * summary.rendered / wall, "make_images_per_min": 60 * summary.rendered / timer.seconds,
+            "images_per_min": 60 * summary.rendered / wall,
+            "make_images_per_min": 60 * summary.rendered / timer.seconds,
             "render": f"640x480 {doc['render'].get('spp')} spp, configs/demo.json"}
 
 
-def run_cutouts(work: Path, base: Path, count: int) -> dict:
-    from synthua_usd.pipeline.cutouts import CutoutsConfig, default_workers, make_bank
+def cutouts_config(work: Path, base: Path, count: int) -> Path:
+    """``base`` with its ``count`` set, written into ``work`` and loaded once (a bad file is refused before
+    anything is timed)."""
+    from synthua_usd.pipeline.cutouts import CutoutsConfig
 
+    CutoutsConfig.load(base)
     doc = json.loads(base.read_text(encoding="utf-8"))
     doc.pop("$schema", None)
     doc["count"] = count
     config = work / "cutouts.bench.json"
     config.write_text(json.dumps(doc), encoding="utf-8")
+    CutoutsConfig.load(config)
+    return config
+
+
+def run_cutouts(work: Path, config: Path) -> dict:
+    from synthua_usd.pipeline.cutouts import CutoutsConfig, default_workers, make_bank
+
     frame = CutoutsConfig.load(config).frame
     workers = CutoutsConfig.load(config).workers or default_workers()
     t0, cpu0 = time.perf_counter(), cpu_seconds()
@@ -147,7 +158,8 @@ def main() -> int:
     parser.add_argument("--bank", type=Path, help="a bank written by `synthua cutouts`")
     parser.add_argument("--drawn-bank", action="store_true", help="use tests/bank_maker.py's drawn bank (a stand-in)")
     parser.add_argument("--cutouts", type=int, metavar="N", help="make a bank of N cut-outs first, timed, and use it")
-    parser.add_argument("--cutouts-config", type=Path, default=REPO / "configs" / "cutouts.json")
+    parser.add_argument("--cutouts-config", type=Path, default=REPO / "configs" / "cutouts.json",
+                        help="the bank's config, its count set to --cutouts N [configs/cutouts.json]")
     parser.add_argument("--backgrounds", type=Path, default=None)
     parser.add_argument("--config", type=Path, default=REPO / "configs" / "composite.json")
     parser.add_argument("--images", type=int, default=600, help="composites to make [600]")
@@ -160,10 +172,19 @@ def main() -> int:
         parser.error("give one of --bank BANK, --cutouts N or --drawn-bank")
     if args.cutouts is not None and args.cutouts < 1:
         parser.error(f"--cutouts {args.cutouts}: expected at least 1")
+    if args.cutouts is None and args.cutouts_config != parser.get_default("cutouts_config"):
+        parser.error("--cutouts-config is the config of the bank --cutouts N makes: give --cutouts too")
     work = args.keep or Path(tempfile.mkdtemp(prefix="bench_composite_"))
     work.mkdir(parents=True, exist_ok=args.keep is None)
     try:
         bank = args.bank
+        if args.cutouts is not None:
+            from synthua_usd.core.errors import InputError
+
+            try:
+                cut_config = cutouts_config(work, args.cutouts_config, args.cutouts)
+            except (InputError, OSError, ValueError) as exc:
+                parser.error(f"--cutouts {args.cutouts} of --cutouts-config {args.cutouts_config}: {exc}")
         if args.drawn_bank:
             sys.path.insert(0, str(REPO / "tests"))
             from bank_maker import write_bank
@@ -174,8 +195,10 @@ def main() -> int:
         generated = run_generate(work, args.gen_images, args.workers)
         cut = None
         if args.cutouts is not None:
-            cut = run_cutouts(work, args.cutouts_config, args.cutouts)
+            cut = run_cutouts(work, cut_config)
             bank = Path(cut["bank"])
+            if args.keep is None:
+                cut["bank"] = None          # a temporary folder, gone after the run
         composited = run_composite(work, backgrounds, bank, args.config, args.images, args.workers)
         load_after = os.getloadavg()
     finally:

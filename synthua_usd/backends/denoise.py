@@ -109,13 +109,27 @@ def _import_pyoidn():
     return pyoidn
 
 
+def _checked(color, albedo, normal) -> dict[str, np.ndarray]:
+    """The three images as contiguous float32 (H, W, 3), by OIDN's names; a guide of another shape is refused."""
+    images = {}
+    for name, image in (("color", color), ("albedo", albedo), ("normal", normal)):
+        image = np.ascontiguousarray(image, np.float32)
+        if image.ndim != 3 or image.shape[2] != 3 or image.shape != np.shape(color):
+            raise ValueError(f"denoiser {name}: shape {image.shape}; expected (H, W, 3) like color "
+                             f"{np.shape(color)}")
+        images[name] = image
+    return images
+
+
 def _hit_box(hit: np.ndarray, margin: int) -> tuple[int, int, int, int] | None:
     """(y0, y1, x0, x1) of the pixels ``hit`` (H, W) widened by ``margin``, from a multiple of :data:`BIN_PX` and
-    a multiple of it long (or to the image's edge); None where nothing is hit or the box is the whole image."""
+    a multiple of it long (or to the image's edge); None where nothing is hit, where the box is the whole image,
+    and where the image's sides are not multiples of :data:`BIN_PX` (OIDN spreads its bins evenly over the image:
+    only then do they fall on those multiples, so that a box sees the exposure the whole image would)."""
     rows, cols = np.flatnonzero(hit.any(axis=1)), np.flatnonzero(hit.any(axis=0))
-    if not len(rows):
-        return None
     h, w = hit.shape
+    if not len(rows) or h % BIN_PX or w % BIN_PX:
+        return None
     box = []
     for first, last, size in ((rows[0], rows[-1], h), (cols[0], cols[-1], w)):
         start = max(0, first - margin) // BIN_PX * BIN_PX
@@ -162,13 +176,7 @@ class Denoiser:
         """(H, W, 3) float32 denoised radiance from HDR scene-linear ``color``, ``albedo`` in [0, 1] and
         ``normal`` (components in [-1, 1], any consistent space; 0 where nothing is hit), all (H, W, 3)."""
         pyoidn = self._oidn
-        images = {}
-        for name, image in (("color", color), ("albedo", albedo), ("normal", normal)):
-            image = np.ascontiguousarray(image, np.float32)
-            if image.ndim != 3 or image.shape[2] != 3 or image.shape != np.shape(color):
-                raise ValueError(f"denoiser {name}: shape {image.shape}; expected (H, W, 3) like color "
-                                 f"{np.shape(color)}")
-            images[name] = image
+        images = _checked(color, albedo, normal)
         output = np.zeros_like(images["color"])
         flt = pyoidn.Filter(self._device, pyoidn.OIDN_FILTER_TYPE_RT)
         try:
@@ -195,22 +203,24 @@ class Denoiser:
         about 1.5 % on a constant sky).
 
         With ``margin`` (pixels), OIDN sees only the box of the pixels something was hit in, widened by
-        ``margin`` and from a multiple of :data:`BIN_PX` (OIDN's exposure bins then fall as in the whole
-        image): for a small subject on an empty frame (a cut-out), where the rest keeps its value anyway. The
+        ``margin`` and from a multiple of :data:`BIN_PX` (OIDN's exposure bins then fall as in the whole image;
+        an image whose sides are not multiples of it is denoised whole): for a small subject on an empty frame (a
+        cut-out), where the rest keeps its value anyway. The
         hit pixels then differ from the whole image's by what OIDN's view beyond the margin would have added
         (64 pixels: at most 3e-5 of their mean and 0.2 % of the brightest, on frames of the cut-out bank)."""
-        cleaned, report = suppress_fireflies(color)
-        normal = np.asarray(normal)
+        images = _checked(color, albedo, normal)
+        cleaned, report = suppress_fireflies(images["color"])
+        normal = images["normal"]
         sky = (normal[..., 0] == 0) & (normal[..., 1] == 0) & (normal[..., 2] == 0)    # ~any(axis=2), faster
         box = _hit_box(~sky, margin) if margin is not None else None
         if box is None:
-            out = self(cleaned, albedo, normal)
+            out = self(cleaned, images["albedo"], normal)
         else:
             y0, y1, x0, x1 = box
             out = cleaned.copy()
-            out[y0:y1, x0:x1] = self(*(np.ascontiguousarray(np.asarray(image, np.float32)[y0:y1, x0:x1])
-                                       for image in (cleaned, albedo, normal)))
-        out[sky] = np.asarray(color, np.float32)[sky]
+            out[y0:y1, x0:x1] = self(*(np.ascontiguousarray(image[y0:y1, x0:x1])
+                                       for image in (cleaned, images["albedo"], normal)))
+        out[sky] = images["color"][sky]
         return out, report
 
     def close(self) -> None:

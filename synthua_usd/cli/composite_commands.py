@@ -74,7 +74,7 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
             f"({', '.join(s.skipped[:3])}{', ...' * (len(s.skipped) > 3)}): their images are no photos")
     if s.labelled:
         say(f"the photos' boxes: {s.boxes_kept} kept, {s.boxes_dropped} dropped (covered by pastes, cut off by the "
-            f"output size, unmapped or crowd regions: see each record's composite.background_boxes)")
+            f"output size, unmapped, empty or crowd regions: see each record's composite.background_boxes)")
     if s.images:
         say(f"{s.images / s.wall_seconds * 60:.0f} images/min over {s.wall_seconds:.1f} s on {s.workers} workers; "
             f"worker time: {worker_time_shares(s.seconds)}")

@@ -141,7 +141,7 @@ class PinholeCamera:
         if self.distortion is not None:
             gx, gy = self.distortion.undistort(gx, gy, where=f"camera {self.path}")
         right, up, forward = self.axes()
-        gx, gy = gx.ravel(), gy.ravel()
+        gx, gy = (v.ravel() for v in np.broadcast_arrays(gx, gy))
         d = np.empty((len(gx), 3))
         for axis in range(3):   # column by column (numpy is slow along a row of 3), the same values as row-wise
             d[:, axis] = gx * right[axis] - gy * up[axis] + forward[axis]

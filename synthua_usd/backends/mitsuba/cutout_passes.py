@@ -34,7 +34,7 @@ SKY_BATCH = 16
 #: keeps about a pixel of softness, as a real sun's penumbra a few metres away).
 SMOOTHING_PX = 0.8
 #: The group is denoised in its box widened by this many pixels, not the whole frame (where nothing else is):
-#: OIDN's cost follows the pixels it sees, and a wider view changes the group's pixels by less than 8 bits show.
+#: OIDN's cost follows the pixels it sees; a wider view moves a few of the group's pixels by one or two 8-bit levels.
 DENOISE_MARGIN_PX = 64
 
 
