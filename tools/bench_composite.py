@@ -100,9 +100,9 @@ def run_generate(work: Path, images: int, workers: int) -> dict:
             "render": f"640x480 {doc['render'].get('spp')} spp, configs/demo.json"}
 
 
-def cutouts_config(work: Path, base: Path, count: int) -> Path:
-    """``base`` with its ``count`` set, written into ``work`` and loaded once (a bad file is refused before
-    anything is timed)."""
+def cutouts_config(work: Path, base: Path, count: int):
+    """``base`` with its ``count`` set, written into ``work``: its path and the loaded config (a bad file is
+    refused before anything is timed)."""
     from synthua_usd.pipeline.cutouts import CutoutsConfig
 
     CutoutsConfig.load(base)
@@ -111,15 +111,14 @@ def cutouts_config(work: Path, base: Path, count: int) -> Path:
     doc["count"] = count
     config = work / "cutouts.bench.json"
     config.write_text(json.dumps(doc), encoding="utf-8")
-    CutoutsConfig.load(config)
-    return config
+    return config, CutoutsConfig.load(config)
 
 
-def run_cutouts(work: Path, config: Path) -> dict:
-    from synthua_usd.pipeline.cutouts import CutoutsConfig, default_workers, make_bank
+def run_cutouts(work: Path, config: Path, loaded) -> dict:
+    from synthua_usd.pipeline.cutouts import default_workers, make_bank
 
-    frame = CutoutsConfig.load(config).frame
-    workers = CutoutsConfig.load(config).workers or default_workers()
+    frame = loaded.frame
+    workers = loaded.workers or default_workers()
     t0, cpu0 = time.perf_counter(), cpu_seconds()
     summary = make_bank(config, work / "bank", workers=workers)
     wall, cpu = time.perf_counter() - t0, cpu_seconds() - cpu0
@@ -182,7 +181,7 @@ def main() -> int:
             from synthua_usd.core.errors import InputError
 
             try:
-                cut_config = cutouts_config(work, args.cutouts_config, args.cutouts)
+                cut_config, cut_loaded = cutouts_config(work, args.cutouts_config, args.cutouts)
             except (InputError, OSError, ValueError) as exc:
                 parser.error(f"--cutouts {args.cutouts} of --cutouts-config {args.cutouts_config}: {exc}")
         if args.drawn_bank:
@@ -195,7 +194,7 @@ def main() -> int:
         generated = run_generate(work, args.gen_images, args.workers)
         cut = None
         if args.cutouts is not None:
-            cut = run_cutouts(work, cut_config)
+            cut = run_cutouts(work, cut_config, cut_loaded)
             bank = Path(cut["bank"])
             if args.keep is None:
                 cut["bank"] = None          # a temporary folder, gone after the run
