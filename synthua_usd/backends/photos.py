@@ -6,7 +6,10 @@ smaller than the output is refused) and its centre cut out, ``region`` in photo 
 orientation other than 1 is turned upright first (as viewers and Ultralytics' loader do); its size and boxes are
 then the upright photo's. Colours are taken as 8-bit sRGB (an embedded ICC profile is not applied); a 16-bit photo
 is scaled to 8 bits (x / 257), one of 32-bit integer or floating-point pixels refused. An EXIF orientation or 35 mm
-focal length that is no such value (damaged, out of range) is taken as absent. Photos of up to
+focal length that is no such value (damaged, out of range) is taken as absent. A photo whose shown pixels are grey
+(:func:`is_monochrome`: a greyscale file, a night CCTV frame, a grey JPEG stored as RGB) is *monochrome*: a composite
+into it is made grey after its camera effects (:func:`to_monochrome`), since colour pastes in a grey photo are a
+difference a detector can learn. Photos of up to
 :data:`MAX_PHOTO_PIXELS` are read (Pillow's own guard against decompression bombs stops at about 179 megapixels,
 below a 200-megapixel phone's).
 """
@@ -36,6 +39,12 @@ HEIC_SUFFIXES = (".heic", ".heif")
 _ORIENTATION = 0x0112
 #: The most pixels a photo may have: a 200-megapixel phone's 16320 x 12240 with room to spare.
 MAX_PHOTO_PIXELS = 250_000_000
+#: A photo is monochrome where its channels differ by more than this many 8-bit levels in at most
+#: :data:`MONOCHROME_SHARE` of its shown pixels (JPEG's rounding moves a grey photo's channels by a level or two).
+MONOCHROME_CHROMA = 2
+MONOCHROME_SHARE = 0.001
+#: Rec. 601 luma weights, JPEG's Y and Pillow's "L": a monochrome composite's grey.
+_LUMA = np.array([0.299, 0.587, 0.114])
 #: EXIF 35 mm equivalent focal lengths taken as stated (mm), a fisheye's to a superzoom's; others are taken as absent.
 FOCAL_35MM_RANGE = (8.0, 3000.0)
 
@@ -158,16 +167,31 @@ def cover_region(size: tuple[int, int], output: tuple[int, int] | None,
     return (x0, y0, x0 + cut_w, y0 + cut_h), scale
 
 
+def is_monochrome(pixels: np.ndarray) -> bool:
+    """Whether 8-bit RGB ``pixels`` (H, W, 3) are grey: max - min over the channels above
+    :data:`MONOCHROME_CHROMA` in at most :data:`MONOCHROME_SHARE` of them."""
+    chroma = pixels.max(axis=2) - pixels.min(axis=2)
+    return int(np.count_nonzero(chroma > MONOCHROME_CHROMA)) <= MONOCHROME_SHARE * chroma.size
+
+
+def to_monochrome(rgb: np.ndarray) -> np.ndarray:
+    """8-bit RGB ``rgb`` (H, W, 3) made grey: every channel its Rec. 601 luma, rounded (a grey pixel is kept)."""
+    luma = np.rint(rgb.astype(np.float64) @ _LUMA).clip(0, 255).astype(np.uint8)
+    return np.repeat(luma[..., None], 3, axis=2)
+
+
 @dataclass(frozen=True, eq=False)
 class Photo:
     """A photo read for one composite: ``pixels`` (H, W, 3) uint8 at the written size, the file's SHA-256, its
-    header, and the ``region`` and ``scale`` it was cut with (:func:`cover_region`)."""
+    header, the ``region`` and ``scale`` it was cut with (:func:`cover_region`), and whether the pixels shown are
+    grey (:func:`is_monochrome`)."""
 
     pixels: np.ndarray
     sha256: str
     header: PhotoHeader
     region: tuple[float, float, float, float]
     scale: float
+    monochrome: bool
 
 
 def read_photo(path: str | Path, output: tuple[int, int] | None) -> Photo:
@@ -194,4 +218,5 @@ def read_photo(path: str | Path, output: tuple[int, int] | None) -> Photo:
         pixels = np.asarray(rgb, np.uint8)[int(y0):int(y1), int(x0):int(x1)]
     else:
         pixels = np.asarray(rgb.resize(size, Image.Resampling.LANCZOS, box=region), np.uint8)
-    return Photo(np.ascontiguousarray(pixels), hashlib.sha256(data).hexdigest(), header, region, scale)
+    pixels = np.ascontiguousarray(pixels)
+    return Photo(pixels, hashlib.sha256(data).hexdigest(), header, region, scale, is_monochrome(pixels))

@@ -4,7 +4,8 @@ Per composite (:func:`make_composite`): the photo read and cut to the output siz
 (:func:`synthua_usd.backends.photos.read_photo`); its camera model and pastes drawn from the ``composite`` stream
 of (config seed, composite number, background path) (:mod:`synthua_usd.dataset.composite_plan`); the pastes
 painted with their labels (:func:`synthua_usd.backends.compositing.compose`); camera effects from the ``effects``
-stream; every visible pasted instance annotated as generate annotates (:func:`synthua_usd.dataset.annotations.annotate`:
+stream, then the whole made grey where the photo is (:func:`synthua_usd.backends.photos.is_monochrome`); every
+visible pasted instance annotated as generate annotates (:func:`synthua_usd.dataset.annotations.annotate`:
 visible and amodal masks, boxes, occlusion, truncation, relations; keypoints with their visibility updated); the
 photo's own boxes kept or dropped; QA; and the files of a dataset image (the same writer as ``synthua generate``'s,
 :func:`synthua_usd.pipeline.dataset_worker.write_image`, on a background thread while the next composite is made),
@@ -25,7 +26,7 @@ from synthua_usd.backends import frame_files
 from synthua_usd.backends.camera_effects import apply_effects
 from synthua_usd.backends.compositing import PasteInput, compose, composite_depth
 from synthua_usd.backends.cutout_pixels import CutoutPixels, read_cutout
-from synthua_usd.backends.photos import read_photo
+from synthua_usd.backends.photos import read_photo, to_monochrome
 from synthua_usd.dataset import keypoints, qa
 from synthua_usd.dataset.annotations import annotate, mark_ignored, panoptic
 from synthua_usd.dataset.composite_config import CompositeConfig
@@ -189,6 +190,8 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
         depth = (composite_depth(drawn.camera.ground_depth(), painted, [p.distance_m for p in placements])
                  if effects.defocus is not None else None)
         display = apply_effects(display, effects, depth)
+    if photo.monochrome:        # a grey photo's composite is grey: colour pastes would give themselves away
+        display = to_monochrome(display)
     seconds = {"compose": time.perf_counter() - t0}
 
     t0 = time.perf_counter()
@@ -233,7 +236,8 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
         composite={"background": {"path": background.relative, "sha256": photo.sha256,
                                   "layout": job.backgrounds.layout, "labelled": job.backgrounds.labelled,
                                   "width": photo.header.width, "height": photo.header.height,
-                                  "region": [float(v) for v in photo.region], "scale": float(photo.scale)},
+                                  "region": [float(v) for v in photo.region], "scale": float(photo.scale),
+                                  "monochrome": photo.monochrome},
                    "bank": {"id": bank.id, "format": BANK_FORMAT}, "pastes": pastes,
                    "background_boxes": [{"label": b["label"], "class_name": b["class_name"],
                                          "bbox": [round(b["frame"][0], 4), round(b["frame"][1], 4),

@@ -12,7 +12,7 @@ from PIL import Image
 from PIL.ExifTags import IFD
 from PIL.TiffImagePlugin import IFDRational
 
-from synthua_usd.backends.photos import cover_region, photo_header, read_photo
+from synthua_usd.backends.photos import cover_region, is_monochrome, photo_header, read_photo, to_monochrome
 from synthua_usd.core.errors import InputError
 
 
@@ -157,3 +157,30 @@ def test_photos_above_pillows_bomb_guard_are_read_up_to_the_stated_limit(tmp_pat
                                              rf"most 0 megapixels"):
             read(path)
         assert Image.MAX_IMAGE_PIXELS == 100
+
+
+def test_grey_photos_are_monochrome_and_colour_ones_are_not(tmp_path, pixels):
+    grey = pixels[..., 1]
+    Image.fromarray(grey).save(tmp_path / "l.jpg", quality=90)                                  # a greyscale JPEG
+    Image.fromarray(grey).save(tmp_path / "l.png")
+    Image.fromarray(np.repeat(grey[..., None], 3, axis=2)).save(tmp_path / "rgb.jpg", quality=75)  # grey, stored RGB
+    for name in ("l.jpg", "l.png", "rgb.jpg"):
+        assert read_photo(tmp_path / name, None).monochrome, name
+    assert not read_photo(_save(tmp_path / "c.png", pixels), None).monochrome
+    # 1,000 grey pixels: one coloured pixel is still grey, two are not, two levels apart is grey (JPEG's rounding)
+    tinted = np.full((40, 25, 3), 120, np.uint8)
+    tinted[0, 0] = (200, 120, 120)
+    assert is_monochrome(tinted)
+    tinted[0, 1] = (120, 120, 160)
+    assert not is_monochrome(tinted)
+    tinted[0, 1] = (121, 120, 119)
+    assert is_monochrome(tinted)
+
+
+def test_to_monochrome_keeps_grey_pixels_and_gives_pillows_luma_to_colour_ones(pixels):
+    grey = np.repeat(pixels[..., :1], 3, axis=2)
+    np.testing.assert_array_equal(to_monochrome(grey), grey)
+    made = to_monochrome(pixels)
+    assert np.array_equal(made[..., 0], made[..., 1]) and np.array_equal(made[..., 1], made[..., 2])
+    pillow = np.asarray(Image.fromarray(pixels).convert("L")).astype(int)      # Pillow's fixed-point Rec. 601
+    assert np.abs(made[..., 0].astype(int) - pillow).max() <= 1

@@ -386,3 +386,31 @@ def test_a_coco_set_with_its_photos_elsewhere_keeps_pastes_off_its_crowd_regions
     assert pasted
     code, said, err = run_cli("replay", out, str(boxed[0]["id"]))
     assert code == 0 and "byte-identical" in said + err, said + err
+
+
+def test_a_grey_photos_composites_are_grey_recorded_verified_and_replayed(inputs, unlabelled, tmp_path, run_cli):
+    """Colour pastes in a grey photo (a night CCTV frame) give themselves away: the composite is made grey after its
+    camera effects (white balance and noise among them), and the record and metadata table say so."""
+    import pyarrow.parquet as pq
+
+    for path in write_photos(tmp_path / "grey", 2, (96, 72), seed=4):
+        Image.open(path).convert("L").save(path)
+    out = tmp_path / "grey_out"
+    assert main([str(a) for a in ("composite", tmp_path / "grey", "--bank", inputs / "bank", "--config",
+                                  inputs / "config.json", "--out", out, "--workers", 1)]) == 0
+    records = _records(out)
+    assert sum(len(r["composite"]["pastes"]) for r in records) >= 2
+    for record in records:
+        assert record["composite"]["background"]["monochrome"] is True
+        image = _png(out / record["files"]["rgb_png"]).astype(int)
+        assert image.ndim == 3 and (image[..., 0] == image[..., 1]).all() and (image[..., 1] == image[..., 2]).all()
+    assert pq.read_table(out / "metadata.parquet").to_pydict()["background_monochrome"] == [True] * len(records)
+    code, text, _ = run_cli("verify", out)
+    assert code == 0 and text.strip().endswith("ok"), text
+    code, text, _ = run_cli("replay", out, str(records[0]["id"]))
+    assert code == 0 and "byte-identical" in text, text
+    # the colour photos' composites stay colour, their pastes too
+    for record in _records(unlabelled):
+        assert record["composite"]["background"]["monochrome"] is False
+        image = _png(unlabelled / record["files"]["rgb_png"]).astype(int)
+        assert (image[..., 0] != image[..., 2]).any()

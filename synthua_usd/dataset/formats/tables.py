@@ -12,7 +12,8 @@ Columns, in this order:
   instance entries of that class; pixels: its class pixel counts);
 * ``qa_verdict``, ``qa_reasons`` (joined by ``"; "``) and ``qa.MEASURE`` for each QA measure;
 * in a dataset of ``synthua composite``: ``background`` (the photo's path), ``background_labelled``,
-  ``horizon_row_px``, ``camera_height_m``, ``pastes`` and the photo's ``boxes_kept`` and ``boxes_dropped``.
+  ``background_monochrome``, ``horizon_row_px``, ``camera_height_m``, ``pastes`` and the photo's ``boxes_kept`` and
+  ``boxes_dropped``.
 
 A value a record does not have is empty in the CSV and null in Parquet.
 """
@@ -101,14 +102,15 @@ def metadata_rows(records: Iterable[DatasetRecord], class_map: ClassMap) -> list
 def _composite_columns(record: DatasetRecord) -> dict:
     """The columns of a composite (None for a rendered image in the same table)."""
     if "composite" not in record:
-        return dict.fromkeys(("background", "background_labelled", "horizon_row_px", "camera_height_m", "pastes",
-                              "boxes_kept", "boxes_dropped"))
+        return dict.fromkeys(("background", "background_labelled", "background_monochrome", "horizon_row_px",
+                              "camera_height_m", "pastes", "boxes_kept", "boxes_dropped"))
     composite, camera = record["composite"], record["camera"]
     boxes = composite["background_boxes"]
-    return {"background": composite["background"]["path"], "background_labelled": composite["background"]["labelled"],
-            "horizon_row_px": camera["horizon_row_px"], "camera_height_m": camera["height_m"],
-            "pastes": len(composite["pastes"]), "boxes_kept": sum(b["kept"] for b in boxes),
-            "boxes_dropped": sum(not b["kept"] for b in boxes)}
+    background = composite["background"]
+    return {"background": background["path"], "background_labelled": background["labelled"],
+            "background_monochrome": background["monochrome"], "horizon_row_px": camera["horizon_row_px"],
+            "camera_height_m": camera["height_m"], "pastes": len(composite["pastes"]),
+            "boxes_kept": sum(b["kept"] for b in boxes), "boxes_dropped": sum(not b["kept"] for b in boxes)}
 
 
 def write_tables(rows: list[dict], csv_path: str | Path, parquet_path: str | Path) -> None:
