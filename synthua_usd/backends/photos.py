@@ -40,9 +40,10 @@ _ORIENTATION = 0x0112
 #: The most pixels a photo may have: a 200-megapixel phone's 16320 x 12240 with room to spare.
 MAX_PHOTO_PIXELS = 250_000_000
 #: A photo is monochrome where its channels differ by more than this many 8-bit levels in at most
-#: :data:`MONOCHROME_SHARE` of its shown pixels (JPEG's rounding moves a grey photo's channels by a level or two).
+#: :data:`MONOCHROME_SHARE` of its shown pixels (JPEG's rounding moves a grey photo's channels by a level or two; a
+#: camera's coloured time stamp may lie over a grey frame; a colour photo's sensor noise alone moves most pixels more).
 MONOCHROME_CHROMA = 2
-MONOCHROME_SHARE = 0.001
+MONOCHROME_SHARE = 0.01
 #: Rec. 601 luma weights, JPEG's Y and Pillow's "L": a monochrome composite's grey.
 _LUMA = np.array([0.299, 0.587, 0.114])
 #: EXIF 35 mm equivalent focal lengths taken as stated (mm), a fisheye's to a superzoom's; others are taken as absent.

@@ -167,13 +167,13 @@ def test_grey_photos_are_monochrome_and_colour_ones_are_not(tmp_path, pixels):
     for name in ("l.jpg", "l.png", "rgb.jpg"):
         assert read_photo(tmp_path / name, None).monochrome, name
     assert not read_photo(_save(tmp_path / "c.png", pixels), None).monochrome
-    # 1,000 grey pixels: one coloured pixel is still grey, two are not, two levels apart is grey (JPEG's rounding)
+    # 1,000 grey pixels: ten coloured ones (a time stamp) are still grey, eleven are not; two levels apart is grey
     tinted = np.full((40, 25, 3), 120, np.uint8)
-    tinted[0, 0] = (200, 120, 120)
+    tinted[0, :10] = (200, 120, 120)
     assert is_monochrome(tinted)
-    tinted[0, 1] = (120, 120, 160)
+    tinted[1, 0] = (120, 120, 160)
     assert not is_monochrome(tinted)
-    tinted[0, 1] = (121, 120, 119)
+    tinted[1, 0] = (121, 120, 119)
     assert is_monochrome(tinted)
 
 
