@@ -34,16 +34,22 @@ class CameraSettings:
     use_exif: bool = True
     pitch_deg: float | None = None
     light: Light | None = None
+    person_height_m: float | None = None
 
     def __post_init__(self) -> None:
         for name, lo, hi in (("horizon_row_share", -10.0, 10.0), ("height_m", 0.05, 1000.0),
                              ("focal_width_share", 0.05, 20.0)):
             object.__setattr__(self, name, _range(f"camera.{name}", getattr(self, name), lo, hi))
+        if self.person_height_m is not None and not 0.5 <= self.person_height_m <= 2.5:
+            raise InputError(f"camera.person_height_m: {self.person_height_m}; expected metres in [0.5, 2.5] or null")
 
     def to_document(self) -> dict:
+        """Every field; ``person_height_m`` only where set (it came after datasets were made, whose job keys stay)."""
         out = {f.name: getattr(self, f.name) for f in fields(self)}
         out.update({k: list(out[k]) for k in ("horizon_row_share", "height_m", "focal_width_share")})
         out["light"] = None if self.light is None else asdict(self.light)
+        if self.person_height_m is None:
+            del out["person_height_m"]
         return out
 
 

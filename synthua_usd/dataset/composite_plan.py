@@ -33,7 +33,7 @@ import numpy as np
 from synthua_usd.dataset.composite_config import BLEND_MODES, CameraSettings, CompositeConfig
 from synthua_usd.dataset.cutout_bank import BankEntry, Light
 from synthua_usd.dataset.record import PhotoCameraEntry
-from synthua_usd.model.photo_camera import PhotoCamera, focal_px_from_35mm
+from synthua_usd.model.photo_camera import PhotoCamera, focal_px_from_35mm, horizon_from_people
 
 #: Least drop, in pixels, from the horizon to an anchor (a paste right at the horizon would be infinitely far).
 MIN_DROP_PX = 1.0
@@ -59,9 +59,12 @@ class DrawnCamera:
 
 
 def draw_camera(settings: CameraSettings, sources: dict, size: tuple[int, int], exif_focal_35mm: float | None,
-                source_size: tuple[int, int], scale: float, rng: np.random.Generator) -> DrawnCamera:
+                source_size: tuple[int, int], scale: float, rng: np.random.Generator,
+                people: Sequence[tuple[float, float, float, float]] = ()) -> DrawnCamera:
     """The camera model of one composite of ``size`` (W, H), written from a photo of ``source_size`` at ``scale``
-    (written px per photo px). Its three ranges are always drawn, in one order, used or not."""
+    (written px per photo px); ``people`` the photo's kept person boxes in the frame (x0, y0, x1, y1), which place
+    the horizon where ``settings.person_height_m`` is set and one is whole in the frame. Its three ranges are always
+    drawn, in one order, used or not."""
     width, height = size
     horizon_share = float(rng.uniform(*settings.horizon_row_share))
     height_m = float(rng.uniform(*settings.height_m))
@@ -77,6 +80,11 @@ def draw_camera(settings: CameraSettings, sources: dict, size: tuple[int, int], 
     else:
         camera = PhotoCamera(width, height, horizon_share * height, height_m, focal)
         horizon_source = sources["horizon_row_share"]
+    found = (horizon_from_people(people, height, height_m, settings.person_height_m)
+             if settings.person_height_m is not None else None)
+    if found is not None:
+        camera = PhotoCamera(width, height, found[0], height_m, focal)
+        horizon_source = f"people:{found[1]}"
     return DrawnCamera(camera, {"horizon_row_px": horizon_source, "height_m": sources["height_m"],
                                 "focal_px": focal_source}, settings.light,
                        None if not exif_focal_35mm else float(exif_focal_35mm))

@@ -15,6 +15,9 @@ photos). Hence, for a paste whose ground point (its *anchor*) lands on row ``y_a
 * an object ``h`` metres tall standing there is ``h f / Z = h (y_a - y_h) / H`` pixels tall: farther is smaller and
   higher in the frame, and the size does not depend on the focal length.
 
+Read the other way, a photo's own people place its horizon (:func:`horizon_from_people`): a person ``h`` metres tall
+whose box stands on row ``y_b`` and is ``p`` pixels tall puts it on ``y_h = y_b - p H / h``.
+
 Pixel coordinates: (0, 0) is the top-left corner of the image, pixel centres at integer + 0.5 (as in
 :mod:`synthua_usd.model.cameras`).
 """
@@ -37,6 +40,22 @@ def focal_px_from_35mm(f35_mm: float, width_px: int, height_px: int) -> float:
     """The focal length in pixels of an image ``width_px`` x ``height_px`` whose EXIF gives the 35 mm equivalent
     focal length ``f35_mm`` (the film's 36 mm lie along the image's long side)."""
     return float(f35_mm) / FILM_WIDTH_MM * max(int(width_px), int(height_px))
+
+
+#: A person box places the horizon only where it is whole in the frame: both of its top and bottom edges at least this
+#: many pixels inside it (a box the frame cuts shows part of a person) and at least :data:`MIN_PERSON_PX` tall.
+PERSON_EDGE_PX = 1.0
+MIN_PERSON_PX = 16.0
+
+
+def horizon_from_people(boxes, frame_height_px: float, camera_height_m: float,
+                        person_height_m: float) -> tuple[float, int] | None:
+    """The horizon row that a photo's standing people put it on, and how many did: for each box ``(x0, y0, x1, y1)``
+    (written pixels) whole in a frame ``frame_height_px`` tall, ``y1 - (y1 - y0) camera_height_m /
+    person_height_m``; their median. None where no box is whole in the frame."""
+    rows = [y1 - (y1 - y0) * camera_height_m / person_height_m for _, y0, _, y1 in boxes
+            if y0 >= PERSON_EDGE_PX and y1 <= frame_height_px - PERSON_EDGE_PX and y1 - y0 >= MIN_PERSON_PX]
+    return (float(np.median(rows)), len(rows)) if rows else None
 
 
 @dataclass(frozen=True)

@@ -176,9 +176,10 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
     rng = stream(config.seed, planned.seed, "composite", planned.background)
     camera_rng, paste_rng = rng.spawn(2)
     settings, sources = config.camera_for(planned.background)
-    drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
-                        (photo.header.width, photo.header.height), photo.scale, camera_rng)
     boxes = _background_entries(background, job.backgrounds.labelled, photo, config, (width, height))
+    drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
+                        (photo.header.width, photo.header.height), photo.scale, camera_rng,
+                        [b["frame"] for b in boxes if b["kept"] and b["class_name"] == "person"])
     placements = plan_pastes(drawn, state.pools, config,      # pastes keep off crowds as off the kept boxes
                              [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng)
     entries = [bank.entry(p.entry_id) for p in placements]

@@ -10,7 +10,8 @@ import pytest
 from conftest import REPO
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.schemas import load_schema
-from synthua_usd.dataset.composite_config import LATER_MATCH_FIELDS, LATER_MATCH_GROUPS, CompositeConfig, MatchSettings
+from synthua_usd.dataset.composite_config import LATER_MATCH_FIELDS, LATER_MATCH_GROUPS, CameraSettings, \
+    CompositeConfig, MatchSettings
 
 
 def _defaults(node, schema) -> dict:
@@ -65,6 +66,18 @@ def test_later_match_fields_are_written_only_where_set_so_earlier_job_keys_hold(
         assert CompositeConfig.from_document(document) == config
 
 
+def test_person_height_is_written_only_where_set_and_checked():
+    assert "person_height_m" not in CompositeConfig().to_document()["camera"]        # earlier job keys hold
+    config = CompositeConfig.from_document({"camera": {"person_height_m": 1.7},
+                                            "folders": {"kids": {"person_height_m": 1.2}}})
+    assert config.to_document()["camera"]["person_height_m"] == 1.7
+    assert CompositeConfig.from_document(config.to_document()) == config
+    settings, sources = config.camera_for("kids/a.jpg")
+    assert settings.person_height_m == 1.2 and sources["person_height_m"] == "folder:kids"
+    with pytest.raises(InputError, match=r"camera\.person_height_m: 3\.0; expected metres in \[0\.5, 2\.5\] or null"):
+        CameraSettings(person_height_m=3.0)
+
+
 def test_match_settings_made_in_code_are_checked():
     with pytest.raises(InputError, match=r"match\.sharpness_strength: nan; expected a share in \[0, 1\]"):
         MatchSettings(sharpness_strength=float("nan"))
@@ -99,6 +112,7 @@ def test_the_shipped_config_is_valid():
     ({"split": {"train": 0.5, "val": 0.1, "test": 0.1}}, r"x\.json: split: train \+ val \+ test = 0\.7; expected"),
     ({"blend": {"hard": 0, "feather": 0, "blur": 0, "poisson": 0}}, r"x\.json: blend: weights"),
     ({"camera": {"height_m": [2, 1]}}, r"x\.json: camera\.height_m: \[2, 1\]"),
+    ({"camera": {"person_height_m": 0.2}}, r"x\.json: camera\.person_height_m: 0\.2"),
     ({"folders": {"a": {"height_m": -1}}}, r"x\.json: folders\.a\.height_m"),
     ({"output": {"width": 8, "height": 48}}, r"x\.json: output"),
 ])

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from synthua_usd.core.errors import InputError
-from synthua_usd.model.photo_camera import PhotoCamera, focal_px_from_35mm
+from synthua_usd.model.photo_camera import PhotoCamera, focal_px_from_35mm, horizon_from_people
 
 
 def _project(point_cam: np.ndarray, f: float, cx: float, cy: float) -> tuple[float, float]:
@@ -75,3 +75,21 @@ def test_impossible_values_are_refused(field, value):
 def test_an_anchor_on_or_above_the_horizon_has_no_distance():
     with pytest.raises(ValueError, match="not below the horizon"):
         PhotoCamera(64, 48, 20.0, 1.5, 60.0).distance_m(20.0)
+
+
+def test_a_photos_standing_people_put_the_horizon_where_the_pinhole_puts_it():
+    """People 1.7 m tall standing at 3, 6 and 15 m, projected by the rotation-free pinhole above, give back the
+    horizon of the level camera that saw them; boxes the frame cuts, or too small, place nothing."""
+    width, height, f, camera_m = 640, 480, 500.0, 1.4
+    boxes = []
+    for distance in (3.0, 6.0, 15.0):
+        _, foot = _project(_to_camera(np.array([0.0, 0.0, distance]), camera_m, 0.0), f, width / 2, 200.0)
+        _, head = _project(_to_camera(np.array([0.0, 1.7, distance]), camera_m, 0.0), f, width / 2, 200.0)
+        boxes.append((100.0, head, 140.0, foot))
+    row, used = horizon_from_people(boxes, height, camera_m, 1.7)
+    assert used == 3 and row == pytest.approx(200.0)         # a level camera's horizon is its principal row
+    cut = [(0.0, 0.0, 50.0, 300.0), (0.0, 200.0, 50.0, 480.0), (0.0, 100.0, 10.0, 110.0)]   # top, bottom, 10 px
+    assert horizon_from_people(cut, height, camera_m, 1.7) is None
+    assert horizon_from_people(boxes[:1] + cut, height, camera_m, 1.7) == (pytest.approx(200.0), 1)
+    # a taller stated person (or a lower camera) puts the horizon lower: y_b - p H / h
+    assert horizon_from_people(boxes[:1], height, camera_m, 1.9)[0] > 200.0

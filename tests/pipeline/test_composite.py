@@ -414,3 +414,35 @@ def test_a_grey_photos_composites_are_grey_recorded_verified_and_replayed(inputs
         assert record["composite"]["background"]["monochrome"] is False
         image = _png(unlabelled / record["files"]["rgb_png"]).astype(int)
         assert (image[..., 0] != image[..., 2]).any()
+
+
+def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled, tmp_path, run_cli):
+    """``camera.person_height_m``: the horizon of each composite of a labelled photo is the median of y_b - h H / 1.7
+    over its person boxes whole in the frame (recomputed here from the record's boxes), said as ``people:N``; the
+    pastes stand on that ground; without it, the config's range, as before."""
+    config = tmp_path / "people.json"
+    config.write_text(json.dumps({**CONFIG, "camera": {"person_height_m": 1.7}}))
+    out = tmp_path / "people"
+    assert main([str(a) for a in ("composite", inputs / "labelled", "--bank", inputs / "bank", "--config", config,
+                                  "--out", out, "--workers", 1)]) == 0
+    records = _records(out)
+    assert records
+    for record in records:
+        camera = record["camera"]
+        whole = [b["bbox"] for b in record["composite"]["background_boxes"]
+                 if b["class_name"] == "person" and b["reason"] in (None, "covered")
+                 and b["bbox"][1] >= 1.0 and b["bbox"][1] + b["bbox"][3] <= HEIGHT - 1.0 and b["bbox"][3] >= 16.0]
+        assert whole, "the fixture's first person box lies whole in the frame"
+        expected = float(np.median([y + h - h * camera["height_m"] / 1.7 for _, y, _, h in whole]))
+        assert camera["sources"]["horizon_row_px"] == f"people:{len(whole)}"
+        assert camera["horizon_row_px"] == pytest.approx(expected, abs=1e-3)
+        for paste in record["composite"]["pastes"]:
+            assert paste["anchor_px"][1] > camera["horizon_row_px"]
+            drop = paste["anchor_px"][1] - camera["horizon_row_px"]
+            assert paste["distance_m"] == pytest.approx(camera["focal_px"] * camera["height_m"] / drop, rel=1e-6)
+    job = json.loads((out / "generate.json").read_text())
+    assert job["job_key"]["config"]["camera"]["person_height_m"] == 1.7
+    code, text, _ = run_cli("replay", out, str(records[0]["id"]))
+    assert code == 0 and "byte-identical" in text, text
+    plain = _records(labelled)
+    assert plain and all(r["camera"]["sources"]["horizon_row_px"] == "config" for r in plain)
