@@ -48,11 +48,12 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     photos, hidden files and the datasets synthua wrote there are left out, linked folders followed.
     \b
     Per composite: the photo scaled down and cut to the config's output size; a camera model (horizon row,
-    camera height, focal length: from the config, its per-folder defaults, or the photo's EXIF); cut-outs
-    standing on that camera's ground plane, sized by their distance (a share of the frame height drawn from
-    the config), chosen for a camera elevation (and light) like the paste's; their shadows, exposure and white
-    balance matched to the photo around them, blend edges mixed (hard, feathered, blurred, Poisson); camera
-    effects where the config asks. Labels are exact: nearer pastes occlude farther ones (visible masks and
+    camera height, focal length: from the config, its per-folder defaults, or the photo's EXIF; the horizon
+    from a labelled photo's standing people where camera.person_height_m is set); cut-outs standing on that
+    camera's ground plane, sized by their distance (a share of the frame height drawn from the config), chosen
+    for a camera elevation (and light) like the paste's; their shadows, exposure and white balance matched to
+    the photo around them, blend edges mixed (hard, feathered, blurred, Poisson); camera effects where the
+    config asks; a grey photo's composite made grey. Labels are exact: nearer pastes occlude farther ones (visible masks and
     keypoint visibility follow, amodal masks kept); the photo's pixels are void (class 0). A labelled photo's
     boxes are kept in the YOLO labels and the records, except those the pastes cover (dropped, recorded).
     \b
