@@ -53,9 +53,10 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     camera's ground plane, sized by their distance (a share of the frame height drawn from the config), chosen
     for a camera elevation (and light) like the paste's; their shadows, exposure and white balance matched to
     the photo around them, blend edges mixed (hard, feathered, blurred, Poisson); camera effects where the
-    config asks; a grey photo's composite made grey. Labels are exact: nearer pastes occlude farther ones (visible masks and
-    keypoint visibility follow, amodal masks kept); the photo's pixels are void (class 0). A labelled photo's
-    boxes are kept in the YOLO labels and the records, except those the pastes cover (dropped, recorded).
+    config asks; a grey photo's composite made grey. Labels are exact: nearer pastes occlude farther ones
+    (visible masks and keypoint visibility follow, amodal masks kept); the photo's pixels are void (class 0). A
+    labelled photo's boxes are kept in the YOLO labels and the records, except those the pastes cover (dropped,
+    recorded).
     \b
     The dataset has synthua generate's layout: images, class and instance PNGs, COCO instances (pasted
     instances, RLE masks, keypoints), panoptic and Cityscapes files, YOLO labels (boxes in the config's box
