@@ -141,6 +141,10 @@ class MatchSettings:
             raise InputError(f"match.sharpness_sigma_px: {self.sharpness_sigma_px}; expected px in [0, 50]")
 
 
+#: The key of ``background_labels.classes`` for every class it does not list (mapped to null: left out).
+OTHER_CLASSES = "*"
+
+
 @dataclass(frozen=True)
 class BackgroundLabels:
     """What becomes of a labelled background's boxes (schema ``background_labels``)."""
@@ -150,8 +154,10 @@ class BackgroundLabels:
     drop_cropped_share: float = 0.5
 
     def our_class(self, name: str) -> str | None:
-        """The class a box of the set's class ``name`` becomes (None: left out)."""
-        return dict(self.classes).get(name, name)
+        """The class a box of the set's class ``name`` becomes (None: left out): as listed, else as ``"*"`` says
+        (null: every class not listed is left out), else the same name."""
+        mapping = dict(self.classes)
+        return mapping[name] if name in mapping else None if OTHER_CLASSES in mapping else name
 
 
 #: The composites' size (width, height) where the config gives no ``output``.

@@ -99,14 +99,21 @@ def plan_composites(backgrounds: BackgroundSet, config: CompositeConfig) -> list
             for n, (k, relative) in enumerate(pairs, 1)]
 
 
+#: How many unmapped class names an error names (a COCO set has 80).
+UNKNOWN_SHOWN = 8
+
+
 def _check_classes(backgrounds: BackgroundSet, config: CompositeConfig, bank, source: str) -> None:
     things = {c.name for c in bank.class_map.classes if c.isthing}
-    for name in backgrounds.names if backgrounds.labelled else ():
-        ours = config.background_labels.our_class(name)
-        if ours is not None and ours not in things:
-            raise InputError(f"{source}: background_labels.classes: {name!r} (a class of {shown(backgrounds.source)}) "
-                             f"becomes {ours!r}, not a thing class of the bank's class map; expected a mapping "
-                             f"{name!r}: one of {', '.join(sorted(things))} (or null to leave its boxes out)")
+    unknown = [name for name in (backgrounds.names if backgrounds.labelled else ())
+               if (ours := config.background_labels.our_class(name)) is not None and ours not in things]
+    if unknown:
+        named = ", ".join(repr(n) for n in unknown[:UNKNOWN_SHOWN]) + (
+            f" and {len(unknown) - UNKNOWN_SHOWN} more" if len(unknown) > UNKNOWN_SHOWN else "")
+        raise InputError(f"{source}: background_labels.classes: {named} ({'a class' if len(unknown) == 1 else 'classes'} of "
+                         f"{shown(backgrounds.source)}) {'is' if len(unknown) == 1 else 'are'} no thing class of the bank's class map; expected "
+                         f"each mapped to one of {', '.join(sorted(things))}, or to null to leave its boxes out "
+                         f"(\"*\": null leaves out every class not listed)")
     pools = eligible(bank.entries, config)
     if not any(pools.values()):
         raise InputError(f"{source}: pastes.aids / pastes.groups: no cut-out of the bank is left; expected aids and "
