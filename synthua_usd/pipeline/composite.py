@@ -105,15 +105,18 @@ UNKNOWN_SHOWN = 8
 
 def _check_classes(backgrounds: BackgroundSet, config: CompositeConfig, bank, source: str) -> None:
     things = {c.name for c in bank.class_map.classes if c.isthing}
+    labels = config.background_labels
     unknown = [name for name in (backgrounds.names if backgrounds.labelled else ())
-               if (ours := config.background_labels.our_class(name)) is not None and ours not in things]
+               if (ours := labels.our_class(name)) is not None and ours not in things]
     if unknown:
-        named = ", ".join(repr(n) for n in unknown[:UNKNOWN_SHOWN]) + (
-            f" and {len(unknown) - UNKNOWN_SHOWN} more" if len(unknown) > UNKNOWN_SHOWN else "")
-        raise InputError(f"{source}: background_labels.classes: {named} ({'a class' if len(unknown) == 1 else 'classes'} of "
-                         f"{shown(backgrounds.source)}) {'is' if len(unknown) == 1 else 'are'} no thing class of the bank's class map; expected "
-                         f"each mapped to one of {', '.join(sorted(things))}, or to null to leave its boxes out "
-                         f"(\"*\": null leaves out every class not listed)")
+        named = ", ".join(repr(n) if labels.our_class(n) == n else f"{n!r} mapped to {labels.our_class(n)!r}"
+                          for n in unknown[:UNKNOWN_SHOWN])
+        named += f" and {len(unknown) - UNKNOWN_SHOWN} more" if len(unknown) > UNKNOWN_SHOWN else ""
+        one = len(unknown) == 1
+        raise InputError(f"{source}: background_labels.classes: {named} ({'a class' if one else 'classes'} of "
+                         f"{shown(backgrounds.source)}) {'is' if one else 'are'} no thing class of the bank's class "
+                         f"map; expected each mapped to one of {', '.join(sorted(things))}, or to null to leave its "
+                         f"boxes out (\"*\": null leaves out every class not listed)")
     pools = eligible(bank.entries, config)
     if not any(pools.values()):
         raise InputError(f"{source}: pastes.aids / pastes.groups: no cut-out of the bank is left; expected aids and "
