@@ -272,6 +272,7 @@ def test_classes_of_a_labelled_set_the_bank_does_not_know_are_named_all_at_once(
                                                                    ("person", None)]
     (case / "config.json").write_text(json.dumps({**CONFIG, "background_labels": {"classes": {"dog": "dogs",
                                                                                               "*": None}}}))
-    _refused(run_cli, case, labelled, "classes: 'dog' mapped to 'dogs' (a class of", "is no thing class")
+    _refused(run_cli, case, labelled, "classes: 'dog' mapped to 'dogs' (a class of", "is no thing class",
+             out=case / "out3")
     (case / "config.json").write_text(json.dumps({**CONFIG, "background_labels": {"classes": {"*": "person"}}}))
     _refused(run_cli, case, labelled, "config.json: background_labels.classes.*", out=case / "out2")
