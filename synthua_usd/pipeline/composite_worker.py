@@ -238,7 +238,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
                                   "layout": job.backgrounds.layout, "labelled": job.backgrounds.labelled,
                                   "width": photo.header.width, "height": photo.header.height,
                                   "region": [float(v) for v in photo.region], "scale": float(photo.scale),
-                                  "monochrome": photo.monochrome},
+                                  **({"monochrome": True} if photo.monochrome else {})},
                    "bank": {"id": bank.id, "format": BANK_FORMAT}, "pastes": pastes,
                    "background_boxes": [{"label": b["label"], "class_name": b["class_name"],
                                          "bbox": [round(b["frame"][0], 4), round(b["frame"][1], 4),

@@ -108,7 +108,7 @@ def _composite_columns(record: DatasetRecord) -> dict:
     boxes = composite["background_boxes"]
     background = composite["background"]
     return {"background": background["path"], "background_labelled": background["labelled"],
-            "background_monochrome": background["monochrome"], "horizon_row_px": camera["horizon_row_px"],
+            "background_monochrome": background.get("monochrome", False), "horizon_row_px": camera["horizon_row_px"],
             "camera_height_m": camera["height_m"], "pastes": len(composite["pastes"]),
             "boxes_kept": sum(b["kept"] for b in boxes), "boxes_dropped": sum(not b["kept"] for b in boxes)}
 
