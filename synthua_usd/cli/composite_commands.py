@@ -74,6 +74,12 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     if s.skipped:
         say(f"left out {len(s.skipped)} dataset{'s' * (len(s.skipped) > 1)} written by synthua below BACKGROUNDS "
             f"({', '.join(s.skipped[:3])}{', ...' * (len(s.skipped) > 3)}): their images are no photos")
+    if s.grey:
+        say(f"{s.grey} composite{'s' * (s.grey > 1)} made grey: {'their photos are' if s.grey > 1 else 'its photo is'} "
+            f"grey (composite.background.monochrome)")
+    if s.horizon_from_people:
+        say(f"{s.horizon_from_people} of {s.images} composites with the horizon placed by their photo's people "
+            f"(camera.person_height_m; the others by camera.horizon_row_share or pitch_deg)")
     if s.labelled:
         say(f"the photos' boxes: {s.boxes_kept} kept, {s.boxes_dropped} dropped (covered by pastes, cut off by the "
             f"output size, unmapped, empty or crowd regions: see each record's composite.background_boxes)")

@@ -65,7 +65,8 @@ class CompositeRequest:
 @dataclass
 class CompositeSummary:
     """What a run made: composites, of which QA flagged and rejected; pastes; the photo's boxes kept and dropped;
-    the photos and whether they were labelled; seconds per phase summed over the workers; wall time."""
+    composites made grey and those whose horizon the photo's people placed; the photos and whether they were
+    labelled; seconds per phase summed over the workers; wall time."""
 
     out_dir: Path
     images: int = 0
@@ -74,6 +75,10 @@ class CompositeSummary:
     pastes: int = 0
     boxes_kept: int = 0
     boxes_dropped: int = 0
+    #: Composites made grey: their photo is (``composite.background.monochrome``).
+    grey: int = 0
+    #: Composites whose horizon the photo's people placed (``camera.sources.horizon_row_px`` ``people:N``).
+    horizon_from_people: int = 0
     backgrounds: int = 0
     labelled: bool = False
     #: Datasets synthua wrote below a folder of photos, left out (paths relative to it).
@@ -202,6 +207,8 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
     boxes = [b for r in records for b in r["composite"]["background_boxes"]]
     summary.boxes_kept = sum(b["kept"] for b in boxes)
     summary.boxes_dropped = len(boxes) - summary.boxes_kept
+    summary.grey = sum(bool(r["composite"]["background"].get("monochrome")) for r in records)
+    summary.horizon_from_people = sum(r["camera"]["sources"]["horizon_row_px"].startswith("people:") for r in records)
     summary.seconds = seconds
     summary.wall_seconds = time.perf_counter() - started
     return summary

@@ -396,9 +396,11 @@ def test_a_grey_photos_composites_are_grey_recorded_verified_and_replayed(inputs
     for path in write_photos(tmp_path / "grey", 2, (96, 72), seed=4):
         Image.open(path).convert("L").save(path)
     out = tmp_path / "grey_out"
-    assert main([str(a) for a in ("composite", tmp_path / "grey", "--bank", inputs / "bank", "--config",
-                                  inputs / "config.json", "--out", out, "--workers", 1)]) == 0
+    code, said, err = run_cli("composite", tmp_path / "grey", "--bank", inputs / "bank", "--config",
+                              inputs / "config.json", "--out", out, "--workers", 1)
+    assert code == 0, said + err
     records = _records(out)
+    assert f"{len(records)} composites made grey: their photos are grey" in said
     assert sum(len(r["composite"]["pastes"]) for r in records) >= 2
     for record in records:
         assert record["composite"]["background"]["monochrome"] is True
@@ -423,10 +425,11 @@ def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled
     config = tmp_path / "people.json"
     config.write_text(json.dumps({**CONFIG, "camera": {"person_height_m": 1.7}}))
     out = tmp_path / "people"
-    assert main([str(a) for a in ("composite", inputs / "labelled", "--bank", inputs / "bank", "--config", config,
-                                  "--out", out, "--workers", 1)]) == 0
+    code, said, err = run_cli("composite", inputs / "labelled", "--bank", inputs / "bank", "--config", config,
+                              "--out", out, "--workers", 1)
+    assert code == 0, said + err
     records = _records(out)
-    assert records
+    assert records and f"{len(records)} of {len(records)} composites with the horizon placed by their photo's" in said
     for record in records:
         camera = record["camera"]
         whole = [b["bbox"] for b in record["composite"]["background_boxes"]
