@@ -153,6 +153,11 @@ class BackgroundLabels:
     drop_covered_share: float = 0.5
     drop_cropped_share: float = 0.5
 
+    def __post_init__(self) -> None:
+        if dict(self.classes).get(OTHER_CLASSES, None) is not None:
+            raise InputError(f"background_labels.classes.{OTHER_CLASSES}: {dict(self.classes)[OTHER_CLASSES]!r}; "
+                             f"expected null (every class not listed left out)")
+
     def our_class(self, name: str) -> str | None:
         """The class a box of the set's class ``name`` becomes (None: left out): as listed, else as ``"*"`` says
         (null: every class not listed is left out), else the same name."""

@@ -42,7 +42,8 @@ MIN_DROP_PX = 1.0
 @dataclass(frozen=True)
 class DrawnCamera:
     """A composite's camera model and where each of its values came from (``config``, ``folder:<name>``,
-    ``exif`` or ``pitch_deg`` of one of those); ``light`` the photo's light when the config gives it."""
+    ``exif``, ``pitch_deg:<one of those>`` or ``people:<boxes used>:<one of those>``); ``light`` the photo's light
+    when the config gives it."""
 
     camera: PhotoCamera
     sources: dict
@@ -62,9 +63,9 @@ def draw_camera(settings: CameraSettings, sources: dict, size: tuple[int, int], 
                 source_size: tuple[int, int], scale: float, rng: np.random.Generator,
                 people: Sequence[tuple[float, float, float, float]] = ()) -> DrawnCamera:
     """The camera model of one composite of ``size`` (W, H), written from a photo of ``source_size`` at ``scale``
-    (written px per photo px); ``people`` the photo's kept person boxes in the frame (x0, y0, x1, y1), which place
-    the horizon where ``settings.person_height_m`` is set and one is whole in the frame. Its three ranges are always
-    drawn, in one order, used or not."""
+    (written px per photo px); ``people`` the photo's person boxes in the frame (x0, y0, x1, y1), which place the
+    horizon where ``settings.person_height_m`` is set, ``settings.pitch_deg`` is not and one is whole in the frame.
+    Its three ranges are always drawn, in one order, used or not."""
     width, height = size
     horizon_share = float(rng.uniform(*settings.horizon_row_share))
     height_m = float(rng.uniform(*settings.height_m))
@@ -81,10 +82,10 @@ def draw_camera(settings: CameraSettings, sources: dict, size: tuple[int, int], 
         camera = PhotoCamera(width, height, horizon_share * height, height_m, focal)
         horizon_source = sources["horizon_row_share"]
     found = (horizon_from_people(people, height, height_m, settings.person_height_m)
-             if settings.person_height_m is not None else None)
-    if found is not None:
+             if settings.person_height_m is not None and settings.pitch_deg is None else None)
+    if found is not None:       # a known pitch wins: a measured camera over the people's estimate
         camera = PhotoCamera(width, height, found[0], height_m, focal)
-        horizon_source = f"people:{found[1]}"
+        horizon_source = f"people:{found[1]}:{sources['person_height_m']}"
     return DrawnCamera(camera, {"horizon_row_px": horizon_source, "height_m": sources["height_m"],
                                 "focal_px": focal_source}, settings.light,
                        None if not exif_focal_35mm else float(exif_focal_35mm))

@@ -43,18 +43,20 @@ def focal_px_from_35mm(f35_mm: float, width_px: int, height_px: int) -> float:
 
 
 #: A person box places the horizon only where it is whole in the frame: both of its top and bottom edges at least this
-#: many pixels inside it (a box the frame cuts shows part of a person) and at least :data:`MIN_PERSON_PX` tall.
-PERSON_EDGE_PX = 1.0
+#: share of the frame height inside it (a box the frame cuts shows part of a person; a label tool may stop one a pixel
+#: or two short of the edge) and at least :data:`MIN_PERSON_PX` tall.
+PERSON_EDGE_SHARE = 0.01
 MIN_PERSON_PX = 16.0
 
 
 def horizon_from_people(boxes, frame_height_px: float, camera_height_m: float,
                         person_height_m: float) -> tuple[float, int] | None:
     """The horizon row that a photo's standing people put it on, and how many did: for each box ``(x0, y0, x1, y1)``
-    (written pixels) whole in a frame ``frame_height_px`` tall, ``y1 - (y1 - y0) camera_height_m /
-    person_height_m``; their median. None where no box is whole in the frame."""
+    (written pixels) whole in a frame ``frame_height_px`` tall (its rows: the sides may cut it), ``y1 - (y1 - y0)
+    camera_height_m / person_height_m``; their median. None where no box is whole in the frame."""
+    edge = PERSON_EDGE_SHARE * frame_height_px
     rows = [y1 - (y1 - y0) * camera_height_m / person_height_m for _, y0, _, y1 in boxes
-            if y0 >= PERSON_EDGE_PX and y1 <= frame_height_px - PERSON_EDGE_PX and y1 - y0 >= MIN_PERSON_PX]
+            if y0 >= edge and y1 <= frame_height_px - edge and y1 - y0 >= MIN_PERSON_PX]
     return (float(np.median(rows)), len(rows)) if rows else None
 
 

@@ -114,14 +114,14 @@ def _check_classes(backgrounds: BackgroundSet, config: CompositeConfig, bank, so
     unknown = [name for name in (backgrounds.names if backgrounds.labelled else ())
                if (ours := labels.our_class(name)) is not None and ours not in things]
     if unknown:
-        named = ", ".join(repr(n) if labels.our_class(n) == n else f"{n!r} mapped to {labels.our_class(n)!r}"
+        named = ", ".join(repr(n) if labels.our_class(n) == n else f"{n!r} -> {labels.our_class(n)!r}"
                           for n in unknown[:UNKNOWN_SHOWN])
         named += f" and {len(unknown) - UNKNOWN_SHOWN} more" if len(unknown) > UNKNOWN_SHOWN else ""
         one = len(unknown) == 1
         raise InputError(f"{source}: background_labels.classes: {named} ({'a class' if one else 'classes'} of "
-                         f"{shown(backgrounds.source)}) {'is' if one else 'are'} no thing class of the bank's class "
-                         f"map; expected each mapped to one of {', '.join(sorted(things))}, or to null to leave its "
-                         f"boxes out (\"*\": null leaves out every class not listed)")
+                         f"{shown(backgrounds.source)}): {'not a thing class' if one else 'not thing classes'} of the "
+                         f"bank's class map; expected each mapped to one of {', '.join(sorted(things))}, or to null "
+                         f"to leave its boxes out (\"*\": null leaves out every class not listed)")
     pools = eligible(bank.entries, config)
     if not any(pools.values()):
         raise InputError(f"{source}: pastes.aids / pastes.groups: no cut-out of the bank is left; expected aids and "
@@ -162,7 +162,7 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
     config_document = config.to_document()
     config_document.pop("workers")
     job_key = {"config": config_document, "class_map": bank.class_map.document(), "bank": bank.id,
-               "backgrounds": [[b.relative, b.width, b.height] for b in backgrounds.images]}
+               "backgrounds": [[b.relative, b.width, b.height] for b in backgrounds.images], "grey_photos": True}
     job_document = {"synthua": __version__, "command": COMMAND, "job_key": job_key,
                     "job_key_digest": document_digest(job_key), "backgrounds": str(Path(request.backgrounds).resolve()),
                     "backgrounds_layout": backgrounds.layout, "backgrounds_split": request.split,
@@ -233,7 +233,8 @@ def remake(job_document: dict, planned: dict, out_dir: Path) -> dict:
         item = PlannedComposite(**planned)
         job = CompositeJob(out_dir=str(out_dir), config_document=job_document["job_key"]["config"],
                            class_map_document=job_document["job_key"]["class_map"], bank_root=job_document["bank"],
-                           backgrounds=backgrounds, city=cityscapes_city(config.name))
+                           backgrounds=backgrounds, city=cityscapes_city(config.name),
+                           grey_photos=job_document["job_key"].get("grey_photos") is True)
     except (KeyError, TypeError) as exc:
         raise InputError(f"generate.json: {type(exc).__name__} {exc}; expected the job `synthua composite` "
                          f"writes") from None

@@ -77,6 +77,9 @@ class CompositeJob:
     bank_root: str
     backgrounds: BackgroundSet
     city: str = "composite"
+    #: Whether a grey photo's composite is made grey: jobs made before 6 December 2026 did not (their ``job_key``
+    #: has no ``grey_photos``), and replay makes them as they were.
+    grey_photos: bool = True
 
 
 @dataclass
@@ -179,7 +182,8 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
     boxes = _background_entries(background, job.backgrounds.labelled, photo, config, (width, height))
     drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
                         (photo.header.width, photo.header.height), photo.scale, camera_rng,
-                        [b["frame"] for b in boxes if b["kept"] and b["class_name"] == "person"])
+                        [b["frame"] for b in boxes            # a box the cut crops at a side still spans its rows
+                         if b["class_name"] == "person" and (b["kept"] or b["reason"] == "cropped")])
     placements = plan_pastes(drawn, state.pools, config,      # pastes keep off crowds as off the kept boxes
                              [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng)
     entries = [bank.entry(p.entry_id) for p in placements]
@@ -191,7 +195,8 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
         depth = (composite_depth(drawn.camera.ground_depth(), painted, [p.distance_m for p in placements])
                  if effects.defocus is not None else None)
         display = apply_effects(display, effects, depth)
-    if photo.monochrome:        # a grey photo's composite is grey: colour pastes would give themselves away
+    grey = photo.monochrome and job.grey_photos
+    if grey:        # a grey photo's composite is grey: colour pastes would give themselves away
         display = to_monochrome(display)
     seconds = {"compose": time.perf_counter() - t0}
 
@@ -238,7 +243,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
                                   "layout": job.backgrounds.layout, "labelled": job.backgrounds.labelled,
                                   "width": photo.header.width, "height": photo.header.height,
                                   "region": [float(v) for v in photo.region], "scale": float(photo.scale),
-                                  **({"monochrome": True} if photo.monochrome else {})},
+                                  **({"monochrome": True} if grey else {})},
                    "bank": {"id": bank.id, "format": BANK_FORMAT}, "pastes": pastes,
                    "background_boxes": [{"label": b["label"], "class_name": b["class_name"],
                                          "bbox": [round(b["frame"][0], 4), round(b["frame"][1], 4),

@@ -5,6 +5,7 @@ most once; checked against the ground-plane relations computed here again."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -163,6 +164,21 @@ def test_the_camera_draw_names_its_sources():
     assert drawn.camera.focal_px == pytest.approx(320.0)
     assert drawn.camera.horizon_row_px == pytest.approx(240 + 320 * math.tan(math.radians(-10.0)))
     assert drawn.sources["horizon_row_px"] == "pitch_deg:config" and drawn.sources["focal_px"] == "config"
+
+
+def test_the_photos_people_place_the_horizon_unless_the_pitch_is_known():
+    sources = {"horizon_row_share": "config", "height_m": "config", "focal_width_share": "config",
+               "use_exif": "config", "pitch_deg": "config", "light": "config", "person_height_m": "folder:kids"}
+    people = [(10.0, 200.0, 60.0, 370.0), (300.0, 0.0, 340.0, 300.0)]     # one whole, one cut at the top
+    settings = CameraSettings(horizon_row_share=(0.25, 0.25), height_m=(1.2, 1.2), person_height_m=1.2)
+    drawn = draw_camera(settings, sources, (640, 480), None, (640, 480), 1.0, np.random.default_rng(0), people)
+    assert drawn.camera.horizon_row_px == pytest.approx(370.0 - 170.0 * 1.2 / 1.2)
+    assert drawn.sources["horizon_row_px"] == "people:1:folder:kids"
+    pitched = draw_camera(replace(settings, pitch_deg=-5.0), sources, (640, 480), None, (640, 480), 1.0,
+                          np.random.default_rng(0), people)
+    assert pitched.sources["horizon_row_px"] == "pitch_deg:config"
+    alone = draw_camera(settings, sources, (640, 480), None, (640, 480), 1.0, np.random.default_rng(0), people[1:])
+    assert alone.sources["horizon_row_px"] == "config" and alone.camera.horizon_row_px == pytest.approx(120.0)
 
 
 def test_the_plan_depends_on_the_seed_only(bank):

@@ -253,16 +253,17 @@ def test_a_yolo_folder_given_by_a_relative_path_and_a_data_yaml_whose_path_point
 
 def test_classes_of_a_labelled_set_the_bank_does_not_know_are_named_all_at_once(case, run_cli):
     """A COCO-style set of many classes: the error names every class to map (up to 8, then how many more), and
-    ``"*": null`` leaves out every class not listed (its boxes dropped as unmapped), ``person`` itself included."""
+    ``"*": null`` leaves out every class not listed (its boxes dropped as unmapped: ``person`` is listed to keep it)."""
     names = ["person", "dog", "traffic light", "bench", "cat", "bird", "horse", "sheep", "cow", "kite", "pizza"]
     labelled = case / "labelled"
     (labelled / "classes.txt").write_text("\n".join(names) + "\n")
     (labelled / "labels" / "photo_01.txt").write_text("0 0.5 0.5 0.2 0.4\n1 0.3 0.7 0.1 0.1\n")
     line = _refused(run_cli, case, labelled, "background_labels.classes: 'dog', 'traffic light', 'bench', 'cat', "
-                    "'bird', 'horse', 'sheep', 'cow' and 2 more (classes of", "are no thing class of the bank's",
+                    "'bird', 'horse', 'sheep', 'cow' and 2 more (classes of", "): not thing classes of the bank's",
                     "\"*\": null leaves out every class not listed")
     assert "'kite'" not in line and "'person'" not in line
-    (case / "config.json").write_text(json.dumps({**CONFIG, "background_labels": {"classes": {"person": "person", "*": None}}}))
+    (case / "config.json").write_text(json.dumps({**CONFIG, "background_labels": {"classes": {"person": "person",
+                                                                                              "*": None}}}))
     code, out, err = run_cli("composite", labelled, "--bank", case / "bank", "--config", case / "config.json",
                              "--out", case / "out", "--workers", "1")
     assert code == 0, out + err
@@ -272,7 +273,7 @@ def test_classes_of_a_labelled_set_the_bank_does_not_know_are_named_all_at_once(
                                                                    ("person", None)]
     (case / "config.json").write_text(json.dumps({**CONFIG, "background_labels": {"classes": {"dog": "dogs",
                                                                                               "*": None}}}))
-    _refused(run_cli, case, labelled, "classes: 'dog' mapped to 'dogs' (a class of", "is no thing class",
+    _refused(run_cli, case, labelled, "classes: 'dog' -> 'dogs' (a class of", "): not a thing class",
              out=case / "out3")
     (case / "config.json").write_text(json.dumps({**CONFIG, "background_labels": {"classes": {"*": "person"}}}))
     _refused(run_cli, case, labelled, "config.json: background_labels.classes.*", out=case / "out2")
