@@ -10,8 +10,8 @@ import pytest
 from conftest import REPO
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.schemas import load_schema
-from synthua_usd.dataset.composite_config import LATER_MATCH_FIELDS, LATER_MATCH_GROUPS, CameraSettings, \
-    CompositeConfig, MatchSettings
+from synthua_usd.dataset.composite_config import LATER_MATCH_FIELDS, LATER_MATCH_GROUPS, BackgroundLabels, \
+    CameraSettings, CompositeConfig, MatchSettings
 
 
 def _defaults(node, schema) -> dict:
@@ -76,6 +76,14 @@ def test_person_height_is_written_only_where_set_and_checked():
     assert settings.person_height_m == 1.2 and sources["person_height_m"] == "folder:kids"
     with pytest.raises(InputError, match=r"camera\.person_height_m: 3\.0; expected metres in \[0\.5, 2\.5\] or null"):
         CameraSettings(person_height_m=3.0)
+
+
+def test_other_classes_may_only_be_left_out():
+    labels = CompositeConfig.from_document({"background_labels": {"classes": {"person": "person", "*": None}}})
+    assert [labels.background_labels.our_class(n) for n in ("person", "dog")] == ["person", None]
+    assert CompositeConfig().background_labels.our_class("dog") == "dog"          # not listed, no "*": its own name
+    with pytest.raises(InputError, match=r"background_labels\.classes\.\*: 'person'; expected null"):
+        BackgroundLabels(classes=(("*", "person"),))
 
 
 def test_match_settings_made_in_code_are_checked():
