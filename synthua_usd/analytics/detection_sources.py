@@ -17,9 +17,9 @@ from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
 
 FORMATS = {
-    "yolo": lambda path, split, images_dir, targets: read_yolo(path, split),
-    "coco": lambda path, split, images_dir, targets: read_coco(path, images_dir),
-    "synthua": lambda path, split, images_dir, targets: read_generated(path, split, targets),
+    "yolo": lambda path, split, images_dir, targets, scored: read_yolo(path, split),
+    "coco": lambda path, split, images_dir, targets, scored: read_coco(path, images_dir),
+    "synthua": lambda path, split, images_dir, targets, scored: read_generated(path, split, targets, scored),
 }
 FORMAT_NAMES = ("auto",) + tuple(FORMATS)
 
@@ -45,15 +45,18 @@ def detect_format(path: Path) -> str:
 
 def read_detection_set(path: str | Path, fmt: str = "auto", split: str | None = None,
                        images_dir: str | Path | None = None,
-                       targets: DetectionTargets | None = None) -> DetectionSet:
+                       targets: DetectionTargets | None = None, scored: str = "all") -> DetectionSet:
     """The detection set at ``path`` in format ``fmt`` (one of :data:`FORMAT_NAMES`); ``split`` for YOLO and
     generated datasets, ``images_dir`` for COCO, ``targets`` (default :class:`DetectionTargets`) for generated
-    datasets."""
+    datasets, ``scored`` (:data:`~synthua_usd.model.detection_limits.SCORED_BOXES`) for composite ones."""
     path = Path(path)
     if fmt not in FORMAT_NAMES:
         raise InputError(f"--format: {fmt!r}; expected one of {', '.join(FORMAT_NAMES)}")
     fmt = detect_format(path) if fmt == "auto" else fmt
-    return FORMATS[fmt](path, split, images_dir, targets or DetectionTargets())
+    if scored != "all" and fmt != "synthua":
+        raise InputError(f"--boxes {scored}: {shown(path)} is read as a {fmt} set, which holds no pastes; expected a "
+                         f"dataset `synthua composite` wrote, or --boxes all")
+    return FORMATS[fmt](path, split, images_dir, targets or DetectionTargets(), scored)
 
 
 def set_id(dataset: DetectionSet) -> str:

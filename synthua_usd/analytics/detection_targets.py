@@ -21,7 +21,7 @@ split is scored (COCO's crowd rule).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from synthua_usd.analytics.dataset_index import dataset_manifest, load_class_map
@@ -33,7 +33,7 @@ from synthua_usd.dataset.layout import SPLITS, Layout
 from synthua_usd.dataset.manifest import kept_images
 from synthua_usd.dataset.record import DatasetRecord, InstanceEntry, read_record
 from synthua_usd.model.box_conventions import CONVENTIONS, DEFAULT_CONVENTION
-from synthua_usd.model.detection_limits import DEFAULT_MIN_HEIGHT_PX, MIN_HEIGHT_PX
+from synthua_usd.model.detection_limits import DEFAULT_MIN_HEIGHT_PX, MIN_HEIGHT_PX, SCORED_BOXES
 
 PERSON = "person"
 #: The classes trained by default: person and the eight mobility aids.
@@ -144,18 +144,28 @@ def background_boxes(record: DatasetRecord, targets: DetectionTargets) -> tuple[
     return tuple(out)
 
 
-def record_boxes(record: DatasetRecord, targets: DetectionTargets) -> tuple[Box, ...]:
+def record_boxes(record: DatasetRecord, targets: DetectionTargets, scored: str = "all") -> tuple[Box, ...]:
     """Every target box of one image record: its instances' (:func:`image_boxes`), then a composite's photo's own
-    (:func:`background_boxes`)."""
-    return image_boxes(record["instances"], targets) + background_boxes(record, targets)
+    (:func:`background_boxes`); with ``scored`` ``pasted`` or ``photo``
+    (:data:`~synthua_usd.model.detection_limits.SCORED_BOXES`) the other group's boxes are ``ignore``."""
+    pasted, photo = image_boxes(record["instances"], targets), background_boxes(record, targets)
+    if scored == "pasted":
+        photo = tuple(replace(b, ignore=True) for b in photo)
+    elif scored == "photo":
+        pasted = tuple(replace(b, ignore=True) for b in pasted)
+    return pasted + photo
 
 
-def read_generated(root, split: str | None, targets: DetectionTargets) -> DetectionSet:
-    """The target boxes of the images of ``split`` (every split when None) of a dataset ``synthua generate``
-    wrote; images QA rejected are left out, as every training format leaves them out."""
+def read_generated(root, split: str | None, targets: DetectionTargets, scored: str = "all") -> DetectionSet:
+    """The target boxes of the images of ``split`` (every split when None) of a dataset ``synthua generate`` or
+    ``synthua composite`` wrote; images QA rejected are left out, as every training format leaves them out.
+    ``scored`` (:data:`~synthua_usd.model.detection_limits.SCORED_BOXES`) other than ``all`` asks for a composite
+    dataset and keeps the other group's boxes as ``ignore`` (:func:`record_boxes`)."""
     layout = Layout(Path(root))
     if split is not None and split not in SPLITS:
         raise InputError(f"--split: {split!r}; expected one of {', '.join(SPLITS)}")
+    if scored not in SCORED_BOXES:
+        raise InputError(f"--boxes: {scored!r}; expected one of {', '.join(SCORED_BOXES)}")
     class_map = load_class_map(layout.root)
     things = {c.name for c in class_map.classes if c.isthing}
     unknown = [c for c in targets.classes if c not in things]
@@ -171,7 +181,10 @@ def read_generated(root, split: str | None, targets: DetectionTargets) -> Detect
         name, image_split = entry["name"], entry["split"]
         path = layout.path(Layout.record(name))
         record = read_record(path)
-        boxes, width, height = record_boxes(record, targets), record["width"], record["height"]
+        if scored != "all" and "composite" not in record:
+            raise InputError(f"--boxes {scored}: {shown(path)} is a rendered image's record (no composite part); "
+                             f"expected a dataset `synthua composite` wrote, or --boxes all")
+        boxes, width, height = record_boxes(record, targets, scored), record["width"], record["height"]
         image = layout.path(Layout.rgb_png(image_split, name))
         if checked_image_size(image, whole=False) != (width, height):  # its header: `synthua verify` checks the rest
             raise InputError(f"{shown(image)}: {'x'.join(map(str, checked_image_size(image, whole=False)))} pixels; "

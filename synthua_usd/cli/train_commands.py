@@ -139,11 +139,14 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
 @click.option("--convention", type=click.Choice(list(CONVENTIONS)),
               help="A generated TEST_SET's boxes drawn by this box convention (see `synthua train --help`), the "
                    "model's classes kept [default: the one the model was trained with]; other sets keep their own.")
+@click.option("--boxes", type=click.Choice(list(L.SCORED_BOXES)), default="all", show_default=True,
+              help="Of a composite TEST_SET (synthua composite): score its pasted instances alone (pasted) or its "
+                   "photos' own boxes alone (photo), the others ignored: neither found nor missed.")
 @click.option("--python", "python", type=click.Path(path_type=Path),
               help="Interpreter holding Ultralytics [default: $SYNTHUA_TRAIN_PYTHON, else .venv-train/bin/python].")
 def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, ...], fmt: str, split: str | None,
                   images_dir: Path | None, confidence: float, imgsz: int | None, device: str,
-                  convention: str | None, python: Path | None) -> int:
+                  convention: str | None, boxes: str, python: Path | None) -> int:
     """Score the detector of run folder MODEL (`synthua train`) on TEST_SET: real photos or a held-out split.
 
     \b
@@ -152,6 +155,8 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
           --map wheelchair=manual_wheelchair,electric_wheelchair --map person=person
       synthua evaluate-real out/runs/synthetic photos/instances.json --images photos/ --out out/eval_coco
       synthua evaluate-real out/runs/synthetic out/sim2real --split test --out out/eval_synthetic
+      synthua evaluate-real out/runs/real out/comp --split train --convention wheelchair-sets --boxes pasted \\
+          --map manual_wheelchair=wheelchair --out out/eval_pastes     # are the pastes wheelchairs to it?
     \b
     TEST_SET: an Ultralytics YOLO folder (data.yaml + images/ + labels/; box or polygon labels), a COCO
     instances .json, or a generated dataset (scored on the boxes the model was trained with, or those of
@@ -165,7 +170,7 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
     from synthua_usd.pipeline.evaluate_real import EvaluateRequest
 
     result = run(EvaluateRequest(model, test_set, out_dir, maps, fmt, split, images_dir, confidence,
-                                 imgsz=imgsz, device=device, python=python, convention=convention))
+                                 imgsz=imgsz, device=device, python=python, convention=convention, boxes=boxes))
     ev = result.evaluation
     click.echo(f"{ev.images} images ({result.document['test_set']['layout']}), mapping "
                f"{result.document['mapping_options']}: COCO AP {ev.stats['AP']:.4f}, AP50 {ev.stats['AP50']:.4f}")

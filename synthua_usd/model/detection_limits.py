@@ -31,3 +31,7 @@ DEFAULT_CONFIDENCE = 0.25
 #: The architecture trained by default: Ultralytics' smallest current detector (YOLO26 nano, 2.5 M parameters).
 DEFAULT_MODEL = "yolo26n.yaml"
 DEVICES = ("auto", "cpu", "cuda")
+#: Which boxes of a composite (`synthua composite`) are scored: ``all``; ``pasted``, its pasted instances' alone;
+#: ``photo``, its photo's own alone. The others are kept as ``ignore`` (neither required nor penalised), so a
+#: detection on the photo's own wheelchair user is no false positive of the pastes' score, nor the reverse.
+SCORED_BOXES = ("all", "pasted", "photo")

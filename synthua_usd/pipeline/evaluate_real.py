@@ -7,7 +7,9 @@ scored by pycocotools (:mod:`synthua_usd.analytics.detection_metrics`); the repo
 (:mod:`synthua_usd.analytics.detection_report`) is written as a set. A generated dataset as the test set is read
 with the box policy the model was trained with (its train.json), so a held-out synthetic split is scored on the
 boxes the model learnt, or with ``convention`` (a named box convention,
-:mod:`synthua_usd.model.box_conventions`) in its place, the model's classes kept.
+:mod:`synthua_usd.model.box_conventions`) in its place, the model's classes kept. A composite dataset
+(`synthua composite`) can be scored on its pasted instances alone or its photos' own boxes alone (``boxes``), the
+other group ignored: how a detector trained on real photos takes the pasted renders against the photos' own people.
 """
 
 from __future__ import annotations
@@ -43,7 +45,8 @@ class EvaluateRequest:
     """``model``: a run folder of `synthua train`; ``test_set`` in ``fmt`` (``split`` for YOLO and generated
     datasets, ``images_dir`` for COCO); ``maps``: ``--map`` values; ``confidence``: the one of precision, recall
     and the false negatives; ``imgsz``: prediction size (default: the training's); ``convention``: the box
-    convention a generated test set's boxes are drawn by (default: the model's training's)."""
+    convention a generated test set's boxes are drawn by (default: the model's training's); ``boxes``: which
+    boxes of a composite dataset are scored (``all``, ``pasted``, ``photo``; the others ignored)."""
 
     model: Path
     test_set: Path
@@ -59,8 +62,11 @@ class EvaluateRequest:
     threads: int | None = None
     python: Path | None = None
     convention: str | None = None
+    boxes: str = "all"
 
     def __post_init__(self):
+        if self.boxes not in L.SCORED_BOXES:
+            raise InputError(f"--boxes: {self.boxes!r}; expected one of {', '.join(L.SCORED_BOXES)}")
         if self.convention is not None and self.convention not in CONVENTIONS:
             raise InputError(f"--convention: {self.convention!r}; expected one of {', '.join(CONVENTIONS)}")
         for name, value in (("--confidence", self.confidence), ("--merge-iou", self.merge_iou)):
@@ -91,7 +97,11 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
                              f"boxes are its own; expected a dataset `synthua generate` wrote, or no --convention")
         targets = targets_for(request.convention, targets.classes, min_height_px=targets.min_height_px)
     split = request.split or ("test" if fmt == "synthua" else None)   # never a generated dataset's train split
-    test = read_detection_set(request.test_set, fmt, split, request.images_dir, targets)
+    test = read_detection_set(request.test_set, fmt, split, request.images_dir, targets, request.boxes)
+    if request.boxes != "all" and not any(test.counts().values()):
+        raise InputError(f"--boxes {request.boxes}: {shown(request.test_set)} has no {request.boxes} boxes of "
+                         f"{', '.join(test.names)} in {'split ' + split if split else 'any split'}; expected a "
+                         f"composite dataset with {'pastes' if request.boxes == 'pasted' else 'labelled photos'}")
     model_classes = tuple(about["classes"])
     mapping = build_mapping(request.maps, test.names, model_classes)
     imgsz = check_imgsz(request.imgsz or int(about["budget"]["imgsz"]))
@@ -120,7 +130,8 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
         "synthua": __version__,
         "test_set": {"source": test.source, "layout": test.layout, "split": test.split, "images": len(test.images),
                      "sha256": set_id(test), "dataset_id": manifest_sha256(test), "boxes": test.counts(),
-                     "targets": targets.document() if test.layout == "synthua" else None},
+                     "targets": targets.document() if test.layout == "synthua" else None,
+                     "scored_boxes": request.boxes},
         "model": {"weights": str(weights), "classes": list(model_classes), "train": about},
         "mapping": mapping.document(), "mapping_options": mapping.text(),
         "prediction": {"confidence_floor": PREDICT_CONFIDENCE, "nms_iou": PREDICT_IOU, "max_det": MAX_DETECTIONS,

@@ -257,6 +257,50 @@ def test_training_targets_take_the_kept_boxes_of_the_photo(labelled):
         assert len(photo_boxes) == len(kept)
 
 
+def test_scored_boxes_keep_one_group_and_ignore_the_other(labelled):
+    """``--boxes pasted`` / ``photo`` of `synthua evaluate-real`: the same boxes as ``all``, the other group's (the
+    photo's kept boxes, by the records' own bboxes; the pasted instances' otherwise) ignored, and only those."""
+    from synthua_usd.analytics.detection_targets import read_generated, targets_for
+
+    targets = targets_for("wheelchair-sets")
+    every = read_generated(labelled, None, targets)
+    pasted, photo = (read_generated(labelled, None, targets, scored) for scored in ("pasted", "photo"))
+    by_name = {r["name"]: r for r in _records(labelled)}
+    groups = {"pasted": 0, "photo": 0}
+    for a, p, q in zip(every.images, pasted.images, photo.images):
+        record = by_name[Path(a.path).stem]
+        kept = [b["bbox"] for b in record["composite"]["background_boxes"]
+                if b["kept"] and b["class_name"] in targets.classes]
+        assert [(b.label, b.x, b.y, b.w, b.h) for b in a.boxes] == [(b.label, b.x, b.y, b.w, b.h) for b in p.boxes] \
+            == [(b.label, b.x, b.y, b.w, b.h) for b in q.boxes]
+        for b, bp, bq in zip(a.boxes, p.boxes, q.boxes):
+            own = [b.x, b.y, b.w, b.h] in kept
+            groups["photo" if own else "pasted"] += not b.ignore
+            assert bp.ignore == (b.ignore or own) and bq.ignore == (b.ignore or not own)
+    assert groups["pasted"] > 0 and groups["photo"] > 0          # both groups are there to be told apart
+    for name in every.names:
+        assert every.counts()[name] == pasted.counts()[name] + photo.counts()[name]
+
+
+def test_evaluate_real_refuses_boxes_a_test_set_has_not(labelled, unlabelled, generated_random, tmp_path, run_cli):
+    """Refused in one line before any detector runs: a rendered dataset has no pastes to tell apart, a YOLO reading
+    none either, and an unlabelled photo's composite no photo boxes."""
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "weights.pt").write_bytes(b"not read before the test set is")
+    (run / "train.json").write_text(json.dumps({"classes": ["person", "wheelchair"], "budget": {"imgsz": 64}}))
+    split = _records(unlabelled)[0]["split"]
+    cases = [((generated_random, "--boxes", "pasted", "--split", "val"), "is a rendered image's record"),
+             ((labelled, "--boxes", "pasted", "--format", "yolo"), "is read as a yolo set, which holds no pastes"),
+             ((unlabelled, "--boxes", "photo", "--split", split, "--convention", "wheelchair-sets"),
+              "has no photo boxes")]
+    for args, found in cases:
+        code, out, err = run_cli("evaluate-real", run, *args, "--out", tmp_path / "eval")
+        lines = err.strip().splitlines()
+        assert code == 2 and len(lines) == 1 and lines[0].startswith("synthua: error: --boxes") and found in lines[0], err
+        assert not (tmp_path / "eval").exists()
+
+
 def test_stats_and_the_metadata_table_read_a_composite_dataset(unlabelled, tmp_path, run_cli):
     import pyarrow.parquet as pq
 
