@@ -124,6 +124,7 @@ def test_evaluate_real_on_the_held_out_split_uses_the_trained_boxes(run, generat
     assert main(["evaluate-real", str(run), str(generated_random), "--split", "val", "--out", str(out)]) == 0
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["test_set"]["layout"] == "synthua" and metrics["test_set"]["targets"]["aid_box"] == "with_user"
+    assert metrics["test_set"]["scored_boxes"] == "all"                  # --boxes: every box of the set scored
     assert metrics["test_set"]["dataset_id"] == json.loads((run / "train.json").read_text())["train_set"]["dataset_id"]
     aps = [c["AP50"] for c in metrics["classes"] if c["AP50"] is not None]
     assert aps and all(0.0 <= v <= 1.0 for v in aps) and np.isfinite(aps).all()
