@@ -174,6 +174,9 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
     ev = result.evaluation
     click.echo(f"{ev.images} images ({result.document['test_set']['layout']}), mapping "
                f"{result.document['mapping_options']}: COCO AP {ev.stats['AP']:.4f}, AP50 {ev.stats['AP50']:.4f}")
+    if boxes != "all":
+        scored = "the pasted instances" if boxes == "pasted" else "the photos' own boxes"
+        click.echo(f"scored: {scored} alone; the others ignored")
     click.echo(f"{'class':20s} {'boxes':>6s} {'AP50':>7s} {'AP50-95':>8s} {'P@' + format(confidence, 'g'):>7s} "
                f"{'R@' + format(confidence, 'g'):>7s}")
     for c in ev.classes:
