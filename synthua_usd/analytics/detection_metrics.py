@@ -129,8 +129,11 @@ def merge_detections(detections: list[Detection], mapping: ClassMapping, merge_i
 
 
 def evaluate_detections(test: DetectionSet, detections: list[Detection], mapping: ClassMapping,
-                        confidence: float = 0.25, merge_iou: float = 0.7) -> DetectionEvaluation:
-    """COCOeval of ``detections`` on ``test`` under ``mapping``; see the module's docstring."""
+                        confidence: float = 0.25, merge_iou: float = 0.7,
+                        unmapped_as_regions: bool = False) -> DetectionEvaluation:
+    """COCOeval of ``detections`` on ``test`` under ``mapping``; see the module's docstring. Each image's
+    ``regions``, and with ``unmapped_as_regions`` its boxes of test classes no mapping scores, are crowd regions of
+    every scored class: a detection on them is neither a hit nor a false positive of any class."""
     from pycocotools.coco import COCO
     from pycocotools.cocoeval import COCOeval
 
@@ -139,14 +142,21 @@ def evaluate_detections(test: DetectionSet, detections: list[Detection], mapping
                          for im in test.images],
               "annotations": [], "categories": [{"id": k, "name": t} for t, k in cat_id.items()]}
     gt_boxes: dict[int, Box] = {}
+
+    def annotate(image_id: int, box: Box, category: int, crowd: bool) -> int:
+        ann_id = len(gt_doc["annotations"]) + 1
+        gt_doc["annotations"].append({"id": ann_id, "image_id": image_id, "category_id": category,
+                                      "bbox": [box.x, box.y, box.w, box.h], "area": box.area, "iscrowd": int(crowd)})
+        return ann_id
+
     for im in test.images:
         for box in im.boxes:
             if box.label in cat_id:
-                ann_id = len(gt_doc["annotations"]) + 1
-                gt_doc["annotations"].append({"id": ann_id, "image_id": im.id, "category_id": cat_id[box.label],
-                                              "bbox": [box.x, box.y, box.w, box.h], "area": box.area,
-                                              "iscrowd": int(box.ignore)})
-                gt_boxes[ann_id] = box
+                gt_boxes[annotate(im.id, box, cat_id[box.label], box.ignore)] = box
+        regions = im.regions + tuple(b for b in im.boxes if unmapped_as_regions and b.label not in cat_id)
+        for box in regions:
+            for category in cat_id.values():
+                annotate(im.id, box, category, True)
     merged = merge_detections(detections, mapping, merge_iou)
     results = [{"image_id": d.image_id, "category_id": cat_id[d.label], "score": d.score, "bbox": [d.x, d.y, d.w, d.h]}
                for d in merged]

@@ -83,6 +83,9 @@ def _html(ev: DetectionEvaluation, about: dict, misses_shown: int) -> str:
     e = html.escape
     rows = [("test set", f"{about['test_set']['source']} ({about['test_set']['layout']}, split "
                          f"{about['test_set']['split'] or '-'}, {ev.images} images)"),
+            ("boxes scored", {"all": "all", "pasted": "the pasted instances alone (the photos' own ignored)",
+                              "photo": "the photos' own alone (the pasted instances ignored)"}
+             [about["test_set"].get("scored_boxes", "all")]),
             ("model", about["model"]["weights"]), ("mapping", about["mapping_options"]),
             ("confidence for precision, recall and false negatives", f"{ev.confidence:g} (IoU 0.5)"),
             ("COCO AP (IoU 0.50:0.95) / AP50 over the scored classes",

@@ -77,13 +77,15 @@ class Box:
 
 @dataclass(frozen=True)
 class SetImage:
-    """One image of a set: ``id`` from 1, its file, size in pixels and boxes."""
+    """One image of a set: ``id`` from 1, its file, size in pixels and boxes; ``regions``: boxes no class is scored
+    on, ignored for every class (with ``--boxes``, a composite's other group: COCO's crowd rule in each class)."""
 
     id: int
     path: Path
     width: int
     height: int
     boxes: tuple[Box, ...] = field(default=())
+    regions: tuple[Box, ...] = field(default=())
 
 
 @dataclass(frozen=True)

@@ -54,8 +54,8 @@ def read_detection_set(path: str | Path, fmt: str = "auto", split: str | None = 
         raise InputError(f"--format: {fmt!r}; expected one of {', '.join(FORMAT_NAMES)}")
     fmt = detect_format(path) if fmt == "auto" else fmt
     if scored != "all" and fmt != "synthua":
-        raise InputError(f"--boxes {scored}: {shown(path)} is read as a {fmt} set, which holds no pastes; expected a "
-                         f"dataset `synthua composite` wrote, or --boxes all")
+        raise InputError(f"--boxes {scored}: {shown(path)} is read as a {fmt} set, which does not record which boxes "
+                         f"were pasted; expected a dataset `synthua composite` wrote, read as one, or --boxes all")
     return FORMATS[fmt](path, split, images_dir, targets or DetectionTargets(), scored)
 
 
@@ -64,6 +64,8 @@ def set_id(dataset: DetectionSet) -> str:
     digest = hashlib.sha256(repr((dataset.names, dataset.split)).encode())
     for im in dataset.images:
         digest.update(repr((str(im.path), im.width, im.height, im.boxes)).encode())
+        if im.regions:                          # a set read with --boxes pasted or photo; others keep their ids
+            digest.update(repr(im.regions).encode())
     return digest.hexdigest()
 
 

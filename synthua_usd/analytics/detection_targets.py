@@ -144,23 +144,51 @@ def background_boxes(record: DatasetRecord, targets: DetectionTargets) -> tuple[
     return tuple(out)
 
 
-def record_boxes(record: DatasetRecord, targets: DetectionTargets, scored: str = "all") -> tuple[Box, ...]:
+#: Why a photo's box was dropped from a composite's labels while it still shows (part of) a labelled object.
+_STILL_SHOWN = ("covered", "cropped", "crowd")
+
+
+def record_boxes(record: DatasetRecord, targets: DetectionTargets) -> tuple[Box, ...]:
     """Every target box of one image record: its instances' (:func:`image_boxes`), then a composite's photo's own
-    (:func:`background_boxes`); with ``scored`` ``pasted`` or ``photo``
-    (:data:`~synthua_usd.model.detection_limits.SCORED_BOXES`) the other group's boxes are ``ignore``."""
+    (:func:`background_boxes`)."""
+    return image_boxes(record["instances"], targets) + background_boxes(record, targets)
+
+
+def _photo_regions(record: DatasetRecord) -> tuple[Box, ...]:
+    """Every box of a composite's photo that still shows something labelled, whatever its class: the kept ones and
+    those dropped as covered, cropped or a crowd region (``label`` the photo set's own)."""
+    if "composite" not in record:
+        return ()
+    out = []
+    for box in record["composite"]["background_boxes"]:
+        x, y, w, h = (float(v) for v in box["bbox"])
+        if (box["kept"] or box["reason"] in _STILL_SHOWN) and w > 0 and h > 0:
+            out.append(Box(box["label"], x, y, w, h, ignore=True))
+    return tuple(out)
+
+
+def scored_boxes(record: DatasetRecord, targets: DetectionTargets,
+                 scored: str = "all") -> tuple[tuple[Box, ...], tuple[Box, ...]]:
+    """The boxes of one record that are scored, and the regions ignored for every class: with ``scored`` ``all``
+    every target box (:func:`record_boxes`) and none; ``pasted``, the pasted instances' boxes, the photo's
+    (:func:`_photo_regions`) as regions; ``photo``, the photo's kept boxes, the pasted instances' (every class) and
+    the photo's dropped ones as regions (:data:`~synthua_usd.model.detection_limits.SCORED_BOXES`)."""
+    if scored == "all":
+        return record_boxes(record, targets), ()
     pasted, photo = image_boxes(record["instances"], targets), background_boxes(record, targets)
     if scored == "pasted":
-        photo = tuple(replace(b, ignore=True) for b in photo)
-    elif scored == "photo":
-        pasted = tuple(replace(b, ignore=True) for b in pasted)
-    return pasted + photo
+        return pasted, _photo_regions(record)
+    everything = replace(targets, classes=tuple(dict.fromkeys(i["class_name"] for i in record["instances"])) or
+                         targets.classes)
+    return photo, tuple(replace(b, ignore=True) for b in image_boxes(record["instances"], everything)) + tuple(
+        b for b in _photo_regions(record) if (b.x, b.y, b.w, b.h) not in {(k.x, k.y, k.w, k.h) for k in photo})
 
 
 def read_generated(root, split: str | None, targets: DetectionTargets, scored: str = "all") -> DetectionSet:
     """The target boxes of the images of ``split`` (every split when None) of a dataset ``synthua generate`` or
     ``synthua composite`` wrote; images QA rejected are left out, as every training format leaves them out.
     ``scored`` (:data:`~synthua_usd.model.detection_limits.SCORED_BOXES`) other than ``all`` asks for a composite
-    dataset and keeps the other group's boxes as ``ignore`` (:func:`record_boxes`)."""
+    dataset and keeps the other group's boxes as regions ignored for every class (:func:`scored_boxes`)."""
     layout = Layout(Path(root))
     if split is not None and split not in SPLITS:
         raise InputError(f"--split: {split!r}; expected one of {', '.join(SPLITS)}")
@@ -184,10 +212,10 @@ def read_generated(root, split: str | None, targets: DetectionTargets, scored: s
         if scored != "all" and "composite" not in record:
             raise InputError(f"--boxes {scored}: {shown(path)} is a rendered image's record (no composite part); "
                              f"expected a dataset `synthua composite` wrote, or --boxes all")
-        boxes, width, height = record_boxes(record, targets, scored), record["width"], record["height"]
+        (boxes, regions), width, height = scored_boxes(record, targets, scored), record["width"], record["height"]
         image = layout.path(Layout.rgb_png(image_split, name))
         if checked_image_size(image, whole=False) != (width, height):  # its header: `synthua verify` checks the rest
             raise InputError(f"{shown(image)}: {'x'.join(map(str, checked_image_size(image, whole=False)))} pixels; "
                              f"expected the {width}x{height} of its record {shown(path)}")
-        images.append(SetImage(n, image, width, height, boxes))
+        images.append(SetImage(n, image, width, height, boxes, regions))
     return DetectionSet(tuple(targets.classes), tuple(images), "synthua", str(layout.root), split)

@@ -98,12 +98,13 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
         targets = targets_for(request.convention, targets.classes, min_height_px=targets.min_height_px)
     split = request.split or ("test" if fmt == "synthua" else None)   # never a generated dataset's train split
     test = read_detection_set(request.test_set, fmt, split, request.images_dir, targets, request.boxes)
-    if request.boxes != "all" and not any(test.counts().values()):
-        raise InputError(f"--boxes {request.boxes}: {shown(request.test_set)} has no {request.boxes} boxes of "
-                         f"{', '.join(test.names)} in {'split ' + split if split else 'any split'}; expected a "
-                         f"composite dataset with {'pastes' if request.boxes == 'pasted' else 'labelled photos'}")
     model_classes = tuple(about["classes"])
     mapping = build_mapping(request.maps, test.names, model_classes)
+    if request.boxes != "all" and not any(test.counts()[t] for t in mapping.test_classes):
+        raise InputError(f"--boxes {request.boxes}: {shown(request.test_set)} has no {request.boxes} boxes of "
+                         f"{', '.join(mapping.test_classes)} in {'split ' + split if split else 'any split'}; expected "
+                         f"a composite dataset with {'pastes' if request.boxes == 'pasted' else 'labelled photos'} "
+                         f"of the classes scored")
     imgsz = check_imgsz(request.imgsz or int(about["budget"]["imgsz"]))
     python = find_detector_python(request.python)
     threads = request.threads or len(os.sched_getaffinity(0))
@@ -125,7 +126,8 @@ def evaluate_real(request: EvaluateRequest) -> EvaluateResult:
         image = test.images[int(d["image"])]
         x1, y1, x2, y2 = d["xyxy"]
         detections.append(Detection(image.id, d["class_name"], float(d["score"]), x1, y1, x2 - x1, y2 - y1))
-    evaluation = evaluate_detections(test, detections, mapping, request.confidence, request.merge_iou)
+    evaluation = evaluate_detections(test, detections, mapping, request.confidence, request.merge_iou,
+                                     unmapped_as_regions=request.boxes != "all")
     document = {
         "synthua": __version__,
         "test_set": {"source": test.source, "layout": test.layout, "split": test.split, "images": len(test.images),

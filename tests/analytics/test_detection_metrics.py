@@ -60,6 +60,23 @@ def test_class_without_boxes_has_no_ap_and_ignored_boxes_cost_nothing():
     assert (wheelchair.ap50, wheelchair.ap50_95, wheelchair.boxes, wheelchair.precision) == (None, None, 0, None)
 
 
+def test_regions_and_unmapped_boxes_cost_nothing_when_asked():
+    """`evaluate-real --boxes`: an image's regions are crowd regions of every scored class, and so, when asked, are
+    its boxes of classes no mapping scores; worked out by hand: one hit, then one detection on a region and one on
+    an unmapped cane, each a false positive unless it lies on an ignored region."""
+    hit, region, cane = Box("wheelchair", 10, 10, 20, 40), Box("person", 100, 10, 20, 40), Box("cane", 150, 10, 20, 40)
+    dets = [Detection(1, "manual_wheelchair", score, b.x, b.y, b.w, b.h) for score, b in
+            ((0.9, hit), (0.8, region), (0.7, cane))]
+    mapping = build_mapping(["wheelchair=manual_wheelchair"], ("wheelchair", "cane"), MODEL)
+    plain = one_set([[hit, cane]], names=("wheelchair", "cane"))
+    with_region = DetectionSet(plain.names, (SetImage(1, plain.images[0].path, 200, 100, (hit, cane), (region,)),),
+                               "synthua", "hand-made", "test")
+    for test, unmapped, fp in ((plain, False, 2), (with_region, False, 1), (with_region, True, 0)):
+        (wheelchair,) = evaluate_detections(test, dets, mapping, unmapped_as_regions=unmapped).classes
+        assert (wheelchair.tp, wheelchair.fp, wheelchair.fn, wheelchair.boxes) == (1, fp, 0, 1)
+        assert wheelchair.ap50 == pytest.approx(1.0)      # the hit ranks first: precision 1 at every recall
+
+
 def test_merged_model_classes_count_once():
     """A chair both wheelchair classes predicted is one detection of 'wheelchair', not a true and a false one."""
     gt = [[Box("wheelchair", 50, 20, 30, 30)]]

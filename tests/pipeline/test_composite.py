@@ -257,47 +257,56 @@ def test_training_targets_take_the_kept_boxes_of_the_photo(labelled):
         assert len(photo_boxes) == len(kept)
 
 
-def test_scored_boxes_keep_one_group_and_ignore_the_other(labelled):
-    """``--boxes pasted`` / ``photo`` of `synthua evaluate-real`: the same boxes as ``all``, the other group's (the
-    photo's kept boxes, by the records' own bboxes; the pasted instances' otherwise) ignored, and only those."""
+def test_scored_boxes_keep_one_group_and_make_the_other_regions(labelled):
+    """``--boxes pasted`` / ``photo`` of `synthua evaluate-real`: the scored boxes are those of ``all`` in the group
+    asked for (the photo's kept boxes told by the records' own bboxes), and the other group's are regions ignored
+    for every class: the photo's kept and covered, cropped or crowd boxes; the pasted instances' boxes."""
     from synthua_usd.analytics.detection_targets import read_generated, targets_for
 
     targets = targets_for("wheelchair-sets")
     every = read_generated(labelled, None, targets)
     pasted, photo = (read_generated(labelled, None, targets, scored) for scored in ("pasted", "photo"))
     by_name = {r["name"]: r for r in _records(labelled)}
-    groups = {"pasted": 0, "photo": 0}
+    seen = {"pasted": 0, "photo": 0, "dropped": 0}
     for a, p, q in zip(every.images, pasted.images, photo.images):
         record = by_name[Path(a.path).stem]
-        kept = [b["bbox"] for b in record["composite"]["background_boxes"]
-                if b["kept"] and b["class_name"] in targets.classes]
-        assert [(b.label, b.x, b.y, b.w, b.h) for b in a.boxes] == [(b.label, b.x, b.y, b.w, b.h) for b in p.boxes] \
-            == [(b.label, b.x, b.y, b.w, b.h) for b in q.boxes]
-        for b, bp, bq in zip(a.boxes, p.boxes, q.boxes):
-            own = [b.x, b.y, b.w, b.h] in kept
-            groups["photo" if own else "pasted"] += not b.ignore
-            assert bp.ignore == (b.ignore or own) and bq.ignore == (b.ignore or not own)
-    assert groups["pasted"] > 0 and groups["photo"] > 0          # both groups are there to be told apart
+        shown = [b["bbox"] for b in record["composite"]["background_boxes"]
+                 if (b["kept"] or b["reason"] in ("covered", "cropped", "crowd")) and min(b["bbox"][2:]) > 0]
+        own = [b for b in a.boxes if [b.x, b.y, b.w, b.h] in shown]
+        others = [b for b in a.boxes if [b.x, b.y, b.w, b.h] not in shown]
+        assert a.regions == () and p.boxes == tuple(others) and q.boxes == tuple(own)
+        assert sorted([r.x, r.y, r.w, r.h] for r in p.regions) == sorted(shown)
+        assert all(r.ignore for r in p.regions + q.regions)
+        q_regions = [[r.x, r.y, r.w, r.h] for r in q.regions]
+        assert all([b.x, b.y, b.w, b.h] in q_regions for b in others)         # every pasted box ignored there
+        assert all(box in q_regions for box in shown if box not in [[b.x, b.y, b.w, b.h] for b in own])
+        seen["pasted"] += len(others)
+        seen["photo"] += len(own)
+        seen["dropped"] += len(shown) - len(own)
+    assert seen["pasted"] > 0 and seen["photo"] > 0 and seen["dropped"] > 0   # every kind is there to tell apart
     for name in every.names:
         assert every.counts()[name] == pasted.counts()[name] + photo.counts()[name]
 
 
 def test_evaluate_real_refuses_boxes_a_test_set_has_not(labelled, unlabelled, generated_random, tmp_path, run_cli):
     """Refused in one line before any detector runs: a rendered dataset has no pastes to tell apart, a YOLO reading
-    none either, and an unlabelled photo's composite no photo boxes."""
+    of a composite does not say which boxes were pasted, and an unlabelled photo's composite has no photo boxes of
+    the classes scored."""
     run = tmp_path / "run"
     run.mkdir()
     (run / "weights.pt").write_bytes(b"not read before the test set is")
     (run / "train.json").write_text(json.dumps({"classes": ["person", "wheelchair"], "budget": {"imgsz": 64}}))
     split = _records(unlabelled)[0]["split"]
     cases = [((generated_random, "--boxes", "pasted", "--split", "val"), "is a rendered image's record"),
-             ((labelled, "--boxes", "pasted", "--format", "yolo"), "is read as a yolo set, which holds no pastes"),
+             ((labelled, "--boxes", "pasted", "--format", "yolo"),
+              "is read as a yolo set, which does not record which boxes were pasted"),
              ((unlabelled, "--boxes", "photo", "--split", split, "--convention", "wheelchair-sets"),
               "has no photo boxes")]
     for args, found in cases:
         code, out, err = run_cli("evaluate-real", run, *args, "--out", tmp_path / "eval")
         lines = err.strip().splitlines()
-        assert code == 2 and len(lines) == 1 and lines[0].startswith("synthua: error: --boxes") and found in lines[0], err
+        assert code == 2 and len(lines) == 1, err
+        assert lines[0].startswith("synthua: error: --boxes") and found in lines[0], err
         assert not (tmp_path / "eval").exists()
 
 
