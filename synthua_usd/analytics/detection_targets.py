@@ -178,10 +178,11 @@ def scored_boxes(record: DatasetRecord, targets: DetectionTargets,
     pasted, photo = image_boxes(record["instances"], targets), background_boxes(record, targets)
     if scored == "pasted":
         return pasted, _photo_regions(record)
-    everything = replace(targets, classes=tuple(dict.fromkeys(i["class_name"] for i in record["instances"])) or
-                         targets.classes)
-    return photo, tuple(replace(b, ignore=True) for b in image_boxes(record["instances"], everything)) + tuple(
-        b for b in _photo_regions(record) if (b.x, b.y, b.w, b.h) not in {(k.x, k.y, k.w, k.h) for k in photo})
+    every_class = tuple(dict.fromkeys(i["class_name"] for i in record["instances"])) or targets.classes
+    every_target = replace(targets, classes=every_class)
+    pastes = tuple(replace(b, ignore=True) for b in image_boxes(record["instances"], every_target))
+    scored_here = {(b.x, b.y, b.w, b.h) for b in photo}
+    return photo, pastes + tuple(b for b in _photo_regions(record) if (b.x, b.y, b.w, b.h) not in scored_here)
 
 
 def read_generated(root, split: str | None, targets: DetectionTargets, scored: str = "all") -> DetectionSet:
