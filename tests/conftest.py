@@ -120,6 +120,19 @@ def third_party(*parts: str) -> Path:
     return path
 
 
+def load_tool(script: str, name: str):
+    """The module of ``tools/<script>`` imported as ``name`` (registered in sys.modules: its dataclasses look their
+    module up)."""
+    import importlib.util
+    import sys
+
+    spec = importlib.util.spec_from_file_location(name, REPO / "tools" / script)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
 #: A generation config for tests: the demo street, 6 images of 64x48 at 2 spp over two conditions.
 TINY_CONFIG = DATA / "configs" / "tiny.json"
 

@@ -47,7 +47,6 @@ import shutil
 import sys
 import tempfile
 import time
-import traceback
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -59,7 +58,7 @@ from synthua_usd.analytics.detection_sets import DetectionSet  # noqa: E402
 from synthua_usd.analytics.detection_sources import detect_format, read_detection_set, set_id  # noqa: E402
 from synthua_usd.analytics.detection_targets import targets_for  # noqa: E402
 from synthua_usd.pipeline.detector.runner import find_detector_python  # noqa: E402
-from synthua_usd.cli.failures import describe as describe_failure  # noqa: E402
+from synthua_usd.cli.failures import tool_main  # noqa: E402
 from synthua_usd.core.atomic import write_json_atomic, write_text_atomic  # noqa: E402
 from synthua_usd.core.errors import InputError  # noqa: E402
 from synthua_usd.model import detection_limits as L  # noqa: E402
@@ -519,14 +518,7 @@ def run(argv: list[str] | None) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    try:
-        return run(argv)
-    except Exception as exc:  # noqa: BLE001 - bad input and failures end in one line, as the synthua command's
-        message, status = describe_failure(exc)
-        if status != 2:          # not bad input but a bug: its traceback helps whoever reports it
-            traceback.print_exc()
-        print(f"synthua: error: {message}", file=sys.stderr)
-        return status
+    return tool_main(run, argv)
 
 
 if __name__ == "__main__":

@@ -137,6 +137,19 @@ def guarded(fn: Callable[[], int], debug: bool) -> int:
         return status
 
 
+def tool_main(run: Callable[[list[str] | None], int], argv: list[str] | None = None) -> int:
+    """A ``tools/`` script's ``main``: ``run(argv)``, any failure one line on stderr as the synthua command's; bad
+    input exits 2, anything else 3 after its traceback (a bug: a tool has no --debug to ask for it)."""
+    try:
+        return run(argv)
+    except Exception as exc:  # noqa: BLE001 - bad input and failures end in one line, as the synthua command's
+        message, status = describe(exc)
+        if status != EXIT_INPUT:
+            traceback.print_exc()
+        print(f"synthua: error: {one_line(message)}", file=sys.stderr)
+        return status
+
+
 class _Held(logging.Filter):
     """Holds back every record it sees (they are handled later, or dropped)."""
 

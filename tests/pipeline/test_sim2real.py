@@ -240,15 +240,9 @@ def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path,
     split the test) and as the mixed set of arm d; one real photo drawn; 4 image-steps a training at imgsz 64; one
     seed (the seeds' spread is tested against NumPy in test_sim2real_plan.py). Hand-worked: (a) 4 / 2 images = 2
     epochs; (b) and (c) 4 / 1 photo = 4 epochs; (d) 1 photo + 2 mixed: 4 / 3 = 1.33 -> 1 epoch, 3 image-steps."""
-    import importlib.util
-    import sys
+    from conftest import load_tool
 
-    from conftest import REPO
-
-    spec = importlib.util.spec_from_file_location("sim2real_e2e", REPO / "tools" / "sim2real.py")
-    tool = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = tool
-    spec.loader.exec_module(tool)
+    tool = load_tool("sim2real.py", "sim2real_e2e")
     work = tmp_path / "work"
     args = ["--synthetic", str(generated_random), "--synthetic-split", "none", "--stand-in", str(generated_random),
             "--stand-in-test-split", "val", "--mix", str(generated_random), "--arms", "a,b,c,d", "--real-sizes", "1",

@@ -4,10 +4,8 @@ tools/sim2real.py's plan (--plan-only) and one-line refusals on a hand-made YOLO
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import shlex
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +13,7 @@ import pytest
 import scipy.stats
 from PIL import Image
 
-from conftest import REPO
+from conftest import load_tool
 from synthua_usd.core.errors import InputError
 from synthua_usd.pipeline import sim2real as S
 from synthua_usd.pipeline.sim2real_report import cell, curve, markdown
@@ -197,11 +195,7 @@ def test_the_markdown_and_the_curve(tmp_path):
 
 @pytest.fixture(scope="module")
 def tool():
-    spec = importlib.util.spec_from_file_location("sim2real_tool", REPO / "tools" / "sim2real.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("sim2real.py", "sim2real_tool")
 
 
 @pytest.fixture(scope="module")

@@ -1,20 +1,15 @@
 """tools/bench_targets.py: ratios and the markdown table it prints (the benchmark itself is not a test)."""
 
-import importlib.util
 import sys
 
 import pytest
 
-from conftest import REPO
+from conftest import REPO, load_tool
 
 
 @pytest.fixture(scope="module")
 def bench():
-    spec = importlib.util.spec_from_file_location("bench_targets", REPO / "tools" / "bench_targets.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("bench_targets.py", "bench_targets")
 
 
 def test_ratios(bench):
