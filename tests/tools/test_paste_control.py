@@ -2,6 +2,7 @@
 independent computation (PIL's own crop and resize, box areas by hand)."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -141,3 +142,127 @@ def test_a_photo_box_the_paste_covers_is_ignored_in_both_scorings(tool, photos):
     crowd = sorted((a["category_id"], a["bbox"]) for a in photo["annotations"] if a["image_id"] == 1 and a["iscrowd"])
     assert crowd == [(1, [10.0, 20.0, 40.0, 60.0]), (1, [20, 20, 60, 60]), (2, [10.0, 20.0, 40.0, 60.0]),
                      (2, [20, 20, 60, 60])]
+
+
+def test_the_feather_ramps_over_its_edge_pixels(tool):
+    alpha = tool.feather(12, 10)
+    ramp = [0.125, 0.375, 0.625, 0.875]
+    assert alpha[5].tolist() == ramp + [1.0] * 4 + ramp[::-1]
+    assert alpha[:, 6].tolist() == ramp + [1.0] * 2 + ramp[::-1]
+    assert alpha[0, 0] == 0.125 and alpha[1, 3] == 0.375
+
+
+def test_sizes_and_places_follow_the_rules(tool, photos, tmp_path):
+    """The paste's height is the donor's share of its image times 0.7-1 of this one's, and of 20 draws the paste
+    takes one that leaves the photo's boxes uncovered when such places are common (here: the right 80 of 160 px)."""
+    from synthua_usd.analytics.detection_sets import Box, read_yolo
+
+    found = read_yolo(photos / "data.yaml", "test")
+    for seed in range(10):
+        for image, paste in zip(found.images, tool.plan(found, "wheelchair", seed)):
+            share = paste.source.h / found.images[paste.donor].height
+            assert 0.7 * share * H - 0.5 <= paste.h <= share * H + 0.5
+            assert paste.y + paste.h >= 0.55 * H and paste.x + paste.w <= W
+    # one photo's boxes fill its lower-left quarter; the pastes (at most 64 px wide) fit right of x = 80 in about
+    # a third of the draws: all 20 draws missing is about 0.67 ** 20, so every seed finds a free place
+    blocked = replace(found.images[0], boxes=(Box("person", 0, 60, 80, 60),))
+    crowded = replace(found, images=(blocked,) + found.images[1:])
+    for seed in range(10):
+        paste = tool.plan(crowded, "wheelchair", seed)[0]
+        assert tool.cover(blocked.boxes[0], paste.x, paste.y, paste.w, paste.h) == 0.0, seed
+
+
+def test_a_box_half_covered_is_kept_and_the_donor_s_neighbours_are_regions(tool, photos):
+    from synthua_usd.analytics.detection_sets import Box, read_yolo
+
+    found = read_yolo(photos / "data.yaml", "test")
+    # image a's wheelchair (10, 20, 40, 60): exactly half covered by (30, 0, 40, 120), scored in photo.json
+    donor = Box("wheelchair", 20.0, 30.0, 40.0, 60.0)
+    neighbour = Box("person", 50.0, 10.0, 40.0, 100.0)      # its cut (20..60, 30..90) reaches x 50..60, y 30..90
+    found = replace(found, images=found.images[:3] + (replace(found.images[3], boxes=(donor, neighbour)),))
+    pastes = [tool.Paste(3, donor, 30, 0, 20, 30)] + [tool.Paste(0, found.images[0].boxes[0], 0, 0, 10, 10)] * 3
+    photo = tool.coco(found, "wheelchair", [tool.Paste(3, donor, 30, 0, 40, 120)] + pastes[1:], "photo")
+    scored = sorted((a["category_id"], a["bbox"]) for a in photo["annotations"] if a["image_id"] == 1
+                    and not a["iscrowd"])
+    assert scored == [(1, [100.0, 10.0, 30.0, 90.0]), (2, [10.0, 20.0, 40.0, 60.0])]
+    # the paste (30, 0, 20, 30) is the cut scaled by 0.5: the neighbour's part (50..60, 30..90) lands at
+    # x 30 + 30 * 0.5 = 45, y 0, 10 * 0.5 = 5 wide, 60 * 0.5 = 30 high
+    pasted = tool.coco(found, "wheelchair", pastes, "pasted")
+    crowd = sorted((a["category_id"], a["bbox"]) for a in pasted["annotations"] if a["image_id"] == 1
+                   and a["iscrowd"])
+    assert crowd == sorted([(c, [10.0, 20.0, 40.0, 60.0]) for c in (1, 2)] + [(c, [100.0, 10.0, 30.0, 90.0])
+                                                                             for c in (1, 2)]
+                           + [(c, [45.0, 0.0, 5.0, 30.0]) for c in (1, 2)])
+
+
+def test_a_coco_set_s_crowd_box_is_no_donor_and_stays_its_own_class_s_region(tool, photos, tmp_path):
+    import shutil
+
+    root = tmp_path / "coco"
+    root.mkdir()
+    images, annotations = [], []
+    for k, (stem, boxes) in enumerate(BOXES.items(), 1):
+        shutil.copy(photos / "images" / "test" / f"{stem}.png", root / f"{stem}.png")
+        images.append({"id": k, "file_name": f"{stem}.png", "width": W, "height": H})
+        for c, x, y, w, h in boxes:
+            annotations.append({"id": len(annotations) + 1, "image_id": k, "category_id": 1 + (c == "wheelchair"),
+                                "bbox": [x, y, w, h], "area": w * h, "iscrowd": 0})
+    crowd_box = [100, 20, 50, 80]                           # a wheelchair crowd on image d: big enough to paste
+    annotations.append({"id": len(annotations) + 1, "image_id": 4, "category_id": 2, "bbox": crowd_box,
+                        "area": 4000, "iscrowd": 1})
+    (root / "set.json").write_text(json.dumps({"images": images, "annotations": annotations, "categories": [
+        {"id": 1, "name": "person"}, {"id": 2, "name": "wheelchair"}]}))
+    for seed in range(6):
+        out = tmp_path / f"c{seed}"
+        assert tool.main([str(root / "set.json"), "--class", "wheelchair", "--out", str(out), "--seed", str(seed)]) == 0
+        record = json.loads((out / "control.json").read_text())
+        assert all(p["donor_box"] != crowd_box for p in record["pastes"])
+        photo = json.loads((out / "photo.json").read_text())
+        paste = record["pastes"][3]["box"]
+        rows = sorted(a["category_id"] for a in photo["annotations"] if a["image_id"] == 4 and a["bbox"] == crowd_box)
+        covered = _cover(("wheelchair", *crowd_box), paste) > 0.5
+        assert rows == ([1, 2] if covered else [2]), seed
+
+
+def test_photos_are_read_as_the_composites_read_them(tool, photos, tmp_path):
+    """A 16-bit grey photo: its pixels x / 257, rounded, in all three channels, and the paste made grey too."""
+    raw = np.random.default_rng(3).integers(0, 65536, (H, W), dtype=np.uint16)
+    Image.fromarray(raw).save(photos / "images" / "test" / "a.png")         # replaces a (its labels kept)
+    out = tmp_path / "control"
+    assert tool.main([str(photos), "--class", "wheelchair", "--out", str(out)]) == 0
+    x, y, w, h = json.loads((out / "control.json").read_text())["pastes"][0]["box"]
+    made = np.asarray(Image.open(out / "images" / "000001.png").convert("RGB")).astype(int)
+    outside = np.ones((H, W), bool)
+    outside[y:y + h, x:x + w] = False
+    expected = (raw.astype(int) + 128) // 257
+    for channel in range(3):
+        assert np.array_equal(made[..., channel][outside], expected[outside])
+    assert np.array_equal(made[..., 0], made[..., 1]) and np.array_equal(made[..., 1], made[..., 2])
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--class", "wheelchair", "--seed", "-1"], "--seed: -1; expected a whole number >= 0"),
+    (["--class", "wheelchair", "--out", "EXISTS"], ": exists; expected a new folder"),
+])
+def test_a_negative_seed_and_an_existing_folder_are_refused(tool, photos, tmp_path, capsys, argv, message):
+    out = tmp_path / "control"
+    if "EXISTS" in argv:
+        out.mkdir()
+        (out / "kept.txt").write_text("mine")
+        argv = [str(out) if a == "EXISTS" else a for a in argv]
+    assert tool.main([str(photos), "--out", str(out)] + argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("synthua: error: ") and message in err and "\n" not in err
+    assert not out.exists() or sorted(p.name for p in out.iterdir()) == ["kept.txt"]
+
+
+def test_a_photo_too_small_to_paste_into_is_refused(tool, photos, tmp_path, capsys):
+    Image.new("RGB", (20, 20)).save(photos / "images" / "test" / "e.png")
+    assert tool.main([str(photos), "--class", "wheelchair", "--out", str(tmp_path / "control")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "e.png: 20x20 pixels; expected at least 32x32 to paste into" in err and not (tmp_path / "control").exists()
+
+
+def test_a_generated_dataset_is_refused(tool, generated, tmp_path, capsys):
+    assert tool.main([str(generated), "--class", "manual_wheelchair", "--out", str(tmp_path / "control")]) == 2
+    assert "a dataset synthua wrote; expected real labelled photos" in capsys.readouterr().err
