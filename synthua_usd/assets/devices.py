@@ -129,10 +129,12 @@ def _arc(centre, radius: float, start_deg: float, stop_deg: float, count: int, p
     return np.asarray(centre, float) + offsets
 
 
-def _spoked_wheel(x: float, y: float, radius: float, spokes: int, dish: float) -> tuple[geo.Mesh, geo.Mesh]:
+def _spoked_wheel(x: float, y: float, radius: float, spokes: int, dish: float,
+                  tyre_m: float | None = None) -> tuple[geo.Mesh, geo.Mesh]:
     """(tyre, rim with hub and spokes) of a wheel of outer ``radius`` touching the ground at (x, y), axle
-    along y; spokes laced to both hub flanges ``dish`` apart."""
-    tyre_r = 0.05 * radius
+    along y; spokes laced to both hub flanges ``dish`` apart; the tyre's section radius ``tyre_m`` (default
+    5 % of ``radius``)."""
+    tyre_r = 0.05 * radius if tyre_m is None else tyre_m
     centre = (x, y, radius)
     tyre = geo.torus(centre, radius - tyre_r, tyre_r, axis="y", major_sections=32, minor_sections=8)
     rim_r = radius - 2 * tyre_r
@@ -160,14 +162,17 @@ def _caster(x: float, y: float, radius: float, stem_top: float) -> tuple[geo.Mes
 
 
 def manual_wheelchair_detailed(fit: DeviceFit = DeviceFit()) -> list[TwinPart]:
-    """Folding manual wheelchair: 0.6 m rear wheels of 16 spokes with push rims (where the posture's hands
-    push), 0.14 m casters on forks, a tubular frame with a cross brace, sling seat (its top at the fitted seat
-    height, its width the fitted width) and backrest, push handles, two footplates under the feet."""
+    """Folding manual wheelchair, as the standard steel chairs of hospitals and streets: 0.6 m rear wheels of
+    24 spokes with pneumatic tyres (36 mm) and push rims (where the posture's hands push), 0.14 m casters on
+    forks, a tubular frame with a cross brace, an upholstered seat (its top at the fitted seat height, its
+    width the fitted width) and backrest, padded armrests on posts with clothing guards under them between
+    seat and wheel, push handles, two footplates under the feet. Upholstery, pads and guards take the seat's
+    fabric."""
     h, w = fit.seat_height_m, fit.seat_width_m / 2
     side, wheel, push = w + 0.015, w + 0.06, w + 0.095
-    tyres, rims, casters, forks, frame, grips = [], [], [], [], [], []
+    tyres, rims, casters, forks, frame, grips, pads = [], [], [], [], [], [], []
     for s in (-1, 1):
-        tyre, rim = _spoked_wheel(REAR_WHEEL_X, s * wheel, 0.3, 16, 0.05)
+        tyre, rim = _spoked_wheel(REAR_WHEEL_X, s * wheel, 0.3, 24, 0.05, tyre_m=0.018)
         standoffs = [[(REAR_WHEEL_X + 0.25 * np.cos(a), s * (wheel + 0.01), 0.3 + 0.25 * np.sin(a)),
                       (REAR_WHEEL_X + RIM_RADIUS_M * np.cos(a), s * push, 0.3 + RIM_RADIUS_M * np.sin(a))]
                      for a in np.linspace(0, 2 * np.pi, 6, endpoint=False) + 0.2]
@@ -183,13 +188,18 @@ def manual_wheelchair_detailed(fit: DeviceFit = DeviceFit()) -> list[TwinPart]:
                             [(0.37, y, 0.22), (0.37, y, 0.26)], [(REAR_WHEEL_X, y, 0.24), (REAR_WHEEL_X, s * (wheel - 0.03), 0.3)]))
         grips.append(geo.tube([(-0.26, y, h + 0.45), (-0.36, y, h + 0.45)], 0.016, 8))
         frame.append(geo.box((0.32, min(s * 0.01, s * (w + 0.01)), 0.055), (0.5, max(s * 0.01, s * (w + 0.01)), 0.07)))
+        frame.append(_tubes(TUBE_M, *[[(x, y, h - 0.03), (x, y, h + 0.2)] for x in (-0.14, 0.16)]))  # armrest posts
+        inner, outer = sorted((s * (w + 0.005), s * (w + 0.065)))
+        pads.append(geo.box((-0.18, inner, h + 0.2), (0.2, outer, h + 0.24)))
+        guard = sorted((s * (w + 0.025), s * (w + 0.035)))
+        pads.append(geo.box((-0.15, guard[0], h - 0.01), (0.13, guard[1], h + 0.2)))  # clothing guard
     frame.append(_tubes(0.01, [(0.0, -side, 0.25), (0.0, side, h - 0.04)], [(0.0, side, 0.25), (0.0, -side, h - 0.04)]))
     return [
         TwinPart.of("RearWheels", geo.merge(*tyres), "Tyre"),
         TwinPart.of("Rims", geo.merge(*rims), "Frame"),
         TwinPart.of("Casters", geo.merge(*casters), "Tyre"),
-        TwinPart.of("Seat", geo.merge(geo.box((-0.18, -w, h - 0.012), (0.3, w, h)),
-                                      geo.box((-0.2, -w, h + 0.08), (-0.185, w, h + 0.42))), "Seat"),
+        TwinPart.of("Seat", geo.merge(geo.box((-0.18, -w, h - 0.04), (0.3, w, h)),
+                                      geo.box((-0.22, -w, h + 0.04), (-0.185, w, h + 0.44)), *pads), "Seat"),
         TwinPart.of("Frame", geo.merge(*frame, *forks), "Frame"),
         TwinPart.of("Grips", geo.merge(*grips), "Tyre"),
     ]

@@ -137,9 +137,10 @@ DEVICE_FINISHES = {
     "anodised": (((0.5, 0.05, 0.05), (0.05, 0.15, 0.5), (0.1, 0.1, 0.12), (0.4, 0.4, 0.42), (0.35, 0.1, 0.4)), 0.25, 0.85),
     "matte_black": (((0.025, 0.025, 0.028),), 0.75, 0.0),
 }
-#: Seat and backrest fabrics of wheelchairs.
-SEAT_FABRICS = ((0.03, 0.05, 0.15), (0.02, 0.02, 0.02), (0.15, 0.15, 0.16), (0.3, 0.04, 0.04), (0.04, 0.15, 0.06),
-                (0.25, 0.18, 0.1))
+#: Seat and backrest fabrics of wheelchairs (and the detailed chairs' armrest pads and clothing guards): black
+#: nylon or vinyl in five draws of nine, as on most chairs, else charcoal, navy, red or brown.
+SEAT_FABRICS = ((0.02, 0.02, 0.02),) * 5 + ((0.08, 0.08, 0.085), (0.03, 0.05, 0.15), (0.3, 0.04, 0.04),
+                                            (0.25, 0.18, 0.1))
 #: Natural hair colours, linear Rec.709 base colour: name -> (colour, roughness). Grey is drawn more with age
 #: (:func:`synthua_usd.randomisation.scene.draw_hair`).
 HAIR_COLOURS = {

@@ -136,7 +136,27 @@ def test_the_detailed_manual_wheelchair_has_spoked_wheels_with_push_rims_of_the_
         radius = np.linalg.norm(ring.vertices[:, [0, 2]] - axle, axis=1)
         assert abs((radius.min() + radius.max()) / 2 - RIM_RADIUS_M) < 1e-3
     spokes = [m for m in pieces if len(m.faces) == 16 and np.ptp(m.vertices[:, [0, 2]], axis=0).max() > 0.1]
-    assert 24 <= len(spokes) <= 36  # 12-18 a wheel
+    assert len(spokes) == 48  # 24 a wheel
+
+
+@pytest.mark.parametrize("fit", FITS, ids=["small", "large"])
+def test_the_detailed_manual_wheelchair_has_armrests_and_clothing_guards_between_seat_and_wheels(fit):
+    """Padded armrests 0.2-0.24 m over the seat, and guards under them from the seat up, both beside the seat
+    (not over the user's thighs) and inside the push rims (where the hands push)."""
+    h, w = fit.seat_height_m, fit.seat_width_m / 2
+    seat = next(p for p in _parts("manual_wheelchair", "detailed", fit) if p.name == "Seat")
+    one_side = [m for m in _pieces(seat) if np.ptp(np.sign(m.vertices[:, 1])) == 0]
+    beside = [m for m in one_side if np.abs(m.vertices[:, 1]).min() >= w - 1e-9]
+    pads = [m for m in beside if m.vertices[:, 2].min() > h + 0.1]
+    guards = [m for m in beside if m.vertices[:, 2].min() < h]
+    assert len(pads) == len(guards) == 2
+    for pad in pads:
+        assert np.allclose([pad.vertices[:, 2].min(), pad.vertices[:, 2].max()], [h + 0.2, h + 0.24])
+        assert np.ptp(pad.vertices[:, 0]) > 0.3  # long enough to rest a forearm on
+    for piece in pads + guards:
+        assert np.abs(piece.vertices[:, 1]).max() < w + 0.095 - 0.02  # clear of the push rims
+    for guard in guards:
+        assert guard.vertices[:, 2].min() < h and guard.vertices[:, 2].max() >= h + 0.2 - 1e-9
 
 
 def test_tube_and_torus_are_closed_and_outward_wound():
