@@ -170,7 +170,7 @@ def manual_wheelchair_detailed(fit: DeviceFit = DeviceFit()) -> list[TwinPart]:
     fabric."""
     h, w = fit.seat_height_m, fit.seat_width_m / 2
     side, wheel, push = w + 0.015, w + 0.06, w + 0.095
-    tyres, rims, casters, forks, frame, grips, pads = [], [], [], [], [], [], []
+    tyres, rims, casters, forks, frame, grips, upholstery = [], [], [], [], [], [], []
     for s in (-1, 1):
         tyre, rim = _spoked_wheel(REAR_WHEEL_X, s * wheel, 0.3, 24, 0.05, tyre_m=0.018)
         standoffs = [[(REAR_WHEEL_X + 0.25 * np.cos(a), s * (wheel + 0.01), 0.3 + 0.25 * np.sin(a)),
@@ -189,17 +189,16 @@ def manual_wheelchair_detailed(fit: DeviceFit = DeviceFit()) -> list[TwinPart]:
         grips.append(geo.tube([(-0.26, y, h + 0.45), (-0.36, y, h + 0.45)], 0.016, 8))
         frame.append(geo.box((0.32, min(s * 0.01, s * (w + 0.01)), 0.055), (0.5, max(s * 0.01, s * (w + 0.01)), 0.07)))
         frame.append(_tubes(TUBE_M, *[[(x, y, h - 0.03), (x, y, h + 0.2)] for x in (-0.14, 0.16)]))  # armrest posts
-        inner, outer = sorted((s * (w + 0.005), s * (w + 0.065)))
-        pads.append(geo.box((-0.18, inner, h + 0.2), (0.2, outer, h + 0.24)))
-        guard = sorted((s * (w + 0.025), s * (w + 0.035)))
-        pads.append(geo.box((-0.15, guard[0], h - 0.01), (0.13, guard[1], h + 0.2)))  # clothing guard
+        pad, guard = sorted((s * (w + 0.005), s * (w + 0.065))), sorted((s * (w + 0.025), s * (w + 0.035)))
+        upholstery += [geo.box((-0.18, pad[0], h + 0.2), (0.2, pad[1], h + 0.24)),  # armrest pad
+                       geo.box((-0.15, guard[0], h - 0.01), (0.13, guard[1], h + 0.2))]  # clothing guard
     frame.append(_tubes(0.01, [(0.0, -side, 0.25), (0.0, side, h - 0.04)], [(0.0, side, 0.25), (0.0, -side, h - 0.04)]))
     return [
         TwinPart.of("RearWheels", geo.merge(*tyres), "Tyre"),
         TwinPart.of("Rims", geo.merge(*rims), "Frame"),
         TwinPart.of("Casters", geo.merge(*casters), "Tyre"),
         TwinPart.of("Seat", geo.merge(geo.box((-0.18, -w, h - 0.04), (0.3, w, h)),
-                                      geo.box((-0.22, -w, h + 0.04), (-0.185, w, h + 0.44)), *pads), "Seat"),
+                                      geo.box((-0.22, -w, h + 0.04), (-0.185, w, h + 0.44)), *upholstery), "Seat"),
         TwinPart.of("Frame", geo.merge(*frame, *forks), "Frame"),
         TwinPart.of("Grips", geo.merge(*grips), "Tyre"),
     ]
