@@ -30,16 +30,17 @@ class PersonLook:
     long_legs: bool = True
 
     @classmethod
-    def random(cls, rng: np.random.Generator, aid_user: bool = False, min_height_m: float = 0.0) -> "PersonLook":
+    def random(cls, rng: np.random.Generator, aid_user: bool = False, min_height_m: float = 0.0,
+               long_sleeves: float = 0.6, long_legs: float = 0.6) -> "PersonLook":
         """A body uniform over the bank's general population (``aid_user``: over its older stratum) at least
         ``min_height_m`` tall, a skin tone uniform over the Monk scale, garment colours uniform over their
-        palettes, long sleeves and long legs each with probability 0.6."""
+        palettes, long sleeves and long legs with probabilities ``long_sleeves`` and ``long_legs``."""
         bank = load_bank()
         pool = np.flatnonzero((bank.aid_stratum if aid_user else ~bank.aid_stratum) & (bank.height_m >= min_height_m))
         return cls(body=int(pool[int(rng.integers(len(pool)))]), skin=SKINS[int(rng.integers(len(SKINS)))].key,
                    shirt=SHIRTS[int(rng.integers(len(SHIRTS)))].key, trousers=TROUSERS[int(rng.integers(len(TROUSERS)))].key,
-                   shoes=SHOES[int(rng.integers(len(SHOES)))].key, long_sleeves=bool(rng.random() < 0.6),
-                   long_legs=bool(rng.random() < 0.6))
+                   shoes=SHOES[int(rng.integers(len(SHOES)))].key, long_sleeves=bool(rng.random() < long_sleeves),
+                   long_legs=bool(rng.random() < long_legs))
 
     def region_material(self, region: str) -> str:
         """The material key of a garment region of :data:`synthua_usd.assets.bodies.REGIONS`."""

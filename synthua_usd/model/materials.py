@@ -25,6 +25,14 @@ SKINS = tuple(Material(f"Skin{i}", tuple(float(c) for c in to_linear(np.array([i
 SHIRTS = tuple(Material(f"Shirt{i}", c, 0.85) for i, c in enumerate(
     [(0.5, 0.06, 0.05), (0.05, 0.15, 0.45), (0.12, 0.35, 0.15), (0.7, 0.6, 0.1), (0.6, 0.6, 0.6), (0.05, 0.05, 0.05),
      (0.45, 0.15, 0.4), (0.8, 0.35, 0.1)]))
+#: Upper garments in the colours most street clothing has: black, charcoal, greys, off-white, navy, dark green,
+#: brown, beige, burgundy, denim blue, and one red (a wardrobe's ``street`` palette; SHIRTS is ``bright``).
+STREET_SHIRTS = tuple(Material(f"StreetShirt{i}", c, 0.85) for i, c in enumerate(
+    [(0.02, 0.02, 0.02), (0.07, 0.07, 0.07), (0.25, 0.25, 0.25), (0.55, 0.55, 0.53), (0.75, 0.74, 0.7),
+     (0.03, 0.05, 0.14), (0.05, 0.1, 0.06), (0.12, 0.07, 0.04), (0.45, 0.38, 0.28), (0.2, 0.03, 0.04),
+     (0.1, 0.18, 0.35), (0.5, 0.06, 0.05)]))
+#: The palettes a wardrobe's upper garments can take their colours from (``randomise.looks.palette``).
+UPPER_PALETTES = {"bright": SHIRTS, "street": STREET_SHIRTS}
 TROUSERS = tuple(Material(f"Trousers{i}", c, 0.85) for i, c in enumerate(
     [(0.07, 0.08, 0.12), (0.15, 0.2, 0.35), (0.25, 0.2, 0.15), (0.3, 0.3, 0.3), (0.04, 0.04, 0.04), (0.35, 0.28, 0.18),
      (0.4, 0.08, 0.1)]))

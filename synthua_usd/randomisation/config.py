@@ -21,7 +21,7 @@ from synthua_usd.core.schemas import unknown_key
 from synthua_usd.assets.devices import DEVICE_MODELS
 from synthua_usd.assets.hair import HAIR_STYLES
 from synthua_usd.assets.look_images import LOWER_FABRICS, SHOES, UPPER_FABRICS
-from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES
+from synthua_usd.model.materials import DEVICE_FINISHES, HAIR_COLOURS, RECOLOUR_PALETTES, UPPER_PALETTES
 from synthua_usd.model.ranges import SEED
 from synthua_usd.randomisation.distractors import DistractorRandomisation
 from synthua_usd.randomisation.settings import SettingsRandomisation
@@ -166,16 +166,20 @@ class LooksRandomisation:
     """How each person of the crowd (with crowd on) looks beyond colours: smooth shading (normals authored on
     the body's meshes), a fabric per garment among ``upper_fabrics`` and ``lower_fabrics`` (a pattern in a second
     colour, the weave and folds in a normal map; ``wardrobe`` upper and lower garments per scene, which its
-    people pick from), shoes among ``shoes`` on soles of another colour, a face
-    (eyes, brows, nostrils, lips, cheeks as an image on the head) and skin with a clear coat; drawn from a stream
-    of its own (switching it off or narrowing it moves no other draw). Off: flat-coloured garments and shoes,
-    faceless matte skin, faceted bodies, as before."""
+    people pick from; upper garments in the colours of ``palette``), shoes among ``shoes`` on soles of another
+    colour, a face (eyes, brows, nostrils, lips, cheeks as an image on the head) and skin with a clear coat; long
+    sleeves and long legs with probabilities ``long_sleeves`` and ``long_legs``; drawn from a stream of its own
+    (switching it off or narrowing it moves no other draw). Off: flat-coloured garments and shoes, faceless matte
+    skin, faceted bodies, long sleeves and legs with probability 0.6 each, as before."""
 
     enabled: bool = True
     upper_fabrics: tuple[str, ...] = UPPER_FABRICS
     lower_fabrics: tuple[str, ...] = LOWER_FABRICS
     shoes: tuple[str, ...] = SHOES
     wardrobe: int = 24
+    palette: str = "bright"
+    long_sleeves: float = 0.6
+    long_legs: float = 0.6
 
     def __post_init__(self) -> None:
         if isinstance(self.wardrobe, bool) or not isinstance(self.wardrobe, int) or not 1 <= self.wardrobe <= 256:
@@ -187,6 +191,12 @@ class LooksRandomisation:
                 raise InputError(f"looks.{name}: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
                                  f"{', '.join(known)}")
             object.__setattr__(self, name, values)
+        if self.palette not in UPPER_PALETTES:
+            raise InputError(f"looks.palette: {echo(self.palette)}; expected one of {', '.join(UPPER_PALETTES)}")
+        for name in ("long_sleeves", "long_legs"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
+                raise InputError(f"looks.{name}: {value!r}; expected a probability in [0, 1]")
 
 
 @dataclass(frozen=True)
@@ -366,7 +376,8 @@ _PARTS = {"crowd": CrowdRandomisation, "devices": DeviceRandomisation, "hair": H
 _LATER_PARTS = {"effects": EffectsRandomisation, "framing": FramingRandomisation, "settings": SettingsRandomisation,
                 "distractors": DistractorRandomisation}
 #: Fields of a part that came after datasets were made: left out of the document while they are their default.
-_LATER_FIELDS = {"devices": {"models": DEVICE_MODEL_NAMES}}
+_LATER_FIELDS = {"devices": {"models": DEVICE_MODEL_NAMES},
+                 "looks": {"palette": "bright", "long_sleeves": 0.6, "long_legs": 0.6}}
 
 
 @dataclass(frozen=True)
@@ -435,7 +446,7 @@ class RandomisationConfig:
                 continue
             part = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(getattr(self, name)).items()}
             for key, default in _LATER_FIELDS.get(name, {}).items():
-                if part[key] == list(default):
+                if part[key] == (list(default) if isinstance(default, tuple) else default):
                     del part[key]          # as before the field existed, for the same reason
             out[name] = part
         return out

@@ -22,7 +22,7 @@ from synthua_usd.assets.people import PersonLook
 from synthua_usd.assets.postures import DeviceFit, fit_device
 from synthua_usd.model.materials import (DEVICE_FINISHES, HAIR_COLOURS, PALETTE, RECOLOUR_PALETTES, SEAT_FABRICS, SHIRTS, SHOES, TROUSERS,
                                    WOOD_COLOURS)
-from synthua_usd.randomisation.config import RandomisationConfig
+from synthua_usd.randomisation.config import LooksRandomisation, RandomisationConfig
 from synthua_usd.randomisation.wear import Wardrobe, Wear, draw_wardrobe, draw_wear, jitter, pick
 
 RGB = tuple[float, float, float]
@@ -206,7 +206,9 @@ def draw_hair(rng: np.random.Generator, body: int, config: RandomisationConfig) 
 def _member(rng: np.random.Generator, profile: str, config: RandomisationConfig, seat=None,
             group=None, min_height_m: float = 0.0) -> CastMember:
     aid = PROFILES[profile].device
-    look = PersonLook.random(rng, aid_user=aid is not None, min_height_m=min_height_m)
+    looks = config.looks if config.looks.enabled else LooksRandomisation()  # off: the defaults, as before
+    look = PersonLook.random(rng, aid_user=aid is not None, min_height_m=min_height_m,
+                             long_sleeves=looks.long_sleeves, long_legs=looks.long_legs)
     amount = config.crowd.clothing_jitter
     colour = {"Shirt": SHIRTS, "Trousers": TROUSERS, "Shoes": SHOES}
     upper, lower, shoes = (jitter(rng, pick(rng, colour[kind]).base_color, amount) for kind in colour)

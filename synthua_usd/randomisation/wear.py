@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from synthua_usd.assets.look_images import FACE_OFFSET, image_path, two_colour
-from synthua_usd.model.materials import (CONTRAST_COLOURS, FABRIC_SHADE, FACE_FEATURES, SHIRTS, SKIN_CLEARCOAT,
-                                        SOLE_COLOURS, TROUSERS)
+from synthua_usd.model.materials import (CONTRAST_COLOURS, FABRIC_SHADE, FACE_FEATURES, SKIN_CLEARCOAT, SOLE_COLOURS,
+                                        TROUSERS, UPPER_PALETTES)
 from synthua_usd.model.materials import SHOES as SHOE_PALETTE
 from synthua_usd.model.normal_maps import NORMAL_BIAS, NORMAL_SCALE
 from synthua_usd.model.scene import Material, Texture
@@ -99,7 +99,7 @@ def _second(fabric: str, colour, u: float) -> RGB:
 
 def draw_wardrobe(rng: np.random.Generator, config: LooksRandomisation, colour_jitter: float) -> Wardrobe:
     """``config.wardrobe`` upper and lower garments and a third as many pairs of shoes (at least 2): each a fabric
-    and kind uniform over the config's, a colour of its palette (shirts, trousers, shoes of
+    and kind uniform over the config's, a colour of its palette (the config's upper palette, trousers, shoes of
     :mod:`synthua_usd.model.materials`) with each channel scaled by 1 + U(-``colour_jitter``, ``colour_jitter``),
     a second colour for its fabric, a sole colour for its kind."""
     def garments(fabrics, palette) -> tuple[Garment, ...]:
@@ -110,7 +110,8 @@ def draw_wardrobe(rng: np.random.Generator, config: LooksRandomisation, colour_j
             out.append(Garment(fabric, colour, _second(fabric, colour, float(rng.random()))))
         return tuple(out)
 
-    uppers, lowers = garments(config.upper_fabrics, SHIRTS), garments(config.lower_fabrics, TROUSERS)
+    uppers = garments(config.upper_fabrics, UPPER_PALETTES[config.palette])
+    lowers = garments(config.lower_fabrics, TROUSERS)
     shoes = []
     for _ in range(max(2, config.wardrobe // 3)):
         kind = pick(rng, config.shoes)

@@ -46,6 +46,7 @@ def test_round_trip_and_off_by_default():
     ({"light": {"latitude_deg": 80}}, "latitude"),
     ({"district": {"enabled": True}, "crowd": {"enabled": False}}, "randomise.district: enabled while"),
     ({"camera": {"focal_length_factor": [2, 1]}}, "randomise.camera.focal_length_factor"),
+    ({"looks": {"long_legs": 1.5}}, "randomise.looks.long_legs"),
 ])
 def test_impossible_ranges_are_refused(block, mentions):
     with pytest.raises(InputError) as err:

@@ -10,7 +10,7 @@ import numpy as np
 
 from synthua_usd.assets.devices import DEVICE_MODELS
 from synthua_usd.assets.hair import HAIR_STYLES
-from synthua_usd.model.materials import HAIR_COLOURS
+from synthua_usd.model.materials import HAIR_COLOURS, STREET_SHIRTS
 from synthua_usd.randomisation import scene
 from synthua_usd.randomisation.config import CrowdRandomisation, HairRandomisation, RandomisationConfig
 from synthua_usd.randomisation.scene import draw_cast
@@ -110,3 +110,31 @@ def test_devices_models_narrow_the_model_draw_and_shift_no_other_draw():
     assert RandomisationConfig.from_document(detailed_config.to_document()) == detailed_config
     both = RandomisationConfig.from_document({"devices": {"models": ["standard", "detailed"]}})
     assert both.devices.models == ("detailed", "standard") and "models" not in both.to_document()["devices"]
+
+
+def _near_palette(colour, palette, jitter: float) -> bool:
+    """Whether ``colour`` is a colour of ``palette`` with each channel scaled by at most 1 +- ``jitter``."""
+    return any(np.all(np.abs(np.asarray(colour) - c.base_color) <= jitter * np.asarray(c.base_color) + 1e-9)
+               for c in palette)
+
+
+def test_the_street_palette_and_long_clothes_change_the_clothes_only():
+    """looks.palette street: every upper garment a street colour; long_sleeves and long_legs 1: every forearm and
+    shin clothed; nothing else drawn differently; the document leaves the three fields out at their defaults."""
+    cast = _cast(3)
+    looks = dataclasses.replace(CONFIG.looks, palette="street", long_sleeves=1.0, long_legs=1.0)
+    street = draw_cast(np.random.default_rng(3), dataclasses.replace(CONFIG, looks=looks), 4000.0, [])[2]
+    jitter = CONFIG.crowd.clothing_jitter
+    assert len(street) == len(cast) > 100
+    assert all(_near_palette(m.upper, STREET_SHIRTS, jitter) for m in street)
+    assert not all(_near_palette(m.upper, STREET_SHIRTS, jitter) for m in cast)
+    assert all(m.long_sleeves and m.long_legs for m in street)
+    assert 0.4 < np.mean([m.long_sleeves for m in cast]) < 0.8 and not all(m.long_legs for m in cast)
+    blank = (0.0, 0.0, 0.0)
+    assert [dataclasses.replace(m, upper=blank, long_sleeves=True, long_legs=True) for m in cast] == \
+        [dataclasses.replace(m, upper=blank) for m in street]
+    assert not {"palette", "long_sleeves", "long_legs"} & set(CONFIG.to_document()["looks"])
+    document = dataclasses.replace(CONFIG, looks=looks).to_document()
+    assert {k: document["looks"][k] for k in ("palette", "long_sleeves", "long_legs")} == \
+        {"palette": "street", "long_sleeves": 1.0, "long_legs": 1.0}
+    assert RandomisationConfig.from_document(document).looks == looks
