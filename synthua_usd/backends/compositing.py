@@ -47,6 +47,10 @@ step):
    nearest one the paste does not label: the edge fades inwards, and nothing shows outside the labels), ``blur``
    (alpha and premultiplied colour blurred by a Gaussian of ``sigma_px``) or ``poisson``
    (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px).
+4. **Sharpening** of a paste the plan sharpens, right after its blend (a nearer paste painted later covers it): the
+   composite's sRGB values ``v`` around the paste, ``v + amount x (v - G(v))`` with ``G`` a Gaussian of
+   ``sigma_px`` (reflecting at the frame's edges), written back over the paste's labelled pixels only. The
+   photo's pixels keep their values; the paste's silhouette is sharpened against the photo behind it.
 
 Labels: a pasted pixel takes the instance of the cut-out's ``ids`` there (nearest, :mod:`.cutout_pixels`), a nearer
 paste over a farther one; the photo's pixels are void (class 0, no instance). Amodal masks are each cut-out's own,
@@ -345,6 +349,22 @@ def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: 
     return poisson_blend(region, hard, domain).astype(np.float32)
 
 
+def sharpen(rgb: np.ndarray, placed: PlacedCutout, amount: float, sigma: float) -> None:
+    """Unsharp-mask ``rgb`` (H, W, 3) uint8 sRGB in place over ``placed``'s labelled pixels (module docstring,
+    step 4)."""
+    height, width = rgb.shape[:2]
+    rows, cols = placed.slices
+    reach = int(np.ceil(4.0 * sigma))
+    y0, y1 = max(0, rows.start - reach), min(height, rows.stop + reach)
+    x0, x1 = max(0, cols.start - reach), min(width, cols.stop + reach)
+    values = rgb[y0:y1, x0:x1].astype(np.float32) / np.float32(255.0)
+    blurred = ndimage.gaussian_filter(values, (sigma, sigma, 0), mode="reflect", truncate=4.0)
+    sharp = np.round(np.clip(values + np.float32(amount) * (values - blurred), 0.0, 1.0) * 255.0).astype(np.uint8)
+    inner = sharp[rows.start - y0:rows.stop - y0, cols.start - x0:cols.stop - x0]
+    labelled = placed.ids > 0
+    rgb[rows, cols] = np.where(labelled[..., None], inner, rgb[rows, cols])
+
+
 def _prim_path(order: int, entry: BankEntry, index: int) -> str:
     """A pasted instance's path: its paste, cut-out and instance (no USD prim: it names where it came from)."""
     role = next(i.role for i in entry.instances if i.index == index)
@@ -415,6 +435,8 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
         colour = soften(pc.premultiplied, sigma) * np.float32(exposure) * np.asarray(balance, np.float32)
         region = LINEAR_LUT[rgb[rows, cols]]
         rgb[rows, cols] = encode(_blend(region, pc, colour, p.placement.blend))
+        if p.placement.sharpen is not None:
+            sharpen(rgb, pc, p.placement.sharpen["amount"], p.placement.sharpen["sigma_px"])
         table = np.zeros(256, np.uint16)
         classes = np.zeros(256, np.uint8)
         for index, gid in ids.items():

@@ -141,6 +141,22 @@ class MatchSettings:
             raise InputError(f"match.sharpness_sigma_px: {self.sharpness_sigma_px}; expected px in [0, 50]")
 
 
+@dataclass(frozen=True)
+class SharpenSettings:
+    """An unsharp mask on a ``share`` of the pastes after their blend (schema ``sharpen``): each sharpened paste's
+    ``amount`` and Gaussian ``sigma_px`` drawn uniform from the ranges."""
+
+    share: float = 0.0
+    amount: Range = (1.0, 3.0)
+    sigma_px: Range = (1.5, 2.5)
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.share <= 1.0:
+            raise InputError(f"sharpen.share: {self.share}; expected a share in [0, 1]")
+        object.__setattr__(self, "amount", _range("sharpen.amount", self.amount, 0.0, 10.0))
+        object.__setattr__(self, "sigma_px", _range("sharpen.sigma_px", self.sigma_px, 0.3, 10.0))
+
+
 #: The key of ``background_labels.classes`` for every class it does not list (mapped to null: left out).
 OTHER_CLASSES = "*"
 
@@ -184,6 +200,7 @@ class CompositeConfig:
     blend: BlendSettings = field(default_factory=BlendSettings)
     shadow_strength: Range = (0.6, 1.0)
     match: MatchSettings = field(default_factory=MatchSettings)
+    sharpen: SharpenSettings = field(default_factory=SharpenSettings)
     effects: EffectsRandomisation = field(default_factory=EffectsRandomisation)
     background_labels: BackgroundLabels = field(default_factory=BackgroundLabels)
     convention: str = "synthua"
@@ -244,6 +261,9 @@ class CompositeConfig:
                       "blur_sigma_px": list(self.blend.blur_sigma_px)},
             "shadow": {"strength": list(self.shadow_strength)},
             "match": _match_document(self.match),
+            **({} if self.sharpen == SharpenSettings() else {"sharpen": {  # later than the datasets made before it
+                "share": self.sharpen.share, "amount": list(self.sharpen.amount),
+                "sigma_px": list(self.sharpen.sigma_px)}}),
             "effects": {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self.effects).items()},
             "background_labels": {"classes": dict(self.background_labels.classes),
                                   "drop_covered_share": self.background_labels.drop_covered_share,
@@ -321,6 +341,7 @@ def _build(doc: dict) -> CompositeConfig:
         blend=BlendSettings(**_tuples(doc.get("blend", {}))),
         shadow_strength=tuple(doc.get("shadow", {}).get("strength", defaults.shadow_strength)),
         match=MatchSettings(**_tuples(doc.get("match", {}))),
+        sharpen=SharpenSettings(**_tuples(doc.get("sharpen", {}))),
         effects=EffectsRandomisation(**effects),
         background_labels=BackgroundLabels(tuple(sorted(labels.get("classes", {}).items())),
                                            labels.get("drop_covered_share", 0.5),

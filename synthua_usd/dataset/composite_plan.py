@@ -16,10 +16,13 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
    ``max_background_cover`` (default ``drop_covered_share``) of each labelled background box; where no column
    does, the least overlapping one (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's
    own labelled people stay in view);
-5. a blend mode by the config's weights (Poisson at most once a composite) and a shadow strength.
+5. a blend mode by the config's weights (Poisson at most once a composite) and a shadow strength;
+6. where ``sharpen.share`` > 0, whether it is sharpened and by what amount and sigma, from a generator spawned
+   for it (the handed one's draws stay as they are: the pastes are those of the same config without sharpening).
 
 Pastes are drawn far to near (by anchor row): ``order`` 0 is drawn first, and a nearer paste covers a farther one.
-Every draw comes from the generator handed in, in a fixed order, so a composite's plan depends on its seed only.
+Every draw comes from the generator handed in (or one spawned from it), in a fixed order, so a composite's plan
+depends on its seed only.
 """
 
 from __future__ import annotations
@@ -98,7 +101,8 @@ class Placement:
     ``box`` (x0, y0, x1, y1) is its group's amodal box in the frame. ``share`` the group's height over the
     frame's as placed, ``share_drawn`` as drawn; ``distance_m`` and ``elevation_deg`` of the anchor on the photo's
     ground plane, ``cutout_elevation_deg`` the cut-out's own; ``blend`` the mode and its parameter
-    (``feather_px`` or ``sigma_px``); ``order`` 0 is drawn first (the farthest)."""
+    (``feather_px`` or ``sigma_px``); ``order`` 0 is drawn first (the farthest); ``sharpen`` the unsharp mask's
+    ``amount`` and ``sigma_px``, None where the paste is not sharpened."""
 
     entry_id: str
     kind: str
@@ -115,6 +119,7 @@ class Placement:
     blend: dict
     shadow_strength: float
     order: int
+    sharpen: dict | None = None
 
     def to_dict(self) -> dict:
         out = asdict(self)
@@ -158,6 +163,15 @@ def _blend(config: CompositeConfig, poisson_used: bool, rng: np.random.Generator
                              else {})}
 
 
+def _sharpen(config: CompositeConfig, rng: np.random.Generator | None) -> dict | None:
+    """The unsharp mask of one paste (``amount``, ``sigma_px``), or None (always None without ``rng``)."""
+    settings = config.sharpen
+    if rng is None:
+        return None
+    u, amount, sigma = rng.random(), float(rng.uniform(*settings.amount)), float(rng.uniform(*settings.sigma_px))
+    return {"amount": amount, "sigma_px": sigma} if u < settings.share else None
+
+
 def eligible(entries: Sequence[BankEntry], config: CompositeConfig) -> dict[str, list[BankEntry]]:
     """The bank's cut-outs the config lets a composite paste, by kind (``aid_user``, ``pedestrian``)."""
     out: dict[str, list[BankEntry]] = {"aid_user": [], "pedestrian": []}
@@ -181,6 +195,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
     count = int(rng.integers(settings.per_image[0], settings.per_image[1] + 1))
     planned: list[dict] = []
     poisson_used = False
+    sharpen_rng = rng.spawn(1)[0] if config.sharpen.share > 0 else None
     for k in range(count):
         kinds = [kind for kind in ("aid_user", "pedestrian") if pools.get(kind)]
         draw_kind, share_drawn = rng.random(), float(rng.uniform(*settings.height_share))
@@ -212,6 +227,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         columns = rng.uniform(0.0, 1.0, settings.placement_tries)
         blend = _blend(config, poisson_used, rng)
         shadow = float(rng.uniform(*config.shadow_strength))
+        sharpen = _sharpen(config, sharpen_rng)
         if lo > hi:
             continue  # wider than the frame at this size
         best: tuple[float, tuple[float, float], tuple[float, float, float, float]] | None = None
@@ -236,7 +252,8 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
             distance_m=camera.distance_m(anchor_row), elevation_deg=camera.elevation_deg(anchor_row),
             cutout_elevation_deg=entry.camera.elevation_deg,
             light_distance=None if drawn.light is None else drawn.light.distance(entry.light),
-            box=tuple(float(v) for v in box), overlap=float(overlap), blend=blend, shadow_strength=shadow, k=k))
+            box=tuple(float(v) for v in box), overlap=float(overlap), blend=blend, shadow_strength=shadow,
+            sharpen=sharpen, k=k))
     planned.sort(key=lambda p: (p["anchor_px"][1], p["k"]))
     return [Placement(**{key: v for key, v in p.items() if key != "k"}, order=n) for n, p in enumerate(planned)]
 

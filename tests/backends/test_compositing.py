@@ -6,6 +6,7 @@ blending solving its equation; sharpness matching reading a known blur and givin
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -522,3 +523,38 @@ def test_tone_matching_changes_the_pastes_colour_only_and_is_recorded(bank):
     # the red person (200, 40, 40 in sRGB) comes out greyer: its channels closer together
     spread_before = np.ptp(as_rendered.rgb[person].astype(int), axis=1).mean()
     assert np.ptp(toned.rgb[person].astype(int), axis=1).mean() < 0.8 * spread_before
+
+
+def _gaussian_by_hand(values: np.ndarray, sigma: float) -> np.ndarray:
+    """``values`` (h, w, c) convolved with a sampled, normalised 2-D Gaussian of ``sigma`` reaching 4 sigma, the
+    frame mirrored at its edges (the edge pixel repeated), summed shift by shift."""
+    reach = int(np.ceil(4.0 * sigma))
+    taps = np.exp(-0.5 * (np.arange(-reach, reach + 1) / sigma) ** 2)
+    taps /= taps.sum()
+    padded = np.pad(values, ((reach, reach), (reach, reach), (0, 0)), mode="symmetric")
+    h, w = values.shape[:2]
+    out = np.zeros_like(values, dtype=np.float64)
+    for dy in range(-reach, reach + 1):
+        for dx in range(-reach, reach + 1):
+            out += taps[dy + reach] * taps[dx + reach] * padded[reach + dy:reach + dy + h, reach + dx:reach + dx + w]
+    return out
+
+
+@pytest.mark.parametrize("anchor", [(40.0, 50.0), (6.0, 59.0)])  # inside the frame, and cut by its corner
+def test_sharpening_unsharp_masks_the_pastes_labelled_pixels_only_and_keeps_labels(bank, anchor):
+    entry = bank.entries[0]
+    photo = _photo()
+    pixels = read_cutout(bank.root, entry)
+    plain = compose(photo, [PasteInput(entry, pixels, _placement(entry, anchor, 1.0, 0))], ClassMap.default(), NO_MATCH)
+    amount, sigma = 2.0, 1.5
+    sharpened = replace(_placement(entry, anchor, 1.0, 0), sharpen={"amount": amount, "sigma_px": sigma})
+    painted = compose(photo, [PasteInput(entry, pixels, sharpened)], ClassMap.default(), NO_MATCH)
+    np.testing.assert_array_equal(painted.instance_ids, plain.instance_ids)
+    np.testing.assert_array_equal(painted.class_ids, plain.class_ids)
+    labelled = plain.instance_ids > 0
+    assert labelled.sum() > 50
+    np.testing.assert_array_equal(painted.rgb[~labelled], plain.rgb[~labelled])
+    values = plain.rgb.astype(np.float64) / 255.0
+    expected = np.round(np.clip(values + amount * (values - _gaussian_by_hand(values, sigma)), 0, 1) * 255)
+    assert np.abs(painted.rgb[labelled].astype(int) - expected[labelled].astype(int)).max() <= 1
+    assert np.abs(painted.rgb[labelled].astype(int) - plain.rgb[labelled].astype(int)).max() > 20

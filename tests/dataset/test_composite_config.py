@@ -11,7 +11,7 @@ from conftest import REPO
 from synthua_usd.core.errors import InputError
 from synthua_usd.core.schemas import load_schema
 from synthua_usd.dataset.composite_config import LATER_MATCH_FIELDS, LATER_MATCH_GROUPS, BackgroundLabels, \
-    CameraSettings, CompositeConfig, MatchSettings
+    CameraSettings, CompositeConfig, MatchSettings, SharpenSettings
 
 
 def _defaults(node, schema) -> dict:
@@ -36,6 +36,12 @@ def test_the_schema_documents_the_dataclass_defaults():
     assert documented, "the schema documents defaults"
     for path, default in documented.items():
         if path == "shadow":
+            continue
+        if path == "sharpen":
+            continue  # left out of the document while it holds its defaults, checked field by field below
+        if path.startswith("sharpen."):
+            field = getattr(SharpenSettings, path.split(".")[1])
+            assert default == (list(field) if isinstance(field, tuple) else field), path
             continue
         if path.startswith("match.") and path.split(".")[1] in LATER_MATCH_FIELDS:
             field = getattr(MatchSettings, path.split(".")[1])
@@ -64,6 +70,13 @@ def test_later_match_fields_are_written_only_where_set_so_earlier_job_keys_hold(
         assert {k: document["match"][k] for k in group} == {**group, **part}  # written together
         assert not set(other) & set(document["match"])                       # the other group still left out
         assert CompositeConfig.from_document(document) == config
+
+
+def test_sharpening_is_written_only_where_set_so_earlier_job_keys_hold():
+    assert "sharpen" not in CompositeConfig().to_document()
+    config = CompositeConfig.from_document({"sharpen": {"share": 0.5}})
+    assert config.to_document()["sharpen"] == {"share": 0.5, "amount": [1.0, 3.0], "sigma_px": [1.5, 2.5]}
+    assert CompositeConfig.from_document(config.to_document()) == config
 
 
 def test_person_height_is_written_only_where_set_and_checked():
@@ -123,6 +136,8 @@ def test_the_shipped_config_is_valid():
     ({"camera": {"person_height_m": 0.2}}, r"x\.json: camera\.person_height_m: 0\.2"),
     ({"folders": {"a": {"height_m": -1}}}, r"x\.json: folders\.a\.height_m"),
     ({"output": {"width": 8, "height": 48}}, r"x\.json: output"),
+    ({"sharpen": {"amount": [3, 1]}}, r"x\.json: sharpen\.amount: \[3, 1\]; expected two finite numbers"),
+    ({"sharpen": {"sigma_px": [0.1, 1]}}, r"x\.json: sharpen\.sigma_px: \[0\.1, 1\]"),
 ])
 def test_bad_documents_are_refused_naming_the_field(document, message):
     with pytest.raises(InputError, match=message):

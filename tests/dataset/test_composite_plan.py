@@ -188,3 +188,25 @@ def test_the_plan_depends_on_the_seed_only(bank):
             for _ in range(2)]
     assert runs[0] == runs[1]
     assert len(default_cutouts()) == len(bank.entries)
+
+
+def test_sharpening_is_drawn_per_paste_within_its_ranges_and_not_at_all_when_off(bank):
+    camera = PhotoCamera(640, 480, 150.0, 1.5, 500.0)
+    pastes = {"per_image": [3, 3]}
+
+    def plans(document):
+        config = CompositeConfig.from_document({"pastes": pastes, **document})
+        return [plan_pastes(_drawn(camera), eligible(bank.entries, config), config, [], np.random.default_rng(seed))
+                for seed in range(12)]
+
+    off = plans({})
+    assert all(p.sharpen is None for plan in off for p in plan)
+    assert plans({"sharpen": {"share": 0.0, "amount": [5, 6]}}) == off   # a share of 0 draws nothing
+    every = [p.sharpen for plan in plans({"sharpen": {"share": 1.0, "amount": [1.5, 2.5], "sigma_px": [1, 2]}})
+             for p in plan]
+    assert every and all(1.5 <= s["amount"] <= 2.5 and 1.0 <= s["sigma_px"] <= 2.0 for s in every)
+    half = [p.sharpen is not None for plan in plans({"sharpen": {"share": 0.5}}) for p in plan]
+    assert 0.2 < np.mean(half) < 0.8
+    # drawn from a generator of their own: the pastes are those of the same config without sharpening
+    strip = [[replace(p, sharpen=None) for p in plan] for plan in plans({"sharpen": {"share": 1.0}})]
+    assert strip == off

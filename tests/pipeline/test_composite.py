@@ -508,3 +508,28 @@ def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled
     assert code == 0 and "byte-identical" in text, text
     plain = _records(labelled)
     assert plain and all(r["camera"]["sources"]["horizon_row_px"] == "config" for r in plain)
+
+
+def test_sharpening_is_recorded_per_paste_changes_only_pasted_pixels_verifies_and_replays(inputs, unlabelled, tmp_path,
+                                                                                         run_cli):
+    config = tmp_path / "unsharp.json"
+    config.write_text(json.dumps({**CONFIG, "sharpen": {"share": 1.0, "amount": [1.5, 2.5], "sigma_px": [1.0, 2.0]}}))
+    out = tmp_path / "unsharp"
+    assert main([str(a) for a in ("composite", inputs / "photos", "--bank", inputs / "bank", "--config", config,
+                                  "--out", out, "--workers", 1)]) == 0
+    pastes = [p for r in _records(out) for p in r["composite"]["pastes"]]
+    assert pastes and all(1.5 <= p["sharpen"]["amount"] <= 2.5 and 1.0 <= p["sharpen"]["sigma_px"] <= 2.0
+                          for p in pastes)
+    assert json.loads((out / "generate.json").read_text())["job_key"]["config"]["sharpen"]["share"] == 1.0
+    assert all("sharpen" not in p for r in _records(unlabelled) for p in r["composite"]["pastes"])
+    code, text, _ = run_cli("verify", out)
+    assert code == 0 and text.strip().endswith("ok"), text
+    record = _records(out)[0]
+    code, text, _ = run_cli("replay", out, str(record["id"]))
+    assert code == 0 and "byte-identical" in text, text
+    # the same draws as without sharpening (its own generator): the same pastes and labels, other pixels
+    plain = next(r for r in _records(unlabelled) if r["id"] == record["id"])
+    assert [p["box"] for p in plain["composite"]["pastes"]] == [p["box"] for p in record["composite"]["pastes"]]
+    for key in ("instance", "class"):
+        np.testing.assert_array_equal(_png(out / record["files"][key]), _png(unlabelled / plain["files"][key]))
+    assert not np.array_equal(_png(out / record["files"]["rgb_png"]), _png(unlabelled / plain["files"]["rgb_png"]))
