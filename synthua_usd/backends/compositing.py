@@ -3,7 +3,7 @@
 Pixel work only: where each paste goes is planned in :mod:`synthua_usd.dataset.composite_plan`.
 
 Order of operations, all in linear light (8-bit sRGB decoded by the sRGB curve, encoded back and rounded once per
-step):
+step) but step 4's, which works on the sRGB values:
 
 0. **Tone** of each paste (where ``contrast_strength`` or ``saturation_strength`` > 0), a partial transfer of colour
    statistics from the photo around the paste (as Reinhard et al., "Color transfer between images", 2001, transfer

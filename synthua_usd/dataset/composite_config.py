@@ -147,7 +147,7 @@ class SharpenSettings:
     ``amount`` and Gaussian ``sigma_px`` drawn uniform from the ranges."""
 
     share: float = 0.0
-    amount: Range = (1.0, 3.0)
+    amount: Range = (2.0, 3.0)
     sigma_px: Range = (1.5, 2.5)
 
     def __post_init__(self) -> None:

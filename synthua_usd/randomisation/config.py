@@ -191,7 +191,7 @@ class LooksRandomisation:
                 raise InputError(f"looks.{name}: {', '.join(map(echo, unknown)) or 'none'}; expected one or more of "
                                  f"{', '.join(known)}")
             object.__setattr__(self, name, values)
-        if self.palette not in UPPER_PALETTES:
+        if not isinstance(self.palette, str) or self.palette not in UPPER_PALETTES:
             raise InputError(f"looks.palette: {echo(self.palette)}; expected one of {', '.join(UPPER_PALETTES)}")
         for name in ("long_sleeves", "long_legs"):
             value = getattr(self, name)

@@ -203,10 +203,14 @@ def draw_hair(rng: np.random.Generator, body: int, config: RandomisationConfig) 
     return HairLook(style, name, tuple(float(c) for c in colour), roughness)
 
 
+#: Whose sleeve and leg lengths a person draws while looks are off: the defaults, as before the fields existed.
+LOOKS_OFF = LooksRandomisation()
+
+
 def _member(rng: np.random.Generator, profile: str, config: RandomisationConfig, seat=None,
             group=None, min_height_m: float = 0.0) -> CastMember:
     aid = PROFILES[profile].device
-    looks = config.looks if config.looks.enabled else LooksRandomisation()  # off: the defaults, as before
+    looks = config.looks if config.looks.enabled else LOOKS_OFF
     look = PersonLook.random(rng, aid_user=aid is not None, min_height_m=min_height_m,
                              long_sleeves=looks.long_sleeves, long_legs=looks.long_legs)
     amount = config.crowd.clothing_jitter

@@ -558,3 +558,26 @@ def test_sharpening_unsharp_masks_the_pastes_labelled_pixels_only_and_keeps_labe
     expected = np.round(np.clip(values + amount * (values - _gaussian_by_hand(values, sigma)), 0, 1) * 255)
     assert np.abs(painted.rgb[labelled].astype(int) - expected[labelled].astype(int)).max() <= 1
     assert np.abs(painted.rgb[labelled].astype(int) - plain.rgb[labelled].astype(int)).max() > 20
+
+
+@pytest.mark.parametrize("sigma", [1.7, 2.4])
+def test_sharpening_reads_the_whole_gaussians_reach_around_labels_at_the_pastes_edge(sigma):
+    """A paste labelled up to its region's edge, far from the frame's: every labelled pixel is sharpened with the
+    photo's pixels a Gaussian reaches beyond the region, exactly as over the whole frame."""
+    from types import SimpleNamespace
+
+    from synthua_usd.backends.compositing import sharpen
+
+    rgb = np.random.default_rng(3).integers(0, 256, (64, 72, 3), dtype=np.uint8)
+    ids = np.zeros((20, 24), np.uint8)
+    ids[:, :] = 1
+    ids[5:9, 6:10] = 0                                   # a hole: photo pixels inside the region stay
+    placed = SimpleNamespace(slices=(slice(22, 42), slice(24, 48)), ids=ids)
+    before = rgb.copy()
+    sharpen(rgb, placed, 1.5, sigma)
+    values = before.astype(np.float64) / 255.0
+    expected = np.round(np.clip(values + 1.5 * (values - _gaussian_by_hand(values, sigma)), 0, 1) * 255)
+    labelled = np.zeros((64, 72), bool)
+    labelled[22:42, 24:48] = ids > 0
+    assert np.abs(rgb[labelled].astype(int) - expected[labelled].astype(int)).max() <= 1
+    np.testing.assert_array_equal(rgb[~labelled], before[~labelled])

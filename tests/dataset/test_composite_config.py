@@ -75,7 +75,7 @@ def test_later_match_fields_are_written_only_where_set_so_earlier_job_keys_hold(
 def test_sharpening_is_written_only_where_set_so_earlier_job_keys_hold():
     assert "sharpen" not in CompositeConfig().to_document()
     config = CompositeConfig.from_document({"sharpen": {"share": 0.5}})
-    assert config.to_document()["sharpen"] == {"share": 0.5, "amount": [1.0, 3.0], "sigma_px": [1.5, 2.5]}
+    assert config.to_document()["sharpen"] == {"share": 0.5, "amount": [2.0, 3.0], "sigma_px": [1.5, 2.5]}
     assert CompositeConfig.from_document(config.to_document()) == config
 
 

@@ -510,26 +510,44 @@ def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled
     assert plain and all(r["camera"]["sources"]["horizon_row_px"] == "config" for r in plain)
 
 
-def test_sharpening_is_recorded_per_paste_changes_only_pasted_pixels_verifies_and_replays(inputs, unlabelled, tmp_path,
-                                                                                         run_cli):
-    config = tmp_path / "unsharp.json"
-    config.write_text(json.dumps({**CONFIG, "sharpen": {"share": 1.0, "amount": [1.5, 2.5], "sigma_px": [1.0, 2.0]}}))
-    out = tmp_path / "unsharp"
-    assert main([str(a) for a in ("composite", inputs / "photos", "--bank", inputs / "bank", "--config", config,
-                                  "--out", out, "--workers", 1)]) == 0
-    pastes = [p for r in _records(out) for p in r["composite"]["pastes"]]
-    assert pastes and all(1.5 <= p["sharpen"]["amount"] <= 2.5 and 1.0 <= p["sharpen"]["sigma_px"] <= 2.0
-                          for p in pastes)
-    assert json.loads((out / "generate.json").read_text())["job_key"]["config"]["sharpen"]["share"] == 1.0
-    assert all("sharpen" not in p for r in _records(unlabelled) for p in r["composite"]["pastes"])
-    code, text, _ = run_cli("verify", out)
+def test_sharpening_is_recorded_per_paste_keeps_labels_and_photo_pixels_verifies_and_replays(inputs, tmp_path, run_cli):
+    """Half the pastes sharpened, camera effects off: each paste's record says whether and how; the labels and
+    the photo's pixels are those of the same config without sharpening, and so is all of a composite none of whose
+    pastes is sharpened (a nearer paste's soft edge may show a sharpened farther one's pixels through it)."""
+    plain_config = {**CONFIG, "effects": {"enabled": False}}
+    made = {}
+    for name, extra in (("plain", {}), ("unsharp", {"sharpen": {"share": 0.5, "sigma_px": [1.0, 2.0]}})):
+        config = tmp_path / f"{name}.json"
+        config.write_text(json.dumps({**plain_config, **extra}))
+        made[name] = tmp_path / name
+        assert main([str(a) for a in ("composite", inputs / "photos", "--bank", inputs / "bank", "--config", config,
+                                      "--out", made[name], "--workers", 1)]) == 0
+    records = _records(made["unsharp"])
+    pastes = [p for r in records for p in r["composite"]["pastes"]]
+    drawn = [p["sharpen"] for p in pastes if p["sharpen"] is not None]
+    assert 0 < len(drawn) < len(pastes)
+    assert all(2.0 <= s["amount"] <= 3.0 and 1.0 <= s["sigma_px"] <= 2.0 for s in drawn)
+    assert all("sharpen" not in p for r in _records(made["plain"]) for p in r["composite"]["pastes"])
+    assert json.loads((made["unsharp"] / "generate.json").read_text())["job_key"]["config"]["sharpen"]["share"] == 0.5
+    changed = 0
+    for record, plain in zip(records, _records(made["plain"])):
+        assert [p["box"] for p in plain["composite"]["pastes"]] == [p["box"] for p in record["composite"]["pastes"]]
+        instance = _png(made["unsharp"] / record["files"]["instance"])
+        np.testing.assert_array_equal(instance, _png(made["plain"] / plain["files"]["instance"]))
+        rgb = _png(made["unsharp"] / record["files"]["rgb_png"])
+        rgb_plain = _png(made["plain"] / plain["files"]["rgb_png"])
+        np.testing.assert_array_equal(rgb[instance == 0], rgb_plain[instance == 0])   # the photo's pixels
+        if not any(p["sharpen"] for p in record["composite"]["pastes"]):
+            np.testing.assert_array_equal(rgb, rgb_plain)
+            continue
+        sharpened = np.zeros(instance.shape, bool)
+        for paste in record["composite"]["pastes"]:
+            if paste["sharpen"] is not None:
+                sharpened |= np.isin(instance, paste["instance_ids"])
+        changed += int((rgb[sharpened] != rgb_plain[sharpened]).any())
+    assert changed > 0
+    code, text, _ = run_cli("verify", made["unsharp"])
     assert code == 0 and text.strip().endswith("ok"), text
-    record = _records(out)[0]
-    code, text, _ = run_cli("replay", out, str(record["id"]))
+    one = next(r for r in records if any(p["sharpen"] for p in r["composite"]["pastes"]))
+    code, text, _ = run_cli("replay", made["unsharp"], str(one["id"]))
     assert code == 0 and "byte-identical" in text, text
-    # the same draws as without sharpening (its own generator): the same pastes and labels, other pixels
-    plain = next(r for r in _records(unlabelled) if r["id"] == record["id"])
-    assert [p["box"] for p in plain["composite"]["pastes"]] == [p["box"] for p in record["composite"]["pastes"]]
-    for key in ("instance", "class"):
-        np.testing.assert_array_equal(_png(out / record["files"][key]), _png(unlabelled / plain["files"][key]))
-    assert not np.array_equal(_png(out / record["files"]["rgb_png"]), _png(unlabelled / plain["files"]["rgb_png"]))

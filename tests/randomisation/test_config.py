@@ -47,6 +47,7 @@ def test_round_trip_and_off_by_default():
     ({"district": {"enabled": True}, "crowd": {"enabled": False}}, "randomise.district: enabled while"),
     ({"camera": {"focal_length_factor": [2, 1]}}, "randomise.camera.focal_length_factor"),
     ({"looks": {"long_legs": 1.5}}, "randomise.looks.long_legs"),
+    ({"looks": {"palette": "neon"}}, "randomise.looks.palette"),
 ])
 def test_impossible_ranges_are_refused(block, mentions):
     with pytest.raises(InputError) as err:

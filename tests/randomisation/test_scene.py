@@ -138,3 +138,11 @@ def test_the_street_palette_and_long_clothes_change_the_clothes_only():
     assert {k: document["looks"][k] for k in ("palette", "long_sleeves", "long_legs")} == \
         {"palette": "street", "long_sleeves": 1.0, "long_legs": 1.0}
     assert RandomisationConfig.from_document(document).looks == looks
+
+
+def test_with_looks_off_the_clothes_fields_change_nothing():
+    off = dataclasses.replace(CONFIG.looks, enabled=False)
+    plain = draw_cast(np.random.default_rng(5), dataclasses.replace(CONFIG, looks=off), 4000.0, [])[2]
+    asked = dataclasses.replace(off, palette="street", long_sleeves=1.0, long_legs=0.0)
+    same = draw_cast(np.random.default_rng(5), dataclasses.replace(CONFIG, looks=asked), 4000.0, [])[2]
+    assert list(same) == list(plain) and len(plain) > 100
