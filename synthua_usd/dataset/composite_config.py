@@ -156,6 +156,11 @@ class SharpenSettings:
         object.__setattr__(self, "amount", _range("sharpen.amount", self.amount, 0.0, 10.0))
         object.__setattr__(self, "sigma_px", _range("sharpen.sigma_px", self.sigma_px, 0.3, 10.0))
 
+    @property
+    def on(self) -> bool:
+        """Whether any paste may be sharpened (and so whether its pastes' records say so)."""
+        return self.share > 0
+
 
 #: The key of ``background_labels.classes`` for every class it does not list (mapped to null: left out).
 OTHER_CLASSES = "*"

@@ -195,7 +195,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
     count = int(rng.integers(settings.per_image[0], settings.per_image[1] + 1))
     planned: list[dict] = []
     poisson_used = False
-    sharpen_rng = rng.spawn(1)[0] if config.sharpen.share > 0 else None
+    sharpen_rng = rng.spawn(1)[0] if config.sharpen.on else None
     for k in range(count):
         kinds = [kind for kind in ("aid_user", "pedestrian") if pools.get(kind)]
         draw_kind, share_drawn = rng.random(), float(rng.uniform(*settings.height_share))

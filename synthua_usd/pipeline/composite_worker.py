@@ -232,7 +232,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
             if name in painted_paste:
                 pastes[-1][name] = painted_paste[name]
         del pastes[-1]["entry_id"]
-        if config.sharpen.share <= 0:  # written where sharpening is on (earlier datasets keep their records)
+        if not config.sharpen.on:  # written where sharpening is on (earlier datasets keep their records)
             del pastes[-1]["sharpen"]
     record = CompositeRecord(
         id=planned.id, name=planned.name, split=planned.split, width=width, height=height, seed=planned.seed,

@@ -167,9 +167,9 @@ class LooksRandomisation:
     the body's meshes), a fabric per garment among ``upper_fabrics`` and ``lower_fabrics`` (a pattern in a second
     colour, the weave and folds in a normal map; ``wardrobe`` upper and lower garments per scene, which its
     people pick from; upper garments in the colours of ``palette``), shoes among ``shoes`` on soles of another
-    colour, a face (eyes, brows, nostrils, lips, cheeks as an image on the head) and skin with a clear coat; long
-    sleeves and long legs with probabilities ``long_sleeves`` and ``long_legs``; drawn from a stream of its own
-    (switching it off or narrowing it moves no other draw). Off: flat-coloured garments and shoes, faceless matte
+    colour, a face (eyes, brows, nostrils, lips, cheeks as an image on the head) and skin with a clear coat, drawn
+    from a stream of its own (switching it off or narrowing it moves no other draw); long sleeves and long legs with
+    probabilities ``long_sleeves`` and ``long_legs``, one number each per person whatever they are. Off: flat-coloured garments and shoes, faceless matte
     skin, faceted bodies, long sleeves and legs with probability 0.6 each, as before."""
 
     enabled: bool = True
