@@ -49,7 +49,8 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     \b
     Per composite: the photo scaled down and cut to the config's output size; a camera model (horizon row,
     camera height, focal length: from the config, its per-folder defaults, or the photo's EXIF; the horizon
-    from a labelled photo's standing people where camera.person_height_m is set); cut-outs standing on that
+    from a labelled photo's people where camera.person_height_m (standing people) or
+    camera.wheelchair_height_m (wheelchair users) is set); cut-outs standing on that
     camera's ground plane, sized by their distance (a share of the frame height drawn from the config), chosen
     for a camera elevation (and light) like the paste's; their shadows, exposure and white balance matched to
     the photo around them, blend edges mixed (hard, feathered, blurred, Poisson); camera effects where the
@@ -79,7 +80,7 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
             f"grey (composite.background.monochrome)")
     if s.horizon_from_people:
         say(f"{s.horizon_from_people} of {s.images} composites with the horizon placed by their photo's people "
-            f"(camera.person_height_m; the others by camera.horizon_row_share or pitch_deg)")
+            f"(camera.person_height_m, wheelchair_height_m; the others by camera.horizon_row_share or pitch_deg)")
     if s.labelled:
         say(f"the photos' boxes: {s.boxes_kept} kept, {s.boxes_dropped} dropped (covered by pastes, cut off by the "
             f"output size, unmapped, empty or crowd regions: see each record's composite.background_boxes)")

@@ -17,11 +17,16 @@ from synthua_usd.core.schemas import read_json, validate_document
 from synthua_usd.dataset.config import QAThresholds, SplitRatios
 from synthua_usd.dataset.cutout_bank import GROUPS, Light
 from synthua_usd.model.box_conventions import CONVENTIONS
+from synthua_usd.model.taxonomy import WHEELCHAIRS
 from synthua_usd.randomisation.config import EffectsRandomisation, Range, _range
 
 SCHEMA = "composite"
 BLEND_MODES = ("hard", "feather", "blur", "poisson")
 _SPLIT_TOLERANCE = 1e-6
+
+
+#: The camera fields that let a labelled photo's people place its horizon (:meth:`CameraSettings.people_heights`).
+PEOPLE_HEIGHTS = ("person_height_m", "wheelchair_height_m")
 
 
 @dataclass(frozen=True)
@@ -35,22 +40,38 @@ class CameraSettings:
     pitch_deg: float | None = None
     light: Light | None = None
     person_height_m: float | None = None
+    wheelchair_height_m: float | None = None
 
     def __post_init__(self) -> None:
         for name, lo, hi in (("horizon_row_share", -10.0, 10.0), ("height_m", 0.05, 1000.0),
                              ("focal_width_share", 0.05, 20.0)):
             object.__setattr__(self, name, _range(f"camera.{name}", getattr(self, name), lo, hi))
-        if self.person_height_m is not None and not 0.5 <= self.person_height_m <= 2.5:
-            raise InputError(f"camera.person_height_m: {self.person_height_m}; expected metres in [0.5, 2.5] or null")
+        for name in PEOPLE_HEIGHTS:
+            value = getattr(self, name)
+            if value is not None and not 0.5 <= value <= 2.5:
+                raise InputError(f"camera.{name}: {value}; expected metres in [0.5, 2.5] or null")
 
     def to_document(self) -> dict:
-        """Every field; ``person_height_m`` only where set (it came after datasets were made, whose job keys stay)."""
+        """Every field; the people's heights only where set (they came after datasets were made, whose job keys
+        stay)."""
         out = {f.name: getattr(self, f.name) for f in fields(self)}
         out.update({k: list(out[k]) for k in ("horizon_row_share", "height_m", "focal_width_share")})
         out["light"] = None if self.light is None else asdict(self.light)
-        if self.person_height_m is None:
-            del out["person_height_m"]
+        for name in PEOPLE_HEIGHTS:
+            if out[name] is None:
+                del out[name]
         return out
+
+    def people_heights(self) -> dict[str, float]:
+        """The height in metres, from the ground up, of each class of the photo's boxes that places its horizon
+        (``person`` standing, each wheelchair with its seated user), as set; empty where none is, or where a known
+        ``pitch_deg`` places the horizon."""
+        if self.pitch_deg is not None:
+            return {}
+        heights = {"person": self.person_height_m} if self.person_height_m is not None else {}
+        if self.wheelchair_height_m is not None:
+            heights.update(dict.fromkeys(WHEELCHAIRS, self.wheelchair_height_m))
+        return heights
 
 
 #: What a paste does that finds no column within its overlap limits (schema ``pastes.when_no_room``).

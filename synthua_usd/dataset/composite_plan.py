@@ -33,7 +33,7 @@ from typing import Sequence
 
 import numpy as np
 
-from synthua_usd.dataset.composite_config import BLEND_MODES, CameraSettings, CompositeConfig
+from synthua_usd.dataset.composite_config import BLEND_MODES, PEOPLE_HEIGHTS, CameraSettings, CompositeConfig
 from synthua_usd.dataset.cutout_bank import BankEntry, Light
 from synthua_usd.dataset.record import PhotoCameraEntry
 from synthua_usd.model.photo_camera import PhotoCamera, focal_px_from_35mm, horizon_from_people
@@ -45,7 +45,7 @@ MIN_DROP_PX = 1.0
 @dataclass(frozen=True)
 class DrawnCamera:
     """A composite's camera model and where each of its values came from (``config``, ``folder:<name>``,
-    ``exif``, ``pitch_deg:<one of those>`` or ``people:<boxes used>:<one of those>``); ``light`` the photo's light
+    ``exif``, ``pitch_deg:<one of those>`` or ``people:<boxes used>:<those of the heights set, joined by +>``); ``light`` the photo's light
     when the config gives it."""
 
     camera: PhotoCamera
@@ -64,11 +64,13 @@ class DrawnCamera:
 
 def draw_camera(settings: CameraSettings, sources: dict, size: tuple[int, int], exif_focal_35mm: float | None,
                 source_size: tuple[int, int], scale: float, rng: np.random.Generator,
-                people: Sequence[tuple[float, float, float, float]] = ()) -> DrawnCamera:
+                people: Sequence[tuple[str, tuple[float, float, float, float]]] = (),
+                photo_rows: tuple[float, float] | None = None) -> DrawnCamera:
     """The camera model of one composite of ``size`` (W, H), written from a photo of ``source_size`` at ``scale``
-    (written px per photo px); ``people`` the photo's person boxes in the frame (x0, y0, x1, y1), which place the
-    horizon where ``settings.person_height_m`` is set, ``settings.pitch_deg`` is not and one is whole in the frame.
-    Its three ranges are always drawn, in one order, used or not."""
+    (written px per photo px); ``people`` the photo's boxes as (class name, (x0, y0, x1, y1) in written px, not
+    clipped to the frame), which place the horizon where :meth:`CameraSettings.people_heights` gives their class a
+    height and one is whole in the photo, whose top and bottom edges are the written rows ``photo_rows`` (None: the
+    frame's). Its three ranges are always drawn, in one order, used or not."""
     width, height = size
     horizon_share = float(rng.uniform(*settings.horizon_row_share))
     height_m = float(rng.uniform(*settings.height_m))
@@ -84,11 +86,13 @@ def draw_camera(settings: CameraSettings, sources: dict, size: tuple[int, int], 
     else:
         camera = PhotoCamera(width, height, horizon_share * height, height_m, focal)
         horizon_source = sources["horizon_row_share"]
-    found = (horizon_from_people(people, height, height_m, settings.person_height_m)
-             if settings.person_height_m is not None and settings.pitch_deg is None else None)
-    if found is not None:       # a known pitch wins: a measured camera over the people's estimate
+    heights = settings.people_heights()     # none where a known pitch wins: a measured camera over an estimate
+    found = horizon_from_people([(box, heights[name]) for name, box in people if name in heights],
+                                photo_rows or (0.0, float(height)), height_m) if heights else None
+    if found is not None:
         camera = PhotoCamera(width, height, found[0], height_m, focal)
-        horizon_source = f"people:{found[1]}:{sources['person_height_m']}"
+        said = dict.fromkeys(sources[n] for n in PEOPLE_HEIGHTS if getattr(settings, n) is not None)
+        horizon_source = f"people:{found[1]}:{'+'.join(said)}"
     return DrawnCamera(camera, {"horizon_row_px": horizon_source, "height_m": sources["height_m"],
                                 "focal_px": focal_source}, settings.light,
                        None if not exif_focal_35mm else float(exif_focal_35mm))

@@ -16,7 +16,8 @@ photos). Hence, for a paste whose ground point (its *anchor*) lands on row ``y_a
   higher in the frame, and the size does not depend on the focal length.
 
 Read the other way, a photo's own people place its horizon (:func:`horizon_from_people`): a person ``h`` metres tall
-whose box stands on row ``y_b`` and is ``p`` pixels tall puts it on ``y_h = y_b - p H / h``.
+(standing, or seated in a wheelchair, from the ground up) whose box stands on row ``y_b`` and is ``p`` pixels tall
+puts it on ``y_h = y_b - p H / h``.
 
 Pixel coordinates: (0, 0) is the top-left corner of the image, pixel centres at integer + 0.5 (as in
 :mod:`synthua_usd.model.cameras`).
@@ -25,6 +26,7 @@ Pixel coordinates: (0, 0) is the top-left corner of the image, pixel centres at 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -42,21 +44,24 @@ def focal_px_from_35mm(f35_mm: float, width_px: int, height_px: int) -> float:
     return float(f35_mm) / FILM_WIDTH_MM * max(int(width_px), int(height_px))
 
 
-#: A person box places the horizon only where it is whole in the frame: both of its top and bottom edges at least this
-#: share of the frame height inside it (a box the frame cuts shows part of a person; a label tool may stop one a pixel
-#: or two short of the edge) and at least :data:`MIN_PERSON_PX` tall.
+#: A box places the horizon only where it is whole in the photo: both of its top and bottom edges at least this share
+#: of the photo's height inside it (a box the photo's edge cuts shows part of a person; a label tool may stop one a
+#: pixel or two short of the edge) and at least :data:`MIN_PERSON_PX` tall (written pixels).
 PERSON_EDGE_SHARE = 0.01
 MIN_PERSON_PX = 16.0
 
 
-def horizon_from_people(boxes, frame_height_px: float, camera_height_m: float,
-                        person_height_m: float) -> tuple[float, int] | None:
-    """The horizon row that a photo's standing people put it on, and how many did: for each box ``(x0, y0, x1, y1)``
-    (written pixels) whole in a frame ``frame_height_px`` tall (its rows: the sides may cut it), ``y1 - (y1 - y0)
-    camera_height_m / person_height_m``; their median. None where no box is whole in the frame."""
-    edge = PERSON_EDGE_SHARE * frame_height_px
-    rows = [y1 - (y1 - y0) * camera_height_m / person_height_m for _, y0, _, y1 in boxes
-            if y0 >= edge and y1 <= frame_height_px - edge and y1 - y0 >= MIN_PERSON_PX]
+def horizon_from_people(people: Sequence[tuple[tuple[float, float, float, float], float]],
+                        photo_rows: tuple[float, float], camera_height_m: float) -> tuple[float, int] | None:
+    """The horizon row that a photo's people on the ground put it on, and how many did: for each ``(box,
+    height_m)``, a box ``(x0, y0, x1, y1)`` in written pixels, not clipped to the frame, of someone ``height_m``
+    tall from the ground up (standing, or seated in a wheelchair), whose rows lie whole in the photo's
+    (``photo_rows``: its top and bottom edges in written rows; a cut for the output may crop the box, the photo must
+    not), ``y1 - (y1 - y0) camera_height_m / height_m``; their median. None where no box is whole."""
+    top, bottom = photo_rows
+    edge = PERSON_EDGE_SHARE * (bottom - top)
+    rows = [y1 - (y1 - y0) * camera_height_m / height_m for (_, y0, _, y1), height_m in people
+            if y0 >= top + edge and y1 <= bottom - edge and y1 - y0 >= MIN_PERSON_PX]
     return (float(np.median(rows)), len(rows)) if rows else None
 
 

@@ -11,6 +11,10 @@ from synthua_usd.core.errors import InputError
 from synthua_usd.core.input_files import shown
 from synthua_usd.core.schemas import bundled_path, read_json, validate_document
 
+#: The wheelchair classes (each with its seated user).
+WHEELCHAIRS = ("manual_wheelchair", "electric_wheelchair")
+
+
 @dataclass(frozen=True)
 class SemanticClass:
     """One class. ``color`` is sRGB, 8 bits a channel; ``isthing`` means countable instances."""

@@ -120,15 +120,16 @@ def work(state: CompositeState, item) -> list[dict]:
     return state.writer.submit(write_image, state, make_composite(state, item), WRITERS)
 
 
-def _frame_box(box, region, scale, size) -> tuple[tuple[float, float, float, float], float]:
-    """A photo box (x, y, w, h) in the written frame as (x0, y0, x1, y1) clipped to it, and the share of the box the
-    cut leaves."""
+def _frame_box(box, region, scale, size) -> tuple[tuple[float, float, float, float], float,
+                                                 tuple[float, float, float, float]]:
+    """A photo box (x, y, w, h) in the written frame as (x0, y0, x1, y1) clipped to it, the share of the box the
+    cut leaves, and the box in the frame's coordinates unclipped."""
     x0, y0 = (box.x - region[0]) * scale, (box.y - region[1]) * scale
     x1, y1 = x0 + box.w * scale, y0 + box.h * scale
     cx0, cy0, cx1, cy1 = max(0.0, x0), max(0.0, y0), min(float(size[0]), x1), min(float(size[1]), y1)
     full = (x1 - x0) * (y1 - y0)
     kept = max(0.0, cx1 - cx0) * max(0.0, cy1 - cy0)
-    return (cx0, cy0, max(cx0, cx1), max(cy0, cy1)), (kept / full if full > 0 else 0.0)
+    return (cx0, cy0, max(cx0, cx1), max(cy0, cy1)), (kept / full if full > 0 else 0.0), (x0, y0, x1, y1)
 
 
 def covered_by_pastes(box: tuple[float, float, float, float], instance_ids: np.ndarray) -> float:
@@ -149,10 +150,10 @@ def _background_entries(background: Background, labelled: bool, photo, config: C
         return out
     for box in background.boxes:
         ours = config.background_labels.our_class(box.label)
-        frame, kept_share = _frame_box(box, photo.region, photo.scale, size)
+        frame, kept_share, whole = _frame_box(box, photo.region, photo.scale, size)
         reason = "crowd" if box.ignore else "unmapped" if ours is None else "empty" if min(box.w, box.h) <= 0 else (
             "cropped" if kept_share < config.background_labels.drop_cropped_share else None)
-        out.append({"label": box.label, "class_name": ours, "frame": frame, "covered_share": None,
+        out.append({"label": box.label, "class_name": ours, "frame": frame, "whole": whole, "covered_share": None,
                     "kept": reason is None, "reason": reason})
     return out
 
@@ -180,10 +181,11 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
     camera_rng, paste_rng = rng.spawn(2)
     settings, sources = config.camera_for(planned.background)
     boxes = _background_entries(background, job.backgrounds.labelled, photo, config, (width, height))
+    top = -photo.region[1] * photo.scale          # the photo's edges in written rows: the cut may crop a box
     drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
                         (photo.header.width, photo.header.height), photo.scale, camera_rng,
-                        [b["frame"] for b in boxes            # a box the cut crops at a side still spans its rows
-                         if b["class_name"] == "person" and (b["kept"] or b["reason"] == "cropped")])
+                        [(b["class_name"], b["whole"]) for b in boxes if b["kept"] or b["reason"] == "cropped"],
+                        (top, top + photo.header.height * photo.scale))
     placements = plan_pastes(drawn, state.pools, config,      # pastes keep off crowds as off the kept boxes
                              [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng)
     entries = [bank.entry(p.entry_id) for p in placements]

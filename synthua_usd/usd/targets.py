@@ -17,9 +17,9 @@ from pxr import Usd, UsdGeom
 from synthua_usd.agents.profiles import PROFILES
 from synthua_usd.core.errors import InputError, echo
 from synthua_usd.model.scene import Instance
+from synthua_usd.model.taxonomy import WHEELCHAIRS
 from synthua_usd.usd.agents_writer import AGENTS_ROOT
 
-WHEELCHAIRS = ("manual_wheelchair", "electric_wheelchair")
 #: Which aid users aim=aid_user tries first: wheelchair users (the rarest in real datasets, and the smallest in
 #: the district's first CCTV view), then walkers, crutches and canes.
 DEVICE_ORDER = ("electric_wheelchair", "manual_wheelchair", "walker", "crutch", "tripod_cane", "orthopedic_cane",

@@ -79,16 +79,26 @@ def test_sharpening_is_written_only_where_set_so_earlier_job_keys_hold():
     assert CompositeConfig.from_document(config.to_document()) == config
 
 
-def test_person_height_is_written_only_where_set_and_checked():
-    assert "person_height_m" not in CompositeConfig().to_document()["camera"]        # earlier job keys hold
+def test_people_heights_are_written_only_where_set_and_checked():
+    camera = CompositeConfig().to_document()["camera"]
+    assert "person_height_m" not in camera and "wheelchair_height_m" not in camera    # earlier job keys hold
+    assert CameraSettings().people_heights() == {}
     config = CompositeConfig.from_document({"camera": {"person_height_m": 1.7},
-                                            "folders": {"kids": {"person_height_m": 1.2}}})
+                                            "folders": {"kids": {"person_height_m": 1.2, "wheelchair_height_m": 1.0}}})
     assert config.to_document()["camera"]["person_height_m"] == 1.7
+    assert "wheelchair_height_m" not in config.to_document()["camera"]
     assert CompositeConfig.from_document(config.to_document()) == config
     settings, sources = config.camera_for("kids/a.jpg")
     assert settings.person_height_m == 1.2 and sources["person_height_m"] == "folder:kids"
-    with pytest.raises(InputError, match=r"camera\.person_height_m: 3\.0; expected metres in \[0\.5, 2\.5\] or null"):
-        CameraSettings(person_height_m=3.0)
+    assert settings.people_heights() == {"person": 1.2, "manual_wheelchair": 1.0, "electric_wheelchair": 1.0}
+    assert config.camera_for("b.jpg")[0].people_heights() == {"person": 1.7}
+    assert CameraSettings(wheelchair_height_m=1.35, pitch_deg=-5.0).people_heights() == {}   # a known pitch wins
+    seated = CompositeConfig.from_document({"camera": {"wheelchair_height_m": 1.35}})
+    assert seated.to_document()["camera"]["wheelchair_height_m"] == 1.35
+    assert CompositeConfig.from_document(seated.to_document()) == seated
+    for name in ("person_height_m", "wheelchair_height_m"):
+        with pytest.raises(InputError, match=rf"camera\.{name}: 3\.0; expected metres in \[0\.5, 2\.5\] or null"):
+            CameraSettings(**{name: 3.0})
 
 
 def test_other_classes_may_only_be_left_out():
@@ -134,6 +144,7 @@ def test_the_shipped_config_is_valid():
     ({"blend": {"hard": 0, "feather": 0, "blur": 0, "poisson": 0}}, r"x\.json: blend: weights"),
     ({"camera": {"height_m": [2, 1]}}, r"x\.json: camera\.height_m: \[2, 1\]"),
     ({"camera": {"person_height_m": 0.2}}, r"x\.json: camera\.person_height_m: 0\.2"),
+    ({"camera": {"wheelchair_height_m": 2.6}}, r"x\.json: camera\.wheelchair_height_m: 2\.6"),
     ({"folders": {"a": {"height_m": -1}}}, r"x\.json: folders\.a\.height_m"),
     ({"output": {"width": 8, "height": 48}}, r"x\.json: output"),
     ({"sharpen": {"amount": [3, 1]}}, r"x\.json: sharpen\.amount: \[3, 1\]; expected two finite numbers"),

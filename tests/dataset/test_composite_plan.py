@@ -168,14 +168,29 @@ def test_the_camera_draw_names_its_sources():
 
 def test_the_photos_people_place_the_horizon_unless_the_pitch_is_known():
     sources = {"horizon_row_share": "config", "height_m": "config", "focal_width_share": "config",
-               "use_exif": "config", "pitch_deg": "config", "light": "config", "person_height_m": "folder:kids"}
-    people = [(10.0, 200.0, 60.0, 370.0), (300.0, 0.0, 340.0, 300.0)]     # one whole, one cut at the top
+               "use_exif": "config", "pitch_deg": "config", "light": "config", "person_height_m": "folder:kids",
+               "wheelchair_height_m": "config"}
+    people = [("person", (10.0, 200.0, 60.0, 370.0)), ("person", (300.0, 0.0, 340.0, 300.0)),   # whole; cut at the top
+              ("manual_wheelchair", (400.0, 260.0, 470.0, 400.0)), ("walker", (500.0, 100.0, 540.0, 200.0))]
     settings = CameraSettings(horizon_row_share=(0.25, 0.25), height_m=(1.2, 1.2), person_height_m=1.2)
     drawn = draw_camera(settings, sources, (640, 480), None, (640, 480), 1.0, np.random.default_rng(0), people)
     assert drawn.camera.horizon_row_px == pytest.approx(370.0 - 170.0 * 1.2 / 1.2)
     assert drawn.sources["horizon_row_px"] == "people:1:folder:kids"
-    pitched = draw_camera(replace(settings, pitch_deg=-5.0), sources, (640, 480), None, (640, 480), 1.0,
-                          np.random.default_rng(0), people)
+    # the wheelchair user counts where wheelchair_height_m is set: the median of the two rows
+    both = draw_camera(replace(settings, wheelchair_height_m=1.4), sources, (640, 480), None, (640, 480), 1.0,
+                       np.random.default_rng(0), people)
+    assert both.camera.horizon_row_px == pytest.approx(np.median([200.0, 400.0 - 140.0 * 1.2 / 1.4]))
+    assert both.sources["horizon_row_px"] == "people:2:folder:kids+config"
+    seated = draw_camera(CameraSettings(height_m=(1.2, 1.2), wheelchair_height_m=1.4), sources, (640, 480), None,
+                         (640, 480), 1.0, np.random.default_rng(0), people)
+    assert seated.camera.horizon_row_px == pytest.approx(280.0)
+    assert seated.sources["horizon_row_px"] == "people:1:config"
+    # the photo reaching above the frame holds the second person whole: it counts then
+    above = draw_camera(settings, sources, (640, 480), None, (640, 480), 1.0, np.random.default_rng(0), people,
+                        (-50.0, 480.0))
+    assert above.camera.horizon_row_px == pytest.approx(np.median([200.0, 300.0 - 300.0 * 1.2 / 1.2]))
+    pitched = draw_camera(replace(settings, pitch_deg=-5.0, wheelchair_height_m=1.4), sources, (640, 480), None,
+                          (640, 480), 1.0, np.random.default_rng(0), people)
     assert pitched.sources["horizon_row_px"] == "pitch_deg:config"
     alone = draw_camera(settings, sources, (640, 480), None, (640, 480), 1.0, np.random.default_rng(0), people[1:])
     assert alone.sources["horizon_row_px"] == "config" and alone.camera.horizon_row_px == pytest.approx(120.0)

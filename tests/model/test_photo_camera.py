@@ -79,17 +79,36 @@ def test_an_anchor_on_or_above_the_horizon_has_no_distance():
 
 def test_a_photos_standing_people_put_the_horizon_where_the_pinhole_puts_it():
     """People 1.7 m tall standing at 3, 6 and 15 m, projected by the rotation-free pinhole above, give back the
-    horizon of the level camera that saw them; boxes the frame cuts, or too small, place nothing."""
+    horizon of the level camera that saw them; boxes the photo's edges cut, or too small, place nothing."""
     width, height, f, camera_m = 640, 480, 500.0, 1.4
     boxes = []
     for distance in (3.0, 6.0, 15.0):
         _, foot = _project(_to_camera(np.array([0.0, 0.0, distance]), camera_m, 0.0), f, width / 2, 200.0)
         _, head = _project(_to_camera(np.array([0.0, 1.7, distance]), camera_m, 0.0), f, width / 2, 200.0)
-        boxes.append((100.0, head, 140.0, foot))
-    row, used = horizon_from_people(boxes, height, camera_m, 1.7)
+        boxes.append(((100.0, head, 140.0, foot), 1.7))
+    photo = (0.0, float(height))
+    row, used = horizon_from_people(boxes, photo, camera_m)
     assert used == 3 and row == pytest.approx(200.0)         # a level camera's horizon is its principal row
-    cut = [(0.0, 0.0, 50.0, 300.0), (0.0, 200.0, 50.0, 480.0), (0.0, 100.0, 10.0, 110.0)]   # top, bottom, 10 px
-    assert horizon_from_people(cut, height, camera_m, 1.7) is None
-    assert horizon_from_people(boxes[:1] + cut, height, camera_m, 1.7) == (pytest.approx(200.0), 1)
+    cut = [((0.0, 0.0, 50.0, 300.0), 1.7), ((0.0, 200.0, 50.0, 480.0), 1.7), ((0.0, 100.0, 10.0, 110.0), 1.7)]
+    assert horizon_from_people(cut, photo, camera_m) is None   # top, bottom, 10 px
+    assert horizon_from_people(boxes[:1] + cut, photo, camera_m) == (pytest.approx(200.0), 1)
     # a taller stated person (or a lower camera) puts the horizon lower: y_b - p H / h
-    assert horizon_from_people(boxes[:1], height, camera_m, 1.9)[0] > 200.0
+    assert horizon_from_people([(boxes[0][0], 1.9)], photo, camera_m)[0] > 200.0
+
+
+def test_seated_wheelchair_users_and_boxes_the_cut_crops_place_the_horizon_too():
+    """A wheelchair user 1.35 m tall from the ground up, seated 4 m away, gives back the same horizon with their
+    height; a box whose head the cut for the output crops (rows above the frame) counts in its whole extent while
+    the photo holds it whole, and not where the photo's own edge cuts it."""
+    f, camera_m, principal = 500.0, 1.0, 120.0
+    _, foot = _project(_to_camera(np.array([0.0, 0.0, 4.0]), camera_m, 0.0), f, 320.0, principal)
+    _, head = _project(_to_camera(np.array([0.0, 1.35, 4.0]), camera_m, 0.0), f, 320.0, principal)
+    _, near_foot = _project(_to_camera(np.array([0.0, 0.0, 1.8]), camera_m, 0.0), f, 320.0, principal)
+    _, near_head = _project(_to_camera(np.array([0.0, 1.7, 1.8]), camera_m, 0.0), f, 320.0, principal)
+    assert near_head < 0.0 < near_foot < 480.0                 # the frame shows the standing person's legs only
+    seated, standing = ((300.0, head, 360.0, foot), 1.35), ((100.0, near_head, 160.0, near_foot), 1.7)
+    assert horizon_from_people([seated], (0.0, 480.0), camera_m) == (pytest.approx(principal), 1)
+    photo = (-100.0, 540.0)                                     # the photo reaches 100 rows above the frame
+    assert horizon_from_people([seated, standing], photo, camera_m) == (pytest.approx(principal), 2)
+    assert horizon_from_people([standing], (0.0, 480.0), camera_m) is None
+    assert horizon_from_people([standing], (near_head + 2.0, 540.0), camera_m) is None   # the photo's edge cuts it

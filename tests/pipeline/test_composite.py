@@ -510,6 +510,44 @@ def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled
     assert plain and all(r["camera"]["sources"]["horizon_row_px"] == "config" for r in plain)
 
 
+def test_wheelchair_users_and_people_the_cut_crops_place_the_horizon_too(inputs, tmp_path, run_cli):
+    """``camera.wheelchair_height_m`` with ``person_height_m``: tall photos cut to the output keep rows 12..60, so
+    a person whose head the cut crops counts in the whole extent the photo holds, a wheelchair user (seated, 1.35
+    m) counts, a person the photo's own bottom edge cuts does not. Recomputed here from the label files and each
+    record's cut: the median of y_b - p H / h; said as ``people:2``; pastes below it; replay byte-identical."""
+    tall = tmp_path / "tall"
+    lines = "0 0.2 0.45 0.15 0.6\n1 0.6 0.6 0.25 0.4\n0 0.85 0.8 0.1 0.4\n"
+    for path in write_photos(tall / "images" / "train", 2, (64, 72), seed=4):
+        (tall / "labels" / "train").mkdir(parents=True, exist_ok=True)
+        (tall / "labels" / "train" / f"{path.stem}.txt").write_text(lines)
+    (tall / "data.yaml").write_text("path: .\ntrain: images/train\nnames:\n  0: person\n  1: wheelchair\n")
+    config = tmp_path / "seated.json"
+    config.write_text(json.dumps({**CONFIG, "camera": {"person_height_m": 1.7, "wheelchair_height_m": 1.35}}))
+    out = tmp_path / "seated"
+    code, said, err = run_cli("composite", tall, "--bank", inputs / "bank", "--config", config, "--out", out,
+                              "--workers", 1)
+    assert code == 0, said + err
+    records = _records(out)
+    assert len(records) == 4 and "4 of 4 composites with the horizon placed by their photo's people" in said
+    boxes = [[float(v) for v in line.split()] for line in lines.splitlines()]
+    for record in records:
+        camera, background = record["camera"], record["composite"]["background"]
+        assert background["region"] == [0.0, 12.0, 64.0, 60.0] and background["scale"] == 1.0
+        rows = []
+        for label, _, cy, _, h in boxes:
+            top, bottom = (cy - h / 2) * 72, (cy + h / 2) * 72     # photo rows
+            if top >= 0.72 and bottom <= 72 - 0.72:                # whole in the photo (1 % of its height)
+                rows.append(bottom - 12 - (bottom - top) * camera["height_m"] / (1.7 if label == 0 else 1.35))
+        assert len(rows) == 2 and (boxes[0][2] - boxes[0][4] / 2) * 72 < 12    # the first person's head is cut
+        assert camera["sources"]["horizon_row_px"] == "people:2:config"
+        assert camera["horizon_row_px"] == pytest.approx(float(np.median(rows)), abs=1e-3)
+        assert all(p["anchor_px"][1] > camera["horizon_row_px"] for p in record["composite"]["pastes"])
+    job = json.loads((out / "generate.json").read_text())
+    assert job["job_key"]["config"]["camera"]["wheelchair_height_m"] == 1.35
+    code, text, _ = run_cli("replay", out, str(records[-1]["id"]))
+    assert code == 0 and "byte-identical" in text, text
+
+
 def test_sharpening_is_recorded_per_paste_keeps_labels_and_photo_pixels_verifies_and_replays(inputs, tmp_path, run_cli):
     """Half the pastes sharpened, camera effects off: each paste's record says whether and how; the labels and
     the photo's pixels are those of the same config without sharpening, and so is all of a composite none of whose
