@@ -45,8 +45,8 @@ MIN_DROP_PX = 1.0
 @dataclass(frozen=True)
 class DrawnCamera:
     """A composite's camera model and where each of its values came from (``config``, ``folder:<name>``,
-    ``exif``, ``pitch_deg:<one of those>`` or ``people:<boxes used>:<those of the heights set, joined by +>``); ``light`` the photo's light
-    when the config gives it."""
+    ``exif``, ``pitch_deg:<one of those>`` or ``people:<boxes used>:<those of the heights set, joined by +>``);
+    ``light`` the photo's light when the config gives it."""
 
     camera: PhotoCamera
     sources: dict
