@@ -133,6 +133,7 @@ def test_the_shipped_config_is_valid():
     assert config.output == (640, 480) and config.convention == "wheelchair-sets"
     assert config.background_labels.our_class("wheelchair") == "manual_wheelchair"
     assert config.background_labels.our_class("person") == "person"
+    assert config.camera.people_heights() == {"person": 1.7, "manual_wheelchair": 1.35, "electric_wheelchair": 1.35}
 
 
 @pytest.mark.parametrize("document, message", [
