@@ -1,7 +1,8 @@
 #!/usr/bin/env python
 """What height a labelled set's own photos give its wheelchair users, for `synthua composite`'s
 `camera.wheelchair_height_m`: in each photo that holds a person box and a wheelchair box whole (the rule of
-`camera.person_height_m`: top and bottom edges at least 1 % of the photo's height inside it, at least 16 px tall),
+`camera.person_height_m`: top and bottom edges at least 1 % of the photo's height inside it, at least 16 px tall,
+here in the photo's own pixels where a composite counts them after scaling the photo to its output),
 the people on foot place the horizon (`synthua_usd.model.photo_camera.horizon_from_people`, standing at
 --person-height, the camera at --camera-height), and each whole wheelchair box, read as a chair with its seated user
 standing on the same ground, is then p H / (y_b - y_h) metres tall. Printed: the median and quartiles of those

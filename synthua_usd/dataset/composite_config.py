@@ -259,6 +259,12 @@ class CompositeConfig:
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
 
+    def sets_people_heights(self) -> bool:
+        """Whether ``camera`` or a folder of ``folders`` sets a height of :data:`PEOPLE_HEIGHTS` (the photo's people
+        may place its horizon)."""
+        return (any(getattr(self.camera, name) is not None for name in PEOPLE_HEIGHTS)
+                or any(part.get(name) is not None for _, part in self.folders for name in PEOPLE_HEIGHTS))
+
     def camera_for(self, relative: str) -> tuple[CameraSettings, dict[str, str]]:
         """The camera settings of the background at ``relative`` (a POSIX path relative to BACKGROUNDS): the
         config's ``camera`` with the fields of the longest folder of ``folders`` holding it, and the source of each

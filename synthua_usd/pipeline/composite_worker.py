@@ -80,6 +80,10 @@ class CompositeJob:
     #: Whether a grey photo's composite is made grey: jobs made before 6 December 2026 did not (their ``job_key``
     #: has no ``grey_photos``), and replay makes them as they were.
     grey_photos: bool = True
+    #: Whether a photo's people place its horizon where the photo holds them whole (else: person boxes whole in the
+    #: frame only): jobs made before 7 December 2026 that set ``camera.person_height_m`` did the latter (their
+    #: ``job_key`` has no ``people_in_photo``), and replay makes them as they were.
+    people_in_photo: bool = True
 
 
 @dataclass
@@ -181,11 +185,14 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
     camera_rng, paste_rng = rng.spawn(2)
     settings, sources = config.camera_for(planned.background)
     boxes = _background_entries(background, job.backgrounds.labelled, photo, config, (width, height))
-    top = -photo.region[1] * photo.scale          # the photo's edges in written rows: the cut may crop a box
+    people = [b for b in boxes if b["kept"] or b["reason"] == "cropped"]
+    if job.people_in_photo:     # the photo's edges in written rows: the cut for the output may crop a box
+        top = -photo.region[1] * photo.scale
+        placing, rows = [(b["class_name"], b["whole"]) for b in people], (top, top + photo.header.height * photo.scale)
+    else:                       # an earlier job's rule: person boxes whole in the frame
+        placing, rows = [("person", b["frame"]) for b in people if b["class_name"] == "person"], None
     drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
-                        (photo.header.width, photo.header.height), photo.scale, camera_rng,
-                        [(b["class_name"], b["whole"]) for b in boxes if b["kept"] or b["reason"] == "cropped"],
-                        (top, top + photo.header.height * photo.scale))
+                        (photo.header.width, photo.header.height), photo.scale, camera_rng, placing, rows)
     placements = plan_pastes(drawn, state.pools, config,      # pastes keep off crowds as off the kept boxes
                              [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng)
     entries = [bank.entry(p.entry_id) for p in placements]

@@ -82,7 +82,7 @@ def test_sharpening_is_written_only_where_set_so_earlier_job_keys_hold():
 def test_people_heights_are_written_only_where_set_and_checked():
     camera = CompositeConfig().to_document()["camera"]
     assert "person_height_m" not in camera and "wheelchair_height_m" not in camera    # earlier job keys hold
-    assert CameraSettings().people_heights() == {}
+    assert CameraSettings().people_heights() == {} and not CompositeConfig().sets_people_heights()
     config = CompositeConfig.from_document({"camera": {"person_height_m": 1.7},
                                             "folders": {"kids": {"person_height_m": 1.2, "wheelchair_height_m": 1.0}}})
     assert config.to_document()["camera"]["person_height_m"] == 1.7
@@ -91,7 +91,8 @@ def test_people_heights_are_written_only_where_set_and_checked():
     settings, sources = config.camera_for("kids/a.jpg")
     assert settings.person_height_m == 1.2 and sources["person_height_m"] == "folder:kids"
     assert settings.people_heights() == {"person": 1.2, "manual_wheelchair": 1.0, "electric_wheelchair": 1.0}
-    assert config.camera_for("b.jpg")[0].people_heights() == {"person": 1.7}
+    assert config.camera_for("b.jpg")[0].people_heights() == {"person": 1.7} and config.sets_people_heights()
+    assert CompositeConfig.from_document({"folders": {"kids": {"wheelchair_height_m": 1.0}}}).sets_people_heights()
     assert CameraSettings(wheelchair_height_m=1.35, pitch_deg=-5.0).people_heights() == {}   # a known pitch wins
     seated = CompositeConfig.from_document({"camera": {"wheelchair_height_m": 1.35}})
     assert seated.to_document()["camera"]["wheelchair_height_m"] == 1.35

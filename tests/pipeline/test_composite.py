@@ -479,8 +479,9 @@ def test_a_grey_photos_composites_are_grey_recorded_verified_and_replayed(inputs
 
 def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled, tmp_path, run_cli):
     """``camera.person_height_m``: the horizon of each composite of a labelled photo is the median of y_b - h H / 1.7
-    over its person boxes whole in the frame (recomputed here from the record's boxes), said as ``people:N``; the
-    pastes stand on that ground; without it, the config's range, as before."""
+    over its person boxes whole in the photo (recomputed here from the record's boxes: the cut to the output keeps
+    every row of these photos), said as ``people:N``; the pastes stand on that ground; without it, the config's
+    range, as before. Its job key says ``people_in_photo``, and a config without the heights leaves it out."""
     config = tmp_path / "people.json"
     config.write_text(json.dumps({**CONFIG, "camera": {"person_height_m": 1.7}}))
     out = tmp_path / "people"
@@ -494,7 +495,7 @@ def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled
         whole = [b["bbox"] for b in record["composite"]["background_boxes"]      # cropped: at a side, rows whole
                  if b["class_name"] == "person" and b["reason"] in (None, "covered", "cropped")
                  and b["bbox"][1] >= 0.48 and b["bbox"][1] + b["bbox"][3] <= HEIGHT - 0.48 and b["bbox"][3] >= 16.0]
-        assert whole, "the fixture's first person box lies whole in the frame"
+        assert whole, "the fixture's first person box lies whole in the photo"
         expected = float(np.median([y + h - h * camera["height_m"] / 1.7 for _, y, _, h in whole]))
         assert camera["sources"]["horizon_row_px"] == f"people:{len(whole)}:config"
         assert camera["horizon_row_px"] == pytest.approx(expected, abs=1e-3)
@@ -503,7 +504,8 @@ def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled
             drop = paste["anchor_px"][1] - camera["horizon_row_px"]
             assert paste["distance_m"] == pytest.approx(camera["focal_px"] * camera["height_m"] / drop, rel=1e-6)
     job = json.loads((out / "generate.json").read_text())
-    assert job["job_key"]["config"]["camera"]["person_height_m"] == 1.7
+    assert job["job_key"]["config"]["camera"]["person_height_m"] == 1.7 and job["job_key"]["people_in_photo"] is True
+    assert "people_in_photo" not in json.loads((labelled / "generate.json").read_text())["job_key"]
     code, text, _ = run_cli("replay", out, str(records[0]["id"]))
     assert code == 0 and "byte-identical" in text, text
     plain = _records(labelled)
@@ -512,11 +514,13 @@ def test_a_labelled_photos_people_place_its_horizon_where_asked(inputs, labelled
 
 def test_wheelchair_users_and_people_the_cut_crops_place_the_horizon_too(inputs, tmp_path, run_cli):
     """``camera.wheelchair_height_m`` with ``person_height_m``: tall photos cut to the output keep rows 12..60, so
-    a person whose head the cut crops counts in the whole extent the photo holds, a wheelchair user (seated, 1.35
-    m) counts, a person the photo's own bottom edge cuts does not. Recomputed here from the label files and each
-    record's cut: the median of y_b - p H / h; said as ``people:2``; pastes below it; replay byte-identical."""
+    a person whose head the cut crops counts in the whole extent the photo holds, and so does one the cut leaves
+    less than half of (dropped from the labels as cropped); a wheelchair user (seated, 1.35 m) counts, a person the
+    photo's own bottom edge cuts does not. Recomputed here from the label files and each record's cut: the median
+    of y_b - p H / h; said as ``people:3``; pastes below it; replay byte-identical, and a job made before this rule
+    (no ``job_key.people_in_photo``) replays by the frame's person boxes alone."""
     tall = tmp_path / "tall"
-    lines = "0 0.2 0.45 0.15 0.6\n1 0.6 0.6 0.25 0.4\n0 0.85 0.8 0.1 0.4\n"
+    lines = "0 0.2 0.45 0.15 0.6\n1 0.6 0.6 0.25 0.4\n0 0.85 0.8 0.1 0.4\n0 0.45 0.158333 0.1 0.294444\n"
     for path in write_photos(tall / "images" / "train", 2, (64, 72), seed=4):
         (tall / "labels" / "train").mkdir(parents=True, exist_ok=True)
         (tall / "labels" / "train" / f"{path.stem}.txt").write_text(lines)
@@ -538,14 +542,19 @@ def test_wheelchair_users_and_people_the_cut_crops_place_the_horizon_too(inputs,
             top, bottom = (cy - h / 2) * 72, (cy + h / 2) * 72     # photo rows
             if top >= 0.72 and bottom <= 72 - 0.72:                # whole in the photo (1 % of its height)
                 rows.append(bottom - 12 - (bottom - top) * camera["height_m"] / (1.7 if label == 0 else 1.35))
-        assert len(rows) == 2 and (boxes[0][2] - boxes[0][4] / 2) * 72 < 12    # the first person's head is cut
-        assert camera["sources"]["horizon_row_px"] == "people:2:config"
+        assert len(rows) == 3 and (boxes[0][2] - boxes[0][4] / 2) * 72 < 12    # the first person's head is cut
+        assert [b["reason"] for b in record["composite"]["background_boxes"]][3] == "cropped"
+        assert camera["sources"]["horizon_row_px"] == "people:3:config"
         assert camera["horizon_row_px"] == pytest.approx(float(np.median(rows)), abs=1e-3)
         assert all(p["anchor_px"][1] > camera["horizon_row_px"] for p in record["composite"]["pastes"])
     job = json.loads((out / "generate.json").read_text())
     assert job["job_key"]["config"]["camera"]["wheelchair_height_m"] == 1.35
     code, text, _ = run_cli("replay", out, str(records[-1]["id"]))
     assert code == 0 and "byte-identical" in text, text
+    assert job["job_key"].pop("people_in_photo") is True
+    (out / "generate.json").write_text(json.dumps(job))
+    code, text, _ = run_cli("replay", out, str(records[-1]["id"]))
+    assert code != 0 and "differs: records/" in text, text
 
 
 def test_sharpening_is_recorded_per_paste_keeps_labels_and_photo_pixels_verifies_and_replays(inputs, tmp_path, run_cli):
