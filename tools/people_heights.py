@@ -32,7 +32,7 @@ sys.path.insert(0, str(REPO))
 from synthua_usd.analytics.detection_sources import read_detection_set  # noqa: E402
 from synthua_usd.cli.failures import tool_main  # noqa: E402
 from synthua_usd.core.errors import InputError  # noqa: E402
-from synthua_usd.model.photo_camera import horizon_from_people  # noqa: E402
+from synthua_usd.model.photo_camera import horizon_from_people, whole_in_photo  # noqa: E402
 
 
 def measure(path: Path, split: str, person: str, wheelchair: str, person_m: float, wheelchair_m: float,
@@ -49,7 +49,7 @@ def measure(path: Path, split: str, person: str, wheelchair: str, person_m: floa
 
         def whole(label: str) -> list[tuple[float, float, float, float]]:
             boxes = [(b.x, b.y, b.x + b.w, b.y + b.h) for b in image.boxes if b.label == label and not b.ignore]
-            return [b for b in boxes if horizon_from_people([(b, 1.0)], rows, 1.0) is not None]
+            return [b for b in boxes if whole_in_photo(b, rows)]
 
         people, chairs = whole(person), whole(wheelchair)
         if not people or not chairs:

@@ -58,11 +58,18 @@ def horizon_from_people(people: Sequence[tuple[tuple[float, float, float, float]
     tall from the ground up (standing, or seated in a wheelchair), whose rows lie whole in the photo's
     (``photo_rows``: its top and bottom edges in written rows; a cut for the output may crop the box, the photo must
     not), ``y1 - (y1 - y0) camera_height_m / height_m``; their median. None where no box is whole."""
+    rows = [box[3] - (box[3] - box[1]) * camera_height_m / height_m for box, height_m in people
+            if whole_in_photo(box, photo_rows)]
+    return (float(np.median(rows)), len(rows)) if rows else None
+
+
+def whole_in_photo(box: tuple[float, float, float, float], photo_rows: tuple[float, float]) -> bool:
+    """Whether a box ``(x0, y0, x1, y1)`` may place the horizon: its rows whole in the photo's ``photo_rows`` (top
+    and bottom edges, the box's coordinates), :data:`PERSON_EDGE_SHARE` of the photo's height inside them, and at
+    least :data:`MIN_PERSON_PX` tall."""
     top, bottom = photo_rows
     edge = PERSON_EDGE_SHARE * (bottom - top)
-    rows = [y1 - (y1 - y0) * camera_height_m / height_m for (_, y0, _, y1), height_m in people
-            if y0 >= top + edge and y1 <= bottom - edge and y1 - y0 >= MIN_PERSON_PX]
-    return (float(np.median(rows)), len(rows)) if rows else None
+    return box[1] >= top + edge and box[3] <= bottom - edge and box[3] - box[1] >= MIN_PERSON_PX
 
 
 @dataclass(frozen=True)
