@@ -154,11 +154,11 @@ def _background_entries(background: Background, labelled: bool, photo, config: C
         return out
     for box in background.boxes:
         ours = config.background_labels.our_class(box.label)
-        frame, kept_share, whole = _frame_box(box, photo.region, photo.scale, size)
+        frame, kept_share, unclipped = _frame_box(box, photo.region, photo.scale, size)
         reason = "crowd" if box.ignore else "unmapped" if ours is None else "empty" if min(box.w, box.h) <= 0 else (
             "cropped" if kept_share < config.background_labels.drop_cropped_share else None)
-        out.append({"label": box.label, "class_name": ours, "frame": frame, "whole": whole, "covered_share": None,
-                    "kept": reason is None, "reason": reason})
+        out.append({"label": box.label, "class_name": ours, "frame": frame, "unclipped": unclipped,
+                    "covered_share": None, "kept": reason is None, "reason": reason})
     return out
 
 
@@ -188,7 +188,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
     people = [b for b in boxes if b["kept"] or b["reason"] == "cropped"]
     if job.people_in_photo:     # the photo's edges in written rows: the cut for the output may crop a box
         top = -photo.region[1] * photo.scale
-        placing, rows = [(b["class_name"], b["whole"]) for b in people], (top, top + photo.header.height * photo.scale)
+        placing, rows = [(b["class_name"], b["unclipped"]) for b in people], (top, top + photo.header.height * photo.scale)
     else:                       # an earlier job's rule: person boxes whole in the frame
         placing, rows = [("person", b["frame"]) for b in people if b["class_name"] == "person"], None
     drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
