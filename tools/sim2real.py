@@ -30,11 +30,12 @@ Examples:
   nice -n 10 python tools/sim2real.py --synthetic out/sim2real --real-train real/ --test real/ \\
       --real-sizes 25,50,100,200,all --budget-images 7500 --seeds 0,1,2 --arms a,b,c --work out/s2r_curve
   # issue 45: the 50 photos alone against the 50 plus composites into them, from a COCO-pretrained checkpoint
-  python tools/sim2real.py --real-train real/ --test real/ --real-sizes 50 --budget-images 7500 --plan-only \\
+  # (from scratch, 7,500 image-steps left the 50 photos' detector undertrained: compare at 15,000 or more)
+  python tools/sim2real.py --real-train real/ --test real/ --real-sizes 50 --budget-images 15000 --plan-only \\
       --work out/s2r_45
   synthua composite out/s2r_45/subsets/n0050 --bank out/bank --config configs/composite.json --out out/comp50
   python tools/sim2real.py --real-train real/ --test real/ --real-sizes 50 --arms b,d --mix 50=out/comp50 \\
-      --budget-images 7500 --seeds 0,1,2 --init ~/weights/yolo11n.pt --device cuda --work out/s2r_45
+      --budget-images 15000 --seeds 0,1,2 --init ~/weights/yolo11n.pt --device cuda --work out/s2r_45
 """
 
 from __future__ import annotations
