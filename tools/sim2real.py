@@ -30,7 +30,7 @@ Examples:
   nice -n 10 python tools/sim2real.py --synthetic out/sim2real --real-train real/ --test real/ \\
       --real-sizes 25,50,100,200,all --budget-images 7500 --seeds 0,1,2 --arms a,b,c --work out/s2r_curve
   # issue 45: the 50 photos alone against the 50 plus composites into them, from a COCO-pretrained checkpoint
-  # (from scratch, 7,500 image-steps left the 50 photos' detector undertrained: compare at 15,000 or more)
+  # (from scratch on the CPU, 7,500 image-steps left the 50 photos' detector undertrained: compare at 15,000 or more)
   python tools/sim2real.py --real-train real/ --test real/ --real-sizes 50 --budget-images 15000 --plan-only \\
       --work out/s2r_45
   synthua composite out/s2r_45/subsets/n0050 --bank out/bank --config configs/composite.json --out out/comp50
