@@ -188,7 +188,8 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
     people = [b for b in boxes if b["kept"] or b["reason"] == "cropped"]
     if job.people_in_photo:     # the photo's edges in written rows: the cut for the output may crop a box
         top = -photo.region[1] * photo.scale
-        placing, rows = [(b["class_name"], b["unclipped"]) for b in people], (top, top + photo.header.height * photo.scale)
+        placing = [(b["class_name"], b["unclipped"]) for b in people]
+        rows: tuple[float, float] | None = (top, top + photo.header.height * photo.scale)
     else:                       # an earlier job's rule: person boxes whole in the frame
         placing, rows = [("person", b["frame"]) for b in people if b["class_name"] == "person"], None
     drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
