@@ -72,6 +72,11 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     kind = "labelled" if s.labelled else "unlabelled (their pixels void, no boxes of their own)"
     say(f"dataset {s.out_dir}: {s.images - s.rejected} composites ({s.flagged} flagged by QA) and {s.rejected} "
         f"rejected by QA, from {s.backgrounds} {kind} photos; {s.pastes} pastes")
+    if s.without_pastes:
+        say(f"{s.without_pastes} of {s.images} composites hold no paste ({s.photos_without_pastes} "
+            f"photo{'s' * (s.photos_without_pastes != 1)} none in any): no room within pastes.max_overlap and "
+            f"max_background_cover (when_no_room skip), a cut-out wider than the frame, or no ground below the "
+            f"horizon; such a composite is its photo alone with the camera effects")
     if s.skipped:
         say(f"left out {len(s.skipped)} dataset{'s' * (len(s.skipped) > 1)} written by synthua below BACKGROUNDS "
             f"({', '.join(s.skipped[:3])}{', ...' * (len(s.skipped) > 3)}): their images are no photos")

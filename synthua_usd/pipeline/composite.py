@@ -64,15 +64,20 @@ class CompositeRequest:
 
 @dataclass
 class CompositeSummary:
-    """What a run made: composites, of which QA flagged and rejected; pastes; the photo's boxes kept and dropped;
-    composites made grey and those whose horizon the photo's people placed; the photos and whether they were
-    labelled; seconds per phase summed over the workers; wall time."""
+    """What a run made: composites, of which QA flagged and rejected; pastes, composites without one and photos
+    without one in any composite; the photo's boxes kept and dropped; composites made grey and those whose horizon
+    the photo's people placed; the photos and whether they were labelled; seconds per phase summed over the workers;
+    wall time."""
 
     out_dir: Path
     images: int = 0
     flagged: int = 0
     rejected: int = 0
     pastes: int = 0
+    #: Composites that hold no paste (no room for one, or no ground in view: the photo alone, with its effects).
+    without_pastes: int = 0
+    #: Photos none of whose composites holds a paste.
+    photos_without_pastes: int = 0
     boxes_kept: int = 0
     boxes_dropped: int = 0
     #: Composites made grey: their photo is (``composite.background.monochrome``).
@@ -205,6 +210,9 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
     summary.flagged = sum(r["qa"]["verdict"] == "flagged" for r in records)
     summary.rejected = sum(is_rejected(r) for r in records)
     summary.pastes = sum(len(r["composite"]["pastes"]) for r in records)
+    summary.without_pastes = sum(not r["composite"]["pastes"] for r in records)
+    pasted_into = {r["composite"]["background"]["path"] for r in records if r["composite"]["pastes"]}
+    summary.photos_without_pastes = len({r["composite"]["background"]["path"] for r in records} - pasted_into)
     boxes = [b for r in records for b in r["composite"]["background_boxes"]]
     summary.boxes_kept = sum(b["kept"] for b in boxes)
     summary.boxes_dropped = len(boxes) - summary.boxes_kept

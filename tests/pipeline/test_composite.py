@@ -441,6 +441,35 @@ def test_a_coco_set_with_its_photos_elsewhere_keeps_pastes_off_its_crowd_regions
     assert code == 0 and "byte-identical" in said + err, said + err
 
 
+def test_the_summary_counts_composites_and_photos_without_a_paste(inputs, tmp_path, run_cli):
+    """A photo whose labelled person fills it leaves no room under ``max_background_cover`` 0 and ``skip``: its
+    composites are the photo alone, and the summary says how many composites and photos hold no paste (counted
+    here from the records)."""
+    photos = sorted((inputs / "photos").glob("*.png"))
+    coco = {"images": [{"id": k + 1, "file_name": p.name, "width": 96, "height": 72} for k, p in enumerate(photos)],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 7, "bbox": [0.0, 0.0, 96.0, 72.0],
+                             "iscrowd": 0}],
+            "categories": [{"id": 7, "name": "person"}]}
+    (tmp_path / "coco.json").write_text(json.dumps(coco))
+    config = {**CONFIG, "pastes": {**CONFIG["pastes"], "max_background_cover": 0.0, "when_no_room": "skip",
+                                   "placement_tries": 40}}
+    (tmp_path / "config.json").write_text(json.dumps(config))
+    out = tmp_path / "out"
+    code, said, err = run_cli("composite", tmp_path / "coco.json", "--images", inputs / "photos", "--bank",
+                              inputs / "bank", "--config", tmp_path / "config.json", "--out", out, "--workers", "1")
+    assert code == 0, said + err
+    records = _records(out)
+    empty = [r for r in records if not r["composite"]["pastes"]]
+    by_photo: dict[str, int] = {}
+    for r in records:
+        path = r["composite"]["background"]["path"]
+        by_photo[path] = by_photo.get(path, 0) + len(r["composite"]["pastes"])
+    assert by_photo[photos[0].name] == 0 and len(empty) < len(records)
+    photos_without = sum(n == 0 for n in by_photo.values())
+    assert (f"{len(empty)} of {len(records)} composites hold no paste ({photos_without} photo"
+            f"{'s' * (photos_without != 1)} none in any)") in said + err, said + err
+
+
 def test_a_grey_photos_composites_are_grey_recorded_verified_and_replayed(inputs, unlabelled, tmp_path, run_cli):
     """Colour pastes in a grey photo (a night CCTV frame) give themselves away: the composite is made grey after its
     camera effects (white balance and noise among them), and the record and metadata table say so."""
