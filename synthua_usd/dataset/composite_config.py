@@ -94,6 +94,7 @@ class PasteSettings:
     placement_tries: int = 12
     max_background_cover: float | None = None
     when_no_room: str = "least_overlap"
+    edge_cut: float = 0.0
 
     def __post_init__(self) -> None:
         lo, hi = _range("pastes.per_image", self.per_image, 0, 100)

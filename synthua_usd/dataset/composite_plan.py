@@ -11,11 +11,12 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
    is (over ``elevation_tolerance_deg``), plus how unalike their light is when the config gives the photo's;
    one of the best ``choose_among`` is drawn;
 4. the anchor row again for the chosen cut-out's own height (the share kept), its scale
-   ``(y_a - y_h) / (H scale_px_per_m)``, and a column where its box lies in the frame, tried ``placement_tries``
-   times for one that covers at most ``max_overlap`` of each earlier paste's box and at most
-   ``max_background_cover`` (default ``drop_covered_share``) of each labelled background box; where no column
-   does, the least overlapping one (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's
-   own labelled people stay in view);
+   ``(y_a - y_h) / (H scale_px_per_m)``, and a column where its box lies in the frame (up to ``edge_cut`` of its
+   width beyond the left or right edge), tried ``placement_tries`` times for one that covers at most
+   ``max_overlap`` of each earlier paste's box and at most ``max_background_cover`` (default
+   ``drop_covered_share``) of each labelled background box; where no column does, the least overlapping one
+   (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in
+   view);
 5. a blend mode by the config's weights (Poisson at most once a composite) and a shadow strength;
 6. where ``sharpen.share`` > 0, whether it is sharpened and by what amount and sigma, from a generator spawned
    for it (the handed one's draws stay as they are: the pastes are those of the same config without sharpening).
@@ -226,8 +227,9 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
                                      camera.horizon_row_px + MIN_DROP_PX))
         scale = (anchor_row - camera.horizon_row_px) / (camera.height_m * entry.scale_px_per_m)
         x0, _, x1, _ = entry.group_box()
-        lo = -scale * (x0 - entry.anchor[0])
-        hi = frame_w - scale * (x1 - entry.anchor[0])
+        beyond = settings.edge_cut * scale * (x1 - x0)
+        lo = -scale * (x0 - entry.anchor[0]) - beyond
+        hi = frame_w - scale * (x1 - entry.anchor[0]) + beyond
         columns = rng.uniform(0.0, 1.0, settings.placement_tries)
         blend = _blend(config, poisson_used, rng)
         shadow = float(rng.uniform(*config.shadow_strength))

@@ -126,6 +126,29 @@ def test_pastes_keep_off_labelled_people_entirely_or_are_skipped(bank):
                                np.random.default_rng(seed))) == 3
 
 
+def test_pastes_stand_partly_beyond_the_side_edges_within_edge_cut(bank):
+    """edge_cut: a paste's box may reach beyond the left or right edge by at most that share of its width (people at
+    a photo's edge are cut off so); where the photo's labelled people fill the middle, that is the room left."""
+    base = {"per_image": [2, 2], "height_share": [0.5, 0.6], "max_overlap": 1.0, "placement_tries": 50,
+            "max_background_cover": 0.0, "when_no_room": "skip"}
+    camera = PhotoCamera(640, 480, 100.0, 1.5, 500.0)
+    middle = [(80.0, 0.0, 560.0, 480.0)]
+    made, cut_off = {}, 0
+    for share in (0.0, 0.5):
+        config = CompositeConfig.from_document({"pastes": {**base, "edge_cut": share}})
+        made[share] = 0
+        for seed in range(8):
+            for p in plan_pastes(_drawn(camera), eligible(bank.entries, config), config, middle,
+                                 np.random.default_rng(seed)):
+                made[share] += 1
+                x0, _, x1, _ = p.box                         # independent: the box against the frame and the kept one
+                assert x1 <= 80.0 + 1e-6 or x0 >= 560.0 - 1e-6
+                outside = max(0.0, -x0) + max(0.0, x1 - 640.0)
+                assert outside <= share * (x1 - x0) + 1e-6
+                cut_off += outside > 1e-6
+    assert made[0.5] > made[0.0] and cut_off > 0, (made, cut_off)
+
+
 def test_the_default_placement_limit_is_the_drop_threshold(bank):
     """max_background_cover null is background_labels.drop_covered_share: the same plans as before the key."""
     camera = PhotoCamera(640, 480, 100.0, 1.5, 500.0)
@@ -143,6 +166,7 @@ def test_the_default_placement_limit_is_the_drop_threshold(bank):
 @pytest.mark.parametrize("pastes, message", [
     ({"when_no_room": "squeeze"}, "pastes.when_no_room"),
     ({"max_background_cover": 1.5}, "pastes.max_background_cover"),
+    ({"edge_cut": 1.0}, "edge_cut"),
 ])
 def test_placement_limits_are_checked(pastes, message):
     with pytest.raises(InputError, match=message):

@@ -441,6 +441,47 @@ def test_a_coco_set_with_its_photos_elsewhere_keeps_pastes_off_its_crowd_regions
     assert code == 0 and "byte-identical" in said + err, said + err
 
 
+def test_pastes_cut_by_the_frames_side_edges_are_labelled_as_far_as_they_are_seen(inputs, tmp_path, run_cli):
+    """pastes.edge_cut lets a paste stand partly beyond the left or right edge: its label maps are its cut-out
+    resampled where the frame holds it (computed here again), its COCO box the extent of what is in view, its
+    truncation above 0 (0 for pastes within the frame); the dataset verifies and replays byte for byte."""
+    from pycocotools.coco import COCO
+
+    config = {**CONFIG, "images_per_background": 4, "pastes": {**CONFIG["pastes"], "edge_cut": 0.6}}
+    (tmp_path / "config.json").write_text(json.dumps(config))
+    out = tmp_path / "out"
+    code, said, err = run_cli("composite", inputs / "photos", "--bank", inputs / "bank", "--config",
+                              tmp_path / "config.json", "--out", out, "--workers", "1")
+    assert code == 0, said + err
+    bank = read_bank(inputs / "bank")
+    coco = COCO(str(out / "annotations" / "instances_train.json"))
+    cut = whole = 0
+    for record in _records(out):
+        instances, classes = _expected_maps(record, bank)
+        np.testing.assert_array_equal(_png(out / record["files"]["instance"]), instances, record["name"])
+        np.testing.assert_array_equal(_png(out / record["files"]["class"]), classes, record["name"])
+        truncation = {i["id"]: i["truncation"] for i in record["instances"]}
+        for paste in record["composite"]["pastes"]:
+            x0, _, x1, _ = paste["box"]
+            outside = max(0.0, -x0) + max(0.0, x1 - WIDTH)
+            assert outside <= 0.6 * (x1 - x0) + 1e-6
+            seen = [i for i in paste["instance_ids"] if i in truncation]
+            if outside > 1.0:
+                cut += 1
+                assert any(truncation[i] > 0 for i in seen), paste
+            elif x0 >= 0 and x1 <= WIDTH and paste["box"][1] >= 0 and paste["box"][3] <= HEIGHT:
+                whole += 1
+                assert all(truncation[i] == 0 for i in seen), paste
+        for ann in coco.loadAnns(coco.getAnnIds(imgIds=[record["id"]])):
+            ys, xs = np.nonzero(instances == ann["instance_id"])
+            assert ann["bbox"] == [xs.min(), ys.min(), xs.max() - xs.min() + 1, ys.max() - ys.min() + 1]
+    assert cut and whole, (cut, whole)
+    code, said, err = run_cli("verify", out)
+    assert code == 0, said + err
+    code, said, err = run_cli("replay", out, str(_records(out)[0]["id"]))
+    assert code == 0 and "byte-identical" in said + err, said + err
+
+
 def test_the_summary_counts_composites_and_photos_without_a_paste(inputs, tmp_path, run_cli):
     """A photo whose labelled person fills it leaves no room under ``max_background_cover`` 0 and ``skip``: its
     composites are the photo alone, and the summary says how many composites and photos hold no paste (counted
