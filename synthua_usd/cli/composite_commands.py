@@ -75,8 +75,8 @@ def composite(backgrounds: Path, bank: Path, config_path: Path, out_dir: Path, w
     if s.without_pastes:
         say(f"{s.without_pastes} of {s.images} composites hold no paste ({s.photos_without_pastes} "
             f"photo{'s' * (s.photos_without_pastes != 1)} none in any): no room within pastes.max_overlap and "
-            f"max_background_cover (when_no_room skip), a cut-out wider than the frame, or no ground below the "
-            f"horizon; such a composite is its photo alone with the camera effects")
+            f"max_background_cover (when_no_room skip), a cut-out wider than the frame, no ground below the "
+            f"horizon, or pastes.per_image drawing 0; such a composite is its photo alone with the camera effects")
     if s.skipped:
         say(f"left out {len(s.skipped)} dataset{'s' * (len(s.skipped) > 1)} written by synthua below BACKGROUNDS "
             f"({', '.join(s.skipped[:3])}{', ...' * (len(s.skipped) > 3)}): their images are no photos")

@@ -102,6 +102,8 @@ class PasteSettings:
         object.__setattr__(self, "height_share", _range("pastes.height_share", self.height_share, 0.001, 1.0))
         if self.when_no_room not in WHEN_NO_ROOM:
             raise InputError(f"pastes.when_no_room: {self.when_no_room!r}; expected one of {', '.join(WHEN_NO_ROOM)}")
+        if not 0.0 <= self.edge_cut <= 0.9:
+            raise InputError(f"pastes.edge_cut: {self.edge_cut}; expected a share in [0, 0.9]")
         if self.max_background_cover is not None and not 0.0 <= self.max_background_cover <= 1.0:
             raise InputError(f"pastes.max_background_cover: {self.max_background_cover}; expected null or a share "
                              f"in [0, 1]")

@@ -12,8 +12,8 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
    one of the best ``choose_among`` is drawn;
 4. the anchor row again for the chosen cut-out's own height (the share kept), its scale
    ``(y_a - y_h) / (H scale_px_per_m)``, and a column where its box lies in the frame (up to ``edge_cut`` of its
-   width beyond the left or right edge), tried ``placement_tries`` times for one that covers at most
-   ``max_overlap`` of each earlier paste's box and at most ``max_background_cover`` (default
+   width beyond the left edge, and as much beyond the right one), tried ``placement_tries`` times for one that
+   covers at most ``max_overlap`` of each earlier paste's box and at most ``max_background_cover`` (default
    ``drop_covered_share``) of each labelled background box; where no column does, the least overlapping one
    (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in
    view);
@@ -235,7 +235,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         shadow = float(rng.uniform(*config.shadow_strength))
         sharpen = _sharpen(config, sharpen_rng)
         if lo > hi:
-            continue  # wider than the frame at this size
+            continue  # wider than the frame (and edge_cut) allows at this size
         best: tuple[float, tuple[float, float], tuple[float, float, float, float]] | None = None
         for c in columns:
             anchor = (float(lo + c * (hi - lo)), float(anchor_row))

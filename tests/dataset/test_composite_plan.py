@@ -127,8 +127,9 @@ def test_pastes_keep_off_labelled_people_entirely_or_are_skipped(bank):
 
 
 def test_pastes_stand_partly_beyond_the_side_edges_within_edge_cut(bank):
-    """edge_cut: a paste's box may reach beyond the left or right edge by at most that share of its width (people at
-    a photo's edge are cut off so); where the photo's labelled people fill the middle, that is the room left."""
+    """edge_cut: a paste's box may reach beyond the left edge, and beyond the right one, by at most that share of its
+    width (people at a photo's edge are cut off so); where the photo's labelled people fill the middle, that is the
+    room left."""
     base = {"per_image": [2, 2], "height_share": [0.5, 0.6], "max_overlap": 1.0, "placement_tries": 50,
             "max_background_cover": 0.0, "when_no_room": "skip"}
     camera = PhotoCamera(640, 480, 100.0, 1.5, 500.0)
@@ -143,8 +144,8 @@ def test_pastes_stand_partly_beyond_the_side_edges_within_edge_cut(bank):
                 made[share] += 1
                 x0, _, x1, _ = p.box                         # independent: the box against the frame and the kept one
                 assert x1 <= 80.0 + 1e-6 or x0 >= 560.0 - 1e-6
+                assert max(-x0, x1 - 640.0) <= share * (x1 - x0) + 1e-6
                 outside = max(0.0, -x0) + max(0.0, x1 - 640.0)
-                assert outside <= share * (x1 - x0) + 1e-6
                 cut_off += outside > 1e-6
     assert made[0.5] > made[0.0] and cut_off > 0, (made, cut_off)
 
@@ -171,6 +172,14 @@ def test_the_default_placement_limit_is_the_drop_threshold(bank):
 def test_placement_limits_are_checked(pastes, message):
     with pytest.raises(InputError, match=message):
         CompositeConfig.from_document({"pastes": pastes})
+
+
+def test_edge_cut_is_checked_by_the_settings_too():
+    """The schema bounds edge_cut; settings made in code (no document) are held to the same range."""
+    from synthua_usd.dataset.composite_config import PasteSettings
+
+    with pytest.raises(InputError, match="pastes.edge_cut: 0.95"):
+        PasteSettings(edge_cut=0.95)
 
 
 def test_the_camera_draw_names_its_sources():
