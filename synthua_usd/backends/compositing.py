@@ -46,7 +46,11 @@ step) but step 4's, which works on the sRGB values:
    keeps the photo), ``feather`` (alpha x clip(d / feather_px, 0, 1), d the distance in pixels from the pixel to the
    nearest one the paste does not label: the edge fades inwards, and nothing shows outside the labels), ``blur``
    (alpha and premultiplied colour blurred by a Gaussian of ``sigma_px``) or ``poisson``
-   (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px).
+   (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px). Where the frame's edge cuts
+   a paste, the paste goes on beyond it: the blur repeats the paste's last row or column there, Poisson leaves the
+   cut open (no photo value imposed along it), and feather's d is measured within the frame (the cut does not fade).
+   Jobs made before 7 December 2026 faded blurred and Poisson pastes towards the photo along a cut (``open_cuts``
+   False keeps that for their replay).
 4. **Sharpening** of a paste the plan sharpens, right after its blend (a nearer paste painted later covers it): the
    composite's sRGB values ``v`` around the paste, ``v + amount x (v - G(v))`` with ``G`` a Gaussian of
    ``sigma_px`` (reflecting at the frame's edges), written back over the paste's labelled pixels only. The
@@ -323,19 +327,39 @@ def soften(premultiplied: np.ndarray, sigma: float) -> np.ndarray:
     return np.stack([_smooth(straight[..., c], alpha, sigma) * alpha for c in range(3)], axis=-1)
 
 
-def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: dict) -> np.ndarray:
+def _blur_beyond_cuts(values: np.ndarray, sigma: float, cut: tuple[bool, bool, bool, bool]) -> np.ndarray:
+    """``values`` (h, w) or (h, w, C) blurred by a Gaussian of ``sigma`` over its first two axes: transparent (0)
+    beyond the crop's own edges, and beyond an edge where the frame cuts it (``cut``: left, top, right, bottom) the
+    crop's last row or column repeated (the paste goes on there)."""
+    reach = int(4.0 * sigma + 0.5) + 1              # scipy's Gaussian reaches int(truncate x sigma + 0.5) pixels
+    left, top, right, bottom = (reach if side else 0 for side in cut)
+    pad = ((top, bottom), (left, right)) + ((0, 0),) * (values.ndim - 2)
+    padded = np.pad(values, pad, mode="edge")
+    blurred = ndimage.gaussian_filter(padded, (sigma, sigma) + (0,) * (values.ndim - 2), mode="constant")
+    h, w = values.shape[:2]
+    return blurred[top:top + h, left:left + w]
+
+
+def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: dict,
+           open_cuts: bool = True) -> np.ndarray:
     """The region (h, w, 3) float32 linear with the paste blended over it; ``colour`` its premultiplied linear RGB
-    with gains applied."""
+    with gains applied. ``open_cuts``: where the frame cuts the paste, the blur and Poisson blends take the paste
+    to go on beyond the frame (else, as jobs made before 7 December 2026 did, the blur fades it to transparent and
+    Poisson meets the photo's colour along the cut)."""
     alpha = placed.premultiplied[..., 3]
     mode = blend["mode"]
+    cut = placed.cut if open_cuts else (False, False, False, False)
     if mode == "feather":
         inside = ndimage.distance_transform_edt(placed.ids > 0)
         fade = np.clip(inside / max(blend["feather_px"], 1e-6), 0.0, 1.0).astype(np.float32)
         return region * (1.0 - alpha * fade)[..., None] + colour * fade[..., None]
     if mode == "blur":
         sigma = blend["sigma_px"]
-        alpha_b = ndimage.gaussian_filter(alpha, sigma, mode="constant")
-        colour_b = ndimage.gaussian_filter(colour, (sigma, sigma, 0), mode="constant")
+        if any(cut):
+            alpha_b, colour_b = _blur_beyond_cuts(alpha, sigma, cut), _blur_beyond_cuts(colour, sigma, cut)
+        else:
+            alpha_b = ndimage.gaussian_filter(alpha, sigma, mode="constant")
+            colour_b = ndimage.gaussian_filter(colour, (sigma, sigma, 0), mode="constant")
         return region * (1.0 - alpha_b)[..., None] + colour_b
     labelled = placed.ids > 0
     # a labelled pixel no sample covered (a spoke thinner than a pixel) has no colour: the photo shows there
@@ -345,7 +369,15 @@ def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: 
     if mode == "hard":
         return hard
     domain = ndimage.binary_dilation(labelled, iterations=POISSON_MARGIN_PX)
-    domain[0], domain[-1], domain[:, 0], domain[:, -1] = False, False, False, False
+    left, top, right, bottom = cut      # the photo's values on the crop's own edges; open where the frame cuts it
+    if not top:
+        domain[0] = False
+    if not bottom:
+        domain[-1] = False
+    if not left:
+        domain[:, 0] = False
+    if not right:
+        domain[:, -1] = False
     return poisson_blend(region, hard, domain).astype(np.float32)
 
 
@@ -379,8 +411,10 @@ def _class_id(class_map: ClassMap, name: str) -> int:
     return found.id
 
 
-def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, settings: MatchSettings) -> Composite:
-    """Paint ``pastes`` (sorted by their placement's ``order``) over ``photo`` (H, W, 3) uint8 sRGB."""
+def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, settings: MatchSettings,
+            open_cuts: bool = True) -> Composite:
+    """Paint ``pastes`` (sorted by their placement's ``order``) over ``photo`` (H, W, 3) uint8 sRGB; ``open_cuts``
+    as :func:`_blend` takes it."""
     height, width = photo.shape[:2]
     placed = [place(p.pixels, p.entry, p.placement.anchor_px, p.placement.scale, (width, height)) for p in pastes]
     tones = [tone_gains(photo, pc, p.placement.box, settings) if pc is not None else (1.0, 1.0)
@@ -434,7 +468,7 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
         rows, cols = pc.slices
         colour = soften(pc.premultiplied, sigma) * np.float32(exposure) * np.asarray(balance, np.float32)
         region = LINEAR_LUT[rgb[rows, cols]]
-        rgb[rows, cols] = encode(_blend(region, pc, colour, p.placement.blend))
+        rgb[rows, cols] = encode(_blend(region, pc, colour, p.placement.blend, open_cuts))
         if p.placement.sharpen is not None:
             sharpen(rgb, pc, p.placement.sharpen["amount"], p.placement.sharpen["sigma_px"])
         table = np.zeros(256, np.uint16)

@@ -85,7 +85,8 @@ class PlacedCutout:
     """A cut-out resampled into a ``frame`` (W, H) at a placement, over the frame ``region`` (x0, y0, x1, y1, ints,
     clipped to the frame: every array below has the region's shape). ``premultiplied`` (h, w, 4) float32 linear RGB x
     alpha and alpha; ``ids`` (h, w) uint8 instance indices; ``amodal`` (h, w) uint16 bit field; ``shadow`` (h, w)
-    float32, 1 = no shadow; ``outside`` instance index -> its amodal pixels that fall outside the frame."""
+    float32, 1 = no shadow; ``outside`` instance index -> its amodal pixels that fall outside the frame; ``cut`` whether
+    the frame's left, top, right and bottom edge cuts the crop (it reaches beyond that edge)."""
 
     frame: tuple[int, int]
     region: tuple[int, int, int, int]
@@ -94,6 +95,7 @@ class PlacedCutout:
     amodal: np.ndarray = field(repr=False)
     shadow: np.ndarray = field(repr=False)
     outside: dict
+    cut: tuple[bool, bool, bool, bool] = (False, False, False, False)
 
     @property
     def slices(self) -> tuple[slice, slice]:
@@ -161,4 +163,4 @@ def place(pixels: CutoutPixels, entry: BankEntry, anchor_px: tuple[float, float]
     np.clip(colour[..., 3], 0.0, 1.0, out=colour[..., 3])
     shadow = _resize(pixels.shadow[..., None].astype(np.float32) / 255.0, box, size, 1.0)[..., 0]
     return PlacedCutout(frame, (x0, y0, x1, y1), colour, full_ids[inside].copy(), full_amodal[inside].copy(),
-                        np.clip(shadow, 0.0, 1.0), outside)
+                        np.clip(shadow, 0.0, 1.0), outside, (fx0 < 0, fy0 < 0, fx1 > width, fy1 > height))

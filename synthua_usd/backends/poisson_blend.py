@@ -8,8 +8,12 @@ Inside a domain Ω (the paste's pixels, widened a little) the result ``f`` has t
 
 The paste keeps its shading and texture while its overall colour and brightness slide to meet the photo at the
 edge. The sparse system (one unknown per pixel of Ω) is factorised once by scipy's SuperLU
-(:func:`scipy.sparse.linalg.splu`) and solved for the three channels. Ω must not touch the border of the arrays
-(the caller pads the crop): every neighbour of an Ω pixel exists.
+(:func:`scipy.sparse.linalg.splu`) and solved for the three channels.
+
+Where Ω touches the border of the arrays, N(p) holds only the neighbours that exist: the border is open (no value
+is imposed there; the gradient across it is free), as the frame's edge is where it cuts a paste, whose surroundings
+lie beyond the photo. A caller that wants the photo's values on a border keeps Ω off it. An Ω with no neighbour
+outside it (the whole array) has no value to meet: it is the source there.
 """
 
 from __future__ import annotations
@@ -23,26 +27,30 @@ def poisson_blend(target: np.ndarray, source: np.ndarray, domain: np.ndarray) ->
     """``target`` (h, w, 3) float with the Poisson solution on ``domain`` (h, w) bool (see the module docstring);
     ``source`` (h, w, 3) gives the gradients. Returns a new float64 array; outside ``domain`` it is ``target``."""
     h, w = domain.shape
-    if domain[0].any() or domain[-1].any() or domain[:, 0].any() or domain[:, -1].any():
-        raise ValueError("poisson_blend: the domain touches the border of the arrays; expected a padded crop")
     out = np.array(target, dtype=np.float64)
     flat = np.flatnonzero(domain.reshape(-1))
     if not flat.size:
         return out
-    index = np.full(h * w, -1, np.int64)
-    index[flat] = np.arange(flat.size)
     s = np.asarray(source, np.float64).reshape(-1, 3)
     t = out.reshape(-1, 3)
-    rows, cols = [np.arange(flat.size)], [np.arange(flat.size)]
-    values = [np.full(flat.size, 4.0)]
+    if flat.size == h * w:
+        t[:] = s
+        return out
+    index = np.full(h * w, -1, np.int64)
+    index[flat] = np.arange(flat.size)
+    y, x = np.divmod(flat, w)
+    degree = np.zeros(flat.size)
+    rows, cols, values = [np.arange(flat.size)], [np.arange(flat.size)], [degree]
     rhs = np.zeros((flat.size, 3))
-    for step in (-w, w, -1, 1):  # the 4 neighbours (never across the border: the domain keeps off it)
-        neighbour = flat + step
-        rhs += s[flat] - s[neighbour]
+    for step, exists in ((-w, y > 0), (w, y < h - 1), (-1, x > 0), (1, x < w - 1)):  # the 4 neighbours
+        at = np.flatnonzero(exists)             # the unknowns that have this neighbour (not beyond the border)
+        neighbour = flat[at] + step
+        degree[at] += 1.0
+        rhs[at] += s[flat[at]] - s[neighbour]
         inner = index[neighbour]
         known = inner < 0
-        rhs[known] += t[neighbour[known]]
-        rows.append(np.flatnonzero(~known))
+        rhs[at[known]] += t[neighbour[known]]
+        rows.append(at[~known])
         cols.append(inner[~known])
         values.append(np.full(int((~known).sum()), -1.0))
     matrix = sparse.csc_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),

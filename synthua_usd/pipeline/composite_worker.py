@@ -84,6 +84,9 @@ class CompositeJob:
     #: frame only): jobs made before 7 December 2026 that set ``camera.person_height_m`` did the latter (their
     #: ``job_key`` has no ``people_in_photo``), and replay makes them as they were.
     people_in_photo: bool = True
+    #: Whether blurred and Poisson pastes go on beyond the frame's edge where it cuts them: jobs made before 7 December
+    #: 2026 faded them towards the photo there (their ``job_key`` has no ``open_cuts``), and replay makes them so.
+    open_cuts: bool = True
 
 
 @dataclass
@@ -198,7 +201,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
                              [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng)
     entries = [bank.entry(p.entry_id) for p in placements]
     painted = compose(photo.pixels, [PasteInput(e, state.cutout(e), p) for e, p in zip(entries, placements)],
-                      class_map, config.match)
+                      class_map, config.match, job.open_cuts)
     display, effects = painted.rgb, None
     if config.effects.enabled:
         effects = draw_effects(stream(config.seed, planned.seed, "effects", planned.background), config.effects)

@@ -1,7 +1,8 @@
 """Painting a composite: label maps by the painter's rule (checked with labels resampled here pixel by pixel), the
 photo untouched outside pastes and shadows, shadows darkening by the factor the shadow layer gives, hard edges
 showing the cut-out's own colours, soft edges soft, the gains of exposure and white balance as defined, and Poisson
-blending solving its equation; sharpness matching reading a known blur and giving it to a sharper paste."""
+blending solving its equation; blurred and Poisson pastes going on beyond the frame's edge where it cuts them;
+sharpness matching reading a known blur and giving it to a sharper paste."""
 
 from __future__ import annotations
 
@@ -171,8 +172,22 @@ def test_poisson_blending_solves_its_equation():
         rhs = sum(source[y, x] - source[y + dy, x + dx] for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1)))
         np.testing.assert_allclose(lhs, rhs, atol=1e-9)
     np.testing.assert_allclose(poisson_blend(target, target, domain), target, atol=1e-9)
-    with pytest.raises(ValueError, match="touches the border"):
-        poisson_blend(target, source, np.ones((20, 24), bool))
+
+
+def test_poisson_blending_leaves_the_arrays_border_open():
+    rng = np.random.default_rng(2)
+    target, source = rng.random((20, 24, 3)), rng.random((20, 24, 3))
+    domain = np.zeros((20, 24), bool)
+    domain[0:12, 0:9] = True                       # at the top-left corner: two sides on the border
+    f = poisson_blend(target, source, domain)
+    np.testing.assert_array_equal(f[~domain], target[~domain])
+    for y, x in zip(*np.nonzero(domain)):           # |N(p)| counts only the neighbours that exist
+        near = [(y + dy, x + dx) for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1))
+                if 0 <= y + dy < 20 and 0 <= x + dx < 24]
+        lhs = len(near) * f[y, x] - sum(f[q] for q in near)
+        np.testing.assert_allclose(lhs, sum(source[y, x] - source[q] for q in near), atol=1e-9)
+    assert not np.allclose(f[0, 0], target[0, 0])   # the corner is solved for, not held at the target
+    np.testing.assert_array_equal(poisson_blend(target, source, np.ones((20, 24), bool)), source)
 
 
 def test_a_poisson_paste_keeps_the_photo_on_its_edge(bank):
@@ -187,6 +202,52 @@ def test_a_poisson_paste_keeps_the_photo_on_its_edge(bank):
         near[1:-1, 1:-1] |= near[:-2, 1:-1] | near[2:, 1:-1] | near[1:-1, :-2] | near[1:-1, 2:]
     np.testing.assert_array_equal(painted.rgb[~near], photo[~near])
     assert (painted.rgb[labelled] != photo[labelled]).any()
+
+
+def _flat_cutout(bank, colour=0.5):
+    """Entry 0 of the bank in one straight linear colour (its alpha, labels and shadow kept)."""
+    from synthua_usd.backends.cutout_pixels import CutoutPixels
+
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    premultiplied = pixels.premultiplied.copy()
+    premultiplied[..., :3] = colour * premultiplied[..., 3:]
+    return entry, CutoutPixels(pixels.rgba, pixels.ids, pixels.amodal, pixels.shadow, premultiplied)
+
+
+def test_placing_records_which_frame_edges_cut_the_crop(bank):
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    assert place(pixels, entry, (40.0, 56.0), 0.9, (80, 60)).cut == (False, False, False, False)  # the whole height
+    assert place(pixels, entry, (40.0, 52.0), 0.9, (80, 60)).cut == (False, True, False, False)
+    assert place(pixels, entry, (3.0, 56.0), 0.9, (80, 60)).cut == (True, False, False, False)
+    assert place(pixels, entry, (77.0, 70.0), 0.9, (80, 60)).cut == (False, False, True, True)
+
+
+@pytest.mark.parametrize("mode,blend", [("poisson", {}), ("blur", {"sigma_px": 1.5})])
+def test_a_paste_the_frame_cuts_goes_on_beyond_the_cut(bank, mode, blend):
+    """A flat paste over a flat photo, its left part beyond the frame: Poisson blending gives the hard paste itself
+    (its source meets the photo on every edge but the cut, which is open), and the blur leaves its colour whole
+    wherever the paste's own edges are beyond the Gaussian's reach (the cut is not an edge); jobs made before
+    7 December 2026 (``open_cuts`` False) faded it towards the photo along the cut."""
+    entry, flat = _flat_cutout(bank)
+    photo = np.full((60, 80, 3), 40, np.uint8)
+    hard = compose(photo, [PasteInput(entry, flat, _placement(entry, (3.0, 56.0), 0.9, 0))], ClassMap.default(),
+                   NO_MATCH)
+    assert (hard.instance_ids[:, 0] > 0).sum() >= 10            # the cut runs through the paste
+    placement = _placement(entry, (3.0, 56.0), 0.9, 0, mode=mode, **blend)
+    opened = compose(photo, [PasteInput(entry, flat, placement)], ClassMap.default(), NO_MATCH)
+    closed = compose(photo, [PasteInput(entry, flat, placement)], ClassMap.default(), NO_MATCH, open_cuts=False)
+    np.testing.assert_array_equal(opened.instance_ids, hard.instance_ids)
+    if mode == "poisson":
+        whole = np.ones(hard.instance_ids.shape, bool)
+    else:                                   # beyond the Gaussian's reach of every pixel the paste does not label
+        whole = ndimage.distance_transform_edt(hard.instance_ids > 0) > int(4.0 * 1.5 + 0.5) + 1
+        assert whole[:, 0].sum() >= 3
+    difference = np.abs(opened.rgb.astype(int) - hard.rgb.astype(int))
+    assert difference[whole].max() <= 1
+    at_cut = hard.instance_ids[:, 0] > 0
+    assert np.abs(closed.rgb[at_cut, 0].astype(int) - hard.rgb[at_cut, 0].astype(int)).max() >= 20
 
 
 def test_depth_for_effects_puts_each_paste_at_its_distance(bank):
