@@ -13,7 +13,9 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
 4. the anchor row again for the chosen cut-out's own height (the share kept), its scale
    ``(y_a - y_h) / (H scale_px_per_m)``, and a column where its box lies in the frame (up to ``edge_cut`` of its
    width beyond the left edge, and as much beyond the right one), tried ``placement_tries`` times for one that
-   covers at most ``max_overlap`` of each earlier paste's box and at most ``max_background_cover`` (default
+   covers at most ``max_overlap`` of each earlier paste's box in view (the part within the frame; with
+   ``visible_overlap`` False, as jobs made before 7 December 2026 did, its whole box, though the frame may cut it)
+   and at most ``max_background_cover`` (default
    ``drop_covered_share``) of each labelled background box; where no column does, the least overlapping one
    (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in
    view);
@@ -190,11 +192,17 @@ def eligible(entries: Sequence[BankEntry], config: CompositeConfig) -> dict[str,
 
 def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: CompositeConfig,
                 background_boxes: Sequence[tuple[float, float, float, float]],
-                rng: np.random.Generator) -> list[Placement]:
+                rng: np.random.Generator, visible_overlap: bool = True) -> list[Placement]:
     """The pastes of one composite (see the module docstring), sorted far to near with their ``order``.
     ``background_boxes`` (x0, y0, x1, y1, written px) are the labelled boxes a paste should not cover."""
     camera, settings = drawn.camera, config.pastes
     frame_w, frame_h = camera.width_px, camera.height_px
+
+    def seen(box):      # an earlier paste's box as overlap measures it
+        if not visible_overlap:
+            return box
+        return (max(box[0], 0.0), max(box[1], 0.0), min(box[2], float(frame_w)), min(box[3], float(frame_h)))
+
     cover = (config.background_labels.drop_covered_share if settings.max_background_cover is None
              else settings.max_background_cover)
     count = int(rng.integers(settings.per_image[0], settings.per_image[1] + 1))
@@ -240,7 +248,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         for c in columns:
             anchor = (float(lo + c * (hi - lo)), float(anchor_row))
             box = _box_in_frame(entry, anchor, scale)
-            excess = max([covered_share(p["box"], box) - settings.max_overlap for p in planned]
+            excess = max([covered_share(seen(p["box"]), box) - settings.max_overlap for p in planned]
                          + [covered_share(b, box) - cover for b in background_boxes] + [0.0])
             if best is None or excess < best[0]:
                 best = (excess, anchor, box)
@@ -251,7 +259,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         if excess > 0 and settings.when_no_room == "skip":
             continue
         poisson_used |= blend["mode"] == "poisson"
-        overlap = max([covered_share(p["box"], box) for p in planned] + [0.0])
+        overlap = max([covered_share(seen(p["box"]), box) for p in planned] + [0.0])
         planned.append(dict(
             entry_id=entry.id, kind=kind, anchor_px=anchor, scale=float(scale),
             share=float(camera.pixel_height(entry.subject_height_m, anchor_row) / frame_h), share_drawn=share_drawn,

@@ -87,6 +87,9 @@ class CompositeJob:
     #: Whether blurred and Poisson pastes go on beyond the frame's edge where it cuts them: jobs made before 7 December
     #: 2026 faded them towards the photo there (their ``job_key`` has no ``open_cuts``), and replay makes them so.
     open_cuts: bool = True
+    #: Whether a paste's overlap with an earlier one is measured on the earlier one's box in view: jobs made before
+    #: 7 December 2026 measured its whole box (their ``job_key`` has no ``visible_overlap``), and replay does so.
+    visible_overlap: bool = True
 
 
 @dataclass
@@ -198,7 +201,8 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
     drawn = draw_camera(settings, sources, (width, height), photo.header.focal_35mm,
                         (photo.header.width, photo.header.height), photo.scale, camera_rng, placing, rows)
     placements = plan_pastes(drawn, state.pools, config,      # pastes keep off crowds as off the kept boxes
-                             [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng)
+                             [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng,
+                             job.visible_overlap)
     entries = [bank.entry(p.entry_id) for p in placements]
     painted = compose(photo.pixels, [PasteInput(e, state.cutout(e), p) for e, p in zip(entries, placements)],
                       class_map, config.match, job.open_cuts)

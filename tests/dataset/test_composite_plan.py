@@ -258,3 +258,35 @@ def test_sharpening_is_drawn_per_paste_within_its_ranges_and_not_at_all_when_off
     # drawn from a generator of their own: the pastes are those of the same config without sharpening
     strip = [[replace(p, sharpen=None) for p in plan] for plan in plans({"sharpen": {"share": 1.0}})]
     assert strip == off
+
+
+def _in_view(box, width, height):
+    return max(box[0], 0.0), max(box[1], 0.0), min(box[2], width), min(box[3], height)
+
+
+def test_overlap_is_measured_on_the_part_of_an_earlier_paste_in_view(bank):
+    """With pastes cut by the frame's sides, ``max_overlap`` holds for the part of the earlier paste the frame shows:
+    of two pastes, the later one (the one whose record's ``overlap`` is not 0) covers at most that share of the
+    earlier one's box clipped to the frame, recomputed here, and its record says how much. Jobs made before
+    7 December 2026 measured the earlier paste's whole box, and then a later paste could hide more of what is seen of
+    it (a narrow frame crowded with large pastes shows it)."""
+    config = CompositeConfig.from_document({"pastes": {
+        "per_image": [2, 2], "height_share": [0.6, 0.8], "max_overlap": 0.3, "placement_tries": 60,
+        "when_no_room": "skip", "edge_cut": 0.8}})
+    camera = PhotoCamera(160, 240, 60.0, 1.5, 250.0)
+    pairs, beyond = {True: 0, False: 0}, {True: 0, False: 0}
+    for visible in (True, False):
+        for seed in range(300):
+            placements = plan_pastes(_drawn(camera), eligible(bank.entries, config), config, [],
+                                     np.random.default_rng(seed), visible_overlap=visible)
+            if len(placements) < 2:
+                continue
+            a, b = placements
+            first, later = (a, b) if a.overlap == 0 else (b, a)
+            shown = covered_share(_in_view(first.box, 160.0, 240.0), later.box)
+            pairs[visible] += 1
+            beyond[visible] += shown > 0.3 + 1e-9
+            if visible and later.overlap > 0:
+                assert later.overlap == pytest.approx(shown)
+    assert pairs[True] >= 100 and beyond[True] == 0, (pairs, beyond)
+    assert beyond[False] > 0, (pairs, beyond)
