@@ -49,8 +49,8 @@ step) but step 4's, which works on the sRGB values:
    (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px). Where the frame's edge cuts
    a paste, the paste goes on beyond it: the blur repeats the paste's last row or column there, Poisson leaves the
    cut open (no photo value imposed along it), and feather's d is measured within the frame (the cut does not fade).
-   Jobs made before 7 December 2026 faded blurred and Poisson pastes towards the photo along a cut (``open_cuts``
-   False keeps that for their replay).
+   Jobs whose ``generate.json`` has no ``job_key.open_cuts`` (made before it, on or before 7 December 2026) faded
+   blurred and Poisson pastes towards the photo along a cut (``open_cuts`` False keeps that for their replay).
 4. **Sharpening** of a paste the plan sharpens, right after its blend (a nearer paste painted later covers it): the
    composite's sRGB values ``v`` around the paste, ``v + amount x (v - G(v))`` with ``G`` a Gaussian of
    ``sigma_px`` (reflecting at the frame's edges), written back over the paste's labelled pixels only. The
@@ -331,11 +331,12 @@ def _blur_beyond_cuts(values: np.ndarray, sigma: float, cut: tuple[bool, bool, b
     """``values`` (h, w) or (h, w, C) blurred by a Gaussian of ``sigma`` over its first two axes: transparent (0)
     beyond the crop's own edges, and beyond an edge where the frame cuts it (``cut``: left, top, right, bottom) the
     crop's last row or column repeated (the paste goes on there)."""
-    reach = int(4.0 * sigma + 0.5) + 1              # scipy's Gaussian reaches int(truncate x sigma + 0.5) pixels
+    reach = int(4.0 * sigma + 0.5) + 1              # the Gaussian below reaches int(truncate x sigma + 0.5) pixels
     left, top, right, bottom = (reach if side else 0 for side in cut)
     pad = ((top, bottom), (left, right)) + ((0, 0),) * (values.ndim - 2)
     padded = np.pad(values, pad, mode="edge")
-    blurred = ndimage.gaussian_filter(padded, (sigma, sigma) + (0,) * (values.ndim - 2), mode="constant")
+    blurred = ndimage.gaussian_filter(padded, (sigma, sigma) + (0,) * (values.ndim - 2), mode="constant",
+                                      truncate=4.0)
     h, w = values.shape[:2]
     return blurred[top:top + h, left:left + w]
 
@@ -344,7 +345,7 @@ def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: 
            open_cuts: bool = True) -> np.ndarray:
     """The region (h, w, 3) float32 linear with the paste blended over it; ``colour`` its premultiplied linear RGB
     with gains applied. ``open_cuts``: where the frame cuts the paste, the blur and Poisson blends take the paste
-    to go on beyond the frame (else, as jobs made before 7 December 2026 did, the blur fades it to transparent and
+    to go on beyond the frame (else, as jobs without ``job_key.open_cuts`` did, the blur fades it to transparent and
     Poisson meets the photo's colour along the cut)."""
     alpha = placed.premultiplied[..., 3]
     mode = blend["mode"]

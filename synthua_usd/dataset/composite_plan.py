@@ -14,7 +14,8 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
    ``(y_a - y_h) / (H scale_px_per_m)``, and a column where its box lies in the frame (up to ``edge_cut`` of its
    width beyond the left edge, and as much beyond the right one), tried ``placement_tries`` times for one that
    covers at most ``max_overlap`` of each earlier paste's box in view (the part within the frame; with
-   ``visible_overlap`` False, as jobs made before 7 December 2026 did, its whole box, though the frame may cut it)
+   ``visible_overlap`` False, as jobs without ``job_key.visible_overlap`` did, its whole box, though the frame may
+   cut it)
    and at most ``max_background_cover`` (default
    ``drop_covered_share``) of each labelled background box; where no column does, the least overlapping one
    (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in

@@ -184,7 +184,8 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
         write_json_atomic(staging / Layout.CONFIG, job_document, indent=1)
         job = CompositeJob(out_dir=str(staging), config_document=config_document,
                            class_map_document=bank.class_map.document(), bank_root=str(bank.root.resolve()),
-                           backgrounds=backgrounds, city=cityscapes_city(config.name))
+                           backgrounds=backgrounds, city=cityscapes_city(config.name),
+                           open_cuts=job_key["open_cuts"] is True, visible_overlap=job_key["visible_overlap"] is True)
         bar = tqdm(total=len(plan), desc="composite", unit="img", disable=not show_progress)
 
         def collect(result) -> None:

@@ -84,11 +84,11 @@ class CompositeJob:
     #: frame only): jobs made before 7 December 2026 that set ``camera.person_height_m`` did the latter (their
     #: ``job_key`` has no ``people_in_photo``), and replay makes them as they were.
     people_in_photo: bool = True
-    #: Whether blurred and Poisson pastes go on beyond the frame's edge where it cuts them: jobs made before 7 December
-    #: 2026 faded them towards the photo there (their ``job_key`` has no ``open_cuts``), and replay makes them so.
+    #: Whether blurred and Poisson pastes go on beyond the frame's edge where it cuts them: jobs whose ``job_key`` has
+    #: no ``open_cuts`` (made up to 7 December 2026) faded them towards the photo there, and replay makes them so.
     open_cuts: bool = True
-    #: Whether a paste's overlap with an earlier one is measured on the earlier one's box in view: jobs made before
-    #: 7 December 2026 measured its whole box (their ``job_key`` has no ``visible_overlap``), and replay does so.
+    #: Whether a paste's overlap with an earlier one is measured on the earlier one's box in view: jobs whose
+    #: ``job_key`` has no ``visible_overlap`` (made up to 7 December 2026) measured its whole box, and replay does so.
     visible_overlap: bool = True
 
 

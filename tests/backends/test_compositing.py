@@ -224,30 +224,61 @@ def test_placing_records_which_frame_edges_cut_the_crop(bank):
     assert place(pixels, entry, (77.0, 70.0), 0.9, (80, 60)).cut == (False, False, True, True)
 
 
-@pytest.mark.parametrize("mode,blend", [("poisson", {}), ("blur", {"sigma_px": 1.5})])
-def test_a_paste_the_frame_cuts_goes_on_beyond_the_cut(bank, mode, blend):
-    """A flat paste over a flat photo, its left part beyond the frame: Poisson blending gives the hard paste itself
-    (its source meets the photo on every edge but the cut, which is open), and the blur leaves its colour whole
-    wherever the paste's own edges are beyond the Gaussian's reach (the cut is not an edge); jobs made before
-    7 December 2026 (``open_cuts`` False) faded it towards the photo along the cut."""
+EDGES = {"left": (slice(None), 0), "top": (0, slice(None)), "right": (slice(None), -1), "bottom": (-1, slice(None))}
+
+
+@pytest.mark.parametrize("anchor, sides", [((3.0, 56.0), ("left",)), ((77.0, 70.0), ("right", "bottom"))])
+@pytest.mark.parametrize("mode,blend", [("poisson", {}), ("blur", {"sigma_px": 1.5}), ("feather", {"feather_px": 2.0})])
+def test_a_paste_the_frame_cuts_goes_on_beyond_the_cut(bank, mode, blend, anchor, sides):
+    """A flat paste over a flat photo, cut by the frame (at its left side; at its right side and bottom): Poisson
+    blending gives the hard paste itself (its source meets the photo on every edge but the cut, which is open), the
+    blur and feather leave its colour whole wherever the paste's own edges are beyond their reach (the cut is not an
+    edge); jobs without ``job_key.open_cuts`` (``open_cuts`` False) faded Poisson and blurred pastes towards the
+    photo along the cut."""
     entry, flat = _flat_cutout(bank)
     photo = np.full((60, 80, 3), 40, np.uint8)
-    hard = compose(photo, [PasteInput(entry, flat, _placement(entry, (3.0, 56.0), 0.9, 0))], ClassMap.default(),
-                   NO_MATCH)
-    assert (hard.instance_ids[:, 0] > 0).sum() >= 10            # the cut runs through the paste
-    placement = _placement(entry, (3.0, 56.0), 0.9, 0, mode=mode, **blend)
+    hard = compose(photo, [PasteInput(entry, flat, _placement(entry, anchor, 0.9, 0))], ClassMap.default(), NO_MATCH)
+    labelled = hard.instance_ids > 0
+    for side in sides:
+        assert labelled[EDGES[side]].sum() >= 10, side            # the cut runs through the paste
+    placement = _placement(entry, anchor, 0.9, 0, mode=mode, **blend)
     opened = compose(photo, [PasteInput(entry, flat, placement)], ClassMap.default(), NO_MATCH)
     closed = compose(photo, [PasteInput(entry, flat, placement)], ClassMap.default(), NO_MATCH, open_cuts=False)
     np.testing.assert_array_equal(opened.instance_ids, hard.instance_ids)
     if mode == "poisson":
-        whole = np.ones(hard.instance_ids.shape, bool)
-    else:                                   # beyond the Gaussian's reach of every pixel the paste does not label
-        whole = ndimage.distance_transform_edt(hard.instance_ids > 0) > int(4.0 * 1.5 + 0.5) + 1
-        assert whole[:, 0].sum() >= 3
-    difference = np.abs(opened.rgb.astype(int) - hard.rgb.astype(int))
-    assert difference[whole].max() <= 1
-    at_cut = hard.instance_ids[:, 0] > 0
-    assert np.abs(closed.rgb[at_cut, 0].astype(int) - hard.rgb[at_cut, 0].astype(int)).max() >= 20
+        whole = np.ones(labelled.shape, bool)
+    else:                                   # beyond the blend's reach of every pixel the paste does not label
+        whole = ndimage.distance_transform_edt(labelled) > int(4.0 * 1.5 + 0.5) + 1
+        for side in sides:
+            assert whole[EDGES[side]].sum() >= 2, side
+    assert np.abs(opened.rgb.astype(int) - hard.rgb.astype(int))[whole].max() <= 1
+    if mode == "feather":                   # feather never faded a cut
+        np.testing.assert_array_equal(closed.rgb, opened.rgb)
+        return
+    for side in sides:
+        at_cut = labelled[EDGES[side]]
+        faded = np.abs(closed.rgb[EDGES[side]][at_cut].astype(int) - hard.rgb[EDGES[side]][at_cut].astype(int))
+        assert faded.max() >= 20, side
+
+
+@pytest.mark.parametrize("sigma", [0.4, 1.5, 3.2])
+@pytest.mark.parametrize("cut", [(True, False, False, False), (False, True, True, False), (True, True, True, True)])
+def test_the_blur_beyond_a_cut_is_the_paste_repeated_as_far_as_the_gaussian_reaches(sigma, cut):
+    """Against the same Gaussian over the crop padded 50 px on every side: by its last row or column where the frame
+    cuts it, by transparency elsewhere."""
+    from synthua_usd.backends.compositing import _blur_beyond_cuts
+
+    values = np.random.default_rng(4).random((17, 13, 3)).astype(np.float32)
+    left, top, right, bottom = cut
+    rows = np.pad(values, ((50, 50), (0, 0), (0, 0)), mode="edge")
+    rows[:50] *= top
+    rows[-50:] *= bottom
+    wide = np.pad(rows, ((0, 0), (50, 50), (0, 0)), mode="edge")
+    wide[:, :50] *= left
+    wide[:, -50:] *= right
+    reference = ndimage.gaussian_filter(wide, (sigma, sigma, 0), mode="constant")[50:-50, 50:-50]
+    np.testing.assert_allclose(_blur_beyond_cuts(values, sigma, cut), reference, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(_blur_beyond_cuts(values[..., 0], sigma, cut), reference[..., 0], rtol=0, atol=1e-6)
 
 
 def test_depth_for_effects_puts_each_paste_at_its_distance(bank):

@@ -493,6 +493,30 @@ def test_pastes_cut_by_the_frames_side_edges_are_labelled_as_far_as_they_are_see
     assert code != 0 and "differs: images/" in said + err, said + err
 
 
+def test_replay_plans_by_the_overlap_measure_its_job_key_names(unlabelled, tmp_path, monkeypatch):
+    """``job_key.visible_overlap`` reaches the planner when a composite is made again; a job key without it (a job
+    made before it) plans by the earlier pastes' whole boxes, as that job did."""
+    import synthua_usd.pipeline.composite_worker as worker
+    from synthua_usd.pipeline.composite import remake
+
+    asked = []
+    planner = worker.plan_pastes
+
+    def spy(*args, **kwargs):
+        asked.append(args[5])
+        return planner(*args, **kwargs)
+
+    monkeypatch.setattr(worker, "plan_pastes", spy)
+    job = json.loads((unlabelled / "generate.json").read_text())
+    assert job["job_key"]["visible_overlap"] is True
+    (tmp_path / "now").mkdir()
+    remake(job, job["plan"][0], tmp_path / "now")
+    del job["job_key"]["visible_overlap"]
+    (tmp_path / "before").mkdir()
+    remake(job, job["plan"][0], tmp_path / "before")
+    assert asked == [True, False]
+
+
 def test_the_summary_counts_composites_and_photos_without_a_paste(inputs, tmp_path, run_cli):
     """A photo whose labelled person fills it leaves no room under ``max_background_cover`` 0 and ``skip``: its
     composites are the photo alone, and the summary says how many composites and photos hold no paste (counted
