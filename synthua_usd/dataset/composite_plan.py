@@ -15,8 +15,7 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
    width beyond the left edge, and as much beyond the right one), tried ``placement_tries`` times for one that
    covers at most ``max_overlap`` of each earlier paste's box in view (the part within the frame; with
    ``visible_overlap`` False, as jobs without ``job_key.visible_overlap`` did, its whole box, though the frame may
-   cut it)
-   and at most ``max_background_cover`` (default
+   cut it) and at most ``max_background_cover`` (default
    ``drop_covered_share``) of each labelled background box; where no column does, the least overlapping one
    (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in
    view);
@@ -246,10 +245,11 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         if lo > hi:
             continue  # wider than the frame (and edge_cut) allows at this size
         best: tuple[float, tuple[float, float], tuple[float, float, float, float]] | None = None
+        earlier = [seen(p["box"]) for p in planned]
         for c in columns:
             anchor = (float(lo + c * (hi - lo)), float(anchor_row))
             box = _box_in_frame(entry, anchor, scale)
-            excess = max([covered_share(seen(p["box"]), box) - settings.max_overlap for p in planned]
+            excess = max([covered_share(e, box) - settings.max_overlap for e in earlier]
                          + [covered_share(b, box) - cover for b in background_boxes] + [0.0])
             if best is None or excess < best[0]:
                 best = (excess, anchor, box)
@@ -260,7 +260,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         if excess > 0 and settings.when_no_room == "skip":
             continue
         poisson_used |= blend["mode"] == "poisson"
-        overlap = max([covered_share(seen(p["box"]), box) for p in planned] + [0.0])
+        overlap = max([covered_share(e, box) for e in earlier] + [0.0])
         planned.append(dict(
             entry_id=entry.id, kind=kind, anchor_px=anchor, scale=float(scale),
             share=float(camera.pixel_height(entry.subject_height_m, anchor_row) / frame_h), share_drawn=share_drawn,
