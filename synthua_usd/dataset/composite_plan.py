@@ -12,13 +12,14 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
    one of the best ``choose_among`` is drawn;
 4. the anchor row again for the chosen cut-out's own height (the share kept), its scale
    ``(y_a - y_h) / (H scale_px_per_m)``, and a column where its box lies in the frame (up to ``edge_cut`` of its
-   width beyond the left edge, and as much beyond the right one), tried ``placement_tries`` times for one that
-   covers at most ``max_overlap`` of each earlier paste's box in view (the part within the frame; with
-   ``visible_overlap`` False, as jobs without ``job_key.visible_overlap`` did, its whole box, though the frame may
-   cut it) and at most ``max_background_cover`` (default
-   ``drop_covered_share``) of each labelled background box; where no column does, the least overlapping one
-   (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in
-   view);
+   width beyond the left edge, and as much beyond the right one), tried ``placement_tries`` times for one where,
+   of it and each earlier paste, the nearer (drawn later) covers at most ``max_overlap`` of the farther one's box
+   in view (the part within the frame; with ``visible_overlap`` False, as jobs without ``job_key.visible_overlap``
+   did, its whole box, though the frame may cut it; with ``overlap_by_depth`` False, as jobs without
+   ``job_key.overlap_by_depth`` did, always the new paste of the earlier one's box, though a farther new paste is
+   drawn behind it), and that covers at most ``max_background_cover`` (default ``drop_covered_share``) of each
+   labelled background box; where no column does, the least overlapping one (``when_no_room``:
+   ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in view);
 5. a blend mode by the config's weights (Poisson at most once a composite) and a shadow strength;
 6. where ``sharpen.share`` > 0, whether it is sharpened and by what amount and sigma, from a generator spawned
    for it (the handed one's draws stay as they are: the pastes are those of the same config without sharpening).
@@ -149,6 +150,12 @@ def covered_share(box, by) -> float:
     return w * h / area if area > 0 else 0.0
 
 
+def _hidden(box, box_seen, earlier) -> list[float]:
+    """Of a paste's ``box`` (``box_seen``: as overlap measures it) and each earlier paste's (box as measured,
+    whether the new one stands behind it), the share of the farther box that the nearer one covers."""
+    return [covered_share(box_seen, e) if behind else covered_share(e, box) for e, behind in earlier]
+
+
 def _rank(candidates: Sequence[BankEntry], elevation: float, light: Light | None, tolerance: float):
     """(score, entry id, entry) of each candidate, best first (ties by id: the order never depends on the bank's
     listing)."""
@@ -192,9 +199,11 @@ def eligible(entries: Sequence[BankEntry], config: CompositeConfig) -> dict[str,
 
 def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: CompositeConfig,
                 background_boxes: Sequence[tuple[float, float, float, float]],
-                rng: np.random.Generator, visible_overlap: bool = True) -> list[Placement]:
+                rng: np.random.Generator, visible_overlap: bool = True,
+                overlap_by_depth: bool = True) -> list[Placement]:
     """The pastes of one composite (see the module docstring), sorted far to near with their ``order``.
-    ``background_boxes`` (x0, y0, x1, y1, written px) are the labelled boxes a paste should not cover."""
+    ``background_boxes`` (x0, y0, x1, y1, written px) are the labelled boxes a paste should not cover.
+    ``visible_overlap`` and ``overlap_by_depth`` False give the overlap measures of earlier jobs (step 4)."""
     camera, settings = drawn.camera, config.pastes
     frame_w, frame_h = camera.width_px, camera.height_px
 
@@ -245,11 +254,13 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         if lo > hi:
             continue  # wider than the frame (and edge_cut) allows at this size
         best: tuple[float, tuple[float, float], tuple[float, float, float, float]] | None = None
-        earlier = [seen(p["box"]) for p in planned]
+        # each earlier paste's box in view, and whether this paste stands behind it (drawn first: farther, by
+        # anchor row, as the plan is sorted below)
+        earlier = [(seen(p["box"]), overlap_by_depth and anchor_row < p["anchor_px"][1]) for p in planned]
         for c in columns:
             anchor = (float(lo + c * (hi - lo)), float(anchor_row))
             box = _box_in_frame(entry, anchor, scale)
-            excess = max([covered_share(e, box) - settings.max_overlap for e in earlier]
+            excess = max([share - settings.max_overlap for share in _hidden(box, seen(box), earlier)]
                          + [covered_share(b, box) - cover for b in background_boxes] + [0.0])
             if best is None or excess < best[0]:
                 best = (excess, anchor, box)
@@ -260,7 +271,7 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         if excess > 0 and settings.when_no_room == "skip":
             continue
         poisson_used |= blend["mode"] == "poisson"
-        overlap = max([covered_share(e, box) for e in earlier] + [0.0])
+        overlap = max(_hidden(box, seen(box), earlier) + [0.0])
         planned.append(dict(
             entry_id=entry.id, kind=kind, anchor_px=anchor, scale=float(scale),
             share=float(camera.pixel_height(entry.subject_height_m, anchor_row) / frame_h), share_drawn=share_drawn,

@@ -90,6 +90,10 @@ class CompositeJob:
     #: Whether a paste's overlap with an earlier one is measured on the earlier one's box in view: jobs whose
     #: ``job_key`` has no ``visible_overlap`` (made up to 7 December 2026) measured its whole box, and replay does so.
     visible_overlap: bool = True
+    #: Whether, of two overlapping pastes, the share hidden is measured of the farther one (drawn behind): jobs whose
+    #: ``job_key`` has no ``overlap_by_depth`` (made up to 7 December 2026) measured the earlier-planned one's box,
+    #: whichever was in front, and replay does so.
+    overlap_by_depth: bool = True
 
 
 @dataclass
@@ -202,7 +206,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
                         (photo.header.width, photo.header.height), photo.scale, camera_rng, placing, rows)
     placements = plan_pastes(drawn, state.pools, config,      # pastes keep off crowds as off the kept boxes
                              [b["frame"] for b in boxes if b["kept"] or b["reason"] == "crowd"], paste_rng,
-                             job.visible_overlap)
+                             job.visible_overlap, job.overlap_by_depth)
     entries = [bank.entry(p.entry_id) for p in placements]
     painted = compose(photo.pixels, [PasteInput(e, state.cutout(e), p) for e, p in zip(entries, placements)],
                       class_map, config.match, job.open_cuts)

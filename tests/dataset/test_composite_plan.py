@@ -278,7 +278,7 @@ def test_overlap_is_measured_on_the_part_of_an_earlier_paste_in_view(bank):
     for visible in (True, False):
         for seed in range(300):
             placements = plan_pastes(_drawn(camera), eligible(bank.entries, config), config, [],
-                                     np.random.default_rng(seed), visible_overlap=visible)
+                                     np.random.default_rng(seed), visible_overlap=visible, overlap_by_depth=False)
             if len(placements) < 2:
                 continue
             a, b = placements
@@ -289,4 +289,36 @@ def test_overlap_is_measured_on_the_part_of_an_earlier_paste_in_view(bank):
             if visible and later.overlap > 0:
                 assert later.overlap == pytest.approx(shown)
     assert pairs[True] >= 100 and beyond[True] == 0, (pairs, beyond)
+    assert beyond[False] > 0, (pairs, beyond)
+
+
+def test_overlap_is_measured_of_the_farther_paste_whichever_was_planned_first(bank):
+    """Of two pastes, the nearer one (drawn later, ``order`` 1) covers at most ``max_overlap`` of the farther one's
+    box in view, recomputed here from the plan, whichever of the two was planned first; the record's ``overlap``
+    (on the paste planned second, the one whose ``overlap`` is not 0) says how much. Jobs made before
+    ``job_key.overlap_by_depth`` measured how much of the first-planned paste the second covers, and then a farther
+    paste planned second could stand mostly hidden behind the first: pastes of very unlike sizes in a narrow frame
+    show it."""
+    config = CompositeConfig.from_document({"pastes": {
+        "per_image": [2, 2], "height_share": [0.25, 0.95], "max_overlap": 0.3, "placement_tries": 60,
+        "when_no_room": "skip", "edge_cut": 0.5}})
+    camera = PhotoCamera(200, 240, 60.0, 1.5, 250.0)
+    pairs, beyond, second_behind = {True: 0, False: 0}, {True: 0, False: 0}, 0
+    for by_depth in (True, False):
+        for seed in range(300):
+            placements = plan_pastes(_drawn(camera), eligible(bank.entries, config), config, [],
+                                     np.random.default_rng(seed), overlap_by_depth=by_depth)
+            if len(placements) < 2:
+                continue
+            far, near = sorted(placements, key=lambda p: p.order)
+            hidden = covered_share(_in_view(far.box, 200.0, 240.0), near.box)
+            pairs[by_depth] += 1
+            beyond[by_depth] += hidden > 0.3 + 1e-9
+            if by_depth:
+                second = far if far.overlap > 0 else near
+                second_behind += second is far
+                if second.overlap > 0:
+                    assert second.overlap == pytest.approx(hidden)
+    assert pairs[True] >= 100 and beyond[True] == 0, (pairs, beyond)
+    assert second_behind >= 10, second_behind
     assert beyond[False] > 0, (pairs, beyond)

@@ -494,8 +494,9 @@ def test_pastes_cut_by_the_frames_side_edges_are_labelled_as_far_as_they_are_see
 
 
 def test_replay_plans_by_the_overlap_measure_its_job_key_names(unlabelled, tmp_path, monkeypatch):
-    """``job_key.visible_overlap`` reaches the planner when a composite is made again; a job key without it (a job
-    made before it) plans by the earlier pastes' whole boxes, as that job did."""
+    """``job_key.visible_overlap`` and ``overlap_by_depth`` reach the planner when a composite is made again; a job
+    key without one (a job made before it) plans as that job did: without ``overlap_by_depth``, by the share of the
+    earlier-planned paste covered, and without ``visible_overlap`` too, by the earlier pastes' whole boxes."""
     import synthua_usd.pipeline.composite_worker as worker
     from synthua_usd.pipeline.composite import remake
 
@@ -503,18 +504,17 @@ def test_replay_plans_by_the_overlap_measure_its_job_key_names(unlabelled, tmp_p
     planner = worker.plan_pastes
 
     def spy(*args, **kwargs):
-        asked.append(args[5])
+        asked.append(args[5:7])
         return planner(*args, **kwargs)
 
     monkeypatch.setattr(worker, "plan_pastes", spy)
     job = json.loads((unlabelled / "generate.json").read_text())
-    assert job["job_key"]["visible_overlap"] is True
-    (tmp_path / "now").mkdir()
-    remake(job, job["plan"][0], tmp_path / "now")
-    del job["job_key"]["visible_overlap"]
-    (tmp_path / "before").mkdir()
-    remake(job, job["plan"][0], tmp_path / "before")
-    assert asked == [True, False]
+    assert job["job_key"]["visible_overlap"] is True and job["job_key"]["overlap_by_depth"] is True
+    for missing in ((), ("overlap_by_depth",), ("overlap_by_depth", "visible_overlap")):
+        key = {k: v for k, v in job["job_key"].items() if k not in missing}
+        (tmp_path / str(len(missing))).mkdir()
+        remake({**job, "job_key": key}, job["plan"][0], tmp_path / str(len(missing)))
+    assert asked == [(True, True), (True, False), (False, False)]
 
 
 def test_the_summary_counts_composites_and_photos_without_a_paste(inputs, tmp_path, run_cli):
