@@ -46,9 +46,13 @@ step) but step 4's, which works on the sRGB values:
    keeps the photo), ``feather`` (alpha x clip(d / feather_px, 0, 1), d the distance in pixels from the pixel to the
    nearest one the paste does not label: the edge fades inwards, and nothing shows outside the labels), ``blur``
    (alpha and premultiplied colour blurred by a Gaussian of ``sigma_px``) or ``poisson``
-   (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px). Where the frame's edge cuts
-   a paste, the paste goes on beyond it: the blur repeats the paste's last row or column there, Poisson leaves the
-   cut open (no photo value imposed along it), and feather's d is measured within the frame (the cut does not fade).
+   (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px within the crop, bounded by
+   the photo's values around it: the paste's own gradients and the photo's, none across the silhouette, so the
+   paste's colour slides to meet the photo; jobs whose ``generate.json`` has no ``job_key.seamless_poisson`` took
+   every gradient of the hard composite, which gives the hard paste back, and kept the photo on the crop's own
+   edges, labelled pixels there too). Where the frame's edge cuts a paste, the paste goes on beyond it: the blur
+   repeats the paste's last row or column there, Poisson leaves the cut open (no photo value imposed along it), and
+   feather's d is measured within the frame (the cut does not fade).
    Jobs whose ``generate.json`` has no ``job_key.open_cuts`` (made before it, on or before 7 December 2026) faded
    blurred and Poisson pastes towards the photo along a cut (``open_cuts`` False keeps that for their replay).
 4. **Sharpening** of a paste the plan sharpens, right after its blend (a nearer paste painted later covers it): the
@@ -342,11 +346,15 @@ def _blur_beyond_cuts(values: np.ndarray, sigma: float, cut: tuple[bool, bool, b
 
 
 def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: dict,
-           open_cuts: bool = True) -> np.ndarray:
+           open_cuts: bool = True, seamless_poisson: bool = True) -> np.ndarray:
     """The region (h, w, 3) float32 linear with the paste blended over it; ``colour`` its premultiplied linear RGB
     with gains applied. ``open_cuts``: where the frame cuts the paste, the blur and Poisson blends take the paste
     to go on beyond the frame (else, as jobs without ``job_key.open_cuts`` did, the blur fades it to transparent and
-    Poisson meets the photo's colour along the cut)."""
+    Poisson meets the photo's colour along the cut). ``seamless_poisson``: Poisson imports the paste's gradients
+    but not the jump at its silhouette, over a domain that may reach the crop's own edges, bounded by the photo's
+    values just beyond them (the region's edge row or column repeated); else, as jobs without
+    ``job_key.seamless_poisson`` did, the hard composite's every gradient, which gives the hard paste back but where
+    a labelled pixel lies on the crop's edge, kept as the photo."""
     alpha = placed.premultiplied[..., 3]
     mode = blend["mode"]
     cut = placed.cut if open_cuts else (False, False, False, False)
@@ -370,7 +378,14 @@ def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: 
     if mode == "hard":
         return hard
     domain = ndimage.binary_dilation(labelled, iterations=POISSON_MARGIN_PX)
-    left, top, right, bottom = cut      # the photo's values on the crop's own edges; open where the frame cuts it
+    left, top, right, bottom = cut
+    if seamless_poisson:    # the photo's values beyond the crop's own edges bound it; open where the frame cuts it
+        pad = ((0 if top else 1, 0 if bottom else 1), (0 if left else 1, 0 if right else 1))
+        h, w = labelled.shape
+        solved = poisson_blend(np.pad(region, pad + ((0, 0),), mode="edge"), np.pad(hard, pad + ((0, 0),), mode="edge"),
+                               np.pad(domain, pad), np.pad(covered, pad))   # the paste's gradients and the photo's
+        return solved[pad[0][0]:pad[0][0] + h, pad[1][0]:pad[1][0] + w].astype(np.float32)
+    # the photo's values on the crop's own edges; open where the frame cuts it
     if not top:
         domain[0] = False
     if not bottom:
@@ -413,9 +428,9 @@ def _class_id(class_map: ClassMap, name: str) -> int:
 
 
 def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, settings: MatchSettings,
-            open_cuts: bool = True) -> Composite:
+            open_cuts: bool = True, seamless_poisson: bool = True) -> Composite:
     """Paint ``pastes`` (sorted by their placement's ``order``) over ``photo`` (H, W, 3) uint8 sRGB; ``open_cuts``
-    as :func:`_blend` takes it."""
+    and ``seamless_poisson`` as :func:`_blend` takes them."""
     height, width = photo.shape[:2]
     placed = [place(p.pixels, p.entry, p.placement.anchor_px, p.placement.scale, (width, height)) for p in pastes]
     tones = [tone_gains(photo, pc, p.placement.box, settings) if pc is not None else (1.0, 1.0)
@@ -469,7 +484,7 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
         rows, cols = pc.slices
         colour = soften(pc.premultiplied, sigma) * np.float32(exposure) * np.asarray(balance, np.float32)
         region = LINEAR_LUT[rgb[rows, cols]]
-        rgb[rows, cols] = encode(_blend(region, pc, colour, p.placement.blend, open_cuts))
+        rgb[rows, cols] = encode(_blend(region, pc, colour, p.placement.blend, open_cuts, seamless_poisson))
         if p.placement.sharpen is not None:
             sharpen(rgb, pc, p.placement.sharpen["amount"], p.placement.sharpen["sigma_px"])
         table = np.zeros(256, np.uint16)

@@ -6,8 +6,12 @@ Inside a domain Ω (the paste's pixels, widened a little) the result ``f`` has t
 
     |N(p)| f_p - Σ_{q ∈ N(p) ∩ Ω} f_q = Σ_{q ∈ N(p)} (s_p - s_q) + Σ_{q ∈ N(p) \\ Ω} t_q.
 
-The paste keeps its shading and texture while its overall colour and brightness slide to meet the photo at the
-edge. The sparse system (one unknown per pixel of Ω) is factorised once by scipy's SuperLU
+Where ``regions`` is given, the source's gradient between p and q counts only where both lie in the same region
+(the sum's term is 0 across a seam): with the paste's covered pixels one region and the photo's the other, the paste
+imports its own gradients but not the jump at its silhouette, so it keeps its shading and texture while its overall
+colour and brightness slide to meet the photo around it (Pérez et al.'s seamless cloning of an object without its
+own background). Without ``regions`` the source's every gradient counts: a source that equals ``t`` on Ω's edge is
+then returned as it is. The sparse system (one unknown per pixel of Ω) is factorised once by scipy's SuperLU
 (:func:`scipy.sparse.linalg.splu`) and solved for the three channels.
 
 Where Ω touches the border of the arrays, N(p) holds only the neighbours that exist: the border is open (no value
@@ -23,15 +27,18 @@ from scipy import sparse
 from scipy.sparse.linalg import splu
 
 
-def poisson_blend(target: np.ndarray, source: np.ndarray, domain: np.ndarray) -> np.ndarray:
+def poisson_blend(target: np.ndarray, source: np.ndarray, domain: np.ndarray,
+                  regions: np.ndarray | None = None) -> np.ndarray:
     """``target`` (h, w, 3) float with the Poisson solution on ``domain`` (h, w) bool (see the module docstring);
-    ``source`` (h, w, 3) gives the gradients. Returns a new float64 array; outside ``domain`` it is ``target``."""
+    ``source`` (h, w, 3) gives the gradients, within each of ``regions`` (h, w) int when given. Returns a new
+    float64 array; outside ``domain`` it is ``target``."""
     h, w = domain.shape
     out = np.array(target, dtype=np.float64)
     flat = np.flatnonzero(domain.reshape(-1))
     if not flat.size:
         return out
     s = np.asarray(source, np.float64).reshape(-1, 3)
+    region = None if regions is None else np.asarray(regions).reshape(-1)
     t = out.reshape(-1, 3)
     if flat.size == h * w:
         t[:] = s
@@ -46,7 +53,10 @@ def poisson_blend(target: np.ndarray, source: np.ndarray, domain: np.ndarray) ->
         at = np.flatnonzero(exists)             # the unknowns that have this neighbour (not beyond the border)
         neighbour = flat[at] + step
         degree[at] += 1.0
-        rhs[at] += s[flat[at]] - s[neighbour]
+        guide = s[flat[at]] - s[neighbour]
+        if region is not None:
+            guide[region[flat[at]] != region[neighbour]] = 0.0     # no gradient across a seam
+        rhs[at] += guide
         inner = index[neighbour]
         known = inner < 0
         rhs[at[known]] += t[neighbour[known]]

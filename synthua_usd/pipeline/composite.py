@@ -168,7 +168,7 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
     config_document.pop("workers")
     job_key = {"config": config_document, "class_map": bank.class_map.document(), "bank": bank.id,
                "backgrounds": [[b.relative, b.width, b.height] for b in backgrounds.images], "grey_photos": True,
-               "open_cuts": True, "visible_overlap": True, "overlap_by_depth": True,
+               "open_cuts": True, "visible_overlap": True, "overlap_by_depth": True, "seamless_poisson": True,
                **({"people_in_photo": True} if config.sets_people_heights() else {})}   # earlier job keys hold
     job_document = {"synthua": __version__, "command": COMMAND, "job_key": job_key,
                     "job_key_digest": document_digest(job_key), "backgrounds": str(Path(request.backgrounds).resolve()),
@@ -186,7 +186,8 @@ def composite(request: CompositeRequest, show_progress: bool = False) -> Composi
                            class_map_document=bank.class_map.document(), bank_root=str(bank.root.resolve()),
                            backgrounds=backgrounds, city=cityscapes_city(config.name),
                            open_cuts=job_key["open_cuts"] is True, visible_overlap=job_key["visible_overlap"] is True,
-                           overlap_by_depth=job_key["overlap_by_depth"] is True)
+                           overlap_by_depth=job_key["overlap_by_depth"] is True,
+                           seamless_poisson=job_key["seamless_poisson"] is True)
         bar = tqdm(total=len(plan), desc="composite", unit="img", disable=not show_progress)
 
         def collect(result) -> None:
@@ -250,7 +251,8 @@ def remake(job_document: dict, planned: dict, out_dir: Path) -> dict:
                            people_in_photo=job_document["job_key"].get("people_in_photo") is True,
                            open_cuts=job_document["job_key"].get("open_cuts") is True,
                            visible_overlap=job_document["job_key"].get("visible_overlap") is True,
-                           overlap_by_depth=job_document["job_key"].get("overlap_by_depth") is True)
+                           overlap_by_depth=job_document["job_key"].get("overlap_by_depth") is True,
+                           seamless_poisson=job_document["job_key"].get("seamless_poisson") is True)
     except (KeyError, TypeError) as exc:
         raise InputError(f"generate.json: {type(exc).__name__} {exc}; expected the job `synthua composite` "
                          f"writes") from None

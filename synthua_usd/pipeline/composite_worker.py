@@ -94,6 +94,11 @@ class CompositeJob:
     #: ``job_key`` has no ``overlap_by_depth`` (made up to 7 December 2026) measured the earlier-planned one's box,
     #: whichever was in front, and replay does so.
     overlap_by_depth: bool = True
+    #: Whether a Poisson paste imports its own gradients but not the jump at its silhouette, over a domain that may
+    #: reach its crop's own edges: jobs whose ``job_key`` has no ``seamless_poisson`` (made up to 7 December 2026)
+    #: took every gradient of the hard composite (the hard paste back) and kept the photo on the crop's edges, and
+    #: replay does so.
+    seamless_poisson: bool = True
 
 
 @dataclass
@@ -209,7 +214,7 @@ def make_composite(state: CompositeState, planned: PlannedComposite) -> ImageBuf
                              job.visible_overlap, job.overlap_by_depth)
     entries = [bank.entry(p.entry_id) for p in placements]
     painted = compose(photo.pixels, [PasteInput(e, state.cutout(e), p) for e, p in zip(entries, placements)],
-                      class_map, config.match, job.open_cuts)
+                      class_map, config.match, job.open_cuts, job.seamless_poisson)
     display, effects = painted.rgb, None
     if config.effects.enabled:
         effects = draw_effects(stream(config.seed, planned.seed, "effects", planned.background), config.effects)

@@ -174,6 +174,29 @@ def test_poisson_blending_solves_its_equation():
     np.testing.assert_allclose(poisson_blend(target, target, domain), target, atol=1e-9)
 
 
+def test_poisson_blending_guides_by_the_source_within_its_regions_only():
+    """With ``regions``, the source's gradient between neighbours in different regions counts as 0 (checked pixel by
+    pixel); a flat paste region over a flat photo then takes the photo's value: nothing guides it elsewhere."""
+    rng = np.random.default_rng(5)
+    target, source = rng.random((20, 24, 3)), rng.random((20, 24, 3))
+    domain = np.zeros((20, 24), bool)
+    domain[3:16, 4:20] = True
+    regions = np.zeros((20, 24), np.int64)
+    regions[6:13, 8:16] = 1
+    regions[8:11, 10:13] = 2
+    f = poisson_blend(target, source, domain, regions)
+    np.testing.assert_array_equal(f[~domain], target[~domain])
+    for y, x in zip(*np.nonzero(domain)):
+        near = [(y + dy, x + dx) for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1))]
+        lhs = 4 * f[y, x] - sum(f[q] for q in near)
+        rhs = sum(source[y, x] - source[q] for q in near if regions[q] == regions[y, x])
+        np.testing.assert_allclose(lhs, rhs, atol=1e-9)
+    flat_target, flat_source = np.full((20, 24, 3), 0.3), np.full((20, 24, 3), 0.3)
+    flat_source[regions > 0] = 0.8
+    np.testing.assert_allclose(poisson_blend(flat_target, flat_source, domain, regions > 0), flat_target, atol=1e-9)
+    np.testing.assert_allclose(poisson_blend(flat_target, flat_source, domain), flat_source, atol=1e-9)
+
+
 def test_poisson_blending_leaves_the_arrays_border_open():
     rng = np.random.default_rng(2)
     target, source = rng.random((20, 24, 3)), rng.random((20, 24, 3))
@@ -197,9 +220,7 @@ def test_a_poisson_paste_keeps_the_photo_on_its_edge(bank):
     painted = compose(photo, [PasteInput(entry, pixels, _placement(entry, (40.0, 52.0), 0.9, 0, mode="poisson"))],
                       ClassMap.default(), NO_MATCH)
     labelled = painted.instance_ids > 0
-    near = labelled.copy()
-    for _ in range(3):
-        near[1:-1, 1:-1] |= near[:-2, 1:-1] | near[2:, 1:-1] | near[1:-1, :-2] | near[1:-1, 2:]
+    near = ndimage.binary_dilation(labelled, iterations=2)       # Poisson's domain: 2 px beyond the labels
     np.testing.assert_array_equal(painted.rgb[~near], photo[~near])
     assert (painted.rgb[labelled] != photo[labelled]).any()
 
@@ -213,6 +234,74 @@ def _flat_cutout(bank, colour=0.5):
     premultiplied = pixels.premultiplied.copy()
     premultiplied[..., :3] = colour * premultiplied[..., 3:]
     return entry, CutoutPixels(pixels.rgba, pixels.ids, pixels.amodal, pixels.shadow, premultiplied)
+
+
+def _opaque_cutout(bank):
+    """Entry 0 of the bank opaque and labelled over its whole crop, in random linear colours."""
+    from synthua_usd.backends.cutout_pixels import CutoutPixels
+
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    colours = np.random.default_rng(3).uniform(0.05, 0.9, pixels.premultiplied.shape[:2] + (3,)).astype(np.float32)
+    return entry, CutoutPixels(pixels.rgba, np.where(pixels.ids > 0, pixels.ids, 1).astype(np.uint8), pixels.amodal,
+                               pixels.shadow, np.concatenate([colours, np.ones(colours.shape[:2] + (1,), np.float32)],
+                                                             -1))
+
+
+@pytest.mark.parametrize("shift, cut", [((20.0, 10.0), (False, False, False, False)),
+                                        ((-6.0, 26.0), (True, False, False, True))])
+def test_a_poisson_paste_is_seamless_cloning_up_to_its_crops_edges(bank, shift, cut):
+    """A cut-out opaque and labelled up to its crop's own edges (a small paste from a tight crop), Poisson-blended
+    over a flat photo, whole in the frame or cut at its left and bottom: the crop is solved with the paste's own
+    gradients, none across its silhouette, bounded by the photo around it and open where the frame cuts it, as
+    :func:`poisson_blend` over the whole frame with the crop as its domain and the paste as one region gives
+    (computed here); its colour slides to the photo's. Jobs without ``job_key.seamless_poisson`` took every gradient
+    of the hard composite (the hard paste back) and kept the photo on the crop's edges, labelled pixels there too."""
+    from synthua_usd.backends.compositing import encode
+
+    entry, opaque = _opaque_cutout(bank)
+    photo = np.full((60, 80, 3), 90, np.uint8)
+    anchor = (0.6 * entry.anchor[0] + shift[0], 0.6 * entry.anchor[1] + shift[1])  # crop edges on pixel edges
+    placed = place(opaque, entry, anchor, 0.6, (80, 60))
+    assert placed.cut == cut
+    rows, cols = placed.slices
+    hard, painted, kept = (compose(photo, [PasteInput(entry, opaque, _placement(entry, anchor, 0.6, 0, mode=mode))],
+                                   ClassMap.default(), NO_MATCH, seamless_poisson=seamless)
+                           for mode, seamless in (("hard", True), ("poisson", True), ("poisson", False)))
+    labelled = painted.instance_ids > 0
+    domain = np.zeros((60, 80), bool)
+    domain[rows, cols] = True
+    np.testing.assert_array_equal(labelled, domain)          # labelled up to the crop's edges, and only there
+    source = LINEAR_LUT[photo].astype(np.float64)
+    source[rows, cols] = placed.premultiplied[..., :3] / placed.premultiplied[..., 3:]   # the hard paste, unrounded
+    expected = encode(poisson_blend(LINEAR_LUT[photo], source, domain, labelled).astype(np.float32))
+    assert np.abs(painted.rgb.astype(int) - expected.astype(int)).max() <= 1
+    # the colour slides towards the photo's (a flat grey): the paste's mean moves, its contrast stays
+    assert abs(painted.rgb[labelled].mean() - 90) < abs(hard.rgb[labelled].mean() - 90) - 10
+    uncut = domain & ~ndimage.binary_erosion(domain, border_value=1)
+    if cut[0]:
+        uncut[:, 0] = False
+    if cut[3]:
+        uncut[-1] = False
+    assert uncut.sum() >= 40
+    np.testing.assert_array_equal(kept.rgb[uncut], photo[uncut])        # an earlier job's rule
+
+
+def test_an_earlier_jobs_poisson_paste_with_room_around_it_was_the_hard_paste(bank):
+    """With every gradient of the hard composite imported (jobs without ``job_key.seamless_poisson``), a paste whose
+    labels keep off its crop's edges came out as the hard paste itself; seamless cloning moves its colours."""
+    entry = bank.entries[0]
+    pixels = read_cutout(bank.root, entry)
+    photo = _photo()
+    hard, kept, painted = (compose(photo, [PasteInput(entry, pixels, _placement(entry, (40.0, 56.0), 0.9, 0,
+                                                                                 mode=mode))],
+                                   ClassMap.default(), NO_MATCH, seamless_poisson=seamless)
+                           for mode, seamless in (("hard", True), ("poisson", False), ("poisson", True)))
+    labelled = hard.instance_ids > 0
+    assert not (labelled[0].any() or labelled[-1].any() or labelled[:, 0].any() or labelled[:, -1].any())
+    np.testing.assert_array_equal(kept.rgb, hard.rgb)
+    moved = np.abs(painted.rgb.astype(int) - hard.rgb.astype(int)).max(axis=-1)
+    assert (moved[labelled] > 5).mean() > 0.5
 
 
 def test_placing_records_which_frame_edges_cut_the_crop(bank):
@@ -230,11 +319,12 @@ EDGES = {"left": (slice(None), 0), "top": (0, slice(None)), "right": (slice(None
 @pytest.mark.parametrize("anchor, sides", [((3.0, 56.0), ("left",)), ((77.0, 70.0), ("right", "bottom"))])
 @pytest.mark.parametrize("mode,blend", [("poisson", {}), ("blur", {"sigma_px": 1.5}), ("feather", {"feather_px": 2.0})])
 def test_a_paste_the_frame_cuts_goes_on_beyond_the_cut(bank, mode, blend, anchor, sides):
-    """A flat paste over a flat photo, cut by the frame (at its left side; at its right side and bottom): Poisson
-    blending gives the hard paste itself (its source meets the photo on every edge but the cut, which is open), the
-    blur and feather leave its colour whole wherever the paste's own edges are beyond their reach (the cut is not an
+    """A flat paste over a flat photo, cut by the frame (at its left side; at its right side and bottom): the blur
+    and feather leave its colour whole wherever the paste's own edges are beyond their reach (the cut is not an
     edge); jobs without ``job_key.open_cuts`` (``open_cuts`` False) faded Poisson and blurred pastes towards the
-    photo along the cut."""
+    photo along the cut. Poisson as jobs with ``open_cuts`` but without ``seamless_poisson`` made it gives the hard
+    paste itself (its source meets the photo on every edge but the cut, which is open); seamless cloning at a cut:
+    :func:`test_a_poisson_paste_is_seamless_cloning_up_to_its_crops_edges`."""
     entry, flat = _flat_cutout(bank)
     photo = np.full((60, 80, 3), 40, np.uint8)
     hard = compose(photo, [PasteInput(entry, flat, _placement(entry, anchor, 0.9, 0))], ClassMap.default(), NO_MATCH)
@@ -242,8 +332,9 @@ def test_a_paste_the_frame_cuts_goes_on_beyond_the_cut(bank, mode, blend, anchor
     for side in sides:
         assert labelled[EDGES[side]].sum() >= 10, side            # the cut runs through the paste
     placement = _placement(entry, anchor, 0.9, 0, mode=mode, **blend)
-    opened = compose(photo, [PasteInput(entry, flat, placement)], ClassMap.default(), NO_MATCH)
-    closed = compose(photo, [PasteInput(entry, flat, placement)], ClassMap.default(), NO_MATCH, open_cuts=False)
+    opened = compose(photo, [PasteInput(entry, flat, placement)], ClassMap.default(), NO_MATCH, seamless_poisson=False)
+    closed = compose(photo, [PasteInput(entry, flat, placement)], ClassMap.default(), NO_MATCH, open_cuts=False,
+                     seamless_poisson=False)
     np.testing.assert_array_equal(opened.instance_ids, hard.instance_ids)
     if mode == "poisson":
         whole = np.ones(labelled.shape, bool)
