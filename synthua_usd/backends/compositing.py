@@ -47,10 +47,10 @@ step) but step 4's, which works on the sRGB values:
    nearest one the paste does not label: the edge fades inwards, and nothing shows outside the labels), ``blur``
    (alpha and premultiplied colour blurred by a Gaussian of ``sigma_px``) or ``poisson``
    (:mod:`synthua_usd.backends.poisson_blend` over the labelled pixels widened by 2 px within the crop, bounded by
-   the photo's values around it: the paste's own gradients and the photo's, none across the silhouette, so the
+   the photo's pixels around it: the paste's own gradients and the photo's, none across the silhouette, so the
    paste's colour slides to meet the photo; jobs whose ``generate.json`` has no ``job_key.seamless_poisson`` took
-   every gradient of the hard composite, which gives the hard paste back, and kept the photo on the crop's own
-   edges, labelled pixels there too). Where the frame's edge cuts a paste, the paste goes on beyond it: the blur
+   every gradient of the hard composite, which gives the hard paste back where the domain keeps off the crop's
+   own edges, and imposed the photo's values on those edges, labelled pixels there too). Where the frame's edge cuts a paste, the paste goes on beyond it: the blur
    repeats the paste's last row or column there, Poisson leaves the cut open (no photo value imposed along it), and
    feather's d is measured within the frame (the cut does not fade).
    Jobs whose ``generate.json`` has no ``job_key.open_cuts`` (made before it, on or before 7 December 2026) faded
@@ -346,15 +346,19 @@ def _blur_beyond_cuts(values: np.ndarray, sigma: float, cut: tuple[bool, bool, b
 
 
 def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: dict,
-           open_cuts: bool = True, seamless_poisson: bool = True) -> np.ndarray:
+           open_cuts: bool = True, seamless_poisson: bool = True,
+           around: tuple[np.ndarray, tuple[int, int, int, int]] | None = None) -> np.ndarray:
     """The region (h, w, 3) float32 linear with the paste blended over it; ``colour`` its premultiplied linear RGB
     with gains applied. ``open_cuts``: where the frame cuts the paste, the blur and Poisson blends take the paste
     to go on beyond the frame (else, as jobs without ``job_key.open_cuts`` did, the blur fades it to transparent and
-    Poisson meets the photo's colour along the cut). ``seamless_poisson``: Poisson imports the paste's gradients
-    but not the jump at its silhouette, over a domain that may reach the crop's own edges, bounded by the photo's
-    values just beyond them (the region's edge row or column repeated); else, as jobs without
-    ``job_key.seamless_poisson`` did, the hard composite's every gradient, which gives the hard paste back but where
-    a labelled pixel lies on the crop's edge, kept as the photo."""
+    Poisson meets the photo's colour along the cut). ``seamless_poisson``: Poisson imports the paste's own gradients
+    and the photo's but not the jump at its silhouette, over a domain that may reach the crop's own edges, bounded
+    by the photo's pixels beyond them: ``around`` holds the linear image over the region grown by the frame pixels
+    beyond each edge (at most one) and how many (top, bottom, left, right); where there is none (the frame cuts
+    the paste there, or the crop ends at the frame's edge) the domain is open. Else, as jobs without
+    ``job_key.seamless_poisson`` did, the hard composite's every gradient, which gives the hard paste back where
+    the domain keeps off the crop's edges; there the photo's values are imposed, a labelled pixel on the edge keeps
+    the photo, and the clash fades into the paste."""
     alpha = placed.premultiplied[..., 3]
     mode = blend["mode"]
     cut = placed.cut if open_cuts else (False, False, False, False)
@@ -379,12 +383,14 @@ def _blend(region: np.ndarray, placed: PlacedCutout, colour: np.ndarray, blend: 
         return hard
     domain = ndimage.binary_dilation(labelled, iterations=POISSON_MARGIN_PX)
     left, top, right, bottom = cut
-    if seamless_poisson:    # the photo's values beyond the crop's own edges bound it; open where the frame cuts it
-        pad = ((0 if top else 1, 0 if bottom else 1), (0 if left else 1, 0 if right else 1))
-        h, w = labelled.shape
-        solved = poisson_blend(np.pad(region, pad + ((0, 0),), mode="edge"), np.pad(hard, pad + ((0, 0),), mode="edge"),
-                               np.pad(domain, pad), np.pad(covered, pad))   # the paste's gradients and the photo's
-        return solved[pad[0][0]:pad[0][0] + h, pad[1][0]:pad[1][0] + w].astype(np.float32)
+    if seamless_poisson:    # the photo's pixels beyond the crop bound it; open where the frame has none
+        wide, (grow_top, _, grow_left, _) = around if around is not None else (region, (0, 0, 0, 0))
+        inner = (slice(grow_top, grow_top + labelled.shape[0]), slice(grow_left, grow_left + labelled.shape[1]))
+        source = np.array(wide)
+        source[inner] = hard
+        grown, regions = np.zeros(wide.shape[:2], bool), np.zeros(wide.shape[:2], bool)
+        grown[inner], regions[inner] = domain, covered     # the paste's gradients and the photo's, none between
+        return poisson_blend(wide, source, grown, regions)[inner].astype(np.float32)
     # the photo's values on the crop's own edges; open where the frame cuts it
     if not top:
         domain[0] = False
@@ -483,8 +489,12 @@ def compose(photo: np.ndarray, pastes: list[PasteInput], class_map: ClassMap, se
             continue
         rows, cols = pc.slices
         colour = soften(pc.premultiplied, sigma) * np.float32(exposure) * np.asarray(balance, np.float32)
-        region = LINEAR_LUT[rgb[rows, cols]]
-        rgb[rows, cols] = encode(_blend(region, pc, colour, p.placement.blend, open_cuts, seamless_poisson))
+        # the region and the frame pixels beyond each of its edges (at most one), for Poisson's boundary
+        grow = (min(1, rows.start), min(1, height - rows.stop), min(1, cols.start), min(1, width - cols.stop))
+        wide = LINEAR_LUT[rgb[rows.start - grow[0]:rows.stop + grow[1], cols.start - grow[2]:cols.stop + grow[3]]]
+        region = wide[grow[0]:wide.shape[0] - grow[1], grow[2]:wide.shape[1] - grow[3]]
+        rgb[rows, cols] = encode(_blend(region, pc, colour, p.placement.blend, open_cuts, seamless_poisson,
+                                        (wide, grow)))
         if p.placement.sharpen is not None:
             sharpen(rgb, pc, p.placement.sharpen["amount"], p.placement.sharpen["sigma_px"])
         table = np.zeros(256, np.uint16)

@@ -16,8 +16,8 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
    of it and each earlier paste, the nearer (drawn later) covers at most ``max_overlap`` of the farther one's box
    in view (the part within the frame; with ``visible_overlap`` False, as jobs without ``job_key.visible_overlap``
    did, its whole box, though the frame may cut it; with ``overlap_by_depth`` False, as jobs without
-   ``job_key.overlap_by_depth`` did, always the new paste of the earlier one's box, though a farther new paste is
-   drawn behind it), and that covers at most ``max_background_cover`` (default ``drop_covered_share``) of each
+   ``job_key.overlap_by_depth`` did, always the share of the earlier one's box the new paste covers, though a
+   farther new paste is drawn behind it), and that covers at most ``max_background_cover`` (default ``drop_covered_share``) of each
    labelled background box; where no column does, the least overlapping one (``when_no_room``:
    ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in view);
 5. a blend mode by the config's weights (Poisson at most once a composite) and a shadow strength;
@@ -150,6 +150,16 @@ def covered_share(box, by) -> float:
     return w * h / area if area > 0 else 0.0
 
 
+def _draw_order(planned: dict) -> tuple[float, int]:
+    """A planned paste's place in drawing order: far to near by anchor row, then in the order planned."""
+    return planned["anchor_px"][1], planned["k"]
+
+
+def _drawn_first(key: tuple[float, int], planned: dict) -> bool:
+    """Whether a paste of drawing-order ``key`` is drawn before (behind) the ``planned`` one."""
+    return key < _draw_order(planned)
+
+
 def _hidden(box, box_seen, earlier) -> list[float]:
     """Of a paste's ``box`` (``box_seen``: as overlap measures it) and each earlier paste's (box as measured,
     whether the new one stands behind it), the share of the farther box that the nearer one covers."""
@@ -254,13 +264,13 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
         if lo > hi:
             continue  # wider than the frame (and edge_cut) allows at this size
         best: tuple[float, tuple[float, float], tuple[float, float, float, float]] | None = None
-        # each earlier paste's box in view, and whether this paste stands behind it (drawn first: farther, by
-        # anchor row, as the plan is sorted below)
-        earlier = [(seen(p["box"]), overlap_by_depth and anchor_row < p["anchor_px"][1]) for p in planned]
+        # each earlier paste's box in view, and whether this paste stands behind it (drawn first, by the key the
+        # plan is sorted by below)
+        earlier = [(seen(p["box"]), overlap_by_depth and _drawn_first((anchor_row, k), p)) for p in planned]
         for c in columns:
             anchor = (float(lo + c * (hi - lo)), float(anchor_row))
             box = _box_in_frame(entry, anchor, scale)
-            excess = max([share - settings.max_overlap for share in _hidden(box, seen(box), earlier)]
+            excess = max([hidden - settings.max_overlap for hidden in _hidden(box, seen(box), earlier)]
                          + [covered_share(b, box) - cover for b in background_boxes] + [0.0])
             if best is None or excess < best[0]:
                 best = (excess, anchor, box)
@@ -280,6 +290,6 @@ def plan_pastes(drawn: DrawnCamera, pools: dict[str, list[BankEntry]], config: C
             light_distance=None if drawn.light is None else drawn.light.distance(entry.light),
             box=tuple(float(v) for v in box), overlap=float(overlap), blend=blend, shadow_strength=shadow,
             sharpen=sharpen, k=k))
-    planned.sort(key=lambda p: (p["anchor_px"][1], p["k"]))
+    planned.sort(key=_draw_order)
     return [Placement(**{key: v for key, v in p.items() if key != "k"}, order=n) for n, p in enumerate(planned)]
 

@@ -15,8 +15,8 @@ import pytest
 from scipy import ndimage
 
 from bank_maker import banded_aid_user, bands, write_bank
-from synthua_usd.backends.compositing import (PasteInput, compose, composite_depth, edge_blur, paste_gains, retone,
-                                              tone_gains)
+from synthua_usd.backends.compositing import (POISSON_MARGIN_PX, PasteInput, compose, composite_depth, edge_blur,
+                                              paste_gains, retone, tone_gains)
 from synthua_usd.backends.cutout_pixels import LINEAR_LUT, PlacedCutout, place, read_cutout
 from synthua_usd.backends.poisson_blend import poisson_blend
 from synthua_usd.dataset.composite_config import MatchSettings
@@ -220,7 +220,7 @@ def test_a_poisson_paste_keeps_the_photo_on_its_edge(bank):
     painted = compose(photo, [PasteInput(entry, pixels, _placement(entry, (40.0, 52.0), 0.9, 0, mode="poisson"))],
                       ClassMap.default(), NO_MATCH)
     labelled = painted.instance_ids > 0
-    near = ndimage.binary_dilation(labelled, iterations=2)       # Poisson's domain: 2 px beyond the labels
+    near = ndimage.binary_dilation(labelled, iterations=POISSON_MARGIN_PX)      # Poisson's domain
     np.testing.assert_array_equal(painted.rgb[~near], photo[~near])
     assert (painted.rgb[labelled] != photo[labelled]).any()
 
@@ -236,55 +236,74 @@ def _flat_cutout(bank, colour=0.5):
     return entry, CutoutPixels(pixels.rgba, pixels.ids, pixels.amodal, pixels.shadow, premultiplied)
 
 
-def _opaque_cutout(bank):
-    """Entry 0 of the bank opaque and labelled over its whole crop, in random linear colours."""
+def _opaque_cutout(bank, inset=0):
+    """Entry 0 of the bank opaque and labelled over its whole crop but an ``inset`` px border, in random linear
+    colours; with an ``inset``, also an 8 x 8 px hole in the middle, labelled but transparent (no sample covers it)."""
     from synthua_usd.backends.cutout_pixels import CutoutPixels
 
     entry = bank.entries[0]
     pixels = read_cutout(bank.root, entry)
-    colours = np.random.default_rng(3).uniform(0.05, 0.9, pixels.premultiplied.shape[:2] + (3,)).astype(np.float32)
-    return entry, CutoutPixels(pixels.rgba, np.where(pixels.ids > 0, pixels.ids, 1).astype(np.uint8), pixels.amodal,
-                               pixels.shadow, np.concatenate([colours, np.ones(colours.shape[:2] + (1,), np.float32)],
-                                                             -1))
+    h, w = pixels.ids.shape
+    colours = np.random.default_rng(3).uniform(0.05, 0.9, (h, w, 3)).astype(np.float32)
+    alpha = np.zeros((h, w, 1), np.float32)
+    alpha[inset:h - inset, inset:w - inset] = 1.0
+    ids = np.where(pixels.ids > 0, pixels.ids, 1).astype(np.uint8) * (alpha[..., 0] > 0)
+    if inset:
+        alpha[h // 2 - 4:h // 2 + 4, w // 2 - 4:w // 2 + 4] = 0.0
+    return entry, CutoutPixels(pixels.rgba, ids.astype(np.uint8), pixels.amodal, pixels.shadow,
+                               np.concatenate([colours * alpha, alpha], -1))
 
 
+@pytest.mark.parametrize("inset", [0, 3])
 @pytest.mark.parametrize("shift, cut", [((20.0, 10.0), (False, False, False, False)),
                                         ((-6.0, 26.0), (True, False, False, True))])
-def test_a_poisson_paste_is_seamless_cloning_up_to_its_crops_edges(bank, shift, cut):
-    """A cut-out opaque and labelled up to its crop's own edges (a small paste from a tight crop), Poisson-blended
-    over a flat photo, whole in the frame or cut at its left and bottom: the crop is solved with the paste's own
-    gradients, none across its silhouette, bounded by the photo around it and open where the frame cuts it, as
-    :func:`poisson_blend` over the whole frame with the crop as its domain and the paste as one region gives
-    (computed here); its colour slides to the photo's. Jobs without ``job_key.seamless_poisson`` took every gradient
-    of the hard composite (the hard paste back) and kept the photo on the crop's edges, labelled pixels there too."""
+def test_a_poisson_paste_is_seamless_cloning_up_to_its_crops_edges(bank, shift, cut, inset):
+    """A cut-out labelled up to its crop's own edges (a small paste from a tight crop), or a few pixels short of them
+    with a labelled hole no sample covers, Poisson-blended over a random photo, whole in the frame or cut at its
+    left and bottom: the crop is solved as :func:`poisson_blend` over the whole frame gives it (computed here), with
+    the labels widened by ``POISSON_MARGIN_PX`` within the crop as its domain, the hard composite as its source and
+    the covered pixels as one region (the paste's own gradients and the photo's, none across the silhouette): bounded
+    by the photo's pixels around the crop, open where the frame cuts it. On a flat grey photo its colour slides to the
+    grey. Jobs without ``job_key.seamless_poisson`` imposed the photo's values on the crop's edges: a labelled pixel
+    there showed the photo."""
     from synthua_usd.backends.compositing import encode
 
-    entry, opaque = _opaque_cutout(bank)
-    photo = np.full((60, 80, 3), 90, np.uint8)
+    entry, cutout = _opaque_cutout(bank, inset)
     anchor = (0.6 * entry.anchor[0] + shift[0], 0.6 * entry.anchor[1] + shift[1])  # crop edges on pixel edges
-    placed = place(opaque, entry, anchor, 0.6, (80, 60))
+    placed = place(cutout, entry, anchor, 0.6, (80, 60))
     assert placed.cut == cut
     rows, cols = placed.slices
-    hard, painted, kept = (compose(photo, [PasteInput(entry, opaque, _placement(entry, anchor, 0.6, 0, mode=mode))],
-                                   ClassMap.default(), NO_MATCH, seamless_poisson=seamless)
-                           for mode, seamless in (("hard", True), ("poisson", True), ("poisson", False)))
-    labelled = painted.instance_ids > 0
-    domain = np.zeros((60, 80), bool)
-    domain[rows, cols] = True
-    np.testing.assert_array_equal(labelled, domain)          # labelled up to the crop's edges, and only there
-    source = LINEAR_LUT[photo].astype(np.float64)
-    source[rows, cols] = placed.premultiplied[..., :3] / placed.premultiplied[..., 3:]   # the hard paste, unrounded
-    expected = encode(poisson_blend(LINEAR_LUT[photo], source, domain, labelled).astype(np.float32))
-    assert np.abs(painted.rgb.astype(int) - expected.astype(int)).max() <= 1
-    # the colour slides towards the photo's (a flat grey): the paste's mean moves, its contrast stays
-    assert abs(painted.rgb[labelled].mean() - 90) < abs(hard.rgb[labelled].mean() - 90) - 10
-    uncut = domain & ~ndimage.binary_erosion(domain, border_value=1)
-    if cut[0]:
-        uncut[:, 0] = False
-    if cut[3]:
-        uncut[-1] = False
-    assert uncut.sum() >= 40
-    np.testing.assert_array_equal(kept.rgb[uncut], photo[uncut])        # an earlier job's rule
+    covered = np.zeros((60, 80), bool)
+    covered[rows, cols] = (placed.ids > 0) & (placed.premultiplied[..., 3] > 1e-6)
+    crop = np.zeros((60, 80), bool)
+    crop[rows, cols] = True
+    for photo in (np.random.default_rng(9).integers(40, 200, (60, 80, 3)).astype(np.uint8),
+                  np.full((60, 80, 3), 90, np.uint8)):
+        hard, painted, kept = (compose(photo, [PasteInput(entry, cutout, _placement(entry, anchor, 0.6, 0, mode=mode))],
+                                       ClassMap.default(), NO_MATCH, seamless_poisson=seamless)
+                               for mode, seamless in (("hard", True), ("poisson", True), ("poisson", False)))
+        labelled = painted.instance_ids > 0
+        if inset:
+            assert (labelled & ~covered).any() and not (labelled & ~crop).any()
+            assert not (labelled & ~ndimage.binary_erosion(crop, border_value=1)).any()
+        else:
+            np.testing.assert_array_equal(labelled, crop)       # labelled up to the crop's edges, and only there
+        domain = ndimage.binary_dilation(labelled, iterations=POISSON_MARGIN_PX) & crop
+        assert (domain & ~ndimage.binary_erosion(crop, border_value=1)).sum() >= 40   # it reaches the crop's edges
+        source = LINEAR_LUT[photo].astype(np.float64)
+        straight = placed.premultiplied[..., :3] / np.maximum(placed.premultiplied[..., 3:], 1e-6)
+        source[covered] = straight[covered[rows, cols]]                              # the hard paste, unrounded
+        expected = encode(poisson_blend(LINEAR_LUT[photo], source, domain, covered).astype(np.float32))
+        assert np.abs(painted.rgb.astype(int) - expected.astype(int)).max() <= 1
+        np.testing.assert_array_equal(painted.rgb[~domain], photo[~domain])
+    # on the flat grey photo, the colour slides towards it: the paste's mean moves
+    assert abs(painted.rgb[covered].mean() - 90) < abs(hard.rgb[covered].mean() - 90) - 10
+    if not inset:
+        uncut = crop & ~ndimage.binary_erosion(crop, border_value=1)
+        uncut[:, 0] &= not cut[0]
+        uncut[-1] &= not cut[3]
+        assert uncut.sum() >= 40
+        np.testing.assert_array_equal(kept.rgb[uncut], photo[uncut])        # an earlier job's rule
 
 
 def test_an_earlier_jobs_poisson_paste_with_room_around_it_was_the_hard_paste(bank):
@@ -298,7 +317,9 @@ def test_an_earlier_jobs_poisson_paste_with_room_around_it_was_the_hard_paste(ba
                                    ClassMap.default(), NO_MATCH, seamless_poisson=seamless)
                            for mode, seamless in (("hard", True), ("poisson", False), ("poisson", True)))
     labelled = hard.instance_ids > 0
-    assert not (labelled[0].any() or labelled[-1].any() or labelled[:, 0].any() or labelled[:, -1].any())
+    own = ndimage.binary_dilation(place(pixels, entry, (40.0, 56.0), 0.9, (80, 60)).ids > 0,
+                                  iterations=POISSON_MARGIN_PX)
+    assert not (own[0].any() or own[-1].any() or own[:, 0].any() or own[:, -1].any())   # off the crop's edges
     np.testing.assert_array_equal(kept.rgb, hard.rgb)
     moved = np.abs(painted.rgb.astype(int) - hard.rgb.astype(int)).max(axis=-1)
     assert (moved[labelled] > 5).mean() > 0.5

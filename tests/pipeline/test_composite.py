@@ -18,6 +18,7 @@ from PIL import Image
 from scipy import ndimage
 
 from bank_maker import banded_aid_user, write_band_photos, write_bank, write_photos
+from synthua_usd.backends.compositing import POISSON_MARGIN_PX
 from synthua_usd.cli.main import main
 from synthua_usd.dataset.cutout_bank import read_bank
 
@@ -518,6 +519,28 @@ def test_replay_plans_by_the_overlap_measure_its_job_key_names(unlabelled, tmp_p
     assert asked == [(True, True), (True, False), (False, False)]
 
 
+def test_replay_blends_as_its_job_key_names(unlabelled, tmp_path, monkeypatch):
+    """``job_key.open_cuts`` and ``seamless_poisson`` reach the painter when a composite is made again; a job key
+    without one (a job made before it) blends as that job did."""
+    import synthua_usd.pipeline.composite_worker as worker
+    from synthua_usd.pipeline.composite import remake
+
+    asked = []
+    painter = worker.compose
+
+    def spy(*args, **kwargs):
+        asked.append(args[4:6])
+        return painter(*args, **kwargs)
+
+    monkeypatch.setattr(worker, "compose", spy)
+    job = json.loads((unlabelled / "generate.json").read_text())
+    for missing in ((), ("seamless_poisson",), ("seamless_poisson", "open_cuts")):
+        key = {k: v for k, v in job["job_key"].items() if k not in missing}
+        (tmp_path / str(len(missing))).mkdir()
+        remake({**job, "job_key": key}, job["plan"][0], tmp_path / str(len(missing)))
+    assert asked == [(True, True), (True, False), (False, False)]
+
+
 def test_the_summary_counts_composites_and_photos_without_a_paste(inputs, tmp_path, run_cli):
     """A photo whose labelled person fills it leaves no room under ``max_background_cover`` 0 and ``skip``: its
     composites are the photo alone, and the summary says how many composites and photos hold no paste (counted
@@ -693,7 +716,7 @@ def test_sharpening_is_recorded_per_paste_keeps_labels_and_photo_pixels_verifies
         rgb_plain = _png(made["plain"] / plain["files"]["rgb_png"])
         photo = instance == 0
         if any(p["blend"]["mode"] == "poisson" for p in record["composite"]["pastes"]):
-            photo &= ~ndimage.binary_dilation(instance > 0, iterations=2)
+            photo &= ~ndimage.binary_dilation(instance > 0, iterations=POISSON_MARGIN_PX)
         np.testing.assert_array_equal(rgb[photo], rgb_plain[photo])   # the photo's pixels
         if not any(p["sharpen"] for p in record["composite"]["pastes"]):
             np.testing.assert_array_equal(rgb, rgb_plain)
