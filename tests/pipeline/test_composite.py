@@ -495,50 +495,37 @@ def test_pastes_cut_by_the_frames_side_edges_are_labelled_as_far_as_they_are_see
     assert code != 0 and "differs: images/" in said + err, said + err
 
 
-def test_replay_plans_by_the_overlap_measure_its_job_key_names(unlabelled, tmp_path, monkeypatch):
-    """``job_key.visible_overlap`` and ``overlap_by_depth`` reach the planner when a composite is made again; a job
-    key without one (a job made before it) plans as that job did: without ``overlap_by_depth``, by the share of the
-    earlier-planned paste covered, and without ``visible_overlap`` too, by the earlier pastes' whole boxes."""
+def test_replay_plans_and_blends_as_its_job_key_names(unlabelled, tmp_path, monkeypatch):
+    """``job_key.visible_overlap`` and ``overlap_by_depth`` reach the planner, ``open_cuts`` and ``seamless_poisson``
+    the painter, when a composite is made again; a job key without one (a job made before it) makes it as that job
+    did: without ``overlap_by_depth``, by the share of the earlier-planned paste covered, and without
+    ``visible_overlap`` too, by the earlier pastes' whole boxes; without ``seamless_poisson``, Poisson from the hard
+    composite's gradients, and without ``open_cuts`` too, blends fading at a cut."""
     import synthua_usd.pipeline.composite_worker as worker
     from synthua_usd.pipeline.composite import remake
 
     asked = []
-    planner = worker.plan_pastes
+    planner, painter = worker.plan_pastes, worker.compose
 
-    def spy(*args, **kwargs):
-        asked.append(args[5:7])
+    def plan(*args, **kwargs):
+        asked.append(("plan",) + args[5:7])
         return planner(*args, **kwargs)
 
-    monkeypatch.setattr(worker, "plan_pastes", spy)
-    job = json.loads((unlabelled / "generate.json").read_text())
-    assert job["job_key"]["visible_overlap"] is True and job["job_key"]["overlap_by_depth"] is True
-    for missing in ((), ("overlap_by_depth",), ("overlap_by_depth", "visible_overlap")):
-        key = {k: v for k, v in job["job_key"].items() if k not in missing}
-        (tmp_path / str(len(missing))).mkdir()
-        remake({**job, "job_key": key}, job["plan"][0], tmp_path / str(len(missing)))
-    assert asked == [(True, True), (True, False), (False, False)]
-
-
-def test_replay_blends_as_its_job_key_names(unlabelled, tmp_path, monkeypatch):
-    """``job_key.open_cuts`` and ``seamless_poisson`` reach the painter when a composite is made again; a job key
-    without one (a job made before it) blends as that job did."""
-    import synthua_usd.pipeline.composite_worker as worker
-    from synthua_usd.pipeline.composite import remake
-
-    asked = []
-    painter = worker.compose
-
-    def spy(*args, **kwargs):
-        asked.append(args[4:6])
+    def paint(*args, **kwargs):
+        asked.append(("paint",) + args[4:6])
         return painter(*args, **kwargs)
 
-    monkeypatch.setattr(worker, "compose", spy)
+    monkeypatch.setattr(worker, "plan_pastes", plan)
+    monkeypatch.setattr(worker, "compose", paint)
     job = json.loads((unlabelled / "generate.json").read_text())
-    for missing in ((), ("seamless_poisson",), ("seamless_poisson", "open_cuts")):
+    for n, missing in enumerate(((), ("overlap_by_depth",), ("overlap_by_depth", "visible_overlap"),
+                                 ("seamless_poisson",), ("seamless_poisson", "open_cuts"))):
         key = {k: v for k, v in job["job_key"].items() if k not in missing}
-        (tmp_path / str(len(missing))).mkdir()
-        remake({**job, "job_key": key}, job["plan"][0], tmp_path / str(len(missing)))
-    assert asked == [(True, True), (True, False), (False, False)]
+        (tmp_path / str(n)).mkdir()
+        remake({**job, "job_key": key}, job["plan"][0], tmp_path / str(n))
+    assert asked == [("plan", True, True), ("paint", True, True), ("plan", True, False), ("paint", True, True),
+                     ("plan", False, False), ("paint", True, True), ("plan", True, True), ("paint", True, False),
+                     ("plan", True, True), ("paint", False, False)]
 
 
 def test_the_summary_counts_composites_and_photos_without_a_paste(inputs, tmp_path, run_cli):
