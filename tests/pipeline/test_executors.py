@@ -34,12 +34,12 @@ SEED = 1234
 # ---- the toy: top-level, so spawned workers and Ray actors import it from this module ---------------------
 
 def make_state(seed: int, fail: str | None = None, meet: tuple[str, int] | None = None) -> dict:
-    """The toy state; ``meet=(folder, n)``: wait (at most 30 s) until n states are being built, so that every
+    """The toy state; ``meet=(folder, n)``: wait (at most 120 s) until n states are being built, so that every
     worker is up before any runs a shard and each gets one."""
     if meet is not None:
         folder, n = Path(meet[0]), meet[1]
         (folder / str(os.getpid())).write_text("")
-        deadline = time.monotonic() + 30
+        deadline = time.monotonic() + 120  # a loaded machine may take over 30 s to start a second Ray actor
         while len(list(folder.iterdir())) < n and time.monotonic() < deadline:
             time.sleep(0.01)
     if fail == "input":
