@@ -50,9 +50,10 @@ step) but step 4's, which works on the sRGB values:
    the photo's pixels around it: the paste's own gradients and the photo's, none across the silhouette, so the
    paste's colour slides to meet the photo; jobs whose ``generate.json`` has no ``job_key.seamless_poisson`` took
    every gradient of the hard composite, which gives the hard paste back where the domain keeps off the crop's
-   own edges, and imposed the photo's values on those edges, labelled pixels there too). Where the frame's edge cuts a paste, the paste goes on beyond it: the blur
-   repeats the paste's last row or column there, Poisson leaves the cut open (no photo value imposed along it), and
-   feather's d is measured within the frame (the cut does not fade).
+   own edges, and imposed the photo's values on those edges, labelled pixels there too). Where the frame's edge
+   cuts a paste, the paste goes on beyond it: the blur repeats the paste's last row or column there, Poisson leaves
+   the cut open (no photo value imposed along it), and feather's d is measured within the frame (the cut does not
+   fade).
    Jobs whose ``generate.json`` has no ``job_key.open_cuts`` (made before it, on or before 7 December 2026) faded
    blurred and Poisson pastes towards the photo along a cut (``open_cuts`` False keeps that for their replay).
 4. **Sharpening** of a paste the plan sharpens, right after its blend (a nearer paste painted later covers it): the

@@ -30,8 +30,8 @@ from scipy.sparse.linalg import splu
 def poisson_blend(target: np.ndarray, source: np.ndarray, domain: np.ndarray,
                   regions: np.ndarray | None = None) -> np.ndarray:
     """``target`` (h, w, 3) float with the Poisson solution on ``domain`` (h, w) bool (see the module docstring);
-    ``source`` (h, w, 3) gives the gradients, within each of ``regions`` (h, w; bool or int labels) when given. Returns a new
-    float64 array; outside ``domain`` it is ``target``."""
+    ``source`` (h, w, 3) gives the gradients, within each of ``regions`` (h, w; bool or int labels) when given.
+    Returns a new float64 array; outside ``domain`` it is ``target``."""
     h, w = domain.shape
     out = np.array(target, dtype=np.float64)
     flat = np.flatnonzero(domain.reshape(-1))

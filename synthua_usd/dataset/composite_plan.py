@@ -17,9 +17,10 @@ A paste is planned on the ground plane of the photo's camera (:class:`synthua_us
    in view (the part within the frame; with ``visible_overlap`` False, as jobs without ``job_key.visible_overlap``
    did, its whole box, though the frame may cut it; with ``overlap_by_depth`` False, as jobs without
    ``job_key.overlap_by_depth`` did, always the share of the earlier one's box the new paste covers, though a
-   farther new paste is drawn behind it), and that covers at most ``max_background_cover`` (default ``drop_covered_share``) of each
-   labelled background box; where no column does, the least overlapping one (``when_no_room``:
-   ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in view);
+   farther new paste is drawn behind it), and that covers at most ``max_background_cover`` (default
+   ``drop_covered_share``) of each labelled background box; where no column does, the least overlapping one
+   (``when_no_room``: ``least_overlap``) or no paste at all (``skip``: the photo's own labelled people stay in
+   view);
 5. a blend mode by the config's weights (Poisson at most once a composite) and a shadow strength;
 6. where ``sharpen.share`` > 0, whether it is sharpened and by what amount and sigma, from a generator spawned
    for it (the handed one's draws stay as they are: the pastes are those of the same config without sharpening).
