@@ -20,7 +20,8 @@ photos trained on, 399 more test photos), and (a) also on the generated dataset'
 be trained on: neither among the training photos or a --mix set, nor the background of a --mix set's composites.
 Outputs under --work: sim2real.md (per test set, arm and real size: AP50 and AP50-95 per class as the mean over
 seeds, min-max and sample standard deviation; every arm against (b): the difference of the AP50 means, seed by seed,
-its 95 % interval by Welch's t and whether that lies above zero, beyond the seeds' spread; every run), sim2real.json
+its 95 % interval by Welch's t and whether that lies above zero, beyond the seeds' spread; the false positives at
+--confidence by what they land on: duplicates, another class's box, nothing labelled; every run), sim2real.json
 (every run's `synthua train` command, seed, epochs, image-steps, seconds, device and initial weights; every score;
 the comparisons) and sim2real.png (AP50 against real photos, one line per arm, the seeds' min-max shaded).
 Finished runs are kept: run the same command again to resume, or to score more test sets.
@@ -99,13 +100,15 @@ def _check_kept(out: Path, about: dict, expected: dict) -> None:
 
 
 def _score(run_name: str, run: Path, test: dict, work: Path, maps: list[str], args) -> dict:
-    """evaluate-real of one run on one test set, kept when the same model was scored on the same set before."""
+    """evaluate-real of one run on one test set, kept when the same model was scored on the same set at the same
+    confidence before, by a version that sorts false positives by what they land on."""
     out = work / "eval" / run_name / test["label"]
     about = json.loads((run / "train.json").read_text(encoding="utf-8"))
     kept = out / "metrics.json"
     if kept.is_file():
         doc = json.loads(kept.read_text(encoding="utf-8"))
-        if doc["model"]["train"] == about and doc["test_set"]["sha256"] == test["sha256"]:
+        if (doc["model"]["train"] == about and doc["test_set"]["sha256"] == test["sha256"]
+                and doc["confidence"] == args.confidence and "false_positive_kinds" in doc):
             return doc
     request = EvaluateRequest(run, test["path"], out, tuple(maps), split=test["split"], confidence=args.confidence,
                               device=args.device, python=args.python)
@@ -176,7 +179,8 @@ def _parse(argv):
     out = p.add_argument_group("output")
     out.add_argument("--work", type=Path, metavar="DIR", default=REPO / "out" / "sim2real_bench",
                      help="[out/sim2real_bench]")
-    out.add_argument("--confidence", type=float, default=L.DEFAULT_CONFIDENCE, help="of precision and recall [0.25]")
+    out.add_argument("--confidence", type=float, default=L.DEFAULT_CONFIDENCE,
+                     help="of precision, recall and the false-positive counts [0.25]")
     out.add_argument("--plot-classes", default="wheelchair,person", metavar="LIST", help="classes of the plot [wheelchair,person]")
     out.add_argument("--table", type=Path, metavar="MD", help="also write the markdown here (e.g. docs/measured/...)")
     out.add_argument("--plot", type=Path, metavar="PNG", help="also write the plot here")
@@ -462,7 +466,8 @@ def score_one(planned: S.PlannedRun, record: dict, args, tests: list[dict], work
         doc = _score(planned.name, Path(record["run"]), test, work, args.maps if planned.arm == "a" else [], args)
         rows += [{"run": planned.name, "arm": planned.arm, "real_images": planned.real_images, "seed": planned.seed,
                   "test": test["label"], "class": c["class"], "boxes": c["boxes"], "AP50": c["AP50"],
-                  "AP50_95": c["AP50_95"], "precision": c["precision"], "recall": c["recall"]}
+                  "AP50_95": c["AP50_95"], "precision": c["precision"], "recall": c["recall"],
+                  "confidence": doc["confidence"]} | {k: c[k] for k in S.COUNTS}
                  for c in doc["classes"]]
     return rows
 

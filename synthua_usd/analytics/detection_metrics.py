@@ -11,7 +11,9 @@ Per scored class: AP50 (IoU 0.5) and AP50-95 (mean over IoU 0.50:0.05:0.95), fro
 area ``all`` and 100 detections an image; and, at one fixed confidence (default 0.25), precision TP / (TP + FP) and
 recall TP / (TP + FN) at IoU 0.5, counted from COCOeval's own matches (its greedy matching takes detections by
 falling score, so the matches of those above the confidence are the ones a run on them alone would make). The
-false negatives at that confidence, largest first, say which objects the model misses.
+false negatives at that confidence, largest first, say which objects the model misses; the false positives, by
+falling score, what it takes for the class, each sorted by what it lands on with TIDE's thresholds (Bolya et al.,
+ECCV 2020; :func:`classify_false_positive`).
 """
 
 from __future__ import annotations
@@ -56,6 +58,27 @@ class Miss:
     best_box: tuple[float, float, float, float] | None = None
 
 
+#: A false positive overlapping a box by this IoU or more lies on it; by less than BACKGROUND_IOU on nothing (TIDE's
+#: foreground and background thresholds).
+FOREGROUND_IOU = 0.5
+BACKGROUND_IOU = 0.1
+#: What a false positive lands on, in the order :func:`classify_false_positive` tries them.
+FP_KINDS = ("duplicate", "other_class", "localisation", "near_other_class", "background")
+
+
+@dataclass(frozen=True)
+class FalsePositive:
+    """A false positive at the fixed confidence (``detection`` in its test class) and what it lands on: ``kind``
+    one of :data:`FP_KINDS`, ``on`` the box of that kind it overlaps most (its own class's for ``duplicate`` and
+    ``localisation``, another label's for ``other_class`` and ``near_other_class``, None for ``background``) and
+    ``iou`` its box IoU with that box (the best over every box for ``background``)."""
+
+    detection: Detection
+    kind: str
+    on: Box | None
+    iou: float
+
+
 @dataclass(frozen=True)
 class ClassResult:
     name: str
@@ -67,6 +90,8 @@ class ClassResult:
     tp: int                     # at the fixed confidence, IoU 0.5
     fp: int
     fn: int
+    fp_kinds: dict[str, int] = field(default_factory=dict)     # FP_KINDS -> count, summing to fp
+    fp_on: dict[str, int] = field(default_factory=dict)        # other label -> its other_class + near_other_class
 
     @property
     def precision(self) -> float | None:
@@ -79,7 +104,8 @@ class ClassResult:
     def row(self) -> dict:
         return {"class": self.name, "model_classes": "+".join(self.model_classes), "boxes": self.boxes,
                 "detections": self.detections, "AP50": self.ap50, "AP50_95": self.ap50_95, "tp": self.tp,
-                "fp": self.fp, "fn": self.fn, "precision": self.precision, "recall": self.recall}
+                "fp": self.fp, "fn": self.fn, "precision": self.precision, "recall": self.recall} | {
+                    f"fp_{kind}": self.fp_kinds.get(kind, 0) for kind in FP_KINDS}
 
 
 @dataclass(frozen=True)
@@ -89,10 +115,14 @@ class DetectionEvaluation:
     confidence: float
     images: int
     misses: tuple[Miss, ...] = field(default=())
+    false_positives: tuple[FalsePositive, ...] = field(default=())
 
     def document(self) -> dict:
         return {"evaluator": "pycocotools COCOeval (bbox)", "images": self.images, "confidence": self.confidence,
-                "iou_for_precision_recall": 0.5, "coco_stats": self.stats, "classes": [c.row() for c in self.classes]}
+                "iou_for_precision_recall": 0.5, "coco_stats": self.stats,
+                "false_positive_kinds": {"kinds": list(FP_KINDS), "foreground_iou": FOREGROUND_IOU,
+                                         "background_iou": BACKGROUND_IOU},
+                "classes": [c.row() | {"fp_on": c.fp_on} for c in self.classes]}
 
 
 def _xywh_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -176,7 +206,7 @@ def evaluate_detections(test: DetectionSet, detections: list[Detection], mapping
     area_all, last_max = 0, len(ev.params.maxDets) - 1
     t50 = int(np.argmin(np.abs(ev.params.iouThrs - 0.5)))
     counts = {k: [0, 0, 0] for k in cat_id.values()}
-    misses = []
+    misses, wrong = [], []
     for e in ev.evalImgs:
         if e is None or e["aRng"] != ev.params.areaRng[area_all] or e["maxDet"] != ev.params.maxDets[last_max]:
             continue
@@ -187,6 +217,7 @@ def evaluate_detections(test: DetectionSet, detections: list[Detection], mapping
         c = counts[e["category_id"]]
         c[0] += int((above & matched & ~ignored).sum())
         c[1] += int((above & ~matched & ~ignored).sum())
+        wrong += [d for d, w in zip(e["dtIds"], above & ~matched & ~ignored) if w]
         dt_score = dict(zip(e["dtIds"], scores))
         for g, gid in enumerate(e["gtIds"]):
             if e["gtIgnore"][g]:
@@ -195,6 +226,14 @@ def evaluate_detections(test: DetectionSet, detections: list[Detection], mapping
             if by == 0 or dt_score.get(by, 0.0) < confidence:
                 c[2] += 1
                 misses.append((e["image_id"], e["category_id"], gid))
+    name_of = {k: t for t, k in cat_id.items()}
+    boxes_of = {im.id: im.boxes for im in test.images}
+    false_positives = []
+    for dt_id in wrong:
+        a = dt.anns[dt_id]
+        d = Detection(a["image_id"], name_of[a["category_id"]], float(a["score"]), *map(float, a["bbox"]))
+        false_positives.append(classify_false_positive(d, boxes_of[d.image_id]))
+    false_positives.sort(key=lambda f: (-f.detection.score, f.detection.image_id, f.detection.x, f.detection.y))
     class_results = []
     for t, models in mapping.pairs:
         k = cat_id[t] - 1
@@ -204,9 +243,38 @@ def evaluate_detections(test: DetectionSet, detections: list[Detection], mapping
         p50 = p[t50]
         ap50 = float(p50[p50 > -1].mean()) if boxes and (p50 > -1).any() else None
         tp, fp, fn = counts[k + 1]
-        class_results.append(ClassResult(t, models, boxes, sum(1 for d in merged if d.label == t), ap50, ap, tp, fp, fn))
+        mine = [f for f in false_positives if f.detection.label == t]
+        kinds = {kind: sum(1 for f in mine if f.kind == kind) for kind in FP_KINDS}
+        on = [f.on.label for f in mine if f.on is not None and f.kind in ("other_class", "near_other_class")]
+        class_results.append(ClassResult(t, models, boxes, sum(1 for d in merged if d.label == t), ap50, ap, tp, fp, fn,
+                                         kinds, {label: on.count(label) for label in sorted(set(on))}))
     return DetectionEvaluation(tuple(class_results), dict(zip(STAT_NAMES, (float(v) for v in ev.stats))), confidence,
-                               len(test.images), tuple(_rank_misses(misses, gt_boxes, merged, cat_id)))
+                               len(test.images), tuple(_rank_misses(misses, gt_boxes, merged, cat_id)),
+                               tuple(false_positives))
+
+
+def classify_false_positive(d: Detection, boxes: tuple[Box, ...]) -> FalsePositive:
+    """What false positive ``d`` lands on among its image's ``boxes`` (every label, ignored boxes too), the first
+    of: ``duplicate``, a box of its own class at IoU >= FOREGROUND_IOU (one a higher-scoring detection took:
+    COCO's greedy matching would have given ``d`` any other); ``other_class``, another label's box at IoU >=
+    FOREGROUND_IOU; ``localisation``, its own class's at IoU >= BACKGROUND_IOU; ``near_other_class``, another
+    label's at IoU >= BACKGROUND_IOU; ``background``, nothing labelled at IoU >= BACKGROUND_IOU."""
+    box = np.array([[d.x, d.y, d.w, d.h]])
+
+    def best(group: list[Box]) -> tuple[Box | None, float]:
+        iou = _xywh_iou(box, np.array([[b.x, b.y, b.w, b.h] for b in group]).reshape(-1, 4)).ravel()
+        k = int(np.argmax(iou)) if len(iou) else -1
+        return (group[k], float(iou[k])) if k >= 0 else (None, 0.0)
+
+    (own, own_iou), (other, other_iou) = best([b for b in boxes if b.label == d.label]), best(
+        [b for b in boxes if b.label != d.label])
+    for kind, on, iou, threshold in (("duplicate", own, own_iou, FOREGROUND_IOU),
+                                     ("other_class", other, other_iou, FOREGROUND_IOU),
+                                     ("localisation", own, own_iou, BACKGROUND_IOU),
+                                     ("near_other_class", other, other_iou, BACKGROUND_IOU)):
+        if on is not None and iou >= threshold:
+            return FalsePositive(d, kind, on, iou)
+    return FalsePositive(d, "background", None, max(own_iou, other_iou))
 
 
 def _rank_misses(misses, gt_boxes: dict[int, Box], merged: list[Detection], cat_id: dict[str, int]) -> list[Miss]:

@@ -7,6 +7,11 @@
                            the best IoU a detection of its class reached on it and that detection's score
     false_negatives.png    the worst (largest) of them, cropped from their images: the missed box in red, the
                            best-overlapping detection dashed yellow
+    false_positives.csv    every false positive at the fixed confidence, highest score first: image, class, score,
+                           box, and what it lands on (duplicate, another class's box, its own class's box badly
+                           placed, near another class's box, or nothing labelled) with that box's class and IoU
+    false_positives.png    the highest-scoring of them, cropped: the detection in red, the box it lands on dashed
+                           yellow
     report.html            the tables and the figure (self-contained: it refers only to files in the folder)
     detections.json        every detection, in the model's classes (COCO results format, with class names)
 """
@@ -20,16 +25,17 @@ import numpy as np
 
 from synthua_usd.analytics import plots
 from synthua_usd.analytics.csv_text import csv_text
-from synthua_usd.analytics.detection_metrics import Detection, DetectionEvaluation, Miss
+from synthua_usd.analytics.detection_metrics import (BACKGROUND_IOU, FOREGROUND_IOU, FP_KINDS, Detection,
+                                                     DetectionEvaluation, FalsePositive, Miss)
 from synthua_usd.analytics.detection_sets import DetectionSet
 from synthua_usd.core.atomic import output_set, write_json_atomic, write_text_atomic
 from synthua_usd.core.input_guard import Inputs
 
 #: Every file of the report (the module's docstring says what each is).
-REPORT_FILES = ("metrics.json", "per_class.csv", "false_negatives.csv", "false_negatives.png", "report.html",
-                "detections.json")
+REPORT_FILES = ("metrics.json", "per_class.csv", "false_negatives.csv", "false_negatives.png",
+                "false_positives.csv", "false_positives.png", "report.html", "detections.json")
 
-#: False negatives shown in the figure.
+#: False negatives, and false positives, shown in each figure.
 SHOWN_MISSES = 12
 #: A crop shows the missed box with this much of its size around it on each side (at least MIN_CROP_PX pixels).
 CROP_MARGIN = 0.5
@@ -57,14 +63,12 @@ def crop_around(rgb: np.ndarray, box: tuple[float, float, float, float]) -> tupl
     return rgb[y0:y1, x0:x1], x0, y0
 
 
-def _panels(test: DetectionSet, misses: tuple[Miss, ...]):
-    from synthua_usd.core.images import read_image
-
+def _panels(test: DetectionSet, misses: tuple[Miss, ...], rgb_of):
     by_id = {im.id: im for im in test.images}
     panels = []
     for miss in misses[:SHOWN_MISSES]:
         image = by_id[miss.image_id]
-        rgb = _rgb8(read_image(image.path)[0])
+        rgb = rgb_of(image.path)
         b = miss.box
         crop, x0, y0 = crop_around(rgb, (b.x, b.y, b.w, b.h))
         near = miss.best_box
@@ -75,11 +79,50 @@ def _panels(test: DetectionSet, misses: tuple[Miss, ...]):
     return panels
 
 
+#: How the report names each kind of false positive.
+FP_KIND_TEXT = {"duplicate": "duplicates", "other_class": "on another class's box",
+                "localisation": "badly placed on a box of their class", "near_other_class": "near another class's box",
+                "background": "on nothing labelled"}
+
+
+def _fp_caption(f: FalsePositive) -> str:
+    where = {"duplicate": "a duplicate on", "other_class": "on", "localisation": "badly placed on",
+             "near_other_class": "near"}
+    if f.on is None:
+        return f"on nothing labelled (best IoU {f.iou:.2f})"
+    return f"{where[f.kind]} {f.on.label}, IoU {f.iou:.2f}"
+
+
+def _fp_panels(test: DetectionSet, false_positives: tuple[FalsePositive, ...], rgb_of):
+    by_id = {im.id: im for im in test.images}
+    panels = []
+    for f in false_positives[:SHOWN_MISSES]:
+        image, d = by_id[f.detection.image_id], f.detection
+        crop, x0, y0 = crop_around(rgb_of(image.path), (d.x, d.y, d.w, d.h))
+        on = None if f.on is None else (f.on.x - x0, f.on.y - y0, f.on.w, f.on.h)
+        caption = f"{image.path.name[:28]}  {d.label} @ {d.score:.2f}\n{_fp_caption(f)}"
+        panels.append((crop, (d.x - x0, d.y - y0, d.w, d.h), on, caption))
+    return panels
+
+
+def _images():
+    """A reader of display pixels that decodes each image once."""
+    from synthua_usd.core.images import read_image
+
+    seen: dict = {}
+
+    def rgb_of(path):
+        if path not in seen:
+            seen[path] = _rgb8(read_image(path)[0])
+        return seen[path]
+    return rgb_of
+
+
 def _fmt(value, digits: int = 3) -> str:
     return "–" if value is None else f"{value:.{digits}f}"
 
 
-def _html(ev: DetectionEvaluation, about: dict, misses_shown: int) -> str:
+def _html(ev: DetectionEvaluation, about: dict, misses_shown: int, false_positives_shown: int) -> str:
     e = html.escape
     rows = [("test set", f"{about['test_set']['source']} ({about['test_set']['layout']}, split "
                          f"{about['test_set']['split'] or '-'}, {ev.images} images)"),
@@ -96,7 +139,9 @@ def _html(ev: DetectionEvaluation, about: dict, misses_shown: int) -> str:
            "td:first-child,th:first-child{text-align:left}img{max-width:100%}</style></head><body>",
            "<h1>Detector on a test set</h1><p>Scored by pycocotools' COCOeval (bbox). Files: "
            '<a href="metrics.json">metrics.json</a>, <a href="per_class.csv">per_class.csv</a>, '
-           '<a href="false_negatives.csv">false_negatives.csv</a>, <a href="detections.json">detections.json</a>.</p>',
+           '<a href="false_negatives.csv">false_negatives.csv</a>, '
+           '<a href="false_positives.csv">false_positives.csv</a>, '
+           '<a href="detections.json">detections.json</a>.</p>',
            "<table>"]
     out += [f"<tr><td>{e(k)}</td><td>{e(str(v))}</td></tr>" for k, v in rows]
     out.append("</table><h2>Per class</h2><table><tr><th>class</th><th>model classes</th><th>boxes</th>"
@@ -105,10 +150,23 @@ def _html(ev: DetectionEvaluation, about: dict, misses_shown: int) -> str:
         out.append(f"<tr><td>{e(c.name)}</td><td>{e(', '.join(c.model_classes))}</td><td>{c.boxes}</td>"
                    f"<td>{_fmt(c.ap50)}</td><td>{_fmt(c.ap50_95)}</td><td>{_fmt(c.precision)}</td>"
                    f"<td>{_fmt(c.recall)}</td><td>{c.tp}</td><td>{c.fp}</td><td>{c.fn}</td></tr>")
+    out.append(f"</table><h2>What the false positives land on</h2><p>At confidence {ev.confidence:g}, each false "
+               f"positive by the first that holds: IoU {FOREGROUND_IOU:g} or more with a box of its own class (a "
+               f"duplicate) or of another class; {BACKGROUND_IOU:g} or more with its own class's box or another "
+               f"class's; else nothing labelled (TIDE's thresholds, Bolya et al. 2020).</p><table><tr><th>class</th>"
+               "<th>FP</th>" + "".join(f"<th>{e(FP_KIND_TEXT[k])}</th>" for k in FP_KINDS)
+               + "<th>other classes landed on or near</th></tr>")
+    for c in ev.classes:
+        on = ", ".join(f"{e(label)} {n}" for label, n in c.fp_on.items()) or "–"
+        out.append(f"<tr><td>{e(c.name)}</td><td>{c.fp}</td>"
+                   + "".join(f"<td>{c.fp_kinds.get(k, 0)}</td>" for k in FP_KINDS) + f"<td>{on}</td></tr>")
     out.append(f"</table><h2>Worst false negatives</h2><p>The {misses_shown} largest of {len(ev.misses)} boxes no "
                f"detection at confidence {ev.confidence:g} matched (IoU 0.5): missed box red, the best-overlapping "
                "detection of its class (any score) dashed yellow.</p>"
-               '<img src="false_negatives.png" alt="worst false negatives"></body></html>')
+               '<img src="false_negatives.png" alt="worst false negatives">'
+               f"<h2>Highest-scoring false positives</h2><p>The {false_positives_shown} of {len(ev.false_positives)} "
+               "with the highest scores: the detection red, the box it lands on dashed yellow.</p>"
+               '<img src="false_positives.png" alt="highest-scoring false positives"></body></html>')
     return "\n".join(out) + "\n"
 
 
@@ -116,10 +174,12 @@ def write_detection_report(out_dir: str | Path, test: DetectionSet, ev: Detectio
                            detections: list[Detection], about: dict, inputs: Inputs | None = None) -> Path:
     """Write the report of ``ev`` (``detections`` as predicted, in the model's classes; ``about``: what was scored
     with what, for metrics.json) into ``out_dir`` as a set, none of its files one of the command's ``inputs``."""
-    panels = _panels(test, ev.misses)   # reads images: a missing one fails before writing
+    rgb_of = _images()                  # reads images: a missing one fails before writing
+    panels, fp_panels = _panels(test, ev.misses, rgb_of), _fp_panels(test, ev.false_positives, rgb_of)
     by_id = {im.id: im for im in test.images}
     with output_set(out_dir, inputs=inputs) as stage:
-        document = about | ev.document() | {"false_negatives": len(ev.misses)}
+        document = about | ev.document() | {"false_negatives": len(ev.misses),
+                                                  "false_positives": len(ev.false_positives)}
         write_json_atomic(stage / "metrics.json", document)
         rows = [c.row() for c in ev.classes]
         write_text_atomic(stage / "per_class.csv", csv_text(list(rows[0]), [list(r.values()) for r in rows]))
@@ -128,10 +188,16 @@ def write_detection_report(out_dir: str | Path, test: DetectionSet, ev: Detectio
             [[str(by_id[m.image_id].path), m.box.label, round(m.box.x, 2), round(m.box.y, 2), round(m.box.w, 2),
               round(m.box.h, 2), round(m.best_iou, 4), None if m.best_score is None else round(m.best_score, 4)]
              for m in ev.misses]))
-        plots.missed_boxes(panels, stage / "false_negatives.png")
+        plots.box_panels(panels, stage / "false_negatives.png", "no false negatives")
+        write_text_atomic(stage / "false_positives.csv", csv_text(
+            ["image", "class", "score", "x", "y", "w", "h", "lands_on", "on_class", "iou"],
+            [[str(by_id[d.image_id].path), d.label, round(d.score, 4), round(d.x, 2), round(d.y, 2), round(d.w, 2),
+              round(d.h, 2), f.kind, None if f.on is None else f.on.label, round(f.iou, 4)]
+             for f in ev.false_positives for d in (f.detection,)]))
+        plots.box_panels(fp_panels, stage / "false_positives.png", "no false positives")
         write_json_atomic(stage / "detections.json",
                           [{"image_id": d.image_id, "file_name": str(by_id[d.image_id].path), "class_name": d.label,
                             "score": round(d.score, 5), "bbox": [round(v, 2) for v in (d.x, d.y, d.w, d.h)]}
                            for d in detections], indent=None)
-        write_text_atomic(stage / "report.html", _html(ev, about, len(panels)))
+        write_text_atomic(stage / "report.html", _html(ev, about, len(panels), len(fp_panels)))
     return Path(out_dir)

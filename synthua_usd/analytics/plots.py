@@ -193,9 +193,11 @@ def diversity(figures: dict, path: Path) -> Path:
     return _save(fig, path)
 
 
-def missed_boxes(panels: list[tuple[np.ndarray, tuple, tuple | None, str]], path: Path, columns: int = 4) -> Path:
-    """A grid of false negatives: per panel an (h, w, 3) uint8 crop, the missed box (x, y, w, h in crop pixels,
-    drawn red), the best-overlapping detection's box or None (dashed yellow) and a caption."""
+def box_panels(panels: list[tuple[np.ndarray, tuple, tuple | None, str]], path: Path, empty: str,
+               columns: int = 4) -> Path:
+    """A grid of crops, ``empty`` written when there are none: per panel an (h, w, 3) uint8 crop, the box it shows
+    (x, y, w, h in crop pixels, drawn red: a missed box, a false positive), another box or None (dashed yellow: the
+    detection nearest the miss, the box the false positive lands on) and a caption."""
     from matplotlib.patches import Rectangle
 
     plt = _pyplot()
@@ -211,7 +213,7 @@ def missed_boxes(panels: list[tuple[np.ndarray, tuple, tuple | None, str]], path
                                    linewidth=1.5, linestyle="--"))
         ax.set_title(caption, fontsize=7)
     if not panels:
-        axes[0, 0].text(0.5, 0.5, "no false negatives", ha="center", va="center")
+        axes[0, 0].text(0.5, 0.5, empty, ha="center", va="center")
     return _save(fig, path)
 
 

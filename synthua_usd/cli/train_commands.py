@@ -120,8 +120,8 @@ def train(train_set: Path, out_dir: Path, minutes: float, epochs: int | None, im
 @click.argument("model", type=click.Path(path_type=Path))
 @click.argument("test_set", type=click.Path(path_type=Path))
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True,
-              help="Report folder (metrics.json, per_class.csv, false_negatives.csv/.png, detections.json, "
-                   "report.html).")
+              help="Report folder (metrics.json, per_class.csv, false_negatives.csv/.png, false_positives.csv/.png, "
+                   "detections.json, report.html).")
 @click.option("--map", "maps", multiple=True,
               help="TEST_CLASS=MODEL_CLASS[,MODEL_CLASS...]: the model classes that score as a class of the test set; "
                    "repeat per class [default: same names, and wheelchair=manual_wheelchair,electric_wheelchair].")
@@ -162,10 +162,12 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
     instances .json, or a generated dataset (scored on the boxes the model was trained with, or those of
     --convention, e.g. wheelchair-sets: the seated user inside the wheelchair's box, no person box). Per mapped
     class: AP50 and AP50-95 by pycocotools' COCOeval (bbox), precision and recall at --confidence (IoU 0.5),
-    and a page of the worst false negatives (report.html, false_negatives.png). Test classes no --map names
+    a page of the worst false negatives (report.html, false_negatives.png), and the false positives by what they
+    land on (a duplicate, another class's box, nothing labelled; false_positives.csv/.png). Test classes no --map names
     are not scored. TEST_SET is read whole before the detector runs, or refused naming the file: every image
     decoded, a COCO image's size its file's, every box on an image of the set and inside it.
     """
+    from synthua_usd.analytics.detection_report import FP_KIND_TEXT
     from synthua_usd.pipeline.evaluate_real import evaluate_real as run
     from synthua_usd.pipeline.evaluate_real import EvaluateRequest
 
@@ -182,5 +184,10 @@ def evaluate_real(model: Path, test_set: Path, out_dir: Path, maps: tuple[str, .
     for c in ev.classes:
         f = [("–" if v is None else f"{v:.4f}") for v in (c.ap50, c.ap50_95, c.precision, c.recall)]
         click.echo(f"{c.name:20s} {c.boxes:6d} {f[0]:>7s} {f[1]:>8s} {f[2]:>7s} {f[3]:>7s}")
-    click.echo(f"{len(ev.misses)} false negatives at confidence {confidence:g}; worst in {out_dir}/report.html")
+    for c in ev.classes:
+        if c.fp:
+            kinds = ", ".join(f"{n} {FP_KIND_TEXT[k]}" for k, n in c.fp_kinds.items() if n)
+            click.echo(f"{c.name}: {c.fp} false positives at confidence {confidence:g}: {kinds}")
+    click.echo(f"{len(ev.misses)} false negatives and {len(ev.false_positives)} false positives at confidence "
+               f"{confidence:g}; the worst of each in {out_dir}/report.html")
     return EXIT_OK

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from synthua_usd.analytics.detection_metrics import FP_KINDS
 from synthua_usd.core.errors import InputError, echo
 
 ARMS = {"a": "synthetic only", "b": "real only", "c": "synthetic, then real", "d": "real + mixed set"}
@@ -197,15 +198,20 @@ def spread(values: Sequence[float | None]) -> dict:
             "std": float(x.std(ddof=1)) if x.size > 1 else None}
 
 
-def summarise(scores: Sequence[dict], measures: Sequence[str] = ("AP50", "AP50_95")) -> list[dict]:
+#: The counts at the detection confidence a score row holds beside its APs: true and false positives, false
+#: negatives, and the false positives by what they land on.
+COUNTS = ("tp", "fp", "fn") + tuple(f"fp_{kind}" for kind in FP_KINDS)
+
+
+def summarise(scores: Sequence[dict], measures: Sequence[str] = ("AP50", "AP50_95") + COUNTS) -> list[dict]:
     """Rows of ``scores`` (one per run, test set and class: ``test``, ``arm``, ``real_images``, ``seed``, ``class``
     and the measures) grouped over seeds: per (test, arm, real_images, class) the seeds and each measure's
-    :func:`spread`, in the order the groups first appear."""
+    :func:`spread` (of the rows that hold it), in the order the groups first appear."""
     groups: dict[tuple, list[dict]] = {}
     for row in scores:
         groups.setdefault((row["test"], row["arm"], row["real_images"], row["class"]), []).append(row)
     return [{"test": test, "arm": arm, "real_images": n, "class": name, "seeds": [r["seed"] for r in rows]}
-            | {m: spread([r[m] for r in rows]) for m in measures}
+            | {m: spread([r.get(m) for r in rows]) for m in measures}
             for (test, arm, n, name), rows in groups.items()]
 
 

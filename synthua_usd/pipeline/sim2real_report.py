@@ -97,6 +97,38 @@ def _comparison_table(document: dict) -> list[str]:
                     "lower end at X or above.", ""]
 
 
+#: The false-positive table's columns: a count of :data:`~synthua_usd.pipeline.sim2real.COUNTS` and its heading.
+FP_COLUMNS = (("tp", "TP"), ("fp", "FP"), ("fp_duplicate", "duplicates"), ("fp_other_class", "on another class's box"),
+              ("fp_localisation", "badly placed on its class's box"),
+              ("fp_near_other_class", "near another class's box"), ("fp_background", "on nothing labelled"))
+
+
+def _count(s: dict) -> str:
+    if not s["n"]:
+        return "–"
+    return f"{s['mean']:.0f}" if s["n"] == 1 else f"{s['mean']:.1f} ({s['min']:.0f}–{s['max']:.0f})"
+
+
+def _false_positive_table(document: dict) -> list[str]:
+    """Per test set, arm and class: true and false positives at the detection confidence, the false positives by
+    what they land on (``synthua evaluate-real``'s kinds); the mean over seeds, then the seeds' min–max."""
+    rows = [s for s in document["summary"] if s.get("fp", {}).get("n")]
+    if not rows:
+        return []
+    confidence = {r.get("confidence") for r in document["scores"]} - {None}
+    at = f"at confidence {confidence.pop():g}" if len(confidence) == 1 else "at the detection confidence"
+    lines = [f"**False positives {at}** (IoU 0.5), by what they land on: IoU 0.5 or more with a box of their class "
+             "(duplicates) or of another; 0.1 or more with one of their class or another's; else nothing labelled. "
+             "The mean over seeds, then the seeds' min–max:", "",
+             "| test | class | arm | real images | " + " | ".join(h for _, h in FP_COLUMNS) + " |",
+             "|---|---|---|---|" + "---|" * len(FP_COLUMNS)]
+    for s in rows:
+        size = "–" if s["real_images"] is None else f"{s['real_images']:,}"
+        lines.append(f"| {s['test']} | {s['class']} | {arm_label(s['arm'])} | {size} | "
+                     + " | ".join(_count(s[k]) for k, _ in FP_COLUMNS) + " |")
+    return lines + [""]
+
+
 def _run_table(document: dict) -> list[str]:
     lines = ["| run | trained on | images | epochs (last without mosaic) | image-steps | from | seconds | images/s | device |",
              "|---|---|---|---|---|---|---|---|---|"]
@@ -127,6 +159,7 @@ def markdown(document: dict) -> str:
     lines += ["AP by pycocotools' COCOeval (bbox, area all, 100 detections an image), in %: the mean over seeds, "
               "(min–max) and sd, the sample standard deviation (n − 1).", ""]
     lines += _comparison_table(document)
+    lines += _false_positive_table(document)
     lines += _run_table(document)
     if document.get("notes"):
         lines += [f"- {note}" for note in document["notes"]] + [""]

@@ -1,5 +1,6 @@
 """Detection scores from pycocotools checked against values worked out by hand and against an independent greedy
-matcher written here in numpy (precision and recall at a fixed confidence on random boxes)."""
+matcher written here in numpy (precision and recall at a fixed confidence on random boxes, and what each false
+positive lands on)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 from synthua_usd.analytics.class_mapping import build_mapping
-from synthua_usd.analytics.detection_metrics import Detection, evaluate_detections, merge_detections
+from synthua_usd.analytics.detection_metrics import FP_KINDS, Detection, evaluate_detections, merge_detections
 from synthua_usd.analytics.detection_sets import Box, DetectionSet, SetImage
 
 MODEL = ("person", "manual_wheelchair", "electric_wheelchair")
@@ -96,11 +97,15 @@ def _iou(a, b) -> float:
     return inter / (a[2] * a[3] + b[2] * b[3] - inter)
 
 
-def greedy_counts(gt_boxes, dets, confidence):
-    """TP, FP, FN at IoU 0.5 of one class over images: detections above ``confidence`` by falling score, each to
-    the unmatched box it overlaps most (COCO's rule)."""
+def greedy_counts(gt_boxes, dets, confidence, label="person"):
+    """TP, FP, FN at IoU 0.5 of class ``label`` over images, and the false positives with what each lands on:
+    detections above ``confidence`` by falling score, each to the unmatched box of its class it overlaps most
+    (COCO's rule); a false positive then by its best IoU with its class's boxes and the others' (0.5, then 0.1)."""
     tp = fp = fn = 0
-    for image_id, boxes in gt_boxes.items():
+    lands = {}
+    for image_id, every in gt_boxes.items():
+        boxes = [b for b in every if b.label == label]
+        others = [b for b in every if b.label != label]
         taken = [False] * len(boxes)
         for d in sorted((d for d in dets if d.image_id == image_id and d.score >= confidence), key=lambda d: -d.score):
             ious = [(-1.0 if taken[k] else _iou((d.x, d.y, d.w, d.h), (b.x, b.y, b.w, b.h))) for k, b in enumerate(boxes)]
@@ -108,31 +113,67 @@ def greedy_counts(gt_boxes, dets, confidence):
             if best >= 0 and ious[best] >= 0.5:
                 taken[best] = True
                 tp += 1
-            else:
-                fp += 1
+                continue
+            fp += 1
+            own = max([_iou((d.x, d.y, d.w, d.h), (b.x, b.y, b.w, b.h)) for b in boxes], default=0.0)
+            other = max([_iou((d.x, d.y, d.w, d.h), (b.x, b.y, b.w, b.h)) for b in others], default=0.0)
+            lands[d] = ("duplicate" if own >= 0.5 else "other_class" if other >= 0.5 else "localisation"
+                        if own >= 0.1 else "near_other_class" if other >= 0.1 else "background")
         fn += taken.count(False)
-    return tp, fp, fn
+    return tp, fp, fn, lands
 
 
 def test_precision_recall_against_an_independent_matcher():
     rng = np.random.default_rng(3)
     gt, dets = [], []
-    for image_id in range(1, 9):
+    for image_id in range(1, 21):
         boxes = []
         for _ in range(rng.integers(0, 6)):
             x, y, w, h = rng.uniform(0, 150), rng.uniform(0, 60), rng.uniform(5, 40), rng.uniform(5, 40)
-            boxes.append(Box("person", x, y, w, h))
-            for _ in range(rng.integers(0, 3)):    # jittered detections: some match, some not
-                j = rng.normal(0, 0.25, 4) * [w, h, w, h]
+            boxes.append(Box(str(rng.choice(["person", "person", "cane"])), x, y, w, h))
+            for _ in range(rng.integers(0, 4)):    # jittered detections: some match, some not
+                j = rng.normal(0, rng.choice([0.1, 0.3]), 4) * [w, h, w, h]
                 dets.append(Detection(image_id, "person", float(rng.uniform()), x + j[0], y + j[1],
                                       max(1.0, w + j[2]), max(1.0, h + j[3])))
         for _ in range(rng.integers(0, 3)):        # stray detections
             dets.append(Detection(image_id, "person", float(rng.uniform()), *rng.uniform(0, 100, 2), 10.0, 10.0))
         gt.append(boxes)
-    mapping = build_mapping([], ("person",), MODEL)
-    test = one_set(gt, names=("person",))
+    mapping = build_mapping([], ("person", "cane"), MODEL)
+    test = one_set(gt, names=("person", "cane"))
     gt_by_image = {im.id: list(im.boxes) for im in test.images}
     for confidence in (0.1, 0.25, 0.5, 0.8):
-        (c,) = evaluate_detections(test, dets, mapping, confidence).classes
-        assert (c.tp, c.fp, c.fn) == greedy_counts(gt_by_image, dets, confidence)
-        assert len(evaluate_detections(test, dets, mapping, confidence).misses) == c.fn
+        ev = evaluate_detections(test, dets, mapping, confidence)
+        (c,) = ev.classes
+        tp, fp, fn, lands = greedy_counts(gt_by_image, dets, confidence)
+        assert (c.tp, c.fp, c.fn) == (tp, fp, fn)
+        assert len(ev.misses) == c.fn
+        assert {f.detection: f.kind for f in ev.false_positives} == lands
+        assert c.fp_kinds == {k: list(lands.values()).count(k) for k in FP_KINDS}
+        assert sum(c.fp_on.values()) == c.fp_kinds["other_class"] + c.fp_kinds["near_other_class"]
+        assert [f.detection.score for f in ev.false_positives] == sorted((d.score for d in lands), reverse=True)
+    assert {"duplicate", "other_class", "localisation", "near_other_class", "background"} <= {
+        f.kind for f in evaluate_detections(test, dets, mapping, 0.1).false_positives}
+
+
+def test_false_positives_by_what_they_land_on_worked_out_by_hand():
+    """A wheelchair box W (10, 10, 40, 40), a person's P (100, 10, 20, 60) and a cane's C (150, 10, 30, 30);
+    wheelchair detections by falling score: W itself (the hit), W moved 2 px (IoU 1520 / 1680 with W: a duplicate),
+    P itself (on another class's box), W moved 20 px (IoU 800 / 2400: badly placed), P moved 10 px (IoU 600 / 1800:
+    near another class's box), C itself, one on nothing, and one under the confidence."""
+    w, p, c = Box("wheelchair", 10, 10, 40, 40), Box("person", 100, 10, 20, 60), Box("cane", 150, 10, 30, 30)
+    dets = [Detection(1, "manual_wheelchair", score, *box) for score, box in (
+        (0.9, (10, 10, 40, 40)), (0.8, (12, 10, 40, 40)), (0.7, (100, 10, 20, 60)), (0.6, (30, 10, 40, 40)),
+        (0.5, (110, 10, 20, 60)), (0.45, (150, 10, 30, 30)), (0.4, (60, 70, 20, 20)), (0.1, (160, 70, 10, 10)))]
+    mapping = build_mapping(["wheelchair=manual_wheelchair"], ("wheelchair", "person", "cane"), MODEL)
+    ev = evaluate_detections(one_set([[w, p, c]], names=("wheelchair", "person", "cane")), dets, mapping)
+    wheelchair = next(k for k in ev.classes if k.name == "wheelchair")
+    assert (wheelchair.tp, wheelchair.fp, wheelchair.fn) == (1, 6, 0)
+    assert [(f.detection.score, f.kind, f.on and f.on.label) for f in ev.false_positives] == [
+        (0.8, "duplicate", "wheelchair"), (0.7, "other_class", "person"), (0.6, "localisation", "wheelchair"),
+        (0.5, "near_other_class", "person"), (0.45, "other_class", "cane"), (0.4, "background", None)]
+    assert [f.iou for f in ev.false_positives] == pytest.approx([1520 / 1680, 1, 1 / 3, 1 / 3, 1, 0])
+    assert wheelchair.fp_kinds == {"duplicate": 1, "other_class": 2, "localisation": 1, "near_other_class": 1,
+                                   "background": 1}
+    assert wheelchair.fp_on == {"cane": 1, "person": 2}
+    row = wheelchair.row()
+    assert [row[f"fp_{k}"] for k in FP_KINDS] == [1, 2, 1, 1, 1]

@@ -9,6 +9,7 @@ Skips with the reason where the detector's environment (.venv-train, tools/setup
 from __future__ import annotations
 
 import contextlib
+import csv
 import hashlib
 import io
 import json
@@ -19,6 +20,7 @@ import pytest
 
 from synthua_usd.pipeline.detector.runner import DetectorUnavailable, find_detector_python
 from synthua_usd.cli.main import main
+from synthua_usd.pipeline.sim2real import COUNTS
 
 
 @pytest.fixture(scope="module")
@@ -97,9 +99,11 @@ def test_evaluate_real_on_coco_json_is_cocoeval(run, generated_random, tmp_path)
     assert set(got) == set(expected)
     for name, value in expected.items():
         assert got[name] == (None if value is None else pytest.approx(value, abs=1e-12)), name
-    for name in ("per_class.csv", "false_negatives.csv", "false_negatives.png", "report.html"):
+    for name in ("per_class.csv", "false_negatives.csv", "false_negatives.png", "false_positives.csv",
+                 "false_positives.png", "report.html"):
         assert (out / name).stat().st_size > 0
     assert "false_negatives.png" in (out / "report.html").read_text()
+    assert "false_positives.png" in (out / "report.html").read_text()
 
 
 def test_evaluate_real_on_a_yolo_folder_with_real_class_names(run, generated_random, tmp_path, capsys):
@@ -116,7 +120,18 @@ def test_evaluate_real_on_a_yolo_folder_with_real_class_names(run, generated_ran
     assert person["boxes"] == person["tp"] + person["fn"] and person["boxes"] > 0
     rows = (out / "false_negatives.csv").read_text().splitlines()
     assert len(rows) - 1 == sum(c["fn"] for c in metrics["classes"]) == metrics["false_negatives"]
-    assert "person" in capsys.readouterr().out
+    with (out / "false_positives.csv").open() as f:
+        wrong = list(csv.DictReader(f))
+    assert len(wrong) == sum(c["fp"] for c in metrics["classes"]) == metrics["false_positives"]
+    for c in metrics["classes"]:          # each class's false positives, by what they land on, as its row counts them
+        kinds = [r["lands_on"] for r in wrong if r["class"] == c["class"]]
+        assert {k: kinds.count(k) for k in metrics["false_positive_kinds"]["kinds"]} == {
+            k: c[f"fp_{k}"] for k in metrics["false_positive_kinds"]["kinds"]}
+        scores = [float(r["score"]) for r in wrong if r["class"] == c["class"]]
+        assert min(scores, default=1.0) >= 0.05
+    assert [float(r["score"]) for r in wrong] == sorted((float(r["score"]) for r in wrong), reverse=True)
+    out_text = capsys.readouterr().out
+    assert "person" in out_text and f"{metrics['false_positives']} false positives" in out_text
 
 
 def test_evaluate_real_on_the_held_out_split_uses_the_trained_boxes(run, generated_random, tmp_path):
@@ -304,6 +319,17 @@ def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path,
     assert "sim2real: training" not in out and out.count("sim2real: kept ") == 4
     assert stamps == {n: (Path(r["run"]) / "train.json").stat().st_mtime_ns for n, r in runs.items()}
     assert json.loads((work / "sim2real.json").read_text())["scores"] == doc["scores"]
+    # each score row holds its report's counts at the confidence it was scored at; another confidence scores again
+    for confidence in (0.25, 0.5):
+        if confidence != 0.25:
+            assert tool.main(args + ["--confidence", str(confidence)]) == 0
+        rows = json.loads((work / "sim2real.json").read_text())["scores"]
+        assert len(rows) == len(doc["scores"])
+        for row in rows:
+            metrics = json.loads((work / "eval" / row["run"] / row["test"] / "metrics.json").read_text())
+            c = next(c for c in metrics["classes"] if c["class"] == row["class"])
+            assert {k: row[k] for k in COUNTS} == {k: c[k] for k in COUNTS}
+            assert row["confidence"] == metrics["confidence"] == confidence
     assert tool.main([a if a != "4" else "8" for a in args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "a_synthetic_s0: kept from an earlier run with epochs 2 (planned 4)" in err[0], err

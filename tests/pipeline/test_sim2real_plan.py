@@ -14,6 +14,7 @@ import scipy.stats
 from PIL import Image
 
 from conftest import load_tool
+from synthua_usd.analytics.detection_metrics import FP_KINDS
 from synthua_usd.core.errors import InputError
 from synthua_usd.pipeline import sim2real as S
 from synthua_usd.pipeline.sim2real_report import cell, curve, markdown
@@ -107,11 +108,14 @@ def test_the_spread_over_seeds_is_numpys():
 
 
 def _scores():
+    """(b) and (c) over three seeds; (a), one seed, scored before the false positives were counted."""
     rows = []
     for seed, (b, c) in enumerate([(0.35, 0.40), (0.39, 0.46), (0.31, 0.49)]):
         for arm, v in (("b", b), ("c", c)):
+            fp = [10 + seed, 0, 2 * seed, 1, 0, 9 - seed] if arm == "b" else [20, 1, 5, 2, 2, 10]
             rows.append({"run": f"{arm}_n0050_s{seed}", "arm": arm, "real_images": 50, "seed": seed, "test": "dev-val",
-                         "class": "wheelchair", "AP50": v, "AP50_95": v / 2})
+                         "class": "wheelchair", "AP50": v, "AP50_95": v / 2, "confidence": 0.25, "tp": 30 + seed,
+                         "fn": 5} | dict(zip(("fp",) + tuple(f"fp_{k}" for k in FP_KINDS), fp)))
     rows.append({"run": "a_synthetic_s0", "arm": "a", "real_images": None, "seed": 0, "test": "dev-val",
                  "class": "wheelchair", "AP50": 0.1, "AP50_95": None})
     return rows
@@ -128,6 +132,8 @@ def test_summaries_group_runs_over_seeds():
     assert summary[2]["AP50_95"]["n"] == 0 and cell(summary[2]["AP50_95"]) == "–"
     assert cell(summary[2]["AP50"]) == "10.0"
     assert cell(b["AP50"]) == "35.0 (31.0–39.0) sd 4.0"
+    assert b["fp"]["mean"] == 11 and (b["fp_other_class"]["min"], b["fp_other_class"]["max"]) == (0, 4)
+    assert b["tp"]["mean"] == 31 and summary[2]["fp"]["n"] == 0          # (a)'s row holds no counts
 
 
 def test_arms_against_b_with_welchs_interval_as_scipy_computes_it():
@@ -186,6 +192,11 @@ def test_the_markdown_and_the_curve(tmp_path):
     assert "every arm from scratch (yolo26n.yaml)" in text and "(8,000 for (a))" in text and "- a note" in text
     assert ("| dev-val | wheelchair | 50 | (c) synthetic, then real | +10.0 | +5.0, +7.0, +18.0 (seeds 0,1,2) | "
             "+0.2 to +19.8 (df 3.9) | yes | no |") in text
+    assert "**False positives at confidence 0.25** (IoU 0.5)" in text
+    assert ("| dev-val | wheelchair | (b) real only | 50 | 31.0 (30–32) | 11.0 (10–12) | 0.0 (0–0) | 2.0 (0–4) | "
+            in text)
+    assert "| dev-val | wheelchair | (c) synthetic, then real | 50 | 31.0 (30–32) | 20.0 (20–20) | 1.0 (1–1) | " in text
+    assert "| dev-val | wheelchair | (a)" not in text
     png = curve(_document(), tmp_path / "curve.png", ["wheelchair", "person"])
     assert png.stat().st_size > 5000 and Image.open(png).size[0] > 300
     assert curve(_document(), tmp_path / "none.png", ["bicycle"]) is None
