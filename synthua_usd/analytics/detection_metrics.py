@@ -12,8 +12,8 @@ area ``all`` and 100 detections an image; and, at one fixed confidence (default 
 recall TP / (TP + FN) at IoU 0.5, counted from COCOeval's own matches (its greedy matching takes detections by
 falling score, so the matches of those above the confidence are the ones a run on them alone would make). The
 false negatives at that confidence, largest first, say which objects the model misses; the false positives, by
-falling score, what it takes for the class, each sorted by what it lands on with TIDE's thresholds (Bolya et al.,
-ECCV 2020; :func:`classify_false_positive`).
+falling score, what it takes for the class, each sorted by what it lands on by TIDE's rules (Bolya et al., ECCV
+2020; :func:`classify_false_positive`).
 """
 
 from __future__ import annotations
@@ -58,12 +58,12 @@ class Miss:
     best_box: tuple[float, float, float, float] | None = None
 
 
-#: A false positive overlapping a box by this IoU or more lies on it; by less than BACKGROUND_IOU on nothing (TIDE's
-#: foreground and background thresholds).
+#: A false positive overlapping a box by this IoU or more lies on it; by BACKGROUND_IOU or less with every box, on
+#: nothing (TIDE's foreground and background thresholds).
 FOREGROUND_IOU = 0.5
 BACKGROUND_IOU = 0.1
 #: What a false positive lands on, in the order :func:`classify_false_positive` tries them.
-FP_KINDS = ("duplicate", "other_class", "localisation", "near_other_class", "background")
+FP_KINDS = ("localisation", "other_class", "duplicate", "background", "near_other_class")
 
 
 @dataclass(frozen=True)
@@ -227,7 +227,7 @@ def evaluate_detections(test: DetectionSet, detections: list[Detection], mapping
                 c[2] += 1
                 misses.append((e["image_id"], e["category_id"], gid))
     name_of = {k: t for t, k in cat_id.items()}
-    boxes_of = {im.id: im.boxes for im in test.images}
+    boxes_of = {im.id: im.boxes + im.regions for im in test.images}
     false_positives = []
     for dt_id in wrong:
         a = dt.anns[dt_id]
@@ -254,11 +254,16 @@ def evaluate_detections(test: DetectionSet, detections: list[Detection], mapping
 
 
 def classify_false_positive(d: Detection, boxes: tuple[Box, ...]) -> FalsePositive:
-    """What false positive ``d`` lands on among its image's ``boxes`` (every label, ignored boxes too), the first
-    of: ``duplicate``, a box of its own class at IoU >= FOREGROUND_IOU (one a higher-scoring detection took:
-    COCO's greedy matching would have given ``d`` any other); ``other_class``, another label's box at IoU >=
-    FOREGROUND_IOU; ``localisation``, its own class's at IoU >= BACKGROUND_IOU; ``near_other_class``, another
-    label's at IoU >= BACKGROUND_IOU; ``background``, nothing labelled at IoU >= BACKGROUND_IOU."""
+    """What false positive ``d`` lands on among its image's labelled ``boxes`` (every label; ignored boxes and crowd
+    regions too, where TIDE looks at the scored boxes alone), by TIDE's rules in TIDE's order, the first that holds
+    (own: its best IoU with a box of its class; other: with another label's):
+
+    1. ``localisation``: BACKGROUND_IOU <= own <= FOREGROUND_IOU (too big, too small or shifted);
+    2. ``other_class``: other >= FOREGROUND_IOU (well placed, wrong class);
+    3. ``duplicate``: own >= FOREGROUND_IOU (a box a higher-scoring detection took: COCO's greedy matching would
+       have given ``d`` any free one);
+    4. ``background``: both <= BACKGROUND_IOU (on nothing labelled);
+    5. ``near_other_class``: the rest, other between the two (TIDE's "both" error: wrong class, badly placed)."""
     box = np.array([[d.x, d.y, d.w, d.h]])
 
     def best(group: list[Box]) -> tuple[Box | None, float]:
@@ -268,13 +273,15 @@ def classify_false_positive(d: Detection, boxes: tuple[Box, ...]) -> FalsePositi
 
     (own, own_iou), (other, other_iou) = best([b for b in boxes if b.label == d.label]), best(
         [b for b in boxes if b.label != d.label])
-    for kind, on, iou, threshold in (("duplicate", own, own_iou, FOREGROUND_IOU),
-                                     ("other_class", other, other_iou, FOREGROUND_IOU),
-                                     ("localisation", own, own_iou, BACKGROUND_IOU),
-                                     ("near_other_class", other, other_iou, BACKGROUND_IOU)):
-        if on is not None and iou >= threshold:
-            return FalsePositive(d, kind, on, iou)
-    return FalsePositive(d, "background", None, max(own_iou, other_iou))
+    if own is not None and BACKGROUND_IOU <= own_iou <= FOREGROUND_IOU:
+        return FalsePositive(d, "localisation", own, own_iou)
+    if other is not None and other_iou >= FOREGROUND_IOU:
+        return FalsePositive(d, "other_class", other, other_iou)
+    if own is not None and own_iou >= FOREGROUND_IOU:
+        return FalsePositive(d, "duplicate", own, own_iou)
+    if max(own_iou, other_iou) <= BACKGROUND_IOU:
+        return FalsePositive(d, "background", None, max(own_iou, other_iou))
+    return FalsePositive(d, "near_other_class", other, other_iou)
 
 
 def _rank_misses(misses, gt_boxes: dict[int, Box], merged: list[Detection], cat_id: dict[str, int]) -> list[Miss]:

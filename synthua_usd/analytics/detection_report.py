@@ -63,19 +63,19 @@ def crop_around(rgb: np.ndarray, box: tuple[float, float, float, float]) -> tupl
     return rgb[y0:y1, x0:x1], x0, y0
 
 
-def _panels(test: DetectionSet, misses: tuple[Miss, ...], rgb_of):
+def _panels(test: DetectionSet, misses: tuple[Miss, ...]):
     by_id = {im.id: im for im in test.images}
     panels = []
     for miss in misses[:SHOWN_MISSES]:
         image = by_id[miss.image_id]
-        rgb = rgb_of(image.path)
+        rgb = _rgb_of(image.path)
         b = miss.box
         crop, x0, y0 = crop_around(rgb, (b.x, b.y, b.w, b.h))
         near = miss.best_box
         best = None if near is None else (near[0] - x0, near[1] - y0, near[2], near[3])
         caption = (f"{image.path.name[:28]}\n{b.label} {b.w:.0f}x{b.h:.0f} px, best IoU {miss.best_iou:.2f}"
                    + (f" @ {miss.best_score:.2f}" if miss.best_score is not None else ", no detection"))
-        panels.append((crop, (b.x - x0, b.y - y0, b.w, b.h), best, caption))
+        panels.append((crop, (b.x - x0, b.y - y0, b.w, b.h), best, _caption(caption)))
     return panels
 
 
@@ -93,29 +93,27 @@ def _fp_caption(f: FalsePositive) -> str:
     return f"{where[f.kind]} {f.on.label}, IoU {f.iou:.2f}"
 
 
-def _fp_panels(test: DetectionSet, false_positives: tuple[FalsePositive, ...], rgb_of):
+def _fp_panels(test: DetectionSet, false_positives: tuple[FalsePositive, ...]):
     by_id = {im.id: im for im in test.images}
     panels = []
     for f in false_positives[:SHOWN_MISSES]:
         image, d = by_id[f.detection.image_id], f.detection
-        crop, x0, y0 = crop_around(rgb_of(image.path), (d.x, d.y, d.w, d.h))
+        crop, x0, y0 = crop_around(_rgb_of(image.path), (d.x, d.y, d.w, d.h))
         on = None if f.on is None else (f.on.x - x0, f.on.y - y0, f.on.w, f.on.h)
         caption = f"{image.path.name[:28]}  {d.label} @ {d.score:.2f}\n{_fp_caption(f)}"
-        panels.append((crop, (d.x - x0, d.y - y0, d.w, d.h), on, caption))
+        panels.append((crop, (d.x - x0, d.y - y0, d.w, d.h), on, _caption(caption)))
     return panels
 
 
-def _images():
-    """A reader of display pixels that decodes each image once."""
+def _rgb_of(path) -> np.ndarray:
     from synthua_usd.core.images import read_image
 
-    seen: dict = {}
+    return _rgb8(read_image(path)[0])
 
-    def rgb_of(path):
-        if path not in seen:
-            seen[path] = _rgb8(read_image(path)[0])
-        return seen[path]
-    return rgb_of
+
+def _caption(text: str) -> str:
+    """``text`` as a matplotlib title shows it (a ``$`` would start mathtext)."""
+    return text.replace("$", r"\$")
 
 
 def _fmt(value, digits: int = 3) -> str:
@@ -151,9 +149,11 @@ def _html(ev: DetectionEvaluation, about: dict, misses_shown: int, false_positiv
                    f"<td>{_fmt(c.ap50)}</td><td>{_fmt(c.ap50_95)}</td><td>{_fmt(c.precision)}</td>"
                    f"<td>{_fmt(c.recall)}</td><td>{c.tp}</td><td>{c.fp}</td><td>{c.fn}</td></tr>")
     out.append(f"</table><h2>What the false positives land on</h2><p>At confidence {ev.confidence:g}, each false "
-               f"positive by the first that holds: IoU {FOREGROUND_IOU:g} or more with a box of its own class (a "
-               f"duplicate) or of another class; {BACKGROUND_IOU:g} or more with its own class's box or another "
-               f"class's; else nothing labelled (TIDE's thresholds, Bolya et al. 2020).</p><table><tr><th>class</th>"
+               f"positive by the first that holds, TIDE's rules (Bolya et al. 2020): IoU {BACKGROUND_IOU:g} to "
+               f"{FOREGROUND_IOU:g} with a box of its class (badly placed); {FOREGROUND_IOU:g} or more with another "
+               f"class's box; {FOREGROUND_IOU:g} or more with a box of its class that another detection took (a "
+               f"duplicate); {BACKGROUND_IOU:g} or less with every labelled box (nothing labelled); else near another "
+               "class's box.</p><table><tr><th>class</th>"
                "<th>FP</th>" + "".join(f"<th>{e(FP_KIND_TEXT[k])}</th>" for k in FP_KINDS)
                + "<th>other classes landed on or near</th></tr>")
     for c in ev.classes:
@@ -174,8 +174,7 @@ def write_detection_report(out_dir: str | Path, test: DetectionSet, ev: Detectio
                            detections: list[Detection], about: dict, inputs: Inputs | None = None) -> Path:
     """Write the report of ``ev`` (``detections`` as predicted, in the model's classes; ``about``: what was scored
     with what, for metrics.json) into ``out_dir`` as a set, none of its files one of the command's ``inputs``."""
-    rgb_of = _images()                  # reads images: a missing one fails before writing
-    panels, fp_panels = _panels(test, ev.misses, rgb_of), _fp_panels(test, ev.false_positives, rgb_of)
+    panels, fp_panels = _panels(test, ev.misses), _fp_panels(test, ev.false_positives)  # a missing image fails here
     by_id = {im.id: im for im in test.images}
     with output_set(out_dir, inputs=inputs) as stage:
         document = about | ev.document() | {"false_negatives": len(ev.misses),

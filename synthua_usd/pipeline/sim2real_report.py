@@ -98,9 +98,9 @@ def _comparison_table(document: dict) -> list[str]:
 
 
 #: The false-positive table's columns: a count of :data:`~synthua_usd.pipeline.sim2real.COUNTS` and its heading.
-FP_COLUMNS = (("tp", "TP"), ("fp", "FP"), ("fp_duplicate", "duplicates"), ("fp_other_class", "on another class's box"),
-              ("fp_localisation", "badly placed on its class's box"),
-              ("fp_near_other_class", "near another class's box"), ("fp_background", "on nothing labelled"))
+FP_COLUMNS = (("tp", "TP"), ("fp", "FP"), ("fp_localisation", "badly placed on its class's box"),
+              ("fp_other_class", "on another class's box"), ("fp_duplicate", "duplicates"),
+              ("fp_background", "on nothing labelled"), ("fp_near_other_class", "near another class's box"))
 
 
 def _count(s: dict) -> str:
@@ -117,9 +117,10 @@ def _false_positive_table(document: dict) -> list[str]:
         return []
     confidence = {r.get("confidence") for r in document["scores"]} - {None}
     at = f"at confidence {confidence.pop():g}" if len(confidence) == 1 else "at the detection confidence"
-    lines = [f"**False positives {at}** (IoU 0.5), by what they land on: IoU 0.5 or more with a box of their class "
-             "(duplicates) or of another; 0.1 or more with one of their class or another's; else nothing labelled. "
-             "The mean over seeds, then the seeds' min–max:", "",
+    lines = [f"**False positives {at}** (IoU 0.5), by what they land on, the first that holds (TIDE's rules): IoU "
+             "0.1 to 0.5 with a box of their class; 0.5 or more with another class's; 0.5 or more with one of their "
+             "class another detection took; 0.1 or less with every box; else 0.1 to 0.5 with another class's. The "
+             "mean over seeds, then the seeds' min–max:", "",
              "| test | class | arm | real images | " + " | ".join(h for _, h in FP_COLUMNS) + " |",
              "|---|---|---|---|" + "---|" * len(FP_COLUMNS)]
     for s in rows:

@@ -100,7 +100,7 @@ def _iou(a, b) -> float:
 def greedy_counts(gt_boxes, dets, confidence, label="person"):
     """TP, FP, FN at IoU 0.5 of class ``label`` over images, and the false positives with what each lands on:
     detections above ``confidence`` by falling score, each to the unmatched box of its class it overlaps most
-    (COCO's rule); a false positive then by its best IoU with its class's boxes and the others' (0.5, then 0.1)."""
+    (COCO's rule); a false positive then by its best IoU with its class's boxes and the others' (TIDE's order)."""
     tp = fp = fn = 0
     lands = {}
     for image_id, every in gt_boxes.items():
@@ -117,8 +117,8 @@ def greedy_counts(gt_boxes, dets, confidence, label="person"):
             fp += 1
             own = max([_iou((d.x, d.y, d.w, d.h), (b.x, b.y, b.w, b.h)) for b in boxes], default=0.0)
             other = max([_iou((d.x, d.y, d.w, d.h), (b.x, b.y, b.w, b.h)) for b in others], default=0.0)
-            lands[d] = ("duplicate" if own >= 0.5 else "other_class" if other >= 0.5 else "localisation"
-                        if own >= 0.1 else "near_other_class" if other >= 0.1 else "background")
+            lands[d] = ("localisation" if 0.1 <= own <= 0.5 else "other_class" if other >= 0.5 else "duplicate"
+                        if own >= 0.5 else "background" if max(own, other) <= 0.1 else "near_other_class")
         fn += taken.count(False)
     return tp, fp, fn, lands
 
@@ -177,3 +177,36 @@ def test_false_positives_by_what_they_land_on_worked_out_by_hand():
     assert wheelchair.fp_on == {"cane": 1, "person": 2}
     row = wheelchair.row()
     assert [row[f"fp_{k}"] for k in FP_KINDS] == [1, 2, 1, 1, 1]
+
+
+def test_false_positives_in_tides_order_at_its_edges_and_on_regions():
+    """TIDE's order where boxes overlap: a seated user's person box P inside a wheelchair's W (the synthua
+    convention). A person detection takes P; a wheelchair detection on P (IoU 2500 / 5100 with W: 0.1 to 0.5) is
+    badly placed, not on another class's box; one on P's twin P2 inside W2 at IoU 0.5 or more with both is on another
+    class's box, not a duplicate. At the edges: IoU exactly 0.5 with a taken box of its class is badly placed, exactly
+    0.1 with another label's is nothing labelled. An ignored box of its class and a crowd region count as boxes."""
+    w, p = Box("wheelchair", 100, 50, 60, 60), Box("person", 105, 20, 50, 80)
+    w2, p2 = Box("wheelchair", 300, 0, 100, 100), Box("person", 300, 0, 100, 80)
+    ignored, region = Box("wheelchair", 0, 150, 40, 40, ignore=True), Box("person", 500, 150, 30, 60)
+    hit = Box("wheelchair", 0, 300, 100, 100)
+    model = [(0.95, "person", (105, 20, 50, 80)), (0.9, "manual_wheelchair", (105, 20, 50, 80)),
+             (0.92, "manual_wheelchair", (300, 0, 100, 100)), (0.85, "manual_wheelchair", (300, 0, 100, 90)),
+             (0.97, "manual_wheelchair", (0, 300, 100, 100)), (0.8, "manual_wheelchair", (0, 300, 100, 50)),
+             (0.75, "manual_wheelchair", (0, 130, 50, 40)), (0.7, "manual_wheelchair", (490, 140, 50, 120)),
+             (0.65, "manual_wheelchair", (600, 150, 20, 20)), (0.6, "manual_wheelchair", (620, 150, 100, 100))]
+    dets = [Detection(1, label, score, *box) for score, label, box in model]
+    far = Box("person", 620, 150, 10, 100)               # IoU with the last detection: 1000 / 10000 = 0.1
+    test = DetectionSet(("wheelchair", "person"), (SetImage(1, Path("/nowhere/1.png"), 800, 500,
+                                                            (w, p, w2, p2, ignored, hit, far), (region,)),),
+                        "synthua", "hand-made", "test")
+    mapping = build_mapping(["wheelchair=manual_wheelchair", "person=person"], test.names, MODEL)
+    ev = evaluate_detections(test, dets, mapping)
+    got = {f.detection.score: (f.kind, f.on and f.on.label, round(f.iou, 4)) for f in ev.false_positives}
+    assert got == {
+        0.9: ("localisation", "wheelchair", round(2500 / 5100, 4)),
+        0.85: ("other_class", "person", round(8000 / 9000, 4)),       # and 0.9 with the taken W2: not a duplicate
+        0.8: ("localisation", "wheelchair", 0.5),                     # exactly 0.5 with the taken hit
+        0.75: ("localisation", "wheelchair", round(800 / 2800, 4)),   # the ignored box: 40 x 20 of 50 x 40 + 40 x 40
+        0.7: ("near_other_class", "person", round(1800 / 6000, 4)),   # the region
+        0.65: ("background", None, 0.0),
+        0.6: ("background", None, 0.1)}

@@ -48,14 +48,28 @@ def test_false_positives_written_as_evaluated(tmp_path):
         (str(tmp_path / "photo1.png"), "wheelchair", 0.7, "other_class", "person", 1.0),
         (str(tmp_path / "photo2.png"), "wheelchair", 0.6, "localisation", "wheelchair", round(800 / 2400, 4))]
     (row,) = [r for r in _rows(out / "per_class.csv") if r["class"] == "wheelchair"]
-    assert [int(row[f"fp_{k}"]) for k in FP_KINDS] == [0, 1, 1, 0, 1] and int(row["fp"]) == 3
+    assert [int(row[f"fp_{k}"]) for k in FP_KINDS] == [1, 1, 0, 1, 0] and int(row["fp"]) == 3
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["false_positives"] == 3
     assert next(c for c in metrics["classes"] if c["class"] == "wheelchair")["fp_on"] == {"person": 1}
     page = (out / "report.html").read_text()
-    assert "<td>wheelchair</td><td>3</td><td>0</td><td>1</td><td>1</td><td>0</td><td>1</td><td>person 1</td>" in page
+    assert "<td>wheelchair</td><td>3</td><td>1</td><td>1</td><td>0</td><td>1</td><td>0</td><td>person 1</td>" in page
     assert 'src="false_positives.png"' in page and 'href="false_positives.csv"' in page
     assert Image.open(out / "false_positives.png").size[0] > 500
+
+
+def test_a_dollar_in_a_file_name_is_shown_as_itself(tmp_path):
+    """matplotlib reads `$...$` in a title as mathtext: `cost$_$x.png` failed the whole report."""
+    w = Box("wheelchair", 10, 10, 40, 40)
+    test = _set(tmp_path, [[w]])
+    odd = tmp_path / "cost$_$x.png"
+    test.images[0].path.rename(odd)
+    test = DetectionSet(test.names, (SetImage(1, odd, 200, 100, (w,)),), "yolo", "hand-made", "test")
+    dets = [Detection(1, "manual_wheelchair", 0.9, 120, 10, 40, 40)]     # a miss and a false positive
+    ev = evaluate_detections(test, dets, build_mapping(["wheelchair=manual_wheelchair"], test.names, MODEL))
+    out = write_detection_report(tmp_path / "report", test, ev, dets, ABOUT)
+    assert _rows(out / "false_positives.csv")[0]["image"] == str(odd)
+    assert Image.open(out / "false_negatives.png").size[0] > 500
 
 
 def test_no_false_positives_still_writes_both_files(tmp_path):
