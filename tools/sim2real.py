@@ -56,6 +56,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from synthua_usd.analytics.detection_metrics import FP_RULES  # noqa: E402
 from synthua_usd.analytics.detection_sets import DetectionSet  # noqa: E402
 from synthua_usd.analytics.detection_sources import detect_format, read_detection_set, set_id  # noqa: E402
 from synthua_usd.analytics.detection_targets import targets_for  # noqa: E402
@@ -101,14 +102,14 @@ def _check_kept(out: Path, about: dict, expected: dict) -> None:
 
 def _score(run_name: str, run: Path, test: dict, work: Path, maps: list[str], args) -> dict:
     """evaluate-real of one run on one test set, kept when the same model was scored on the same set at the same
-    confidence before, by a version that sorts false positives by what they land on."""
+    confidence before, its false positives sorted by the rules of this version."""
     out = work / "eval" / run_name / test["label"]
     about = json.loads((run / "train.json").read_text(encoding="utf-8"))
     kept = out / "metrics.json"
     if kept.is_file():
         doc = json.loads(kept.read_text(encoding="utf-8"))
         if (doc["model"]["train"] == about and doc["test_set"]["sha256"] == test["sha256"]
-                and doc["confidence"] == args.confidence and "false_positive_kinds" in doc):
+                and doc["confidence"] == args.confidence and doc.get("false_positive_kinds") == FP_RULES):
             return doc
     request = EvaluateRequest(run, test["path"], out, tuple(maps), split=test["split"], confidence=args.confidence,
                               device=args.device, python=args.python)

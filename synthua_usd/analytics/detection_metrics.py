@@ -64,6 +64,9 @@ FOREGROUND_IOU = 0.5
 BACKGROUND_IOU = 0.1
 #: What a false positive lands on, in the order :func:`classify_false_positive` tries them.
 FP_KINDS = ("localisation", "other_class", "duplicate", "background", "near_other_class")
+#: How false positives are sorted, as metrics.json records it: a report whose record differs sorted them otherwise.
+FP_RULES = {"kinds": list(FP_KINDS), "order": "TIDE's", "foreground_iou": FOREGROUND_IOU,
+            "background_iou": BACKGROUND_IOU, "boxes": "every labelled box and crowd region of the image"}
 
 
 @dataclass(frozen=True)
@@ -120,8 +123,7 @@ class DetectionEvaluation:
     def document(self) -> dict:
         return {"evaluator": "pycocotools COCOeval (bbox)", "images": self.images, "confidence": self.confidence,
                 "iou_for_precision_recall": 0.5, "coco_stats": self.stats,
-                "false_positive_kinds": {"kinds": list(FP_KINDS), "foreground_iou": FOREGROUND_IOU,
-                                         "background_iou": BACKGROUND_IOU},
+                "false_positive_kinds": dict(FP_RULES),
                 "classes": [c.row() | {"fp_on": c.fp_on} for c in self.classes]}
 
 

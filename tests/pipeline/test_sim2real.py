@@ -21,6 +21,7 @@ import pytest
 from synthua_usd.pipeline.detector.runner import DetectorUnavailable, find_detector_python
 from synthua_usd.cli.main import main
 from synthua_usd.pipeline.sim2real import COUNTS
+from synthua_usd.analytics.detection_metrics import FP_KINDS
 
 
 @pytest.fixture(scope="module")
@@ -328,15 +329,20 @@ def test_the_experiment_tool_end_to_end(checkpoints, generated_random, tmp_path,
             c = next(c for c in metrics["classes"] if c["class"] == row["class"])
             assert {k: row[k] for k in COUNTS} == {k: c[k] for k in COUNTS}
             assert row["confidence"] == metrics["confidence"] == confidence
-    # a kept report from before the false positives were sorted is scored again; the others are kept
+    # kept reports whose false positives were sorted otherwise, or not at all, are scored again; the others are kept
     reports = sorted((work / "eval").glob("*/*/metrics.json"))
-    old = json.loads(reports[0].read_text())
-    del old["false_positive_kinds"]
-    reports[0].write_text(json.dumps(old))
-    stamps = {r: r.stat().st_mtime_ns for r in reports[1:]}
+    for report, change in zip(reports, ("drop", "reorder")):
+        old = json.loads(report.read_text())
+        if change == "drop":
+            del old["false_positive_kinds"]
+        else:
+            old["false_positive_kinds"]["kinds"].reverse()
+        report.write_text(json.dumps(old))
+    stamps = {r: r.stat().st_mtime_ns for r in reports[2:]}
     assert tool.main(args + ["--confidence", "0.5"]) == 0
-    assert "false_positive_kinds" in json.loads(reports[0].read_text())
-    assert stamps == {r: r.stat().st_mtime_ns for r in reports[1:]}
+    for report in reports[:2]:
+        assert json.loads(report.read_text())["false_positive_kinds"]["kinds"] == list(FP_KINDS)
+    assert stamps == {r: r.stat().st_mtime_ns for r in reports[2:]}
     assert tool.main([a if a != "4" else "8" for a in args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "a_synthetic_s0: kept from an earlier run with epochs 2 (planned 4)" in err[0], err
