@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from synthua_usd.analytics.detection_metrics import FP_KINDS
+from synthua_usd.analytics.detection_report import FP_KIND_TEXT
 from synthua_usd.analytics.plots import low_data_curve
 from synthua_usd.pipeline.init_weights import describe
 from synthua_usd.pipeline.sim2real import ARMS
@@ -98,9 +100,7 @@ def _comparison_table(document: dict) -> list[str]:
 
 
 #: The false-positive table's columns: a count of :data:`~synthua_usd.pipeline.sim2real.COUNTS` and its heading.
-FP_COLUMNS = (("tp", "TP"), ("fp", "FP"), ("fp_localisation", "badly placed on its class's box"),
-              ("fp_other_class", "on another class's box"), ("fp_duplicate", "duplicates"),
-              ("fp_background", "on nothing labelled"), ("fp_near_other_class", "near another class's box"))
+FP_COLUMNS = (("tp", "TP"), ("fp", "FP")) + tuple((f"fp_{kind}", FP_KIND_TEXT[kind]) for kind in FP_KINDS)
 
 
 def _count(s: dict) -> str:
